@@ -1,0 +1,1 @@
+//! Craig-Bampton reduction (work in progress: see the FE issue).

@@ -1,0 +1,136 @@
+//! Contact points, damper sides, the Jenkins contact law parameters and contact states.
+//!
+//! A [`ContactPoint`] couples the structure through two scalar relative displacements built
+//! from the DOFs by sparse linear rows:
+//!
+//! * tangential u = Σ aₜ[i] q[i]            (m)
+//! * normal     v = Σ aₙ[i] q[i] − gap      (m; v > 0 is penetration, i.e. compression)
+//!
+//! For a damper pressed against a body, aₜ and aₙ are the local frame vectors t, n applied to
+//! the relative displacement r = (damper point) − (body point). The contact forces are
+//! N = max(kₙ v, 0) and the Jenkins tangential force T (paper Eqs. 4-6), and they enter the
+//! equations of motion M q̈ + C q̇ + K q + F_c = F_ex as F_c = aₜ T + aₙ N (virtual work), so
+//! the damper is pushed back along −n and the body along +n.
+//!
+//! Each point belongs to a [`DamperSide`]; the limit method assigns one initial tangential
+//! state m to all points of a side (paper Eqs. 14-15).
+
+use serde::{Deserialize, Serialize};
+
+/// How the normal force evolves over the period.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum NormalLoad {
+    /// N(τ) = kₙ v(τ) follows the normal relative motion (paper Eq. 4).
+    #[default]
+    Variable,
+    /// N is constant over the period, N = kₙ v₀ from the 0th harmonic of v only.
+    Constant,
+}
+
+/// Contact-law effects a scene may switch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ContactEffects {
+    /// Variable or constant normal load.
+    pub normal_load: NormalLoad,
+    /// Whether the contact may separate (N = max(kₙv, 0)); without lift-off the normal spring
+    /// is bilateral (N = kₙ v may become negative) and friction is limited by μ·max(N, 0).
+    pub liftoff: bool,
+}
+
+impl Default for ContactEffects {
+    fn default() -> Self {
+        Self {
+            normal_load: NormalLoad::Variable,
+            liftoff: true,
+        }
+    }
+}
+
+/// Jenkins element parameters of one contact point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JenkinsLaw {
+    /// Tangential contact stiffness kₜ (N/m), > 0.
+    pub kt: f64,
+    /// Normal contact stiffness kₙ (N/m), > 0.
+    pub kn: f64,
+    /// Friction coefficient μ (–), ≥ 0.
+    pub mu: f64,
+    /// Initial tangential state m ∈ [−1, 1]: the march starts at T(τ=0) = m μ N(τ=0).
+    pub initial_state: f64,
+}
+
+/// A contact point with its kinematics and law.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactPoint {
+    /// Name used in outputs (`<name>_state`).
+    pub name: String,
+    /// Index into the problem's damper sides.
+    pub side: usize,
+    /// Sparse row (dof index, coefficient) giving u.
+    pub tangential: Vec<(usize, f64)>,
+    /// Sparse row (dof index, coefficient) giving n·r (before the gap).
+    pub normal: Vec<(usize, f64)>,
+    /// Initial normal gap g (m): v = aₙ·q − g; negative g is an interference.
+    pub gap: f64,
+    /// Contact law.
+    pub law: JenkinsLaw,
+}
+
+impl ContactPoint {
+    /// u = aₜ · q.
+    pub fn tangential_of(&self, q: &[f64]) -> f64 {
+        self.tangential.iter().map(|&(i, a)| a * q[i]).sum()
+    }
+
+    /// aₙ · q (without the gap).
+    pub fn normal_of(&self, q: &[f64]) -> f64 {
+        self.normal.iter().map(|&(i, a)| a * q[i]).sum()
+    }
+}
+
+/// A damper side: the contact points that share one initial tangential state in a limit case.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DamperSide {
+    /// Side name from the scene.
+    pub name: String,
+    /// Indices of the side's contact points.
+    pub contacts: Vec<usize>,
+}
+
+/// Contact state of a point over one steady-state period.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ContactState {
+    /// Stuck at every sample with N > 0: T⁰ is not unique (paper §3.1).
+    Stuck,
+    /// Alternates stick and slip, always closed.
+    StickSlip,
+    /// Separates for part of the period (with or without slip).
+    StickSlipLiftoff,
+    /// Separated over the whole period.
+    Open,
+}
+
+impl ContactState {
+    /// Label used in CSV files.
+    pub fn label(self) -> &'static str {
+        match self {
+            ContactState::Stuck => "stuck",
+            ContactState::StickSlip => "stick-slip",
+            ContactState::StickSlipLiftoff => "stick-slip-liftoff",
+            ContactState::Open => "open",
+        }
+    }
+
+    /// Whether the tangential force of this state is unique (it slipped or separated).
+    pub fn is_unique(self) -> bool {
+        !matches!(self, ContactState::Stuck)
+    }
+}
+
+impl std::fmt::Display for ContactState {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.label())
+    }
+}

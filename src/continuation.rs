@@ -1,0 +1,505 @@
+//! Newton's method with pseudo-arc-length continuation in the frequency (paper Eqs. 8-9).
+//!
+//! The path y(s) = (x(s), ω(s)) is followed in a scaled space where one unit of ω is 1 Hz
+//! (ω/2π) and one unit of x is `x_scale` (m), so step sizes read as "Hz-equivalent" arc length.
+//! Each step predicts along the unit tangent t, y_p = y + Δs·t, and corrects with Newton on
+//!
+//! R(x, ω) = 0,   tᵀ (y − y_p) = 0.
+//!
+//! A point converges when ‖R‖ ≤ tol_R·‖F_ex‖ and the scaled Newton step ≤ tol_y. A failed
+//! corrector (iteration limit, divergence, singular Jacobian, failed AFT) is not a result: the
+//! step is cut and the reason reported to the observer; below the minimum step the run ends
+//! with [`ContinuationError::Stalled`]. Turning points (sign changes of dω/ds) are reported and
+//! traversed. The last point is solved at exactly the end frequency.
+
+use std::f64::consts::PI;
+
+use faer::Mat;
+
+use crate::linalg::{solve_dense, LinearSolveError};
+use crate::model::Analysis;
+
+/// An operator R(x, λ) with its Jacobian, as continuation needs it.
+pub trait ParametricResidual {
+    /// Evaluation error of the operator.
+    type Error: std::error::Error + Clone;
+    /// Number of unknowns x.
+    fn dim(&self) -> usize;
+    /// Norm that makes residuals relative (e.g. the load norm).
+    fn residual_scale(&self) -> f64;
+    /// R(x, λ) into r.
+    fn residual(&mut self, x: &[f64], lambda: f64, r: &mut [f64]) -> Result<(), Self::Error>;
+    /// R, ∂R/∂x and ∂R/∂λ.
+    fn residual_and_jacobian(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        r: &mut [f64],
+        jac: &mut Mat<f64>,
+        dr_dlambda: &mut [f64],
+    ) -> Result<(), Self::Error>;
+}
+
+impl ParametricResidual for crate::hbm::HbmSystem<'_> {
+    type Error = crate::hbm::HbmError;
+    fn dim(&self) -> usize {
+        crate::hbm::HbmSystem::dim(self)
+    }
+    fn residual_scale(&self) -> f64 {
+        self.load_norm()
+    }
+    fn residual(&mut self, x: &[f64], lambda: f64, r: &mut [f64]) -> Result<(), Self::Error> {
+        crate::hbm::HbmSystem::residual(self, x, lambda, r)
+    }
+    fn residual_and_jacobian(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        r: &mut [f64],
+        jac: &mut Mat<f64>,
+        dr_dlambda: &mut [f64],
+    ) -> Result<(), Self::Error> {
+        crate::hbm::HbmSystem::residual_and_jacobian(self, x, lambda, r, jac, dr_dlambda)
+    }
+}
+
+/// Why a Newton corrector failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NewtonFailure {
+    /// Iteration limit reached.
+    #[error("no convergence in {iterations} iterations (relative residual {residual:.3e})")]
+    MaxIterations {
+        /// Iterations made.
+        iterations: usize,
+        /// Last relative residual.
+        residual: f64,
+    },
+    /// The residual grew far beyond its starting value.
+    #[error("diverged (relative residual {residual:.3e})")]
+    Diverged {
+        /// Relative residual when stopped.
+        residual: f64,
+    },
+    /// A linear solve failed.
+    #[error("{0}")]
+    Linear(#[from] LinearSolveError),
+    /// The operator failed to evaluate.
+    #[error("{0}")]
+    Evaluation(String),
+    /// The tangent turned too sharply between two points (possible branch jump).
+    #[error("tangent turned by {degrees:.1}° in one step")]
+    SharpTurn {
+        /// Angle between successive tangents.
+        degrees: f64,
+    },
+}
+
+/// Fatal continuation errors.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ContinuationError {
+    /// The first point could not be solved.
+    #[error("no solution at the start frequency {freq_hz:.4} Hz: {reason}")]
+    Start {
+        /// Start frequency (Hz).
+        freq_hz: f64,
+        /// Cause.
+        reason: NewtonFailure,
+    },
+    /// The step fell below the minimum.
+    #[error("continuation stalled at {freq_hz:.4} Hz (step {step:.3e} below minimum): {reason}")]
+    Stalled {
+        /// Frequency of the last converged point (Hz).
+        freq_hz: f64,
+        /// Step that failed.
+        step: f64,
+        /// Last failure.
+        reason: NewtonFailure,
+    },
+}
+
+/// A converged point of the path.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathPoint {
+    /// Angular frequency ω (rad/s).
+    pub omega: f64,
+    /// Unknowns x.
+    pub x: Vec<f64>,
+    /// Newton iterations used.
+    pub iterations: usize,
+    /// Final residual relative to the residual scale.
+    pub residual: f64,
+    /// Arc-length step that reached this point (0 for the first).
+    pub step: f64,
+}
+
+impl PathPoint {
+    /// Frequency in Hz.
+    pub fn freq_hz(&self) -> f64 {
+        self.omega / (2.0 * PI)
+    }
+}
+
+/// Receives continuation events; writing results as they come is an observer's job.
+pub trait Observer<S: ParametricResidual> {
+    /// A point converged. The operator was last evaluated at this point.
+    fn accepted(&mut self, _system: &mut S, _point: &PathPoint) {}
+    /// A step was rejected and will be retried with `new_step`.
+    fn rejected(&mut self, _freq_hz: f64, _step: f64, _new_step: f64, _reason: &NewtonFailure) {}
+    /// dω/ds changed sign between the previous and this point.
+    fn turning_point(&mut self, _freq_hz: f64) {}
+}
+
+/// An observer that does nothing.
+pub struct NoObserver;
+impl<S: ParametricResidual> Observer<S> for NoObserver {}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathSummary {
+    /// Converged points, in path order.
+    pub points: Vec<PathPoint>,
+    /// Frequencies (Hz) of turning points.
+    pub turning_points: Vec<f64>,
+    /// Rejected steps.
+    pub rejected_steps: usize,
+    /// Why the run stopped.
+    pub end: PathEnd,
+}
+
+/// Reason a run stopped normally.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PathEnd {
+    /// Reached the end frequency.
+    EndFrequency,
+    /// The path turned back below the start frequency.
+    LeftRangeBelow,
+    /// The point budget was used up.
+    MaxPoints,
+}
+
+/// Newton/continuation driver.
+pub struct Continuation {
+    /// Settings (frequencies in Hz).
+    pub analysis: Analysis,
+    /// Scale of x in the arc length (m).
+    pub x_scale: f64,
+}
+
+const OMEGA_SCALE: f64 = 2.0 * PI;
+
+impl Continuation {
+    /// Newton at fixed ω from `x0`, with backtracking on the residual norm.
+    pub fn solve_fixed<S: ParametricResidual>(
+        &self,
+        system: &mut S,
+        x0: &[f64],
+        omega: f64,
+    ) -> Result<PathPoint, NewtonFailure> {
+        let n = system.dim();
+        let scale = system.residual_scale();
+        let mut x = x0.to_vec();
+        let mut r = vec![0.0; n];
+        let mut dr = vec![0.0; n];
+        let mut jac = Mat::<f64>::zeros(n, n);
+        let mut trial = vec![0.0; n];
+        let mut rt = vec![0.0; n];
+        let eval_err = |e: S::Error| NewtonFailure::Evaluation(e.to_string());
+        let max_iter = self.analysis.max_iterations.max(1) * 3;
+        let mut rel = f64::INFINITY;
+        for it in 1..=max_iter {
+            system
+                .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
+                .map_err(eval_err)?;
+            rel = norm(&r) / scale;
+            let neg: Vec<f64> = r.iter().map(|v| -v).collect();
+            let dx = solve_dense(&jac, &neg)?;
+            let step_norm = norm(&dx) / self.x_scale;
+            let mut alpha = 1.0;
+            loop {
+                for i in 0..n {
+                    trial[i] = x[i] + alpha * dx[i];
+                }
+                system.residual(&trial, omega, &mut rt).map_err(eval_err)?;
+                let rel_t = norm(&rt) / scale;
+                if rel_t < rel || alpha < 1e-3 {
+                    rel = rel_t;
+                    break;
+                }
+                alpha *= 0.5;
+            }
+            x.copy_from_slice(&trial);
+            if rel <= self.analysis.residual_tolerance
+                && alpha * step_norm <= self.analysis.step_tolerance.max(1e-14)
+            {
+                // Leave the operator evaluated at the returned point.
+                system
+                    .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
+                    .map_err(eval_err)?;
+                return Ok(PathPoint {
+                    omega,
+                    x,
+                    iterations: it,
+                    residual: norm(&r) / scale,
+                    step: 0.0,
+                });
+            }
+        }
+        Err(NewtonFailure::MaxIterations {
+            iterations: max_iter,
+            residual: rel,
+        })
+    }
+
+    /// Unit tangent in scaled space at a converged point, oriented along `previous` (or
+    /// towards increasing ω when there is none).
+    fn tangent<S: ParametricResidual>(
+        &self,
+        system: &mut S,
+        point: &PathPoint,
+        previous: Option<&[f64]>,
+    ) -> Result<Vec<f64>, NewtonFailure> {
+        let n = system.dim();
+        let mut r = vec![0.0; n];
+        let mut dr = vec![0.0; n];
+        let mut jac = Mat::<f64>::zeros(n, n);
+        system
+            .residual_and_jacobian(&point.x, point.omega, &mut r, &mut jac, &mut dr)
+            .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
+        let mut aug = Mat::<f64>::zeros(n + 1, n + 1);
+        for j in 0..n {
+            for i in 0..n {
+                aug[(i, j)] = jac[(i, j)] * self.x_scale;
+            }
+        }
+        for i in 0..n {
+            aug[(i, n)] = dr[i] * OMEGA_SCALE;
+        }
+        let mut rhs = vec![0.0; n + 1];
+        rhs[n] = 1.0;
+        match previous {
+            Some(p) => {
+                for j in 0..=n {
+                    aug[(n, j)] = p[j];
+                }
+            }
+            None => aug[(n, n)] = 1.0,
+        }
+        let mut t = solve_dense(&aug, &rhs)?;
+        let nt = norm(&t);
+        t.iter_mut().for_each(|v| *v /= nt);
+        let orientation = match previous {
+            Some(p) => dot(&t, p),
+            None => t[n],
+        };
+        if orientation < 0.0 {
+            t.iter_mut().for_each(|v| *v = -*v);
+        }
+        Ok(t)
+    }
+
+    /// Corrector: Newton on R = 0 and tᵀ(y − y_p) = 0 in scaled space.
+    fn correct<S: ParametricResidual>(
+        &self,
+        system: &mut S,
+        predicted: &[f64],
+        tangent: &[f64],
+    ) -> Result<(Vec<f64>, usize, f64), NewtonFailure> {
+        let n = system.dim();
+        let scale = system.residual_scale();
+        let mut y = predicted.to_vec();
+        let mut r = vec![0.0; n];
+        let mut dr = vec![0.0; n];
+        let mut jac = Mat::<f64>::zeros(n, n);
+        let mut aug = Mat::<f64>::zeros(n + 1, n + 1);
+        let mut x = vec![0.0; n];
+        let mut first = f64::NAN;
+        let mut rel = f64::INFINITY;
+        for it in 1..=self.analysis.max_iterations {
+            for i in 0..n {
+                x[i] = y[i] * self.x_scale;
+            }
+            let omega = y[n] * OMEGA_SCALE;
+            system
+                .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
+                .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
+            rel = norm(&r) / scale;
+            if first.is_nan() {
+                first = rel;
+            } else if rel > 1e4 * first.max(self.analysis.residual_tolerance) {
+                return Err(NewtonFailure::Diverged { residual: rel });
+            }
+            for j in 0..n {
+                for i in 0..n {
+                    aug[(i, j)] = jac[(i, j)] * self.x_scale;
+                }
+            }
+            for i in 0..n {
+                aug[(i, n)] = dr[i] * OMEGA_SCALE;
+            }
+            for j in 0..=n {
+                aug[(n, j)] = tangent[j];
+            }
+            let mut rhs: Vec<f64> = r.iter().map(|v| -v).collect();
+            rhs.push(-(0..=n).map(|j| tangent[j] * (y[j] - predicted[j])).sum::<f64>());
+            let dy = solve_dense(&aug, &rhs)?;
+            for j in 0..=n {
+                y[j] += dy[j];
+            }
+            let step = norm(&dy);
+            if rel <= self.analysis.residual_tolerance && step <= self.analysis.step_tolerance {
+                return Ok((y, it, rel));
+            }
+            if step <= self.analysis.step_tolerance {
+                // The step is converged: check the residual at the updated point.
+                for i in 0..n {
+                    x[i] = y[i] * self.x_scale;
+                }
+                system
+                    .residual(&x, y[n] * OMEGA_SCALE, &mut r)
+                    .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
+                let rel_new = norm(&r) / scale;
+                if rel_new <= self.analysis.residual_tolerance {
+                    return Ok((y, it, rel_new));
+                }
+            }
+        }
+        Err(NewtonFailure::MaxIterations {
+            iterations: self.analysis.max_iterations,
+            residual: rel,
+        })
+    }
+
+    /// Follows the path from `x_guess` at the start frequency to the end frequency.
+    pub fn run<S: ParametricResidual, O: Observer<S>>(
+        &self,
+        system: &mut S,
+        x_guess: &[f64],
+        observer: &mut O,
+    ) -> Result<PathSummary, ContinuationError> {
+        let a = &self.analysis;
+        let omega_start = a.freq_start_hz * OMEGA_SCALE;
+        let omega_end = a.freq_end_hz * OMEGA_SCALE;
+        let n = system.dim();
+        let first = self
+            .solve_fixed(system, x_guess, omega_start)
+            .map_err(|reason| ContinuationError::Start {
+                freq_hz: a.freq_start_hz,
+                reason,
+            })?;
+        observer.accepted(system, &first);
+        let mut tangent =
+            self.tangent(system, &first, None)
+                .map_err(|reason| ContinuationError::Start {
+                    freq_hz: a.freq_start_hz,
+                    reason,
+                })?;
+        let mut summary = PathSummary {
+            points: vec![first],
+            turning_points: Vec::new(),
+            rejected_steps: 0,
+            end: PathEnd::MaxPoints,
+        };
+        let mut ds = a.initial_step.clamp(a.min_step, a.max_step);
+        while summary.points.len() < a.max_points {
+            let last = summary.points.last().expect("at least the first point");
+            let y: Vec<f64> = last
+                .x
+                .iter()
+                .map(|v| v / self.x_scale)
+                .chain(std::iter::once(last.omega / OMEGA_SCALE))
+                .collect();
+            let predicted: Vec<f64> = (0..=n).map(|j| y[j] + ds * tangent[j]).collect();
+            if predicted[n] * OMEGA_SCALE >= omega_end {
+                // Land exactly on the end frequency from the linearly interpolated guess.
+                let frac = ((omega_end / OMEGA_SCALE - y[n]) / (predicted[n] - y[n])).clamp(0.0, 1.0);
+                let guess: Vec<f64> = (0..n)
+                    .map(|j| (y[j] + frac * (predicted[j] - y[j])) * self.x_scale)
+                    .collect();
+                match self.solve_fixed(system, &guess, omega_end) {
+                    Ok(mut p) => {
+                        p.step = ds * frac;
+                        observer.accepted(system, &p);
+                        summary.points.push(p);
+                        summary.end = PathEnd::EndFrequency;
+                        return Ok(summary);
+                    }
+                    Err(reason) => {
+                        let new_ds = ds * 0.5;
+                        observer.rejected(last.freq_hz(), ds, new_ds, &reason);
+                        summary.rejected_steps += 1;
+                        if new_ds < a.min_step {
+                            return Err(ContinuationError::Stalled {
+                                freq_hz: last.freq_hz(),
+                                step: ds,
+                                reason,
+                            });
+                        }
+                        ds = new_ds;
+                        continue;
+                    }
+                }
+            }
+            let outcome = self.correct(system, &predicted, &tangent).and_then(|(yc, it, rel)| {
+                let point = PathPoint {
+                    omega: yc[n] * OMEGA_SCALE,
+                    x: yc[..n].iter().map(|v| v * self.x_scale).collect(),
+                    iterations: it,
+                    residual: rel,
+                    step: ds,
+                };
+                let t_new = self.tangent(system, &point, Some(&tangent))?;
+                let cos = dot(&t_new, &tangent).clamp(-1.0, 1.0);
+                if cos < 0.7 && ds > 2.0 * a.min_step {
+                    return Err(NewtonFailure::SharpTurn {
+                        degrees: cos.acos().to_degrees(),
+                    });
+                }
+                Ok((point, t_new))
+            });
+            match outcome {
+                Ok((point, t_new)) => {
+                    if t_new[n] * tangent[n] < 0.0 {
+                        summary.turning_points.push(point.freq_hz());
+                        observer.turning_point(point.freq_hz());
+                    }
+                    let iterations = point.iterations;
+                    observer.accepted(system, &point);
+                    let below = point.omega < omega_start;
+                    summary.points.push(point);
+                    tangent = t_new;
+                    if below {
+                        summary.end = PathEnd::LeftRangeBelow;
+                        return Ok(summary);
+                    }
+                    let factor =
+                        (a.target_iterations as f64 / iterations.max(1) as f64).clamp(0.5, 2.0);
+                    ds = (ds * factor).clamp(a.min_step, a.max_step);
+                }
+                Err(reason) => {
+                    let new_ds = ds * 0.5;
+                    observer.rejected(last.freq_hz(), ds, new_ds, &reason);
+                    summary.rejected_steps += 1;
+                    if new_ds < a.min_step {
+                        return Err(ContinuationError::Stalled {
+                            freq_hz: last.freq_hz(),
+                            step: ds,
+                            reason,
+                        });
+                    }
+                    ds = new_ds;
+                }
+            }
+        }
+        summary.end = PathEnd::MaxPoints;
+        Ok(summary)
+    }
+}
+
+/// Euclidean norm.
+pub fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}

@@ -1,0 +1,515 @@
+//! Harmonic-balance residual R(x, ω) = D(ω) x + F̂_c(x) − F̂_ex (paper Eq. 7) and its Jacobian.
+//!
+//! The unknown x holds the Fourier coefficients of all DOFs, harmonic-major (see
+//! [`crate::harmonic`]). For harmonic h the linear part acting on (q_ch, q_sh) is
+//!
+//! ```text
+//! ⎡ K − (hω)²M     hωC      ⎤ ⎡q_ch⎤
+//! ⎣   −hωC       K − (hω)²M ⎦ ⎣q_sh⎦
+//! ```
+//!
+//! and the 0th harmonic (when coupled) is K q₀ + F̂_c,0 − F_static = 0, which carries the pre-load
+//! into the contacts (paper Eq. 3: statics and dynamics coupled through the contact forces).
+//! In the uncoupled mode the 0th harmonic is fixed by a static pre-solve ([`static_solve`]) and
+//! only h ≥ 1 are unknowns.
+//!
+//! The Jacobian ∂R/∂x is dense here (lumped and reduced models); contact blocks come from the
+//! analytic AFT Jacobian or, as a checked alternative, from finite differences.
+
+use faer::Mat;
+
+use crate::aft::{AftError, AftWorkspace};
+use crate::contact::ContactState;
+use crate::harmonic::{Block, HarmonicSet};
+use crate::linalg::{solve_dense, LinearSolveError};
+use crate::model::{Coupling, JacobianStrategy, Problem};
+
+/// Errors while evaluating or solving the harmonic balance.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum HbmError {
+    /// The AFT of a contact failed.
+    #[error("contact `{contact}`: {source}")]
+    Aft {
+        /// Contact name.
+        contact: String,
+        /// Cause.
+        source: AftError,
+    },
+    /// A linear solve failed.
+    #[error("linear solve: {0}")]
+    Linear(#[from] LinearSolveError),
+    /// The static pre-solve of the uncoupled mode did not converge.
+    #[error("static pre-solve did not converge in {iterations} iterations (relative residual {residual:.3e})")]
+    StaticNotConverged {
+        /// Iterations made.
+        iterations: usize,
+        /// Final residual norm relative to the static load.
+        residual: f64,
+    },
+}
+
+/// The harmonic-balance operator of a problem.
+pub struct HbmSystem<'p> {
+    problem: &'p Problem,
+    unknowns: HarmonicSet,
+    /// For each unknown block, its index in the AFT block list.
+    block_map: Vec<usize>,
+    /// Fixed 0th harmonic of the DOFs in the uncoupled mode (zeros when coupled).
+    static_offset: Vec<f64>,
+    excitation: Vec<f64>,
+    aft: AftWorkspace,
+    u_coef: Vec<f64>,
+    v_coef: Vec<f64>,
+    scratch_r: Vec<f64>,
+    scratch_x: Vec<f64>,
+    /// Contact states of the last evaluation, one per contact.
+    pub states: Vec<ContactState>,
+    /// Jacobian strategy (from the problem, may be changed for checks and benchmarks).
+    pub strategy: JacobianStrategy,
+}
+
+impl<'p> HbmSystem<'p> {
+    /// Builds the operator; in the uncoupled mode this runs the static pre-solve.
+    pub fn new(problem: &'p Problem) -> Result<Self, HbmError> {
+        let unknowns = problem.unknown_harmonics();
+        let force_set = problem.force_harmonics();
+        let block_map = unknowns
+            .blocks()
+            .iter()
+            .map(|b| {
+                force_set
+                    .blocks()
+                    .iter()
+                    .position(|c| c == b)
+                    .expect("unknown harmonics are a subset of the force harmonics")
+            })
+            .collect();
+        let n = problem.model.n_dofs();
+        let nbf = force_set.n_blocks();
+        let mut aft = AftWorkspace::new(&force_set, problem.samples);
+        aft.settings = problem.march;
+        let mut excitation = vec![0.0; n * unknowns.n_blocks()];
+        if let Some(j) = unknowns.constant_block() {
+            excitation[j * n..(j + 1) * n].copy_from_slice(&problem.static_load);
+        }
+        for load in &problem.harmonic_loads {
+            if let Some(j) = unknowns.cos_block(load.harmonic) {
+                excitation[j * n + load.dof] += load.cos;
+            }
+            if let Some(j) = unknowns.sin_block(load.harmonic) {
+                excitation[j * n + load.dof] += load.sin;
+            }
+        }
+        let static_offset = match problem.effects.coupling {
+            Coupling::Coupled => vec![0.0; n],
+            Coupling::Uncoupled => static_solve(problem)?,
+        };
+        Ok(Self {
+            problem,
+            block_map,
+            static_offset,
+            excitation,
+            aft,
+            u_coef: vec![0.0; nbf],
+            v_coef: vec![0.0; nbf],
+            scratch_r: Vec::new(),
+            scratch_x: Vec::new(),
+            states: vec![ContactState::Open; problem.contacts.len()],
+            strategy: problem.analysis.jacobian,
+            unknowns,
+        })
+    }
+
+    /// The problem.
+    pub fn problem(&self) -> &'p Problem {
+        self.problem
+    }
+
+    /// Harmonic set of the unknowns.
+    pub fn unknowns(&self) -> &HarmonicSet {
+        &self.unknowns
+    }
+
+    /// Number of unknowns (DOFs × coefficient blocks).
+    pub fn dim(&self) -> usize {
+        self.problem.model.n_dofs() * self.unknowns.n_blocks()
+    }
+
+    /// The fixed 0th harmonic in the uncoupled mode (zeros when coupled).
+    pub fn static_offset(&self) -> &[f64] {
+        &self.static_offset
+    }
+
+    /// Excitation vector F̂_ex in the unknown layout (N).
+    pub fn excitation(&self) -> &[f64] {
+        &self.excitation
+    }
+
+    /// Norm used to make residuals relative: ‖F̂_ex‖ including static loads, and the static
+    /// load in the uncoupled mode (N).
+    pub fn load_norm(&self) -> f64 {
+        let e: f64 = self.excitation.iter().map(|x| x * x).sum();
+        let s: f64 = self.problem.static_load.iter().map(|x| x * x).sum();
+        e.max(s).sqrt().max(f64::MIN_POSITIVE)
+    }
+
+    /// Mutable access to the AFT workspace (for time histories after an evaluation).
+    pub fn aft(&mut self) -> &mut AftWorkspace {
+        &mut self.aft
+    }
+
+    /// Fills û, v̂ of contact `c` on the AFT blocks from the unknowns x.
+    fn contact_coefficients(&mut self, c: usize, x: &[f64]) {
+        let n = self.problem.model.n_dofs();
+        let contact = &self.problem.contacts[c];
+        self.u_coef.iter_mut().for_each(|v| *v = 0.0);
+        self.v_coef.iter_mut().for_each(|v| *v = 0.0);
+        for (j, &jf) in self.block_map.iter().enumerate() {
+            let q = &x[j * n..(j + 1) * n];
+            self.u_coef[jf] = contact.tangential_of(q);
+            self.v_coef[jf] = contact.normal_of(q);
+        }
+        // The AFT set always has the constant block first (harmonic 0 sorts first).
+        if !self.unknowns.has_constant() {
+            self.u_coef[0] = contact.tangential_of(&self.static_offset);
+            self.v_coef[0] = contact.normal_of(&self.static_offset);
+        }
+        self.v_coef[0] -= contact.gap;
+    }
+
+    /// Runs the AFT of contact `c` at x; results stay in the workspace.
+    pub fn contact_forces(
+        &mut self,
+        c: usize,
+        x: &[f64],
+        jacobian: bool,
+    ) -> Result<ContactState, HbmError> {
+        self.contact_coefficients(c, x);
+        let contact = &self.problem.contacts[c];
+        let report = self
+            .aft
+            .evaluate(
+                &contact.law,
+                self.problem.effects.contact,
+                &self.u_coef,
+                &self.v_coef,
+                jacobian,
+            )
+            .map_err(|source| HbmError::Aft {
+                contact: contact.name.clone(),
+                source,
+            })?;
+        self.states[c] = report.state;
+        Ok(report.state)
+    }
+
+    /// Linear part D(ω)x − F̂_ex into r, and ∂(D x)/∂ω into `dr_domega` if given.
+    fn linear_residual(&self, x: &[f64], omega: f64, r: &mut [f64], dr_domega: Option<&mut [f64]>) {
+        let n = self.problem.model.n_dofs();
+        let m = &self.problem.model;
+        let blocks = self.unknowns.blocks();
+        for (j, b) in blocks.iter().enumerate() {
+            let h = b.harmonic() as f64;
+            let xj = &x[j * n..(j + 1) * n];
+            let rj = &mut r[j * n..(j + 1) * n];
+            let partner = match b {
+                Block::Cos(hh) => self.unknowns.sin_block(*hh),
+                Block::Sin(hh) => self.unknowns.cos_block(*hh),
+                Block::Constant => None,
+            };
+            let c_sign = match b {
+                Block::Cos(_) => 1.0,
+                Block::Sin(_) => -1.0,
+                Block::Constant => 0.0,
+            };
+            let hw = h * omega;
+            for p in 0..n {
+                let mut acc = -self.excitation[j * n + p];
+                for q in 0..n {
+                    acc += (m.stiffness[(p, q)] - hw * hw * m.mass[(p, q)]) * xj[q];
+                }
+                if let Some(pj) = partner {
+                    let xp = &x[pj * n..(pj + 1) * n];
+                    for q in 0..n {
+                        acc += c_sign * hw * m.damping[(p, q)] * xp[q];
+                    }
+                }
+                rj[p] = acc;
+            }
+        }
+        if let Some(dr) = dr_domega {
+            for (j, b) in blocks.iter().enumerate() {
+                let h = b.harmonic() as f64;
+                let xj = &x[j * n..(j + 1) * n];
+                let partner = match b {
+                    Block::Cos(hh) => self.unknowns.sin_block(*hh),
+                    Block::Sin(hh) => self.unknowns.cos_block(*hh),
+                    Block::Constant => None,
+                };
+                let c_sign = match b {
+                    Block::Cos(_) => 1.0,
+                    Block::Sin(_) => -1.0,
+                    Block::Constant => 0.0,
+                };
+                for p in 0..n {
+                    let mut acc = 0.0;
+                    for q in 0..n {
+                        acc += -2.0 * h * h * omega * m.mass[(p, q)] * xj[q];
+                    }
+                    if let Some(pj) = partner {
+                        let xp = &x[pj * n..(pj + 1) * n];
+                        for q in 0..n {
+                            acc += c_sign * h * m.damping[(p, q)] * xp[q];
+                        }
+                    }
+                    dr[j * n + p] = acc;
+                }
+            }
+        }
+    }
+
+    /// Linear part of ∂R/∂x into `jac` (overwrites).
+    fn linear_jacobian(&self, omega: f64, jac: &mut Mat<f64>) {
+        let n = self.problem.model.n_dofs();
+        let m = &self.problem.model;
+        jac.fill(0.0);
+        for (j, b) in self.unknowns.blocks().iter().enumerate() {
+            let hw = b.harmonic() as f64 * omega;
+            for p in 0..n {
+                for q in 0..n {
+                    jac[(j * n + p, j * n + q)] = m.stiffness[(p, q)] - hw * hw * m.mass[(p, q)];
+                }
+            }
+            let (partner, c_sign) = match b {
+                Block::Cos(hh) => (self.unknowns.sin_block(*hh), 1.0),
+                Block::Sin(hh) => (self.unknowns.cos_block(*hh), -1.0),
+                Block::Constant => (None, 0.0),
+            };
+            if let Some(pj) = partner {
+                for p in 0..n {
+                    for q in 0..n {
+                        jac[(j * n + p, pj * n + q)] = c_sign * hw * m.damping[(p, q)];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Adds the contact forces to r (and, with `jac`, the analytic contact Jacobian).
+    fn add_contacts(
+        &mut self,
+        x: &[f64],
+        r: &mut [f64],
+        mut jac: Option<&mut Mat<f64>>,
+    ) -> Result<(), HbmError> {
+        let n = self.problem.model.n_dofs();
+        let nbf = self.aft.harmonic_set().n_blocks();
+        let problem = self.problem;
+        for c in 0..problem.contacts.len() {
+            self.contact_forces(c, x, jac.is_some())?;
+            let contact = &problem.contacts[c];
+            for (j, &jf) in self.block_map.iter().enumerate() {
+                let t = self.aft.t_hat[jf];
+                let nn = self.aft.n_hat[jf];
+                for &(p, a) in &contact.tangential {
+                    r[j * n + p] += a * t;
+                }
+                for &(p, a) in &contact.normal {
+                    r[j * n + p] += a * nn;
+                }
+            }
+            if let Some(jac) = jac.as_deref_mut() {
+                for (j, &jf) in self.block_map.iter().enumerate() {
+                    for (i, &if_) in self.block_map.iter().enumerate() {
+                        let tu = self.aft.dt_du[jf * nbf + if_];
+                        let tv = self.aft.dt_dv[jf * nbf + if_];
+                        let nv = self.aft.dn_dv[jf * nbf + if_];
+                        if tu == 0.0 && tv == 0.0 && nv == 0.0 {
+                            continue;
+                        }
+                        for &(p, ap) in &contact.tangential {
+                            for &(q, aq) in &contact.tangential {
+                                jac[(j * n + p, i * n + q)] += ap * tu * aq;
+                            }
+                            for &(q, aq) in &contact.normal {
+                                jac[(j * n + p, i * n + q)] += ap * tv * aq;
+                            }
+                        }
+                        for &(p, ap) in &contact.normal {
+                            for &(q, aq) in &contact.normal {
+                                jac[(j * n + p, i * n + q)] += ap * nv * aq;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Residual R(x, ω) into r (length [`Self::dim`]); ω in rad/s.
+    pub fn residual(&mut self, x: &[f64], omega: f64, r: &mut [f64]) -> Result<(), HbmError> {
+        self.linear_residual(x, omega, r, None);
+        self.add_contacts(x, r, None)
+    }
+
+    /// Residual, ∂R/∂x (by the current strategy) and ∂R/∂ω at (x, ω).
+    pub fn residual_and_jacobian(
+        &mut self,
+        x: &[f64],
+        omega: f64,
+        r: &mut [f64],
+        jac: &mut Mat<f64>,
+        dr_domega: &mut [f64],
+    ) -> Result<(), HbmError> {
+        match self.strategy {
+            JacobianStrategy::Analytic => {
+                self.linear_residual(x, omega, r, Some(dr_domega));
+                self.linear_jacobian(omega, jac);
+                self.add_contacts(x, r, Some(jac))
+            }
+            JacobianStrategy::ForwardDifference | JacobianStrategy::CentralDifference => {
+                self.linear_residual(x, omega, r, Some(dr_domega));
+                self.add_contacts(x, r, None)?;
+                let states = self.states.clone();
+                self.finite_difference_jacobian(x, omega, r, jac)?;
+                self.states = states;
+                Ok(())
+            }
+        }
+    }
+
+    /// ∂R/∂x by forward or central differences (the strategy decides), given R at x.
+    fn finite_difference_jacobian(
+        &mut self,
+        x: &[f64],
+        omega: f64,
+        r0: &[f64],
+        jac: &mut Mat<f64>,
+    ) -> Result<(), HbmError> {
+        let dim = self.dim();
+        let central = self.strategy == JacobianStrategy::CentralDifference;
+        let mut xp = std::mem::take(&mut self.scratch_x);
+        let mut rp = std::mem::take(&mut self.scratch_r);
+        xp.clear();
+        xp.extend_from_slice(x);
+        rp.resize(dim, 0.0);
+        let mut rm = vec![0.0; if central { dim } else { 0 }];
+        let typical = (x.iter().map(|v| v * v).sum::<f64>() / dim as f64).sqrt();
+        let eps = if central { 6e-6 } else { 1.5e-8 };
+        let result = (|| {
+            for i in 0..dim {
+                let step = eps * x[i].abs().max(typical).max(1e-12);
+                xp[i] = x[i] + step;
+                self.residual(&xp, omega, &mut rp)?;
+                if central {
+                    xp[i] = x[i] - step;
+                    self.residual(&xp, omega, &mut rm)?;
+                    for k in 0..dim {
+                        jac[(k, i)] = (rp[k] - rm[k]) / (2.0 * step);
+                    }
+                } else {
+                    for k in 0..dim {
+                        jac[(k, i)] = (rp[k] - r0[k]) / step;
+                    }
+                }
+                xp[i] = x[i];
+            }
+            Ok(())
+        })();
+        self.scratch_x = xp;
+        self.scratch_r = rp;
+        result
+    }
+}
+
+/// Static pre-solve of the uncoupled mode: K q + F_c,static(q) = F_static, with each contact
+/// loaded from rest (slider at zero): N = kₙ max(v, 0), T = clamp(kₜ u, −μN, μN).
+pub fn static_solve(problem: &Problem) -> Result<Vec<f64>, HbmError> {
+    let n = problem.model.n_dofs();
+    let k = &problem.model.stiffness;
+    let f = &problem.static_load;
+    let fnorm = f.iter().map(|x| x * x).sum::<f64>().sqrt().max(f64::MIN_POSITIVE);
+    let mut q = vec![0.0; n];
+    let residual_of = |q: &[f64], r: &mut [f64], jac: Option<&mut Mat<f64>>| {
+        for p in 0..n {
+            r[p] = (0..n).map(|s| k[(p, s)] * q[s]).sum::<f64>() - f[p];
+        }
+        let mut jac = jac;
+        if let Some(j) = jac.as_deref_mut() {
+            for p in 0..n {
+                for s in 0..n {
+                    j[(p, s)] = k[(p, s)];
+                }
+            }
+        }
+        for c in &problem.contacts {
+            let law = &c.law;
+            let u = c.tangential_of(q);
+            let v = c.normal_of(q) - c.gap;
+            let nf = (law.kn * v).max(0.0);
+            let limit = law.mu * nf;
+            let tp = law.kt * u;
+            let t = tp.clamp(-limit, limit);
+            for &(p, a) in &c.tangential {
+                r[p] += a * t;
+            }
+            for &(p, a) in &c.normal {
+                r[p] += a * nf;
+            }
+            if let Some(j) = jac.as_deref_mut() {
+                if v >= 0.0 {
+                    for &(p, ap) in &c.normal {
+                        for &(s, as_) in &c.normal {
+                            j[(p, s)] += ap * law.kn * as_;
+                        }
+                    }
+                    for &(p, ap) in &c.tangential {
+                        if tp.abs() <= limit || limit == 0.0 {
+                            for &(s, as_) in &c.tangential {
+                                j[(p, s)] += ap * law.kt * as_;
+                            }
+                        } else {
+                            for &(s, as_) in &c.normal {
+                                j[(p, s)] += ap * tp.signum() * law.mu * law.kn * as_;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    };
+    let mut r = vec![0.0; n];
+    let mut jac = Mat::<f64>::zeros(n, n);
+    let max_iterations = 100;
+    let mut rel = f64::INFINITY;
+    for _ in 0..max_iterations {
+        residual_of(&q, &mut r, Some(&mut jac));
+        rel = r.iter().map(|x| x * x).sum::<f64>().sqrt() / fnorm;
+        if rel <= 1e-12 {
+            return Ok(q);
+        }
+        let neg: Vec<f64> = r.iter().map(|x| -x).collect();
+        let dq = solve_dense(&jac, &neg)?;
+        // Backtracking on the residual norm keeps the non-smooth contact law from cycling.
+        let mut alpha = 1.0;
+        let mut trial = vec![0.0; n];
+        let mut rt = vec![0.0; n];
+        loop {
+            for p in 0..n {
+                trial[p] = q[p] + alpha * dq[p];
+            }
+            residual_of(&trial, &mut rt, None);
+            let rel_t = rt.iter().map(|x| x * x).sum::<f64>().sqrt() / fnorm;
+            if rel_t < rel || alpha < 1e-4 {
+                break;
+            }
+            alpha *= 0.5;
+        }
+        q.copy_from_slice(&trial);
+    }
+    Err(HbmError::StaticNotConverged {
+        iterations: max_iterations,
+        residual: rel,
+    })
+}

@@ -1,0 +1,13 @@
+//! fricbound: steady-state forced response of structures with dry-friction contacts, by
+//! harmonic balance with alternating frequency/time contact forces, and the limits of that
+//! response among the multiple steady states friction allows (Ferhatoglu & Zucca, JSV 2021).
+
+pub mod aft;
+pub mod contact;
+pub mod continuation;
+pub mod harmonic;
+pub mod hbm;
+pub mod linalg;
+pub mod linear;
+pub mod model;
+pub mod scene;

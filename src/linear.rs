@@ -1,0 +1,177 @@
+//! Linear references: the structure with all contacts open, and with all contacts stuck
+//! (tangential and normal contact springs kₜ aₜaₜᵀ + kₙ aₙaₙᵀ added to K).
+//!
+//! These are closed-form linear solves of the real 2n-block form of (K − ω²M + iωC) q = F
+//! (the complex dynamic stiffness is complex-symmetric, not Hermitian, so an LU is used).
+//! With contacts open, a free body such as an unloaded wedge damper would make the system
+//! singular; only the DOFs connected (through M, C, K) to a loaded DOF are solved, the others
+//! do not move.
+
+use faer::Mat;
+
+use crate::harmonic::Block;
+use crate::linalg::{solve_dense, LinearSolveError};
+use crate::model::Problem;
+
+/// Which linear reference.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LinearCase {
+    /// Contacts removed.
+    Open,
+    /// Contacts replaced by their tangential and normal springs.
+    Stuck,
+}
+
+/// Stiffness of all contacts as linear springs: Σ kₜ aₜaₜᵀ + kₙ aₙaₙᵀ (N/m).
+pub fn contact_stiffness(problem: &Problem) -> Mat<f64> {
+    let n = problem.model.n_dofs();
+    let mut k = Mat::<f64>::zeros(n, n);
+    for c in &problem.contacts {
+        for &(p, ap) in &c.tangential {
+            for &(q, aq) in &c.tangential {
+                k[(p, q)] += c.law.kt * ap * aq;
+            }
+        }
+        for &(p, ap) in &c.normal {
+            for &(q, aq) in &c.normal {
+                k[(p, q)] += c.law.kn * ap * aq;
+            }
+        }
+    }
+    k
+}
+
+/// Stiffness matrix of a linear case.
+fn case_stiffness(problem: &Problem, case: LinearCase) -> Mat<f64> {
+    let mut k = problem.model.stiffness.clone();
+    if case == LinearCase::Stuck {
+        let kc = contact_stiffness(problem);
+        for j in 0..k.ncols() {
+            for i in 0..k.nrows() {
+                k[(i, j)] += kc[(i, j)];
+            }
+        }
+    }
+    k
+}
+
+/// DOFs connected to a loaded DOF through nonzero entries of M, C and `k`.
+fn connected_to_loads(problem: &Problem, k: &Mat<f64>, harmonic: usize) -> Vec<usize> {
+    let n = problem.model.n_dofs();
+    let m = &problem.model;
+    let mut seen = vec![false; n];
+    let mut stack: Vec<usize> = problem
+        .harmonic_loads
+        .iter()
+        .filter(|l| l.harmonic == harmonic && (l.cos != 0.0 || l.sin != 0.0))
+        .map(|l| l.dof)
+        .collect();
+    while let Some(p) = stack.pop() {
+        if seen[p] {
+            continue;
+        }
+        seen[p] = true;
+        for q in 0..n {
+            if !seen[q] && (k[(p, q)] != 0.0 || m.mass[(p, q)] != 0.0 || m.damping[(p, q)] != 0.0) {
+                stack.push(q);
+            }
+        }
+    }
+    (0..n).filter(|&p| seen[p]).collect()
+}
+
+/// Cosine and sine response (m) to the loads of harmonic `h` at ω (rad/s), for stiffness `k`.
+fn harmonic_response(
+    problem: &Problem,
+    k: &Mat<f64>,
+    dofs: &[usize],
+    harmonic: usize,
+    omega: f64,
+) -> Result<(Vec<f64>, Vec<f64>), LinearSolveError> {
+    let n = problem.model.n_dofs();
+    let m = &problem.model;
+    let na = dofs.len();
+    let hw = harmonic as f64 * omega;
+    let mut a = Mat::<f64>::zeros(2 * na, 2 * na);
+    for (i, &p) in dofs.iter().enumerate() {
+        for (j, &q) in dofs.iter().enumerate() {
+            let d = k[(p, q)] - hw * hw * m.mass[(p, q)];
+            let c = hw * m.damping[(p, q)];
+            a[(i, j)] = d;
+            a[(na + i, na + j)] = d;
+            a[(i, na + j)] = c;
+            a[(na + i, j)] = -c;
+        }
+    }
+    let mut rhs = vec![0.0; 2 * na];
+    for l in problem.harmonic_loads.iter().filter(|l| l.harmonic == harmonic) {
+        if let Some(i) = dofs.iter().position(|&d| d == l.dof) {
+            rhs[i] += l.cos;
+            rhs[na + i] += l.sin;
+        }
+    }
+    let mut qc = vec![0.0; n];
+    let mut qs = vec![0.0; n];
+    if na == 0 {
+        return Ok((qc, qs));
+    }
+    let sol = solve_dense(&a, &rhs)?;
+    for (i, &p) in dofs.iter().enumerate() {
+        qc[p] = sol[i];
+        qs[p] = sol[na + i];
+    }
+    Ok((qc, qs))
+}
+
+/// First-harmonic amplitude √(c² + s²) of every DOF (m) at each frequency (Hz).
+pub fn frf(
+    problem: &Problem,
+    case: LinearCase,
+    freqs_hz: &[f64],
+) -> Result<Vec<Vec<f64>>, LinearSolveError> {
+    let k = case_stiffness(problem, case);
+    let dofs = connected_to_loads(problem, &k, 1);
+    freqs_hz
+        .iter()
+        .map(|f| {
+            let (c, s) = harmonic_response(problem, &k, &dofs, 1, 2.0 * std::f64::consts::PI * f)?;
+            Ok(c.iter().zip(&s).map(|(a, b)| a.hypot(*b)).collect())
+        })
+        .collect()
+}
+
+/// Stuck-contact linear solution in the unknown layout of `set` at ω (rad/s): the starting
+/// guess of the nonlinear solve. The constant block includes the gap preload kₙ g aₙ.
+pub fn stuck_guess(
+    problem: &Problem,
+    set: &crate::harmonic::HarmonicSet,
+    omega: f64,
+) -> Result<Vec<f64>, LinearSolveError> {
+    let n = problem.model.n_dofs();
+    let k = case_stiffness(problem, LinearCase::Stuck);
+    let mut x = vec![0.0; n * set.n_blocks()];
+    let all: Vec<usize> = (0..n).collect();
+    for &h in set.harmonics() {
+        if h == 0 {
+            let mut rhs = problem.static_load.clone();
+            for c in &problem.contacts {
+                for &(p, a) in &c.normal {
+                    rhs[p] += c.law.kn * c.gap * a;
+                }
+            }
+            let q0 = solve_dense(&k, &rhs)?;
+            let j = set.constant_block().expect("h = 0 is in the set");
+            x[j * n..(j + 1) * n].copy_from_slice(&q0);
+        } else {
+            let (qc, qs) = harmonic_response(problem, &k, &all, h, omega)?;
+            for (j, b) in set.blocks().iter().enumerate() {
+                match *b {
+                    Block::Cos(hh) if hh == h => x[j * n..(j + 1) * n].copy_from_slice(&qc),
+                    Block::Sin(hh) if hh == h => x[j * n..(j + 1) * n].copy_from_slice(&qs),
+                    _ => {}
+                }
+            }
+        }
+    }
+    Ok(x)
+}

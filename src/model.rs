@@ -1,0 +1,156 @@
+//! The checked problem: linear structure, contacts, loads, effects and analysis settings.
+//!
+//! A [`Problem`] is what a validated scene becomes (see [`crate::scene`]); the solver never
+//! sees unchecked input. Units are SI throughout: masses in kg, stiffness in N/m, damping in
+//! N·s/m, forces in N, displacements in m; frequencies are in Hz in [`Analysis`] and converted
+//! to ω (rad/s) by the solver.
+
+use faer::Mat;
+
+use crate::aft::MarchSettings;
+use crate::contact::{ContactEffects, ContactPoint, DamperSide};
+use crate::harmonic::HarmonicSet;
+
+/// Dense linear structure for lumped or reduced models.
+#[derive(Debug, Clone)]
+pub struct LinearModel {
+    /// DOF names, in matrix order.
+    pub dof_names: Vec<String>,
+    /// Mass matrix M (kg), symmetric positive semi-definite.
+    pub mass: Mat<f64>,
+    /// Viscous damping matrix C (N·s/m).
+    pub damping: Mat<f64>,
+    /// Stiffness matrix K (N/m), symmetric positive semi-definite (free bodies allowed).
+    pub stiffness: Mat<f64>,
+}
+
+impl LinearModel {
+    /// Number of DOFs.
+    pub fn n_dofs(&self) -> usize {
+        self.dof_names.len()
+    }
+
+    /// Index of a DOF by name.
+    pub fn dof_index(&self, name: &str) -> Option<usize> {
+        self.dof_names.iter().position(|d| d == name)
+    }
+}
+
+/// A harmonic force on one DOF: F(τ) = cos·cos(hτ) + sin·sin(hτ) (N).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HarmonicLoad {
+    /// DOF index.
+    pub dof: usize,
+    /// Harmonic number h ≥ 1.
+    pub harmonic: usize,
+    /// Cosine amplitude (N).
+    pub cos: f64,
+    /// Sine amplitude (N).
+    pub sin: f64,
+}
+
+/// Whether statics and dynamics are solved together.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Coupling {
+    /// The 0th harmonic is an unknown of the harmonic balance (paper Eq. 3, coupled approach).
+    #[default]
+    Coupled,
+    /// A static pre-solve fixes the 0th harmonic; only h ≥ 1 are solved dynamically.
+    Uncoupled,
+}
+
+/// Effects switched on by the scene. An effect that is off adds no unknowns and no work.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Effects {
+    /// Contact-law effects (normal-load model, lift-off).
+    pub contact: ContactEffects,
+    /// Static/dynamic coupling through the 0th harmonic.
+    pub coupling: Coupling,
+}
+
+/// How the Jacobian of the harmonic-balance residual is formed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum JacobianStrategy {
+    /// Chain rule through the contact march (default).
+    #[default]
+    Analytic,
+    /// Forward finite differences (one residual per unknown).
+    ForwardDifference,
+    /// Central finite differences (two residuals per unknown).
+    CentralDifference,
+}
+
+/// Continuation and Newton settings. Frequencies in Hz; arc-length steps are measured in the
+/// scaled space where a unit of frequency is 1 Hz (see [`crate::continuation`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Analysis {
+    /// Start frequency (Hz), > 0.
+    pub freq_start_hz: f64,
+    /// End frequency (Hz), > start.
+    pub freq_end_hz: f64,
+    /// First arc-length step (Hz-equivalent).
+    pub initial_step: f64,
+    /// Smallest step before continuation gives up.
+    pub min_step: f64,
+    /// Largest step.
+    pub max_step: f64,
+    /// Most continuation points.
+    pub max_points: usize,
+    /// Newton iterations aimed at per point; steps grow below and shrink above it.
+    pub target_iterations: usize,
+    /// Newton iterations before a point fails.
+    pub max_iterations: usize,
+    /// Convergence: ‖R‖ ≤ residual_tolerance · ‖F_ex‖ (static and harmonic loads).
+    pub residual_tolerance: f64,
+    /// Convergence: scaled Newton step norm ≤ step_tolerance.
+    pub step_tolerance: f64,
+    /// Jacobian strategy.
+    pub jacobian: JacobianStrategy,
+}
+
+/// A checked problem, ready to solve.
+#[derive(Debug, Clone)]
+pub struct Problem {
+    /// Linear structure.
+    pub model: LinearModel,
+    /// Contact points.
+    pub contacts: Vec<ContactPoint>,
+    /// Damper sides grouping the contact points.
+    pub sides: Vec<DamperSide>,
+    /// Static loads per DOF (N), length n_dofs.
+    pub static_load: Vec<f64>,
+    /// Harmonic loads.
+    pub harmonic_loads: Vec<HarmonicLoad>,
+    /// Dynamic harmonics h ≥ 1 balanced (the 0th is added by the coupling effect).
+    pub harmonics: Vec<usize>,
+    /// AFT time samples per period.
+    pub samples: usize,
+    /// Switched effects.
+    pub effects: Effects,
+    /// March limits of the AFT.
+    pub march: MarchSettings,
+    /// Analysis settings.
+    pub analysis: Analysis,
+    /// DOF indices reported in outputs.
+    pub outputs: Vec<usize>,
+}
+
+impl Problem {
+    /// The harmonic set of the unknowns: the dynamic harmonics, plus 0 when coupled.
+    pub fn unknown_harmonics(&self) -> HarmonicSet {
+        let mut h = self.harmonics.clone();
+        if self.effects.coupling == Coupling::Coupled {
+            h.push(0);
+        }
+        HarmonicSet::new(h)
+    }
+
+    /// The harmonic set used by the AFT (always includes the 0th harmonic).
+    pub fn force_harmonics(&self) -> HarmonicSet {
+        let mut h = self.harmonics.clone();
+        h.push(0);
+        HarmonicSet::new(h)
+    }
+}

@@ -1,0 +1,855 @@
+//! Scene files: the TOML schema, `--set` overrides, and validation into a [`Problem`].
+//!
+//! Every table rejects unknown fields, and [`Scene::validate`] checks every value at the door,
+//! naming the file, the field (dotted path, e.g. `contacts[1].mu`) and the reason. The full
+//! field reference with units is `docs/scene.md`.
+
+use std::path::{Path, PathBuf};
+
+use faer::Mat;
+use serde::{Deserialize, Serialize};
+
+use crate::aft::MarchSettings;
+use crate::contact::{ContactEffects, ContactPoint, DamperSide, JenkinsLaw, NormalLoad};
+use crate::model::{
+    Analysis, Coupling, Effects, HarmonicLoad, JacobianStrategy, LinearModel, Problem,
+};
+
+/// A scene could not be read or is invalid.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read.
+    #[error("{file}: cannot read scene: {source}")]
+    Io {
+        /// Scene file.
+        file: String,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// The file is not valid TOML or does not match the schema (unknown or missing field,
+    /// wrong type).
+    #[error("{file}: {message}")]
+    Parse {
+        /// Scene file.
+        file: String,
+        /// Parser message with location and field.
+        message: String,
+    },
+    /// A value is out of range or inconsistent.
+    #[error("{file}: field `{field}`: {reason}")]
+    Invalid {
+        /// Scene file.
+        file: String,
+        /// Dotted path of the field.
+        field: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A `--set FIELD=VALUE` override could not be applied.
+    #[error("{file}: --set `{assignment}`: {reason}")]
+    Override {
+        /// Scene file.
+        file: String,
+        /// The override as given.
+        assignment: String,
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+/// Top-level scene.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Free text shown in plots and summaries.
+    #[serde(default)]
+    pub title: String,
+    /// Linear structure.
+    pub model: ModelSpec,
+    /// Contact points.
+    #[serde(default)]
+    pub contacts: Vec<ContactSpec>,
+    /// Static loads (N).
+    #[serde(default)]
+    pub static_loads: Vec<StaticLoadSpec>,
+    /// Harmonic loads (N).
+    #[serde(default)]
+    pub harmonic_loads: Vec<HarmonicLoadSpec>,
+    /// Harmonics and time sampling.
+    pub harmonics: HarmonicsSpec,
+    /// Switched effects.
+    #[serde(default)]
+    pub effects: EffectsSpec,
+    /// Frequency range, continuation and tolerances.
+    pub analysis: AnalysisSpec,
+    /// Outputs.
+    pub output: OutputSpec,
+}
+
+/// Inline dense matrices with DOF names.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSpec {
+    /// DOF names, in matrix order.
+    pub dofs: Vec<String>,
+    /// Mass matrix (kg), rows.
+    pub mass: Vec<Vec<f64>>,
+    /// Stiffness matrix (N/m), rows.
+    pub stiffness: Vec<Vec<f64>>,
+    /// Viscous damping matrix (N·s/m), rows; zero when absent.
+    #[serde(default)]
+    pub damping: Option<Vec<Vec<f64>>>,
+}
+
+/// One contact point.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// Unique name.
+    pub name: String,
+    /// Damper side the point belongs to (defaults to the contact name).
+    #[serde(default)]
+    pub side: Option<String>,
+    /// DOFs of the damper point (one per direction: x or x, y).
+    pub damper: Vec<String>,
+    /// DOFs of the body point, same directions; empty for a grounded body.
+    #[serde(default)]
+    pub body: Vec<String>,
+    /// Frame by angle (degrees, 2D): t = (cos a, sin a), n = (−sin a, cos a) (paper Eq. 16).
+    #[serde(default)]
+    pub angle_deg: Option<f64>,
+    /// Frame by vectors: tangent direction (normalised here).
+    #[serde(default)]
+    pub tangent: Option<Vec<f64>>,
+    /// Frame by vectors: normal direction, pointing from the damper into the body.
+    #[serde(default)]
+    pub normal: Option<Vec<f64>>,
+    /// Tangential stiffness (N/m).
+    pub kt: f64,
+    /// Normal stiffness (N/m).
+    pub kn: f64,
+    /// Friction coefficient.
+    pub mu: f64,
+    /// Initial normal gap (m); negative for an interference.
+    #[serde(default)]
+    pub gap: f64,
+    /// Initial tangential state m ∈ [−1, 1].
+    #[serde(default)]
+    pub initial_state: f64,
+}
+
+/// A static force on one DOF.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StaticLoadSpec {
+    /// DOF name.
+    pub dof: String,
+    /// Force (N).
+    pub value: f64,
+}
+
+/// A harmonic force on one DOF: cos·cos(hωt) + sin·sin(hωt).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HarmonicLoadSpec {
+    /// DOF name.
+    pub dof: String,
+    /// Harmonic h ≥ 1.
+    #[serde(default = "one")]
+    pub harmonic: usize,
+    /// Cosine amplitude (N).
+    #[serde(default)]
+    pub cos: f64,
+    /// Sine amplitude (N).
+    #[serde(default)]
+    pub sin: f64,
+}
+
+fn one() -> usize {
+    1
+}
+
+/// Harmonic set and AFT sampling.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HarmonicsSpec {
+    /// Highest harmonic H: balance 1..H (and 0 when coupled).
+    #[serde(default)]
+    pub max: Option<usize>,
+    /// Explicit dynamic harmonics, e.g. [1, 3, 5] (0 may be listed; coupling decides).
+    #[serde(default)]
+    pub list: Option<Vec<usize>>,
+    /// Time samples per period of the AFT (> 2·H).
+    #[serde(default = "default_samples")]
+    pub samples: usize,
+    /// Most periods in the contact march before it is reported as not settling.
+    #[serde(default = "default_max_periods")]
+    pub max_periods: usize,
+}
+
+fn default_samples() -> usize {
+    256
+}
+fn default_max_periods() -> usize {
+    64
+}
+
+/// Switched effects.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EffectsSpec {
+    /// `variable` (default) or `constant` normal load.
+    #[serde(default)]
+    pub normal_load: NormalLoad,
+    /// Whether contacts may separate (default true).
+    #[serde(default = "yes")]
+    pub liftoff: bool,
+    /// `coupled` (default) or `uncoupled` statics.
+    #[serde(default)]
+    pub coupling: Coupling,
+}
+
+impl Default for EffectsSpec {
+    fn default() -> Self {
+        Self {
+            normal_load: NormalLoad::Variable,
+            liftoff: true,
+            coupling: Coupling::Coupled,
+        }
+    }
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// Frequency range and continuation settings.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnalysisSpec {
+    /// Start frequency (Hz).
+    pub freq_start_hz: f64,
+    /// End frequency (Hz).
+    pub freq_end_hz: f64,
+    /// First arc-length step (Hz-equivalent); default range/200.
+    #[serde(default)]
+    pub initial_step: Option<f64>,
+    /// Smallest step; default range·1e-7.
+    #[serde(default)]
+    pub min_step: Option<f64>,
+    /// Largest step; default range/50.
+    #[serde(default)]
+    pub max_step: Option<f64>,
+    /// Most continuation points.
+    #[serde(default = "default_max_points")]
+    pub max_points: usize,
+    /// Newton iterations aimed at per step.
+    #[serde(default = "default_target_iterations")]
+    pub target_iterations: usize,
+    /// Newton iterations before a step is cut.
+    #[serde(default = "default_max_iterations")]
+    pub max_iterations: usize,
+    /// Relative residual tolerance (to the load norm).
+    #[serde(default = "default_residual_tolerance")]
+    pub residual_tolerance: f64,
+    /// Scaled step tolerance.
+    #[serde(default = "default_step_tolerance")]
+    pub step_tolerance: f64,
+    /// `analytic` (default), `forward-difference` or `central-difference`.
+    #[serde(default)]
+    pub jacobian: JacobianStrategy,
+    /// Points of the uniform grid for the linear references.
+    #[serde(default = "default_linear_points")]
+    pub linear_points: usize,
+}
+
+fn default_max_points() -> usize {
+    5000
+}
+fn default_target_iterations() -> usize {
+    4
+}
+fn default_max_iterations() -> usize {
+    12
+}
+fn default_residual_tolerance() -> f64 {
+    1e-10
+}
+fn default_step_tolerance() -> f64 {
+    1e-8
+}
+fn default_linear_points() -> usize {
+    501
+}
+
+/// Outputs.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Response DOFs reported in `frf.csv` and plotted.
+    pub dofs: Vec<String>,
+}
+
+/// Reads a scene file, applying `--set` overrides (`path=value`).
+pub fn load(path: &Path, overrides: &[String]) -> Result<Scene, SceneError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        file: file.clone(),
+        source,
+    })?;
+    parse(&text, &file, overrides)
+}
+
+/// Parses scene text (`file` names it in errors), applying overrides.
+pub fn parse(text: &str, file: &str, overrides: &[String]) -> Result<Scene, SceneError> {
+    if overrides.is_empty() {
+        return toml::from_str(text).map_err(|e| SceneError::Parse {
+            file: file.to_string(),
+            message: e.to_string().trim_end().to_string(),
+        });
+    }
+    let mut table: toml::Table = text.parse().map_err(|e: toml::de::Error| SceneError::Parse {
+        file: file.to_string(),
+        message: e.to_string().trim_end().to_string(),
+    })?;
+    for assignment in overrides {
+        apply_override(&mut table, assignment).map_err(|reason| SceneError::Override {
+            file: file.to_string(),
+            assignment: assignment.clone(),
+            reason,
+        })?;
+    }
+    toml::Value::Table(table)
+        .try_into()
+        .map_err(|e: toml::de::Error| SceneError::Parse {
+            file: file.to_string(),
+            message: format!("after --set overrides: {}", e.to_string().trim_end()),
+        })
+}
+
+/// Applies one `a.b.0.c=value` override to a TOML table. The value is read as TOML (number,
+/// boolean, array, quoted string) and otherwise taken as a bare string.
+pub fn apply_override(table: &mut toml::Table, assignment: &str) -> Result<(), String> {
+    let (path, raw) = assignment
+        .split_once('=')
+        .ok_or_else(|| "expected FIELD=VALUE".to_string())?;
+    let path = path.trim();
+    if path.is_empty() {
+        return Err("empty field path".into());
+    }
+    let value: toml::Value = match format!("v = {}", raw.trim()).parse::<toml::Table>() {
+        Ok(mut t) => t.remove("v").expect("parsed key v"),
+        Err(_) => toml::Value::String(raw.trim().to_string()),
+    };
+    let segments: Vec<&str> = path.split('.').collect();
+    let mut current = toml::Value::Table(std::mem::take(table));
+    let result = set_path(&mut current, &segments, value, path);
+    if let toml::Value::Table(t) = current {
+        *table = t;
+    }
+    result
+}
+
+fn set_path(node: &mut toml::Value, segments: &[&str], value: toml::Value, full: &str) -> Result<(), String> {
+    let (head, rest) = segments.split_first().expect("non-empty path");
+    let child: &mut toml::Value = match node {
+        toml::Value::Table(t) => {
+            if rest.is_empty() {
+                t.insert(head.to_string(), value);
+                return Ok(());
+            }
+            t.get_mut(*head)
+                .ok_or_else(|| format!("no field `{head}` in `{full}`"))?
+        }
+        toml::Value::Array(a) => {
+            let i: usize = head
+                .parse()
+                .map_err(|_| format!("`{head}` is not an array index in `{full}`"))?;
+            let len = a.len();
+            let slot = a
+                .get_mut(i)
+                .ok_or_else(|| format!("index {i} out of range (length {len}) in `{full}`"))?;
+            if rest.is_empty() {
+                *slot = value;
+                return Ok(());
+            }
+            slot
+        }
+        _ => return Err(format!("`{head}` is below a value that is not a table or array in `{full}`")),
+    };
+    set_path(child, rest, value, full)
+}
+
+/// Validation context: file name for messages.
+struct Checker<'a> {
+    file: &'a str,
+}
+
+impl Checker<'_> {
+    fn err(&self, field: impl Into<String>, reason: impl Into<String>) -> SceneError {
+        SceneError::Invalid {
+            file: self.file.to_string(),
+            field: field.into(),
+            reason: reason.into(),
+        }
+    }
+
+    fn finite(&self, field: &str, v: f64) -> Result<f64, SceneError> {
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(self.err(field, format!("must be a finite number, got {v}")))
+        }
+    }
+
+    fn positive(&self, field: &str, v: f64) -> Result<f64, SceneError> {
+        self.finite(field, v)?;
+        if v > 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(field, format!("must be > 0, got {v}")))
+        }
+    }
+
+    fn matrix(&self, field: &str, rows: &[Vec<f64>], n: usize) -> Result<Mat<f64>, SceneError> {
+        if rows.len() != n {
+            return Err(self.err(
+                field,
+                format!("has {} rows but the model has {n} DOFs", rows.len()),
+            ));
+        }
+        for (i, r) in rows.iter().enumerate() {
+            if r.len() != n {
+                return Err(self.err(
+                    format!("{field}[{i}]"),
+                    format!("has {} entries but the model has {n} DOFs", r.len()),
+                ));
+            }
+            for (j, v) in r.iter().enumerate() {
+                self.finite(&format!("{field}[{i}][{j}]"), *v)?;
+            }
+        }
+        let m = Mat::from_fn(n, n, |i, j| rows[i][j]);
+        let scale = rows
+            .iter()
+            .flatten()
+            .fold(0.0_f64, |a, v| a.max(v.abs()))
+            .max(f64::MIN_POSITIVE);
+        for i in 0..n {
+            for j in 0..i {
+                if (m[(i, j)] - m[(j, i)]).abs() > 1e-12 * scale {
+                    return Err(self.err(
+                        field,
+                        format!(
+                            "is not symmetric: [{i}][{j}] = {} but [{j}][{i}] = {}",
+                            m[(i, j)],
+                            m[(j, i)]
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(m)
+    }
+
+    fn semidefinite(&self, field: &str, m: &Mat<f64>) -> Result<(), SceneError> {
+        if m.nrows() == 0 {
+            return Ok(());
+        }
+        let eig = m
+            .self_adjoint_eigenvalues(faer::Side::Lower)
+            .map_err(|_| self.err(field, "eigenvalues could not be computed"))?;
+        let max = eig.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+        let min = eig.iter().cloned().fold(f64::INFINITY, f64::min);
+        if min < -1e-10 * max {
+            return Err(self.err(
+                field,
+                format!("is indefinite (smallest eigenvalue {min:.4e}, largest magnitude {max:.4e})"),
+            ));
+        }
+        Ok(())
+    }
+
+    fn dof(&self, field: &str, name: &str, dofs: &[String]) -> Result<usize, SceneError> {
+        dofs.iter().position(|d| d == name).ok_or_else(|| {
+            self.err(
+                field,
+                format!("unknown DOF `{name}` (the model has {})", dofs.join(", ")),
+            )
+        })
+    }
+}
+
+impl Scene {
+    /// Checks every value and builds the problem. `file` names the scene in errors.
+    pub fn validate(&self, file: &str) -> Result<Problem, SceneError> {
+        let ck = Checker { file };
+        let dofs = &self.model.dofs;
+        let n = dofs.len();
+        if n == 0 {
+            return Err(ck.err("model.dofs", "must name at least one DOF"));
+        }
+        for (i, d) in dofs.iter().enumerate() {
+            if dofs[..i].contains(d) {
+                return Err(ck.err(format!("model.dofs[{i}]"), format!("duplicate DOF `{d}`")));
+            }
+        }
+        let mass = ck.matrix("model.mass", &self.model.mass, n)?;
+        let stiffness = ck.matrix("model.stiffness", &self.model.stiffness, n)?;
+        let damping = match &self.model.damping {
+            Some(c) => ck.matrix("model.damping", c, n)?,
+            None => Mat::zeros(n, n),
+        };
+        ck.semidefinite("model.mass", &mass)?;
+        ck.semidefinite("model.stiffness", &stiffness)?;
+        ck.semidefinite("model.damping", &damping)?;
+
+        if self.contacts.is_empty() {
+            return Err(ck.err(
+                "contacts",
+                "the contact set is empty: a friction analysis needs at least one [[contacts]] entry",
+            ));
+        }
+        let mut contacts = Vec::new();
+        let mut sides: Vec<DamperSide> = Vec::new();
+        for (ci, c) in self.contacts.iter().enumerate() {
+            let f = |name: &str| format!("contacts[{ci}].{name}");
+            if c.name.trim().is_empty() {
+                return Err(ck.err(f("name"), "must not be empty"));
+            }
+            if self.contacts[..ci].iter().any(|o| o.name == c.name) {
+                return Err(ck.err(f("name"), format!("duplicate contact name `{}`", c.name)));
+            }
+            let dim = c.damper.len();
+            if dim == 0 {
+                return Err(ck.err(f("damper"), "must list the damper point's DOFs"));
+            }
+            if !c.body.is_empty() && c.body.len() != dim {
+                return Err(ck.err(
+                    f("body"),
+                    format!("has {} DOFs but `damper` has {dim}", c.body.len()),
+                ));
+            }
+            let damper_idx: Vec<usize> = c
+                .damper
+                .iter()
+                .enumerate()
+                .map(|(i, d)| ck.dof(&format!("contacts[{ci}].damper[{i}]"), d, dofs))
+                .collect::<Result<_, _>>()?;
+            let body_idx: Vec<usize> = c
+                .body
+                .iter()
+                .enumerate()
+                .map(|(i, d)| ck.dof(&format!("contacts[{ci}].body[{i}]"), d, dofs))
+                .collect::<Result<_, _>>()?;
+            let (t, nv) = match (c.angle_deg, &c.tangent, &c.normal) {
+                (Some(a), None, None) => {
+                    ck.finite(&f("angle_deg"), a)?;
+                    if dim != 2 {
+                        return Err(ck.err(
+                            f("angle_deg"),
+                            format!("a frame by angle needs 2 DOFs per point, this point has {dim}"),
+                        ));
+                    }
+                    let r = a.to_radians();
+                    (vec![r.cos(), r.sin()], vec![-r.sin(), r.cos()])
+                }
+                (None, Some(t), Some(nn)) => {
+                    for (name, v) in [("tangent", t), ("normal", nn)] {
+                        if v.len() != dim {
+                            return Err(ck.err(
+                                f(name),
+                                format!("has {} components but the point has {dim} DOFs", v.len()),
+                            ));
+                        }
+                        for (i, x) in v.iter().enumerate() {
+                            ck.finite(&format!("contacts[{ci}].{name}[{i}]"), *x)?;
+                        }
+                    }
+                    let tn = t.iter().map(|x| x * x).sum::<f64>().sqrt();
+                    if tn == 0.0 {
+                        return Err(ck.err(f("tangent"), "must not be the zero vector"));
+                    }
+                    let nn_norm = nn.iter().map(|x| x * x).sum::<f64>().sqrt();
+                    let t: Vec<f64> = t.iter().map(|x| x / tn).collect();
+                    let nn: Vec<f64> = if nn_norm > 0.0 {
+                        nn.iter().map(|x| x / nn_norm).collect()
+                    } else {
+                        nn.clone()
+                    };
+                    let dot: f64 = t.iter().zip(&nn).map(|(a, b)| a * b).sum();
+                    if dot.abs() > 1e-9 {
+                        return Err(ck.err(
+                            f("normal"),
+                            format!("must be perpendicular to `tangent` (t·n = {dot:.3e})"),
+                        ));
+                    }
+                    (t, nn)
+                }
+                _ => {
+                    return Err(ck.err(
+                        f("angle_deg"),
+                        "give the frame either by `angle_deg` or by both `tangent` and `normal`",
+                    ))
+                }
+            };
+            let kt = ck.positive(&f("kt"), c.kt)?;
+            let kn = ck.positive(&f("kn"), c.kn)?;
+            let mu = ck.finite(&f("mu"), c.mu)?;
+            if mu < 0.0 {
+                return Err(ck.err(f("mu"), format!("friction coefficient must be ≥ 0, got {mu}")));
+            }
+            let gap = ck.finite(&f("gap"), c.gap)?;
+            let m = ck.finite(&f("initial_state"), c.initial_state)?;
+            if !(-1.0..=1.0).contains(&m) {
+                return Err(ck.err(
+                    f("initial_state"),
+                    format!("must lie in [-1, 1] (T(0) = m·μN(0)), got {m}"),
+                ));
+            }
+            let mut tangential = Vec::new();
+            let mut normal = Vec::new();
+            for d in 0..dim {
+                push_coefficient(&mut tangential, damper_idx[d], t[d]);
+                push_coefficient(&mut normal, damper_idx[d], nv[d]);
+                if let Some(&b) = body_idx.get(d) {
+                    push_coefficient(&mut tangential, b, -t[d]);
+                    push_coefficient(&mut normal, b, -nv[d]);
+                }
+            }
+            let side_name = c.side.clone().unwrap_or_else(|| c.name.clone());
+            let side = match sides.iter().position(|s| s.name == side_name) {
+                Some(s) => s,
+                None => {
+                    sides.push(DamperSide {
+                        name: side_name,
+                        contacts: Vec::new(),
+                    });
+                    sides.len() - 1
+                }
+            };
+            sides[side].contacts.push(ci);
+            contacts.push(ContactPoint {
+                name: c.name.clone(),
+                side,
+                tangential,
+                normal,
+                gap,
+                law: JenkinsLaw {
+                    kt,
+                    kn,
+                    mu,
+                    initial_state: m,
+                },
+            });
+        }
+
+        let mut static_load = vec![0.0; n];
+        for (i, l) in self.static_loads.iter().enumerate() {
+            let d = ck.dof(&format!("static_loads[{i}].dof"), &l.dof, dofs)?;
+            static_load[d] += ck.finite(&format!("static_loads[{i}].value"), l.value)?;
+        }
+
+        let harmonics: Vec<usize> = match (&self.harmonics.max, &self.harmonics.list) {
+            (Some(h), None) => {
+                if *h == 0 {
+                    return Err(ck.err(
+                        "harmonics.max",
+                        "must be ≥ 1 (the 0th harmonic alone has no dynamics)",
+                    ));
+                }
+                (1..=*h).collect()
+            }
+            (None, Some(list)) => {
+                let mut l: Vec<usize> = list.iter().copied().filter(|&h| h > 0).collect();
+                l.sort_unstable();
+                l.dedup();
+                if l.is_empty() {
+                    return Err(ck.err("harmonics.list", "must hold at least one harmonic ≥ 1"));
+                }
+                l
+            }
+            _ => {
+                return Err(ck.err(
+                    "harmonics",
+                    "give exactly one of `max` (harmonics 1..H) or `list`",
+                ))
+            }
+        };
+        let h_max = *harmonics.last().expect("non-empty");
+        if self.harmonics.samples <= 2 * h_max || self.harmonics.samples < 8 {
+            return Err(ck.err(
+                "harmonics.samples",
+                format!(
+                    "must be ≥ 8 and > 2·H = {} to resolve harmonic {h_max}, got {}",
+                    2 * h_max,
+                    self.harmonics.samples
+                ),
+            ));
+        }
+        if self.harmonics.max_periods < 2 {
+            return Err(ck.err("harmonics.max_periods", "must be ≥ 2"));
+        }
+
+        let mut harmonic_loads = Vec::new();
+        for (i, l) in self.harmonic_loads.iter().enumerate() {
+            let dof = ck.dof(&format!("harmonic_loads[{i}].dof"), &l.dof, dofs)?;
+            if l.harmonic == 0 {
+                return Err(ck.err(
+                    format!("harmonic_loads[{i}].harmonic"),
+                    "must be ≥ 1 (static forces go in [[static_loads]])",
+                ));
+            }
+            if !harmonics.contains(&l.harmonic) {
+                return Err(ck.err(
+                    format!("harmonic_loads[{i}].harmonic"),
+                    format!("harmonic {} is not in the harmonic set {harmonics:?}", l.harmonic),
+                ));
+            }
+            harmonic_loads.push(HarmonicLoad {
+                dof,
+                harmonic: l.harmonic,
+                cos: ck.finite(&format!("harmonic_loads[{i}].cos"), l.cos)?,
+                sin: ck.finite(&format!("harmonic_loads[{i}].sin"), l.sin)?,
+            });
+        }
+        if harmonic_loads.iter().all(|l| l.cos == 0.0 && l.sin == 0.0) {
+            return Err(ck.err(
+                "harmonic_loads",
+                "no non-zero harmonic load: a forced response needs an excitation",
+            ));
+        }
+
+        let a = &self.analysis;
+        let f0 = ck.positive("analysis.freq_start_hz", a.freq_start_hz)?;
+        let f1 = ck.finite("analysis.freq_end_hz", a.freq_end_hz)?;
+        if f1 <= f0 {
+            return Err(ck.err(
+                "analysis.freq_end_hz",
+                format!("the range is reversed or empty: end {f1} Hz ≤ start {f0} Hz"),
+            ));
+        }
+        let range = f1 - f0;
+        let initial_step = ck.positive("analysis.initial_step", a.initial_step.unwrap_or(range / 200.0))?;
+        let min_step = ck.positive("analysis.min_step", a.min_step.unwrap_or(range * 1e-7))?;
+        let max_step = ck.positive("analysis.max_step", a.max_step.unwrap_or(range / 50.0))?;
+        if min_step > max_step {
+            return Err(ck.err("analysis.min_step", format!("{min_step} exceeds max_step {max_step}")));
+        }
+        for (field, v) in [
+            ("analysis.max_points", a.max_points),
+            ("analysis.target_iterations", a.target_iterations),
+            ("analysis.max_iterations", a.max_iterations),
+            ("analysis.linear_points", a.linear_points),
+        ] {
+            if v == 0 {
+                return Err(ck.err(field, "must be ≥ 1"));
+            }
+        }
+        if a.linear_points < 2 {
+            return Err(ck.err("analysis.linear_points", "must be ≥ 2"));
+        }
+        let residual_tolerance = ck.positive("analysis.residual_tolerance", a.residual_tolerance)?;
+        let step_tolerance = ck.positive("analysis.step_tolerance", a.step_tolerance)?;
+
+        if self.output.dofs.is_empty() {
+            return Err(ck.err("output.dofs", "name at least one response DOF"));
+        }
+        let outputs = self
+            .output
+            .dofs
+            .iter()
+            .enumerate()
+            .map(|(i, d)| ck.dof(&format!("output.dofs[{i}]"), d, dofs))
+            .collect::<Result<Vec<_>, _>>()?;
+
+        let problem = Problem {
+            model: LinearModel {
+                dof_names: dofs.clone(),
+                mass,
+                damping,
+                stiffness,
+            },
+            contacts,
+            sides,
+            static_load,
+            harmonic_loads,
+            harmonics,
+            samples: self.harmonics.samples,
+            effects: Effects {
+                contact: ContactEffects {
+                    normal_load: self.effects.normal_load,
+                    liftoff: self.effects.liftoff,
+                },
+                coupling: self.effects.coupling,
+            },
+            march: MarchSettings {
+                max_periods: self.harmonics.max_periods,
+                ..MarchSettings::default()
+            },
+            analysis: Analysis {
+                freq_start_hz: f0,
+                freq_end_hz: f1,
+                initial_step,
+                min_step,
+                max_step,
+                max_points: a.max_points,
+                target_iterations: a.target_iterations,
+                max_iterations: a.max_iterations,
+                residual_tolerance,
+                step_tolerance,
+                jacobian: a.jacobian,
+            },
+            outputs,
+        };
+        // The structure with stuck contacts must be able to carry static loads.
+        let k_stuck = {
+            let mut k = problem.model.stiffness.clone();
+            let kc = crate::linear::contact_stiffness(&problem);
+            for j in 0..n {
+                for i in 0..n {
+                    k[(i, j)] += kc[(i, j)];
+                }
+            }
+            k
+        };
+        let eig = k_stuck
+            .self_adjoint_eigenvalues(faer::Side::Lower)
+            .map_err(|_| ck.err("model.stiffness", "eigenvalues could not be computed"))?;
+        let max = eig.iter().fold(0.0_f64, |acc, v| acc.max(v.abs()));
+        let min = eig.iter().cloned().fold(f64::INFINITY, f64::min);
+        if min <= 1e-12 * max {
+            return Err(ck.err(
+                "model.stiffness",
+                "the structure is singular even with all contacts stuck (a body is free: \
+                 ground it or connect it through a contact)",
+            ));
+        }
+        Ok(problem)
+    }
+}
+
+fn push_coefficient(row: &mut Vec<(usize, f64)>, dof: usize, value: f64) {
+    if value == 0.0 {
+        return;
+    }
+    match row.iter_mut().find(|(d, _)| *d == dof) {
+        Some((_, v)) => *v += value,
+        None => row.push((dof, value)),
+    }
+}
+
+/// Loads and validates a scene in one go; returns the scene (for echoing) and the problem.
+pub fn load_problem(path: &Path, overrides: &[String]) -> Result<(Scene, Problem), SceneError> {
+    let scene = load(path, overrides)?;
+    let problem = scene.validate(&path.display().to_string())?;
+    Ok((scene, problem))
+}
+
+/// The paper's default scene (β = 120°, F0 = 120 N, full range), shipped in the binary.
+pub const PAPER_DEFAULT_SCENE: &str = include_str!("../meshes/paper-wedge/full-range.toml");
+
+/// Path label used for the built-in default scene in messages.
+pub fn default_scene_label() -> PathBuf {
+    PathBuf::from("meshes/paper-wedge/full-range.toml")
+}
