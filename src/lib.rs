@@ -11,3 +11,5 @@ pub mod linalg;
 pub mod linear;
 pub mod model;
 pub mod scene;
+pub mod frf;
+pub mod report;

@@ -175,3 +175,34 @@ pub fn stuck_guess(
     }
     Ok(x)
 }
+
+/// A linear reference curve on a frequency grid, for the output DOFs.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct LinearCurve {
+    /// Frequencies (Hz).
+    pub freqs_hz: Vec<f64>,
+    /// First-harmonic amplitude (m), indexed `[frequency][output]`.
+    pub amplitudes: Vec<Vec<f64>>,
+}
+
+/// The linear reference of `case` on `points` uniformly spaced frequencies of the analysis
+/// range, for the problem's output DOFs.
+pub fn reference_curve(
+    problem: &Problem,
+    case: LinearCase,
+    points: usize,
+) -> Result<LinearCurve, LinearSolveError> {
+    let a = &problem.analysis;
+    let freqs_hz: Vec<f64> = (0..points)
+        .map(|i| a.freq_start_hz + (a.freq_end_hz - a.freq_start_hz) * i as f64 / (points - 1).max(1) as f64)
+        .collect();
+    let all = frf(problem, case, &freqs_hz)?;
+    let amplitudes = all
+        .iter()
+        .map(|row| problem.outputs.iter().map(|&d| row[d]).collect())
+        .collect();
+    Ok(LinearCurve {
+        freqs_hz,
+        amplitudes,
+    })
+}

@@ -1,0 +1,168 @@
+//! Frequency-response runs: continuation of the harmonic balance over the scene's range, with
+//! per-point outputs (amplitudes, peaks, contact states) handed to an observer as they come.
+
+use std::f64::consts::PI;
+use std::time::Instant;
+
+use crate::contact::ContactState;
+use crate::continuation::{Continuation, ContinuationError, NewtonFailure, Observer, PathEnd, PathPoint};
+use crate::harmonic::HarmonicSet;
+use crate::hbm::{HbmError, HbmSystem};
+use crate::linalg::LinearSolveError;
+use crate::linear;
+use crate::model::Problem;
+
+/// One converged point of a nonlinear frequency response.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct FrfPoint {
+    /// Excitation frequency (Hz).
+    pub freq_hz: f64,
+    /// First-harmonic amplitude √(c₁² + s₁²) of each output DOF (m).
+    pub amplitudes: Vec<f64>,
+    /// Peak |q(τ)| over the period of each output DOF, static part included (m).
+    pub peaks: Vec<f64>,
+    /// Contact state of each contact over the period.
+    pub states: Vec<ContactState>,
+    /// Newton iterations.
+    pub newton_iterations: usize,
+    /// Final residual relative to the load norm.
+    pub residual: f64,
+    /// All Fourier coefficients, harmonic-major (m).
+    pub coefficients: Vec<f64>,
+}
+
+/// Receives the events of an FRF run.
+pub trait FrfObserver {
+    /// A point converged.
+    fn point(&mut self, _point: &FrfPoint) {}
+    /// A step was cut (frequency of the last converged point, Hz).
+    fn step_cut(&mut self, _freq_hz: f64, _step: f64, _new_step: f64, _reason: &NewtonFailure) {}
+    /// A turning point was passed (Hz).
+    fn turning_point(&mut self, _freq_hz: f64) {}
+}
+
+/// Observer that ignores everything.
+pub struct Silent;
+impl FrfObserver for Silent {}
+
+/// Result of an FRF run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrfRun {
+    /// Converged points in path order.
+    pub points: Vec<FrfPoint>,
+    /// Turning-point frequencies (Hz).
+    pub turning_points: Vec<f64>,
+    /// Number of cut steps.
+    pub rejected_steps: usize,
+    /// Why the run ended.
+    pub end: PathEnd,
+    /// Wall time of the run (s).
+    pub elapsed_s: f64,
+}
+
+/// Errors of an FRF run.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FrfError {
+    /// Building the operator failed.
+    #[error("{0}")]
+    Setup(#[from] HbmError),
+    /// The linear starting guess failed.
+    #[error("linear starting guess: {0}")]
+    Guess(#[from] LinearSolveError),
+    /// Continuation failed.
+    #[error("{0}")]
+    Continuation(#[from] ContinuationError),
+}
+
+/// Output quantities of a converged point.
+pub fn point_outputs(problem: &Problem, set: &HarmonicSet, static_offset: &[f64], x: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let n = problem.model.n_dofs();
+    let c1 = set.cos_block(1);
+    let s1 = set.sin_block(1);
+    let samples = problem.samples.max(64);
+    let mut amplitudes = Vec::with_capacity(problem.outputs.len());
+    let mut peaks = Vec::with_capacity(problem.outputs.len());
+    let mut coef = vec![0.0; set.n_blocks()];
+    for &d in &problem.outputs {
+        let c = c1.map(|j| x[j * n + d]).unwrap_or(0.0);
+        let s = s1.map(|j| x[j * n + d]).unwrap_or(0.0);
+        amplitudes.push(c.hypot(s));
+        for (j, v) in coef.iter_mut().enumerate() {
+            *v = x[j * n + d];
+        }
+        let offset = if set.has_constant() { 0.0 } else { static_offset[d] };
+        let peak = (0..samples)
+            .map(|k| (offset + set.evaluate(&coef, 2.0 * PI * k as f64 / samples as f64)).abs())
+            .fold(0.0, f64::max);
+        peaks.push(peak);
+    }
+    (amplitudes, peaks)
+}
+
+/// Scale of x in the arc length: the largest stuck-linear response norm over the range,
+/// divided so that climbing to it costs a quarter of the range in arc length.
+fn arc_length_x_scale(problem: &Problem, set: &HarmonicSet) -> Result<f64, LinearSolveError> {
+    let a = &problem.analysis;
+    let mut x_ref = 0.0_f64;
+    for i in 0..=40 {
+        let f = a.freq_start_hz + (a.freq_end_hz - a.freq_start_hz) * i as f64 / 40.0;
+        let x = linear::stuck_guess(problem, set, 2.0 * PI * f)?;
+        x_ref = x_ref.max(crate::continuation::norm(&x));
+    }
+    let range = a.freq_end_hz - a.freq_start_hz;
+    Ok((x_ref / (0.25 * range)).max(f64::MIN_POSITIVE))
+}
+
+struct Adapter<'o, O: FrfObserver> {
+    observer: &'o mut O,
+    points: Vec<FrfPoint>,
+}
+
+impl<O: FrfObserver> Observer<HbmSystem<'_>> for Adapter<'_, O> {
+    fn accepted(&mut self, system: &mut HbmSystem<'_>, p: &PathPoint) {
+        let problem = system.problem();
+        let (amplitudes, peaks) = point_outputs(problem, system.unknowns(), system.static_offset(), &p.x);
+        let point = FrfPoint {
+            freq_hz: p.freq_hz(),
+            amplitudes,
+            peaks,
+            states: system.states.clone(),
+            newton_iterations: p.iterations,
+            residual: p.residual,
+            coefficients: p.x.clone(),
+        };
+        self.observer.point(&point);
+        self.points.push(point);
+    }
+    fn rejected(&mut self, freq_hz: f64, step: f64, new_step: f64, reason: &NewtonFailure) {
+        self.observer.step_cut(freq_hz, step, new_step, reason);
+    }
+    fn turning_point(&mut self, freq_hz: f64) {
+        self.observer.turning_point(freq_hz);
+    }
+}
+
+/// Solves the nonlinear frequency response of a problem over its analysis range.
+pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfRun, FrfError> {
+    let started = Instant::now();
+    let mut system = HbmSystem::new(problem)?;
+    let set = system.unknowns().clone();
+    let omega0 = 2.0 * PI * problem.analysis.freq_start_hz;
+    let guess = linear::stuck_guess(problem, &set, omega0)?;
+    let continuation = Continuation {
+        analysis: problem.analysis,
+        x_scale: arc_length_x_scale(problem, &set)?,
+    };
+    let mut adapter = Adapter {
+        observer,
+        points: Vec::new(),
+    };
+    let summary = continuation.run(&mut system, &guess, &mut adapter)?;
+    Ok(FrfRun {
+        points: adapter.points,
+        turning_points: summary.turning_points,
+        rejected_steps: summary.rejected_steps,
+        end: summary.end,
+        elapsed_s: started.elapsed().as_secs_f64(),
+    })
+}

@@ -1,0 +1,3 @@
+//! Result files and figures.
+
+pub mod plot;
