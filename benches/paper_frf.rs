@@ -1,1 +1,34 @@
-fn main(){}
+//! One full-range FRF of the paper's wedge-damper case (β = 120°, F₀ = 120 N), at H = 1 and
+//! H = 5, analytic Jacobian; and H = 1 with forward differences as the baseline.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use fricbound::frf::{self, Silent};
+use fricbound::reference::paper_wedge_scene;
+use fricbound::scene;
+
+fn problem(overrides: &[&str]) -> fricbound::model::Problem {
+    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    scene::parse(paper_wedge_scene(), "paper", &o)
+        .expect("paper scene parses")
+        .validate("paper")
+        .expect("paper scene is valid")
+}
+
+fn paper_frf(c: &mut Criterion) {
+    let mut group = c.benchmark_group("paper_frf");
+    group.sample_size(20);
+    for (name, overrides) in [
+        ("H1_analytic", vec![]),
+        ("H5_analytic", vec!["harmonics.max=5"]),
+        ("H1_forward_difference", vec!["analysis.jacobian=forward-difference"]),
+    ] {
+        let p = problem(&overrides);
+        group.bench_function(name, |b| {
+            b.iter(|| frf::solve(&p, &mut Silent).expect("paper FRF solves"))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, paper_frf);
+criterion_main!(benches);

@@ -13,3 +13,5 @@ pub mod model;
 pub mod scene;
 pub mod frf;
 pub mod report;
+pub mod commands;
+pub mod reference;

@@ -1,14 +1,74 @@
-fn main() {
-    let scene = fricbound::scene::parse(fricbound::scene::PAPER_DEFAULT_SCENE, "default", &[]).unwrap();
-    let problem = scene.validate("default").unwrap();
-    struct P;
-    impl fricbound::frf::FrfObserver for P {
-        fn step_cut(&mut self, f: f64, s: f64, ns: f64, r: &fricbound::continuation::NewtonFailure) { eprintln!("cut at {f:.3} {s:.3e}->{ns:.3e}: {r}"); }
-        fn turning_point(&mut self, f: f64) { eprintln!("turn {f}"); }
+//! `fricbound` command line: parses arguments and dispatches to [`fricbound::commands`].
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Steady-state forced response of friction-damped structures, and its limits.
+#[derive(Parser)]
+#[command(name = "fricbound", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Solve a scene (the paper's wedge-damper scene when none is given) and write results.
+    Run {
+        /// Scene file (TOML).
+        scene: Option<PathBuf>,
+        /// Output folder (default: out/<scene name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override a scene field by its dotted path, e.g. --set harmonics.max=5
+        #[arg(long = "set", value_name = "FIELD=VALUE")]
+        overrides: Vec<String>,
+        /// No progress bar or step messages.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Validate a scene and print a summary.
+    Check {
+        /// Scene file (TOML).
+        scene: Option<PathBuf>,
+        /// Override a scene field by its dotted path.
+        #[arg(long = "set", value_name = "FIELD=VALUE")]
+        overrides: Vec<String>,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run {
+            scene,
+            out,
+            overrides,
+            quiet,
+        } => {
+            let options = fricbound::commands::RunOptions {
+                scene,
+                out,
+                overrides,
+                quiet,
+            };
+            fricbound::commands::run(&options).map(|r| {
+                if !quiet {
+                    println!("{}", fricbound::commands::run_summary(&r));
+                }
+            })
+        }
+        Command::Check { scene, overrides } => {
+            fricbound::commands::check(scene.as_deref(), &overrides).map(|s| print!("{s}"))
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
     }
-    let run = fricbound::frf::solve(&problem, &mut P).unwrap();
-    for p in run.points.iter().step_by(5) {
-        println!("{:9.3} {:.4e} {:?} {}", p.freq_hz, p.amplitudes[0], p.states, p.newton_iterations);
-    }
-    println!("points {} rejected {} time {:.3}s end {:?}", run.points.len(), run.rejected_steps, run.elapsed_s, run.end);
 }

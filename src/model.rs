@@ -108,6 +108,8 @@ pub struct Analysis {
     pub step_tolerance: f64,
     /// Jacobian strategy.
     pub jacobian: JacobianStrategy,
+    /// Points of the uniform frequency grid of the linear references.
+    pub linear_points: usize,
 }
 
 /// A checked problem, ready to solve.

@@ -301,30 +301,64 @@ pub fn load(path: &Path, overrides: &[String]) -> Result<Scene, SceneError> {
 }
 
 /// Parses scene text (`file` names it in errors), applying overrides.
+///
+/// The text must match the schema on its own; then each override is applied in turn and the
+/// result checked against the schema again, so that an unknown field or a wrong type is
+/// reported against the `--set` that introduced it.
 pub fn parse(text: &str, file: &str, overrides: &[String]) -> Result<Scene, SceneError> {
-    if overrides.is_empty() {
-        return toml::from_str(text).map_err(|e| SceneError::Parse {
-            file: file.to_string(),
-            message: e.to_string().trim_end().to_string(),
-        });
-    }
-    let mut table: toml::Table = text.parse().map_err(|e: toml::de::Error| SceneError::Parse {
+    let parse_err = |e: toml::de::Error| SceneError::Parse {
         file: file.to_string(),
-        message: e.to_string().trim_end().to_string(),
-    })?;
+        message: parse_message(&e, text),
+    };
+    let scene: Scene = toml::from_str(text).map_err(parse_err)?;
+    if overrides.is_empty() {
+        return Ok(scene);
+    }
+    let mut table: toml::Table = text.parse().map_err(parse_err)?;
     for assignment in overrides {
-        apply_override(&mut table, assignment).map_err(|reason| SceneError::Override {
+        let override_err = |reason: String| SceneError::Override {
             file: file.to_string(),
             assignment: assignment.clone(),
             reason,
-        })?;
+        };
+        apply_override(&mut table, assignment).map_err(override_err)?;
+        toml::Value::Table(table.clone())
+            .try_into::<Scene>()
+            .map_err(|e| override_err(one_line(&e.to_string())))?;
     }
     toml::Value::Table(table)
         .try_into()
         .map_err(|e: toml::de::Error| SceneError::Parse {
             file: file.to_string(),
-            message: format!("after --set overrides: {}", e.to_string().trim_end()),
+            message: format!("after --set overrides: {}", one_line(&e.to_string())),
         })
+}
+
+/// A parser error as `line L, column C: message` (one line, so that the first line of the
+/// report names the field), followed by the offending source line.
+fn parse_message(e: &toml::de::Error, text: &str) -> String {
+    let located = e.span().and_then(|span| {
+        let before = text.get(..span.start)?;
+        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        let line_no = before.matches('\n').count() + 1;
+        let column = before[line_start..].chars().count() + 1;
+        let source = text[line_start..].lines().next().unwrap_or("");
+        Some(format!(
+            "line {line_no}, column {column}: {}\n  | {source}",
+            one_line(e.message())
+        ))
+    });
+    located.unwrap_or_else(|| one_line(&e.to_string()))
+}
+
+fn one_line(message: &str) -> String {
+    message
+        .trim()
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 /// Applies one `a.b.0.c=value` override to a TOML table. The value is read as TOML (number,
@@ -520,6 +554,9 @@ impl Scene {
             if self.contacts[..ci].iter().any(|o| o.name == c.name) {
                 return Err(ck.err(f("name"), format!("duplicate contact name `{}`", c.name)));
             }
+            if c.side.as_deref().is_some_and(|s| s.trim().is_empty()) {
+                return Err(ck.err(f("side"), "must not be empty (omit it to use the contact name)"));
+            }
             let dim = c.damper.len();
             if dim == 0 {
                 return Err(ck.err(f("damper"), "must list the damper point's DOFs"));
@@ -542,6 +579,26 @@ impl Scene {
                 .enumerate()
                 .map(|(i, d)| ck.dof(&format!("contacts[{ci}].body[{i}]"), d, dofs))
                 .collect::<Result<_, _>>()?;
+            for (list, idx) in [("damper", &damper_idx), ("body", &body_idx)] {
+                for (i, d) in idx.iter().enumerate() {
+                    if idx[..i].contains(d) {
+                        return Err(ck.err(
+                            format!("contacts[{ci}].{list}[{i}]"),
+                            format!("DOF `{}` is listed twice in the same point", dofs[*d]),
+                        ));
+                    }
+                }
+            }
+            if let Some(i) = body_idx.iter().position(|b| damper_idx.contains(b)) {
+                return Err(ck.err(
+                    format!("contacts[{ci}].body[{i}]"),
+                    format!(
+                        "DOF `{}` is also a DOF of the damper point; the damper and the body \
+                         must use distinct DOFs",
+                        dofs[body_idx[i]]
+                    ),
+                ));
+            }
             let (t, nv) = match (c.angle_deg, &c.tangent, &c.normal) {
                 (Some(a), None, None) => {
                     ck.finite(&f("angle_deg"), a)?;
@@ -650,7 +707,7 @@ impl Scene {
             static_load[d] += ck.finite(&format!("static_loads[{i}].value"), l.value)?;
         }
 
-        let harmonics: Vec<usize> = match (&self.harmonics.max, &self.harmonics.list) {
+        let h_max = match (&self.harmonics.max, &self.harmonics.list) {
             (Some(h), None) => {
                 if *h == 0 {
                     return Err(ck.err(
@@ -658,17 +715,14 @@ impl Scene {
                         "must be ≥ 1 (the 0th harmonic alone has no dynamics)",
                     ));
                 }
-                (1..=*h).collect()
+                *h
             }
-            (None, Some(list)) => {
-                let mut l: Vec<usize> = list.iter().copied().filter(|&h| h > 0).collect();
-                l.sort_unstable();
-                l.dedup();
-                if l.is_empty() {
-                    return Err(ck.err("harmonics.list", "must hold at least one harmonic ≥ 1"));
+            (None, Some(list)) => match list.iter().copied().max() {
+                Some(h) if h > 0 => h,
+                _ => {
+                    return Err(ck.err("harmonics.list", "must hold at least one harmonic ≥ 1"))
                 }
-                l
-            }
+            },
             _ => {
                 return Err(ck.err(
                     "harmonics",
@@ -676,13 +730,14 @@ impl Scene {
                 ))
             }
         };
-        let h_max = *harmonics.last().expect("non-empty");
-        if self.harmonics.samples <= 2 * h_max || self.harmonics.samples < 8 {
+        // The sampling check comes before the set is built, so that an absurd H is an error
+        // rather than an allocation of H entries.
+        if self.harmonics.samples <= h_max.saturating_mul(2) || self.harmonics.samples < 8 {
             return Err(ck.err(
                 "harmonics.samples",
                 format!(
                     "must be ≥ 8 and > 2·H = {} to resolve harmonic {h_max}, got {}",
-                    2 * h_max,
+                    h_max.saturating_mul(2),
                     self.harmonics.samples
                 ),
             ));
@@ -690,6 +745,15 @@ impl Scene {
         if self.harmonics.max_periods < 2 {
             return Err(ck.err("harmonics.max_periods", "must be ≥ 2"));
         }
+        let harmonics: Vec<usize> = match &self.harmonics.list {
+            Some(list) => {
+                let mut l: Vec<usize> = list.iter().copied().filter(|&h| h > 0).collect();
+                l.sort_unstable();
+                l.dedup();
+                l
+            }
+            None => (1..=h_max).collect(),
+        };
 
         let mut harmonic_loads = Vec::new();
         for (i, l) in self.harmonic_loads.iter().enumerate() {
@@ -799,6 +863,7 @@ impl Scene {
                 residual_tolerance,
                 step_tolerance,
                 jacobian: a.jacobian,
+                linear_points: a.linear_points,
             },
             outputs,
         };

@@ -1,3 +1,4 @@
 //! Result files and figures.
 
 pub mod plot;
+pub mod files;

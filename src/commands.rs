@@ -1,0 +1,337 @@
+//! The command-line commands (`run`, `check`), as library functions so that `main.rs` only
+//! parses arguments and dispatches.
+
+use std::path::{Path, PathBuf};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use sha2::{Digest, Sha256};
+
+use crate::continuation::NewtonFailure;
+use crate::frf::{self, FrfError, FrfObserver, FrfPoint};
+use crate::harmonic::Block;
+use crate::linear::{self, LinearCase};
+use crate::model::Problem;
+use crate::report::files::{self, FrfWriter, RunInfo, WriteError};
+use crate::report::plot::{self, FrfFigure, PlotError};
+use crate::scene::{self, Scene, SceneError};
+
+/// Errors of a command, each naming what failed.
+#[derive(Debug, thiserror::Error)]
+pub enum CommandError {
+    /// The scene is unreadable or invalid.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// A result file could not be written.
+    #[error(transparent)]
+    Write(#[from] WriteError),
+    /// A figure could not be drawn.
+    #[error(transparent)]
+    Plot(#[from] PlotError),
+    /// The output folder could not be created.
+    #[error("{path}: cannot create output folder: {source}")]
+    OutputDir {
+        /// Folder.
+        path: String,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// The solve failed; the points finished before are on disk.
+    #[error("{scene}: {source} ({points} converged points kept in {dir})")]
+    Solve {
+        /// Scene label.
+        scene: String,
+        /// Cause.
+        source: FrfError,
+        /// Points written before the failure.
+        points: usize,
+        /// Output folder.
+        dir: String,
+    },
+    /// A linear reference failed.
+    #[error("{scene}: linear reference: {reason}")]
+    Linear {
+        /// Scene label.
+        scene: String,
+        /// Cause.
+        reason: String,
+    },
+}
+
+/// Options of `fricbound run`.
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Scene file; `None` runs the built-in paper scene.
+    pub scene: Option<PathBuf>,
+    /// Output folder; default `out/<scene stem>`.
+    pub out: Option<PathBuf>,
+    /// `FIELD=VALUE` overrides.
+    pub overrides: Vec<String>,
+    /// No progress bar and no per-step messages.
+    pub quiet: bool,
+}
+
+/// What `run` produced.
+#[derive(Debug, Clone)]
+pub struct RunReport {
+    /// Output folder.
+    pub dir: PathBuf,
+    /// Converged points.
+    pub points: usize,
+    /// Turning points (Hz).
+    pub turning_points: Vec<f64>,
+    /// Cut steps.
+    pub step_cuts: usize,
+    /// Solve wall time (s).
+    pub elapsed_s: f64,
+}
+
+/// Loads the scene named by `path` (or the built-in default) with overrides.
+pub fn load_scene(path: Option<&Path>, overrides: &[String]) -> Result<(String, Scene, Problem), SceneError> {
+    match path {
+        Some(p) => {
+            let (scene, problem) = scene::load_problem(p, overrides)?;
+            Ok((p.display().to_string(), scene, problem))
+        }
+        None => {
+            let label = scene::default_scene_label().display().to_string();
+            let scene = scene::parse(scene::PAPER_DEFAULT_SCENE, &label, overrides)?;
+            let problem = scene.validate(&label)?;
+            Ok((label, scene, problem))
+        }
+    }
+}
+
+/// SHA-256 of the scene's canonical TOML, hex.
+pub fn scene_hash(scene: &Scene) -> String {
+    let canonical = toml::to_string(scene).unwrap_or_default();
+    let digest = Sha256::digest(canonical.as_bytes());
+    digest.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+fn block_names(problem: &Problem) -> Vec<String> {
+    problem
+        .unknown_harmonics()
+        .blocks()
+        .iter()
+        .map(|b| match b {
+            Block::Constant => "0".to_string(),
+            Block::Cos(h) => format!("c{h}"),
+            Block::Sin(h) => format!("s{h}"),
+        })
+        .collect()
+}
+
+/// Progress bar plus result writer.
+struct RunObserver<'a> {
+    writer: FrfWriter,
+    bar: Option<ProgressBar>,
+    problem: &'a Problem,
+    quiet: bool,
+}
+
+impl FrfObserver for RunObserver<'_> {
+    fn point(&mut self, point: &FrfPoint) {
+        self.writer.point(point);
+        if let Some(bar) = &self.bar {
+            let a = &self.problem.analysis;
+            let frac = ((point.freq_hz - a.freq_start_hz) / (a.freq_end_hz - a.freq_start_hz)).clamp(0.0, 1.0);
+            bar.set_position((frac * 1000.0) as u64);
+            bar.set_message(format!("{:.3} Hz, {} points", point.freq_hz, self.writer.points().len()));
+        }
+    }
+    fn step_cut(&mut self, freq_hz: f64, step: f64, new_step: f64, reason: &NewtonFailure) {
+        self.writer.step_cut(freq_hz, step, new_step, reason);
+        if !self.quiet {
+            let msg = format!("step cut after {freq_hz:.4} Hz ({step:.3e} -> {new_step:.3e}): {reason}");
+            match &self.bar {
+                Some(bar) => bar.println(msg),
+                None => eprintln!("{msg}"),
+            }
+        }
+    }
+    fn turning_point(&mut self, freq_hz: f64) {
+        self.writer.turning_point(freq_hz);
+    }
+}
+
+/// `fricbound run`: solves the scene and writes results, linear references and figures.
+pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
+    let (label, scene, problem) = load_scene(options.scene.as_deref(), &options.overrides)?;
+    let stem = options
+        .scene
+        .as_deref()
+        .and_then(|p| p.file_stem())
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "paper-wedge".to_string());
+    let dir = options
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(stem));
+    std::fs::create_dir_all(&dir).map_err(|source| CommandError::OutputDir {
+        path: dir.display().to_string(),
+        source,
+    })?;
+
+    let linear_err = |e: crate::linalg::LinearSolveError| CommandError::Linear {
+        scene: label.clone(),
+        reason: e.to_string(),
+    };
+    let points = problem.analysis.linear_points;
+    let open = linear::reference_curve(&problem, LinearCase::Open, points).map_err(linear_err)?;
+    let stuck = linear::reference_curve(&problem, LinearCase::Stuck, points).map_err(linear_err)?;
+    files::write_atomic(&dir.join("linear_open.csv"), files::linear_csv(&problem, &open).as_bytes())?;
+    files::write_atomic(&dir.join("linear_stuck.csv"), files::linear_csv(&problem, &stuck).as_bytes())?;
+
+    let info = RunInfo {
+        version: env!("CARGO_PKG_VERSION").to_string(),
+        scene: label.clone(),
+        scene_hash: scene_hash(&scene),
+        dofs: problem.model.dof_names.clone(),
+        blocks: block_names(&problem),
+        contacts: problem.contacts.iter().map(|c| c.name.clone()).collect(),
+        outputs: problem.outputs.iter().map(|&d| problem.model.dof_names[d].clone()).collect(),
+    };
+    let bar = if options.quiet {
+        None
+    } else {
+        let bar = ProgressBar::new(1000);
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {msg}")
+                .expect("static template"),
+        );
+        Some(bar)
+    };
+    let mut observer = RunObserver {
+        writer: FrfWriter::new(&dir, &problem, info.clone()),
+        bar,
+        problem: &problem,
+        quiet: options.quiet,
+    };
+    let result = frf::solve(&problem, &mut observer);
+    if let Some(bar) = &observer.bar {
+        bar.finish_and_clear();
+    }
+    let run = match result {
+        Ok(run) => run,
+        Err(source) => {
+            let status = format!("failed: {source}");
+            observer.writer.write_solution(&status)?;
+            return Err(CommandError::Solve {
+                scene: label,
+                source,
+                points: observer.writer.points().len(),
+                dir: dir.display().to_string(),
+            });
+        }
+    };
+    if let Some(e) = observer.writer.error.take() {
+        return Err(e.into());
+    }
+    observer.writer.write_solution("complete")?;
+
+    let title = if scene.title.is_empty() { label.as_str() } else { scene.title.as_str() };
+    let contact_names: Vec<String> = problem.contacts.iter().map(|c| c.name.clone()).collect();
+    for (k, &d) in problem.outputs.iter().enumerate() {
+        let name = &problem.model.dof_names[d];
+        let fig = FrfFigure {
+            title,
+            output_index: k,
+            output_name: name,
+            contact_names: &contact_names,
+            points: &run.points,
+            open: &open,
+            stuck: &stuck,
+        };
+        plot::plot_frf(&fig, &dir.join(format!("frf_{name}.png")), &dir.join(format!("frf_{name}.svg")))?;
+    }
+    Ok(RunReport {
+        dir,
+        points: run.points.len(),
+        turning_points: run.turning_points,
+        step_cuts: run.rejected_steps,
+        elapsed_s: run.elapsed_s,
+    })
+}
+
+/// `fricbound check`: validates the scene and returns a printable summary.
+pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, CommandError> {
+    let (label, scene, problem) = load_scene(scene_path, overrides)?;
+    let set = problem.unknown_harmonics();
+    let n = problem.model.n_dofs();
+    let e = &problem.effects;
+    let a = &problem.analysis;
+    let mut s = String::new();
+    use std::fmt::Write as _;
+    let _ = writeln!(s, "scene        {label}");
+    if !scene.title.is_empty() {
+        let _ = writeln!(s, "title        {}", scene.title);
+    }
+    let _ = writeln!(s, "DOFs         {n}: {}", problem.model.dof_names.join(", "));
+    let _ = writeln!(
+        s,
+        "harmonics    {:?} ({} blocks), {} samples per period",
+        set.harmonics(),
+        set.n_blocks(),
+        problem.samples
+    );
+    let _ = writeln!(s, "unknowns     {} (+1 frequency in continuation)", n * set.n_blocks());
+    let _ = writeln!(
+        s,
+        "effects      normal load {:?}, lift-off {}, statics {:?}",
+        e.contact.normal_load, e.contact.liftoff, e.coupling
+    );
+    let _ = writeln!(s, "contacts     {} on {} damper side(s)", problem.contacts.len(), problem.sides.len());
+    for c in &problem.contacts {
+        let _ = writeln!(
+            s,
+            "  {:<12} side {:<8} kt {:.3e} N/m  kn {:.3e} N/m  mu {}  gap {:.3e} m  m {}",
+            c.name, problem.sides[c.side].name, c.law.kt, c.law.kn, c.law.mu, c.gap, c.law.initial_state
+        );
+    }
+    let statics: Vec<String> = problem
+        .static_load
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| **v != 0.0)
+        .map(|(i, v)| format!("{} {v} N", problem.model.dof_names[i]))
+        .collect();
+    let _ = writeln!(s, "static loads {}", if statics.is_empty() { "none".into() } else { statics.join(", ") });
+    for l in &problem.harmonic_loads {
+        let _ = writeln!(
+            s,
+            "harmonic load {} h{}: cos {} N, sin {} N",
+            problem.model.dof_names[l.dof], l.harmonic, l.cos, l.sin
+        );
+    }
+    let _ = writeln!(
+        s,
+        "analysis     {} .. {} Hz, steps {:.3e} (min {:.3e}, max {:.3e}), jacobian {:?}",
+        a.freq_start_hz, a.freq_end_hz, a.initial_step, a.min_step, a.max_step, a.jacobian
+    );
+    let _ = writeln!(
+        s,
+        "outputs      {}",
+        problem.outputs.iter().map(|&d| problem.model.dof_names[d].as_str()).collect::<Vec<_>>().join(", ")
+    );
+    Ok(s)
+}
+
+/// One-paragraph summary of a finished run.
+pub fn run_summary(r: &RunReport) -> String {
+    let turning = if r.turning_points.is_empty() {
+        "none".to_string()
+    } else {
+        r.turning_points
+            .iter()
+            .map(|f| format!("{f:.3} Hz"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    format!(
+        "{} converged points in {:.3} s ({} step cuts); turning points: {turning}\nresults in {}",
+        r.points,
+        r.elapsed_s,
+        r.step_cuts,
+        r.dir.display()
+    )
+}

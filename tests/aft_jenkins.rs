@@ -1,0 +1,212 @@
+//! AFT of a single Jenkins element: describing function (paper Appendix) and the analytic
+//! Jacobian against central differences in every contact regime.
+
+use fricbound::aft::AftWorkspace;
+use fricbound::contact::{ContactEffects, ContactState, JenkinsLaw, NormalLoad};
+use fricbound::harmonic::HarmonicSet;
+use fricbound::reference::jenkins_describing_function;
+use proptest::prelude::*;
+
+fn law(kt: f64, kn: f64, mu: f64, m: f64) -> JenkinsLaw {
+    JenkinsLaw { kt, kn, mu, initial_state: m }
+}
+
+/// First harmonic of T for u = q cos τ and constant N0, both normal-load models.
+fn first_harmonic(ratio: f64, normal_load: NormalLoad) -> (f64, f64, ContactState) {
+    let (kt, kn, mu, n0) = (2.0e5, 1.0e5, 0.4, 50.0);
+    let q = mu * n0 / (kt * ratio);
+    let set = HarmonicSet::up_to(1);
+    let mut aft = AftWorkspace::new(&set, 1024);
+    let u = [0.0, q, 0.0];
+    let v = [n0 / kn, 0.0, 0.0];
+    let effects = ContactEffects { normal_load, liftoff: true };
+    let report = aft.evaluate(&law(kt, kn, mu, 0.0), effects, &u, &v, false).unwrap();
+    (aft.t_hat[1] / q, -aft.t_hat[2] / q, report.state)
+}
+
+#[test]
+fn describing_function_matches_paper_appendix_over_stick_slip_range() {
+    let (kt, mu, n0) = (2.0e5, 0.4, 50.0);
+    for i in 0..=47 {
+        let ratio = 0.01 + (0.95 - 0.01) * i as f64 / 47.0;
+        let q = mu * n0 / (kt * ratio);
+        let (k_ref, c_ref) = jenkins_describing_function(kt, mu, n0, q);
+        for model in [NormalLoad::Variable, NormalLoad::Constant] {
+            let (k, c, state) = first_harmonic(ratio, model);
+            assert_eq!(state, ContactState::StickSlip, "ratio {ratio}");
+            let ek = (k - k_ref).abs() / k_ref;
+            let ec = (c - c_ref).abs() / c_ref;
+            assert!(ek < 1e-3, "k_eq at ratio {ratio}: {k} vs {k_ref} (rel {ek:.2e})");
+            assert!(ec < 1e-3, "c_eq at ratio {ratio}: {c} vs {c_ref} (rel {ec:.2e})");
+        }
+    }
+}
+
+#[test]
+fn describing_function_full_stick() {
+    for ratio in [1.05, 2.0, 10.0] {
+        let (k, c, state) = first_harmonic(ratio, NormalLoad::Variable);
+        assert_eq!(state, ContactState::Stuck);
+        assert!((k - 2.0e5).abs() / 2.0e5 < 1e-12, "k {k}");
+        assert!(c.abs() < 1e-9 * 2.0e5, "c {c}");
+    }
+}
+
+#[test]
+fn stuck_static_force_follows_initial_state() {
+    // Fully stuck: T(0) = m μ N(0), and the mean of T moves with m (the paper's non-uniqueness).
+    let set = HarmonicSet::up_to(1);
+    let mut aft = AftWorkspace::new(&set, 256);
+    let (kt, kn, mu) = (1.0e5, 1.0e5, 0.5);
+    let u = [0.0, 1e-5, 0.0];
+    let v = [1e-3, 0.0, 0.0];
+    let mut means = Vec::new();
+    for m in [-1.0, 0.0, 1.0] {
+        let r = aft.evaluate(&law(kt, kn, mu, m), ContactEffects::default(), &u, &v, false).unwrap();
+        assert_eq!(r.state, ContactState::Stuck);
+        assert!((aft.t[0] - m * mu * kn * 1e-3).abs() < 1e-9);
+        means.push(aft.t_hat[0]);
+    }
+    assert!(means[0] < means[1] && means[1] < means[2]);
+}
+
+/// Largest |analytic − central difference| relative to the largest Jacobian entry.
+fn jacobian_error(l: JenkinsLaw, effects: ContactEffects, u: &[f64], v: &[f64]) -> (f64, ContactState) {
+    let set = HarmonicSet::up_to(3);
+    let nb = set.n_blocks();
+    let mut aft = AftWorkspace::new(&set, 128);
+    let state = aft.evaluate(&l, effects, u, v, true).unwrap().state;
+    let (tu, tv, nv) = (aft.dt_du.clone(), aft.dt_dv.clone(), aft.dn_dv.clone());
+    let scale_u = u.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+    let scale_v = v.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+    let mut max_err = 0.0_f64;
+    let mut max_entry = 0.0_f64;
+    for i in 0..nb {
+        for (which, scale) in [(0, scale_u), (1, scale_v)] {
+            let h = 1e-7 * scale;
+            let (mut up, mut vp) = (u.to_vec(), v.to_vec());
+            let (mut um, mut vm) = (u.to_vec(), v.to_vec());
+            if which == 0 {
+                up[i] += h;
+                um[i] -= h;
+            } else {
+                vp[i] += h;
+                vm[i] -= h;
+            }
+            aft.evaluate(&l, effects, &up, &vp, false).unwrap();
+            let (tp, np) = (aft.t_hat.clone(), aft.n_hat.clone());
+            aft.evaluate(&l, effects, &um, &vm, false).unwrap();
+            for j in 0..nb {
+                let dt = (tp[j] - aft.t_hat[j]) / (2.0 * h);
+                let dn = (np[j] - aft.n_hat[j]) / (2.0 * h);
+                let (at, an) = if which == 0 {
+                    (tu[j * nb + i], 0.0)
+                } else {
+                    (tv[j * nb + i], nv[j * nb + i])
+                };
+                max_err = max_err.max((dt - at).abs() * scale).max((dn - an).abs() * scale);
+                max_entry = max_entry.max(at.abs() * scale).max(an.abs() * scale);
+            }
+        }
+    }
+    (max_err / max_entry.max(f64::MIN_POSITIVE), state)
+}
+
+/// Random coefficients for harmonics 0..3: u with amplitude `ua`, v with mean `v0` and
+/// oscillation amplitude `va`.
+fn coefficients(seed: &[f64], ua: f64, v0: f64, va: f64) -> (Vec<f64>, Vec<f64>) {
+    let mut u = vec![0.0; 7];
+    let mut v = vec![0.0; 7];
+    u[0] = ua * seed[0];
+    v[0] = v0;
+    for j in 1..7 {
+        let decay = 1.0 / (1 + (j - 1) / 2) as f64;
+        u[j] = ua * seed[j] * decay;
+        v[j] = va * seed[6 + j] * decay;
+    }
+    (u, v)
+}
+
+fn regime_strategy() -> impl Strategy<Value = (Vec<f64>, f64, f64)> {
+    (
+        prop::collection::vec(-1.0..1.0f64, 13),
+        -1.0..1.0f64,
+        0.1..1.0f64,
+    )
+        .prop_map(|(s, m, mu)| (s, m, mu))
+}
+
+fn effects(constant: bool, liftoff: bool) -> ContactEffects {
+    ContactEffects {
+        normal_load: if constant { NormalLoad::Constant } else { NormalLoad::Variable },
+        liftoff,
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+    #[test]
+    fn jacobian_stuck((s, m, mu) in regime_strategy(), constant in any::<bool>()) {
+        // Large normal load, small tangential motion: never slips.
+        let (u, v) = coefficients(&s, 1e-6, 1e-3, 1e-5);
+        let (err, state) = jacobian_error(law(1e5, 1e5, mu, m * 0.5), effects(constant, true), &u, &v);
+        prop_assert_eq!(state, ContactState::Stuck);
+        prop_assert!(err < 1e-6, "relative error {}", err);
+    }
+
+    #[test]
+    fn jacobian_stick_slip((s, m, mu) in regime_strategy(), constant in any::<bool>()) {
+        let (mut u, v) = coefficients(&s, 1e-4, 1e-4, 3e-5);
+        u[1] += 2e-4; // guarantee enough tangential motion to slip
+        let (err, state) = jacobian_error(law(1e5, 1e5, mu, m), effects(constant, true), &u, &v);
+        prop_assert_eq!(state, ContactState::StickSlip);
+        prop_assert!(err < 1e-6, "relative error {}", err);
+    }
+
+    #[test]
+    fn jacobian_stick_slip_liftoff((s, m, mu) in regime_strategy()) {
+        let (mut u, mut v) = coefficients(&s, 1e-4, 2e-5, 2e-5);
+        u[1] += 2e-4;
+        v[2] += 4e-5; // normal oscillation larger than the mean: separates part of the period
+        let (err, state) = jacobian_error(law(1e5, 1e5, mu, m), effects(false, true), &u, &v);
+        prop_assert_eq!(state, ContactState::StickSlipLiftoff);
+        prop_assert!(err < 1e-6, "relative error {}", err);
+    }
+
+    #[test]
+    fn jacobian_open((s, m, mu) in regime_strategy()) {
+        let (u, v) = coefficients(&s, 1e-4, -1e-3, 1e-4);
+        let (_, state) = jacobian_error(law(1e5, 1e5, mu, m), effects(false, true), &u, &v);
+        prop_assert_eq!(state, ContactState::Open);
+        // All derivatives vanish; jacobian_error is 0/0 → compare absolute values instead.
+        let set = HarmonicSet::up_to(3);
+        let mut aft = AftWorkspace::new(&set, 128);
+        aft.evaluate(&law(1e5, 1e5, mu, m), effects(false, true), &u, &v, true).unwrap();
+        prop_assert!(aft.dt_du.iter().chain(&aft.dt_dv).chain(&aft.dn_dv).all(|x| *x == 0.0));
+        prop_assert!(aft.t_hat.iter().chain(&aft.n_hat).all(|x| *x == 0.0));
+    }
+
+    #[test]
+    fn jacobian_grazing((s, m, mu) in regime_strategy(), touch in 0.97..1.03f64) {
+        // Mean normal gap about equal to the normal amplitude: the contact just touches or
+        // just separates once per period.
+        let mut u = vec![0.0; 7];
+        let mut v = vec![0.0; 7];
+        v[1] = 3e-5;
+        v[0] = 3e-5 * touch;
+        for j in 0..7 { u[j] = 1e-5 * s[j]; }
+        u[1] += 1e-4;
+        let (err, _) = jacobian_error(law(1e5, 1e5, mu, m), effects(false, true), &u, &v);
+        prop_assert!(err < 1e-6, "relative error {}", err);
+    }
+
+    #[test]
+    fn jacobian_without_liftoff((s, m, mu) in regime_strategy()) {
+        let (mut u, mut v) = coefficients(&s, 1e-4, 2e-5, 2e-5);
+        u[1] += 2e-4;
+        v[2] += 4e-5;
+        let (err, _) = jacobian_error(law(1e5, 1e5, mu, m), effects(false, false), &u, &v);
+        prop_assert!(err < 1e-6, "relative error {}", err);
+    }
+}
