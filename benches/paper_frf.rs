@@ -20,7 +20,10 @@ fn paper_frf(c: &mut Criterion) {
     for (name, overrides) in [
         ("H1_analytic", vec![]),
         ("H5_analytic", vec!["harmonics.max=5"]),
-        ("H1_forward_difference", vec!["analysis.jacobian=forward-difference"]),
+        (
+            "H1_forward_difference",
+            vec!["analysis.jacobian=forward-difference"],
+        ),
     ] {
         let p = problem(&overrides);
         group.bench_function(name, |b| {

@@ -208,7 +208,11 @@ impl AftWorkspace {
         };
         self.fft_buffer.copy_from_slice(src);
         self.forward
-            .process_with_scratch(&mut self.fft_buffer, &mut self.spectrum, &mut self.scratch_fwd)
+            .process_with_scratch(
+                &mut self.fft_buffer,
+                &mut self.spectrum,
+                &mut self.scratch_fwd,
+            )
             .expect("forward real FFT of a buffer of the planned length");
         let scale = 1.0 / self.n_samples as f64;
         let out = match which {
@@ -373,7 +377,10 @@ impl AftWorkspace {
                 } else {
                     ContactState::Stuck
                 };
-                return Ok(MarchReport { state, periods: period });
+                return Ok(MarchReport {
+                    state,
+                    periods: period,
+                });
             }
             w_start = w;
         }

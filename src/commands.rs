@@ -86,7 +86,10 @@ pub struct RunReport {
 }
 
 /// Loads the scene named by `path` (or the built-in default) with overrides.
-pub fn load_scene(path: Option<&Path>, overrides: &[String]) -> Result<(String, Scene, Problem), SceneError> {
+pub fn load_scene(
+    path: Option<&Path>,
+    overrides: &[String],
+) -> Result<(String, Scene, Problem), SceneError> {
     match path {
         Some(p) => {
             let (scene, problem) = scene::load_problem(p, overrides)?;
@@ -134,18 +137,24 @@ impl FrfObserver for RunObserver<'_> {
         self.writer.point(point);
         if let Some(bar) = &self.bar {
             let a = &self.problem.analysis;
-            let frac = ((point.freq_hz - a.freq_start_hz) / (a.freq_end_hz - a.freq_start_hz)).clamp(0.0, 1.0);
+            let frac = ((point.freq_hz - a.freq_start_hz) / (a.freq_end_hz - a.freq_start_hz))
+                .clamp(0.0, 1.0);
             bar.set_position((frac * 1000.0) as u64);
-            bar.set_message(format!("{:.3} Hz, {} points", point.freq_hz, self.writer.points().len()));
+            bar.set_message(format!(
+                "{:.3} Hz, {} points",
+                point.freq_hz,
+                self.writer.points().len()
+            ));
         }
     }
     fn step_cut(&mut self, freq_hz: f64, step: f64, new_step: f64, reason: &NewtonFailure) {
         self.writer.step_cut(freq_hz, step, new_step, reason);
         if !self.quiet {
-            let msg = format!("step cut after {freq_hz:.4} Hz ({step:.3e} -> {new_step:.3e}): {reason}");
+            let msg =
+                format!("step cut after {freq_hz:.4} Hz ({step:.3e} -> {new_step:.3e}): {reason}");
             match &self.bar {
-                Some(bar) => bar.println(msg),
-                None => eprintln!("{msg}"),
+                Some(bar) if !bar.is_hidden() => bar.println(msg),
+                _ => eprintln!("{msg}"),
             }
         }
     }
@@ -179,8 +188,14 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
     let points = problem.analysis.linear_points;
     let open = linear::reference_curve(&problem, LinearCase::Open, points).map_err(linear_err)?;
     let stuck = linear::reference_curve(&problem, LinearCase::Stuck, points).map_err(linear_err)?;
-    files::write_atomic(&dir.join("linear_open.csv"), files::linear_csv(&problem, &open).as_bytes())?;
-    files::write_atomic(&dir.join("linear_stuck.csv"), files::linear_csv(&problem, &stuck).as_bytes())?;
+    files::write_atomic(
+        &dir.join("linear_open.csv"),
+        files::linear_csv(&problem, &open).as_bytes(),
+    )?;
+    files::write_atomic(
+        &dir.join("linear_stuck.csv"),
+        files::linear_csv(&problem, &stuck).as_bytes(),
+    )?;
 
     let info = RunInfo {
         version: env!("CARGO_PKG_VERSION").to_string(),
@@ -189,7 +204,11 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
         dofs: problem.model.dof_names.clone(),
         blocks: block_names(&problem),
         contacts: problem.contacts.iter().map(|c| c.name.clone()).collect(),
-        outputs: problem.outputs.iter().map(|&d| problem.model.dof_names[d].clone()).collect(),
+        outputs: problem
+            .outputs
+            .iter()
+            .map(|&d| problem.model.dof_names[d].clone())
+            .collect(),
     };
     let bar = if options.quiet {
         None
@@ -229,7 +248,11 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
     }
     observer.writer.write_solution("complete")?;
 
-    let title = if scene.title.is_empty() { label.as_str() } else { scene.title.as_str() };
+    let title = if scene.title.is_empty() {
+        label.as_str()
+    } else {
+        scene.title.as_str()
+    };
     let contact_names: Vec<String> = problem.contacts.iter().map(|c| c.name.clone()).collect();
     for (k, &d) in problem.outputs.iter().enumerate() {
         let name = &problem.model.dof_names[d];
@@ -242,7 +265,11 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
             open: &open,
             stuck: &stuck,
         };
-        plot::plot_frf(&fig, &dir.join(format!("frf_{name}.png")), &dir.join(format!("frf_{name}.svg")))?;
+        plot::plot_frf(
+            &fig,
+            &dir.join(format!("frf_{name}.png")),
+            &dir.join(format!("frf_{name}.svg")),
+        )?;
     }
     Ok(RunReport {
         dir,
@@ -266,7 +293,11 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
     if !scene.title.is_empty() {
         let _ = writeln!(s, "title        {}", scene.title);
     }
-    let _ = writeln!(s, "DOFs         {n}: {}", problem.model.dof_names.join(", "));
+    let _ = writeln!(
+        s,
+        "DOFs         {n}: {}",
+        problem.model.dof_names.join(", ")
+    );
     let _ = writeln!(
         s,
         "harmonics    {:?} ({} blocks), {} samples per period",
@@ -274,18 +305,33 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
         set.n_blocks(),
         problem.samples
     );
-    let _ = writeln!(s, "unknowns     {} (+1 frequency in continuation)", n * set.n_blocks());
+    let _ = writeln!(
+        s,
+        "unknowns     {} (+1 frequency in continuation)",
+        n * set.n_blocks()
+    );
     let _ = writeln!(
         s,
         "effects      normal load {:?}, lift-off {}, statics {:?}",
         e.contact.normal_load, e.contact.liftoff, e.coupling
     );
-    let _ = writeln!(s, "contacts     {} on {} damper side(s)", problem.contacts.len(), problem.sides.len());
+    let _ = writeln!(
+        s,
+        "contacts     {} on {} damper side(s)",
+        problem.contacts.len(),
+        problem.sides.len()
+    );
     for c in &problem.contacts {
         let _ = writeln!(
             s,
             "  {:<12} side {:<8} kt {:.3e} N/m  kn {:.3e} N/m  mu {}  gap {:.3e} m  m {}",
-            c.name, problem.sides[c.side].name, c.law.kt, c.law.kn, c.law.mu, c.gap, c.law.initial_state
+            c.name,
+            problem.sides[c.side].name,
+            c.law.kt,
+            c.law.kn,
+            c.law.mu,
+            c.gap,
+            c.law.initial_state
         );
     }
     let statics: Vec<String> = problem
@@ -295,7 +341,15 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
         .filter(|(_, v)| **v != 0.0)
         .map(|(i, v)| format!("{} {v} N", problem.model.dof_names[i]))
         .collect();
-    let _ = writeln!(s, "static loads {}", if statics.is_empty() { "none".into() } else { statics.join(", ") });
+    let _ = writeln!(
+        s,
+        "static loads {}",
+        if statics.is_empty() {
+            "none".into()
+        } else {
+            statics.join(", ")
+        }
+    );
     for l in &problem.harmonic_loads {
         let _ = writeln!(
             s,
@@ -311,7 +365,12 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
     let _ = writeln!(
         s,
         "outputs      {}",
-        problem.outputs.iter().map(|&d| problem.model.dof_names[d].as_str()).collect::<Vec<_>>().join(", ")
+        problem
+            .outputs
+            .iter()
+            .map(|&d| problem.model.dof_names[d].as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
     );
     Ok(s)
 }

@@ -92,6 +92,14 @@ pub enum NewtonFailure {
         /// Angle between successive tangents.
         degrees: f64,
     },
+    /// The corrector converged far from the predicted point (possible branch jump).
+    #[error("corrector moved {distance:.3e} from the prediction, more than the step {step:.3e}")]
+    FarCorrection {
+        /// Scaled distance between predicted and corrected points.
+        distance: f64,
+        /// Step length.
+        step: f64,
+    },
 }
 
 /// Fatal continuation errors.
@@ -186,6 +194,8 @@ pub struct Continuation {
 }
 
 const OMEGA_SCALE: f64 = 2.0 * PI;
+/// Largest turn of the tangent in one step before the step is cut (unless it is a corner).
+const MAX_TURN_DEGREES: f64 = 45.0;
 
 impl Continuation {
     /// Newton at fixed ω from `x0`, with backtracking on the residual norm.
@@ -340,7 +350,11 @@ impl Continuation {
                 aug[(n, j)] = tangent[j];
             }
             let mut rhs: Vec<f64> = r.iter().map(|v| -v).collect();
-            rhs.push(-(0..=n).map(|j| tangent[j] * (y[j] - predicted[j])).sum::<f64>());
+            rhs.push(
+                -(0..=n)
+                    .map(|j| tangent[j] * (y[j] - predicted[j]))
+                    .sum::<f64>(),
+            );
             let dy = solve_dense(&aug, &rhs)?;
             for j in 0..=n {
                 y[j] += dy[j];
@@ -400,6 +414,7 @@ impl Continuation {
             end: PathEnd::MaxPoints,
         };
         let mut ds = a.initial_step.clamp(a.min_step, a.max_step);
+        let mut previous_quality: Option<f64> = None;
         while summary.points.len() < a.max_points {
             let last = summary.points.last().expect("at least the first point");
             let y: Vec<f64> = last
@@ -411,7 +426,8 @@ impl Continuation {
             let predicted: Vec<f64> = (0..=n).map(|j| y[j] + ds * tangent[j]).collect();
             if predicted[n] * OMEGA_SCALE >= omega_end {
                 // Land exactly on the end frequency from the linearly interpolated guess.
-                let frac = ((omega_end / OMEGA_SCALE - y[n]) / (predicted[n] - y[n])).clamp(0.0, 1.0);
+                let frac =
+                    ((omega_end / OMEGA_SCALE - y[n]) / (predicted[n] - y[n])).clamp(0.0, 1.0);
                 let guess: Vec<f64> = (0..n)
                     .map(|j| (y[j] + frac * (predicted[j] - y[j])) * self.x_scale)
                     .collect();
@@ -439,25 +455,44 @@ impl Continuation {
                     }
                 }
             }
-            let outcome = self.correct(system, &predicted, &tangent).and_then(|(yc, it, rel)| {
-                let point = PathPoint {
-                    omega: yc[n] * OMEGA_SCALE,
-                    x: yc[..n].iter().map(|v| v * self.x_scale).collect(),
-                    iterations: it,
-                    residual: rel,
-                    step: ds,
-                };
-                let t_new = self.tangent(system, &point, Some(&tangent))?;
-                let cos = dot(&t_new, &tangent).clamp(-1.0, 1.0);
-                if cos < 0.7 && ds > 2.0 * a.min_step {
-                    return Err(NewtonFailure::SharpTurn {
-                        degrees: cos.acos().to_degrees(),
-                    });
-                }
-                Ok((point, t_new))
-            });
+            let outcome = self
+                .correct(system, &predicted, &tangent)
+                .and_then(|(yc, it, rel)| {
+                    let distance = norm(
+                        &yc.iter()
+                            .zip(&predicted)
+                            .map(|(a, b)| a - b)
+                            .collect::<Vec<_>>(),
+                    );
+                    let point = PathPoint {
+                        omega: yc[n] * OMEGA_SCALE,
+                        x: yc[..n].iter().map(|v| v * self.x_scale).collect(),
+                        iterations: it,
+                        residual: rel,
+                        step: ds,
+                    };
+                    let t_new = self.tangent(system, &point, Some(&tangent))?;
+                    let degrees = dot(&t_new, &tangent).clamp(-1.0, 1.0).acos().to_degrees();
+                    // Step quality: > 1 means the corrector went far or the path turned sharply.
+                    let quality = (distance / ds).max(degrees / MAX_TURN_DEGREES);
+                    if quality > 1.0 && ds > 2.0 * a.min_step {
+                        // A corner of the piecewise-smooth path (a contact changing state) turns
+                        // the tangent by the same angle whatever the step; a branch jump does not.
+                        let corner = previous_quality.is_some_and(|q| quality >= 0.7 * q);
+                        if !corner {
+                            previous_quality = Some(quality);
+                            return Err(if distance / ds >= degrees / MAX_TURN_DEGREES {
+                                NewtonFailure::FarCorrection { distance, step: ds }
+                            } else {
+                                NewtonFailure::SharpTurn { degrees }
+                            });
+                        }
+                    }
+                    Ok((point, t_new))
+                });
             match outcome {
                 Ok((point, t_new)) => {
+                    previous_quality = None;
                     if t_new[n] * tangent[n] < 0.0 {
                         summary.turning_points.push(point.freq_hz());
                         observer.turning_point(point.freq_hz());

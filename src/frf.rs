@@ -5,7 +5,9 @@ use std::f64::consts::PI;
 use std::time::Instant;
 
 use crate::contact::ContactState;
-use crate::continuation::{Continuation, ContinuationError, NewtonFailure, Observer, PathEnd, PathPoint};
+use crate::continuation::{
+    Continuation, ContinuationError, NewtonFailure, Observer, PathEnd, PathPoint,
+};
 use crate::harmonic::HarmonicSet;
 use crate::hbm::{HbmError, HbmSystem};
 use crate::linalg::LinearSolveError;
@@ -75,7 +77,12 @@ pub enum FrfError {
 }
 
 /// Output quantities of a converged point.
-pub fn point_outputs(problem: &Problem, set: &HarmonicSet, static_offset: &[f64], x: &[f64]) -> (Vec<f64>, Vec<f64>) {
+pub fn point_outputs(
+    problem: &Problem,
+    set: &HarmonicSet,
+    static_offset: &[f64],
+    x: &[f64],
+) -> (Vec<f64>, Vec<f64>) {
     let n = problem.model.n_dofs();
     let c1 = set.cos_block(1);
     let s1 = set.sin_block(1);
@@ -90,7 +97,11 @@ pub fn point_outputs(problem: &Problem, set: &HarmonicSet, static_offset: &[f64]
         for (j, v) in coef.iter_mut().enumerate() {
             *v = x[j * n + d];
         }
-        let offset = if set.has_constant() { 0.0 } else { static_offset[d] };
+        let offset = if set.has_constant() {
+            0.0
+        } else {
+            static_offset[d]
+        };
         let peak = (0..samples)
             .map(|k| (offset + set.evaluate(&coef, 2.0 * PI * k as f64 / samples as f64)).abs())
             .fold(0.0, f64::max);
@@ -121,7 +132,8 @@ struct Adapter<'o, O: FrfObserver> {
 impl<O: FrfObserver> Observer<HbmSystem<'_>> for Adapter<'_, O> {
     fn accepted(&mut self, system: &mut HbmSystem<'_>, p: &PathPoint) {
         let problem = system.problem();
-        let (amplitudes, peaks) = point_outputs(problem, system.unknowns(), system.static_offset(), &p.x);
+        let (amplitudes, peaks) =
+            point_outputs(problem, system.unknowns(), system.static_offset(), &p.x);
         let point = FrfPoint {
             freq_hz: p.freq_hz(),
             amplitudes,

@@ -429,7 +429,12 @@ pub fn static_solve(problem: &Problem) -> Result<Vec<f64>, HbmError> {
     let n = problem.model.n_dofs();
     let k = &problem.model.stiffness;
     let f = &problem.static_load;
-    let fnorm = f.iter().map(|x| x * x).sum::<f64>().sqrt().max(f64::MIN_POSITIVE);
+    let fnorm = f
+        .iter()
+        .map(|x| x * x)
+        .sum::<f64>()
+        .sqrt()
+        .max(f64::MIN_POSITIVE);
     let mut q = vec![0.0; n];
     let residual_of = |q: &[f64], r: &mut [f64], jac: Option<&mut Mat<f64>>| {
         for p in 0..n {
@@ -547,7 +552,9 @@ pub fn check_jacobian(
     let mut dw = vec![0.0; dim];
     let result = (|| {
         system.residual_and_jacobian(x, omega, &mut r, &mut jac, &mut dw)?;
-        let typical = (x.iter().map(|v| v * v).sum::<f64>() / dim as f64).sqrt().max(1e-12);
+        let typical = (x.iter().map(|v| v * v).sum::<f64>() / dim as f64)
+            .sqrt()
+            .max(1e-12);
         let mut xp = x.to_vec();
         let (mut rp, mut rm) = (vec![0.0; dim], vec![0.0; dim]);
         let mut max_error = 0.0_f64;

@@ -3,15 +3,15 @@
 //! response among the multiple steady states friction allows (Ferhatoglu & Zucca, JSV 2021).
 
 pub mod aft;
+pub mod commands;
 pub mod contact;
 pub mod continuation;
+pub mod frf;
 pub mod harmonic;
 pub mod hbm;
 pub mod linalg;
 pub mod linear;
 pub mod model;
-pub mod scene;
-pub mod frf;
-pub mod report;
-pub mod commands;
 pub mod reference;
+pub mod report;
+pub mod scene;

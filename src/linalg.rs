@@ -1,7 +1,7 @@
 //! Small dense linear solves on top of faer, with singularity reported instead of NaN.
 
-use faer::Mat;
 use faer::prelude::Solve;
+use faer::Mat;
 
 /// A dense solve failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -104,7 +104,11 @@ fn harmonic_response(
         }
     }
     let mut rhs = vec![0.0; 2 * na];
-    for l in problem.harmonic_loads.iter().filter(|l| l.harmonic == harmonic) {
+    for l in problem
+        .harmonic_loads
+        .iter()
+        .filter(|l| l.harmonic == harmonic)
+    {
         if let Some(i) = dofs.iter().position(|&d| d == l.dof) {
             rhs[i] += l.cos;
             rhs[na + i] += l.sin;
@@ -194,7 +198,10 @@ pub fn reference_curve(
 ) -> Result<LinearCurve, LinearSolveError> {
     let a = &problem.analysis;
     let freqs_hz: Vec<f64> = (0..points)
-        .map(|i| a.freq_start_hz + (a.freq_end_hz - a.freq_start_hz) * i as f64 / (points - 1).max(1) as f64)
+        .map(|i| {
+            a.freq_start_hz
+                + (a.freq_end_hz - a.freq_start_hz) * i as f64 / (points - 1).max(1) as f64
+        })
         .collect();
     let all = frf(problem, case, &freqs_hz)?;
     let amplitudes = all

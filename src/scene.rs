@@ -384,7 +384,12 @@ pub fn apply_override(table: &mut toml::Table, assignment: &str) -> Result<(), S
     result
 }
 
-fn set_path(node: &mut toml::Value, segments: &[&str], value: toml::Value, full: &str) -> Result<(), String> {
+fn set_path(
+    node: &mut toml::Value,
+    segments: &[&str],
+    value: toml::Value,
+    full: &str,
+) -> Result<(), String> {
     let (head, rest) = segments.split_first().expect("non-empty path");
     let child: &mut toml::Value = match node {
         toml::Value::Table(t) => {
@@ -409,7 +414,11 @@ fn set_path(node: &mut toml::Value, segments: &[&str], value: toml::Value, full:
             }
             slot
         }
-        _ => return Err(format!("`{head}` is below a value that is not a table or array in `{full}`")),
+        _ => {
+            return Err(format!(
+                "`{head}` is below a value that is not a table or array in `{full}`"
+            ))
+        }
     };
     set_path(child, rest, value, full)
 }
@@ -498,7 +507,9 @@ impl Checker<'_> {
         if min < -1e-10 * max {
             return Err(self.err(
                 field,
-                format!("is indefinite (smallest eigenvalue {min:.4e}, largest magnitude {max:.4e})"),
+                format!(
+                    "is indefinite (smallest eigenvalue {min:.4e}, largest magnitude {max:.4e})"
+                ),
             ));
         }
         Ok(())
@@ -555,7 +566,10 @@ impl Scene {
                 return Err(ck.err(f("name"), format!("duplicate contact name `{}`", c.name)));
             }
             if c.side.as_deref().is_some_and(|s| s.trim().is_empty()) {
-                return Err(ck.err(f("side"), "must not be empty (omit it to use the contact name)"));
+                return Err(ck.err(
+                    f("side"),
+                    "must not be empty (omit it to use the contact name)",
+                ));
             }
             let dim = c.damper.len();
             if dim == 0 {
@@ -605,7 +619,9 @@ impl Scene {
                     if dim != 2 {
                         return Err(ck.err(
                             f("angle_deg"),
-                            format!("a frame by angle needs 2 DOFs per point, this point has {dim}"),
+                            format!(
+                                "a frame by angle needs 2 DOFs per point, this point has {dim}"
+                            ),
                         ));
                     }
                     let r = a.to_radians();
@@ -654,7 +670,10 @@ impl Scene {
             let kn = ck.positive(&f("kn"), c.kn)?;
             let mu = ck.finite(&f("mu"), c.mu)?;
             if mu < 0.0 {
-                return Err(ck.err(f("mu"), format!("friction coefficient must be ≥ 0, got {mu}")));
+                return Err(ck.err(
+                    f("mu"),
+                    format!("friction coefficient must be ≥ 0, got {mu}"),
+                ));
             }
             let gap = ck.finite(&f("gap"), c.gap)?;
             let m = ck.finite(&f("initial_state"), c.initial_state)?;
@@ -719,9 +738,7 @@ impl Scene {
             }
             (None, Some(list)) => match list.iter().copied().max() {
                 Some(h) if h > 0 => h,
-                _ => {
-                    return Err(ck.err("harmonics.list", "must hold at least one harmonic ≥ 1"))
-                }
+                _ => return Err(ck.err("harmonics.list", "must hold at least one harmonic ≥ 1")),
             },
             _ => {
                 return Err(ck.err(
@@ -767,7 +784,10 @@ impl Scene {
             if !harmonics.contains(&l.harmonic) {
                 return Err(ck.err(
                     format!("harmonic_loads[{i}].harmonic"),
-                    format!("harmonic {} is not in the harmonic set {harmonics:?}", l.harmonic),
+                    format!(
+                        "harmonic {} is not in the harmonic set {harmonics:?}",
+                        l.harmonic
+                    ),
                 ));
             }
             harmonic_loads.push(HarmonicLoad {
@@ -794,11 +814,17 @@ impl Scene {
             ));
         }
         let range = f1 - f0;
-        let initial_step = ck.positive("analysis.initial_step", a.initial_step.unwrap_or(range / 200.0))?;
+        let initial_step = ck.positive(
+            "analysis.initial_step",
+            a.initial_step.unwrap_or(range / 200.0),
+        )?;
         let min_step = ck.positive("analysis.min_step", a.min_step.unwrap_or(range * 1e-7))?;
         let max_step = ck.positive("analysis.max_step", a.max_step.unwrap_or(range / 50.0))?;
         if min_step > max_step {
-            return Err(ck.err("analysis.min_step", format!("{min_step} exceeds max_step {max_step}")));
+            return Err(ck.err(
+                "analysis.min_step",
+                format!("{min_step} exceeds max_step {max_step}"),
+            ));
         }
         for (field, v) in [
             ("analysis.max_points", a.max_points),
@@ -813,7 +839,8 @@ impl Scene {
         if a.linear_points < 2 {
             return Err(ck.err("analysis.linear_points", "must be ≥ 2"));
         }
-        let residual_tolerance = ck.positive("analysis.residual_tolerance", a.residual_tolerance)?;
+        let residual_tolerance =
+            ck.positive("analysis.residual_tolerance", a.residual_tolerance)?;
         let step_tolerance = ck.positive("analysis.step_tolerance", a.step_tolerance)?;
 
         if self.output.dofs.is_empty() {

@@ -8,7 +8,12 @@ use fricbound::reference::jenkins_describing_function;
 use proptest::prelude::*;
 
 fn law(kt: f64, kn: f64, mu: f64, m: f64) -> JenkinsLaw {
-    JenkinsLaw { kt, kn, mu, initial_state: m }
+    JenkinsLaw {
+        kt,
+        kn,
+        mu,
+        initial_state: m,
+    }
 }
 
 /// First harmonic of T for u = q cos τ and constant N0, both normal-load models.
@@ -19,8 +24,13 @@ fn first_harmonic(ratio: f64, normal_load: NormalLoad) -> (f64, f64, ContactStat
     let mut aft = AftWorkspace::new(&set, 1024);
     let u = [0.0, q, 0.0];
     let v = [n0 / kn, 0.0, 0.0];
-    let effects = ContactEffects { normal_load, liftoff: true };
-    let report = aft.evaluate(&law(kt, kn, mu, 0.0), effects, &u, &v, false).unwrap();
+    let effects = ContactEffects {
+        normal_load,
+        liftoff: true,
+    };
+    let report = aft
+        .evaluate(&law(kt, kn, mu, 0.0), effects, &u, &v, false)
+        .unwrap();
     (aft.t_hat[1] / q, -aft.t_hat[2] / q, report.state)
 }
 
@@ -36,8 +46,14 @@ fn describing_function_matches_paper_appendix_over_stick_slip_range() {
             assert_eq!(state, ContactState::StickSlip, "ratio {ratio}");
             let ek = (k - k_ref).abs() / k_ref;
             let ec = (c - c_ref).abs() / c_ref;
-            assert!(ek < 1e-3, "k_eq at ratio {ratio}: {k} vs {k_ref} (rel {ek:.2e})");
-            assert!(ec < 1e-3, "c_eq at ratio {ratio}: {c} vs {c_ref} (rel {ec:.2e})");
+            assert!(
+                ek < 1e-3,
+                "k_eq at ratio {ratio}: {k} vs {k_ref} (rel {ek:.2e})"
+            );
+            assert!(
+                ec < 1e-3,
+                "c_eq at ratio {ratio}: {c} vs {c_ref} (rel {ec:.2e})"
+            );
         }
     }
 }
@@ -53,25 +69,65 @@ fn describing_function_full_stick() {
 }
 
 #[test]
-fn stuck_static_force_follows_initial_state() {
-    // Fully stuck: T(0) = m μ N(0), and the mean of T moves with m (the paper's non-uniqueness).
+fn stuck_limit_states_touch_the_coulomb_limits() {
+    // Fully stuck at steady state: the tangential force is only known up to a constant. The
+    // limit cases m = ±1 end on the curves that touch +μN and −μN (paper Eqs. 14-15, Fig. 5);
+    // m = 0 starts at T(0) = 0 and never slips.
     let set = HarmonicSet::up_to(1);
     let mut aft = AftWorkspace::new(&set, 256);
     let (kt, kn, mu) = (1.0e5, 1.0e5, 0.5);
     let u = [0.0, 1e-5, 0.0];
     let v = [1e-3, 0.0, 0.0];
+    let limit = mu * kn * 1e-3;
     let mut means = Vec::new();
+    let mut dynamic = Vec::new();
     for m in [-1.0, 0.0, 1.0] {
-        let r = aft.evaluate(&law(kt, kn, mu, m), ContactEffects::default(), &u, &v, false).unwrap();
-        assert_eq!(r.state, ContactState::Stuck);
-        assert!((aft.t[0] - m * mu * kn * 1e-3).abs() < 1e-9);
+        let r = aft
+            .evaluate(
+                &law(kt, kn, mu, m),
+                ContactEffects::default(),
+                &u,
+                &v,
+                false,
+            )
+            .unwrap();
+        assert_eq!(r.state, ContactState::Stuck, "m = {m}");
+        let max = aft.t.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        let min = aft.t.iter().cloned().fold(f64::INFINITY, f64::min);
+        assert!(max <= limit * (1.0 + 1e-12) && min >= -limit * (1.0 + 1e-12));
+        if m == 1.0 {
+            assert!(
+                (max - limit).abs() < 1e-9 * limit,
+                "T_max touches +μN: {max}"
+            );
+        } else if m == -1.0 {
+            assert!(
+                (min + limit).abs() < 1e-9 * limit,
+                "T_min touches −μN: {min}"
+            );
+        } else {
+            assert!(aft.t[0].abs() < 1e-12 * limit, "T(0) = {}", aft.t[0]);
+        }
         means.push(aft.t_hat[0]);
+        dynamic.push((aft.t_hat[1], aft.t_hat[2]));
     }
-    assert!(means[0] < means[1] && means[1] < means[2]);
+    assert!(
+        means[0] < means[1] && means[1] < means[2],
+        "T⁰ by m: {means:?}"
+    );
+    // The dynamic part is the same whatever m (paper §3.1): kₜ times the motion.
+    for (c, s) in dynamic {
+        assert!((c - kt * 1e-5).abs() < 1e-9 * kt * 1e-5 && s.abs() < 1e-9 * kt * 1e-5);
+    }
 }
 
 /// Largest |analytic − central difference| relative to the largest Jacobian entry.
-fn jacobian_error(l: JenkinsLaw, effects: ContactEffects, u: &[f64], v: &[f64]) -> (f64, ContactState) {
+fn jacobian_error(
+    l: JenkinsLaw,
+    effects: ContactEffects,
+    u: &[f64],
+    v: &[f64],
+) -> (f64, ContactState) {
     let set = HarmonicSet::up_to(3);
     let nb = set.n_blocks();
     let mut aft = AftWorkspace::new(&set, 128);
@@ -104,7 +160,9 @@ fn jacobian_error(l: JenkinsLaw, effects: ContactEffects, u: &[f64], v: &[f64]) 
                 } else {
                     (tv[j * nb + i], nv[j * nb + i])
                 };
-                max_err = max_err.max((dt - at).abs() * scale).max((dn - an).abs() * scale);
+                max_err = max_err
+                    .max((dt - at).abs() * scale)
+                    .max((dn - an).abs() * scale);
                 max_entry = max_entry.max(at.abs() * scale).max(an.abs() * scale);
             }
         }
@@ -138,7 +196,11 @@ fn regime_strategy() -> impl Strategy<Value = (Vec<f64>, f64, f64)> {
 
 fn effects(constant: bool, liftoff: bool) -> ContactEffects {
     ContactEffects {
-        normal_load: if constant { NormalLoad::Constant } else { NormalLoad::Variable },
+        normal_load: if constant {
+            NormalLoad::Constant
+        } else {
+            NormalLoad::Variable
+        },
         liftoff,
     }
 }

@@ -54,9 +54,20 @@ fn forced_open_and_stuck_contacts_reproduce_linear_frfs() {
         let lin = linear::frf(&problem, case, &freqs).unwrap();
         let y2 = problem.outputs[0];
         for (p, l) in run.points.iter().zip(&lin) {
-            assert!(p.states.iter().all(|s| *s == expected_state), "{:?} at {} Hz", p.states, p.freq_hz);
+            assert!(
+                p.states.iter().all(|s| *s == expected_state),
+                "{:?} at {} Hz",
+                p.states,
+                p.freq_hz
+            );
             let rel = (p.amplitudes[0] - l[y2]).abs() / l[y2];
-            assert!(rel < 1e-8, "{case:?} at {} Hz: {} vs {} (rel {rel:.2e})", p.freq_hz, p.amplitudes[0], l[y2]);
+            assert!(
+                rel < 1e-8,
+                "{case:?} at {} Hz: {} vs {} (rel {rel:.2e})",
+                p.freq_hz,
+                p.amplitudes[0],
+                l[y2]
+            );
         }
     }
 }
@@ -108,14 +119,29 @@ fn damper_static_balance_holds_at_every_point() {
 
 #[test]
 fn analytic_jacobian_matches_central_differences_on_the_paper_path() {
-    let problem = paper(&["harmonics.max=3", "analysis.freq_start_hz=150.0", "analysis.freq_end_hz=230.0"]);
+    let problem = paper(&[
+        "harmonics.max=3",
+        "analysis.freq_start_hz=150.0",
+        "analysis.freq_end_hz=230.0",
+    ]);
     let run = frf::solve(&problem, &mut Silent).unwrap();
     let mut system = HbmSystem::new(&problem).unwrap();
     let mut regimes = std::collections::HashSet::new();
     for p in run.points.iter().step_by(3) {
-        let check = check_jacobian(&mut system, &p.coefficients, 2.0 * std::f64::consts::PI * p.freq_hz, 1e-7).unwrap();
+        let check = check_jacobian(
+            &mut system,
+            &p.coefficients,
+            2.0 * std::f64::consts::PI * p.freq_hz,
+            1e-7,
+        )
+        .unwrap();
         regimes.extend(system.states.iter().copied());
-        assert!(check.relative() < 1e-6, "{} Hz: relative error {:.3e}", p.freq_hz, check.relative());
+        assert!(
+            check.relative() < 1e-6,
+            "{} Hz: relative error {:.3e}",
+            p.freq_hz,
+            check.relative()
+        );
     }
     assert!(regimes.contains(&ContactState::Stuck) && regimes.contains(&ContactState::StickSlip));
 }
@@ -146,7 +172,12 @@ fn second_resonance_both_contacts_slip_and_m_does_not_matter() {
     let (pp, pm) = (peak(&plus), peak(&minus));
     let mut states = pp.states.clone();
     states.sort_by_key(|s| s.label());
-    assert_eq!(states, vec![ContactState::StickSlip, ContactState::StickSlipLiftoff], "at {} Hz", pp.freq_hz);
+    assert_eq!(
+        states,
+        vec![ContactState::StickSlip, ContactState::StickSlipLiftoff],
+        "at {} Hz",
+        pp.freq_hz
+    );
     let rel = (pp.amplitudes[0] - pm.amplitudes[0]).abs() / pp.amplitudes[0];
     assert!(rel < 1e-4, "2nd-resonance peaks differ by {rel:.2e}");
 }
@@ -157,9 +188,23 @@ fn third_resonance_one_side_stuck_and_m_changes_the_answer() {
     let minus = zoom(200.0, 235.0, -1.0);
     let (pp, pm) = (peak(&plus), peak(&minus));
     for p in [pp, pm] {
-        let stuck = p.states.iter().filter(|s| **s == ContactState::Stuck).count();
-        let slipping = p.states.iter().filter(|s| **s == ContactState::StickSlip).count();
-        assert_eq!((stuck, slipping), (1, 1), "states {:?} at {} Hz", p.states, p.freq_hz);
+        let stuck = p
+            .states
+            .iter()
+            .filter(|s| **s == ContactState::Stuck)
+            .count();
+        let slipping = p
+            .states
+            .iter()
+            .filter(|s| **s == ContactState::StickSlip)
+            .count();
+        assert_eq!(
+            (stuck, slipping),
+            (1, 1),
+            "states {:?} at {} Hz",
+            p.states,
+            p.freq_hz
+        );
     }
     let rel = (pp.amplitudes[0] - pm.amplitudes[0]).abs() / pp.amplitudes[0].max(pm.amplitudes[0]);
     assert!(rel > 0.05, "3rd-resonance peaks differ by only {rel:.2e}");

@@ -1,4 +1,4 @@
 //! Result files and figures.
 
-pub mod plot;
 pub mod files;
+pub mod plot;
