@@ -105,6 +105,9 @@ pub struct AftWorkspace {
     fft_buffer: Vec<f64>,
     kinds: Vec<SampleKind>,
     normal_active: Vec<bool>,
+    gram_weights: [Vec<f64>; 3],
+    gram_spectra: [Vec<Complex<f64>>; 3],
+    anchor_sum: Vec<f64>,
     /// Tangential relative displacement samples u(τ_k) (m).
     pub u: Vec<f64>,
     /// Normal relative displacement samples v(τ_k) (m).
@@ -142,6 +145,7 @@ impl AftWorkspace {
         let forward = planner.plan_fft_forward(n_samples);
         let inverse = planner.plan_fft_inverse(n_samples);
         let nb = set.n_blocks();
+        let gram_spectra = std::array::from_fn(|_| forward.make_output_vec());
         Self {
             set: set.clone(),
             basis: SampleBasis::new(set, n_samples),
@@ -154,6 +158,13 @@ impl AftWorkspace {
             inverse,
             kinds: vec![SampleKind::Open; n_samples],
             normal_active: vec![false; n_samples],
+            gram_weights: [
+                vec![0.0; n_samples],
+                vec![0.0; n_samples],
+                vec![0.0; n_samples],
+            ],
+            gram_spectra,
+            anchor_sum: vec![0.0; nb],
             u: vec![0.0; n_samples],
             v: vec![0.0; n_samples],
             t: vec![0.0; n_samples],
@@ -313,9 +324,11 @@ impl AftWorkspace {
         let mut drift = f64::INFINITY;
         let mut open_samples;
         let mut stick_margin_slips;
+        let mut any_slip;
         for period in 1..=self.settings.max_periods.max(2) {
             open_samples = 0usize;
             stick_margin_slips = 0usize;
+            any_slip = false;
             // The first sample of the first period is the initial condition itself.
             let first = if period == 1 { 1 } else { 0 };
             if period == 1 {
@@ -359,6 +372,7 @@ impl AftWorkspace {
                     self.kinds[k] = SampleKind::Slip { sign };
                     anchor = k;
                     anchor_sign = sign;
+                    any_slip = true;
                     // A slip by rounding only (the limit-case stuck side touches μN) is
                     // not a state change.
                     if predictor.abs() - limit > 1e-9 * (limit + law.kt * scale) {
@@ -367,7 +381,11 @@ impl AftWorkspace {
                 }
             }
             drift = (w - w_start).abs();
-            if period >= 2 && drift <= tol {
+            // A first period without slip or separation is already periodic (the slider never
+            // moved); otherwise the sample kinds must come from a repeated period, whose
+            // anchors are the steady-state ones.
+            let settled = drift <= tol && (period >= 2 || (!any_slip && open_samples == 0));
+            if settled {
                 let state = if open_samples == ns {
                     ContactState::Open
                 } else if open_samples > 0 {
@@ -390,66 +408,137 @@ impl AftWorkspace {
         })
     }
 
+    /// Assembles ∂T̂/∂û, ∂T̂/∂v̂, ∂N̂/∂v̂ from the recorded sample kinds.
+    ///
+    /// Sums over samples of P_k ⊗ E_k weighted by an indicator g (stick, slip sign, closed) are
+    /// weighted Gram matrices of the trigonometric basis; products of cosines and sines reduce
+    /// to single harmonics |a ± b| of g, so one real FFT of g gives each matrix in
+    /// O(N log N + n_blocks²) instead of O(N · n_blocks²). The anchor terms are rank-1
+    /// updates, one per stick segment.
     fn accumulate_jacobian(&mut self, law: &JenkinsLaw, effects: ContactEffects) {
         let nb = self.set.n_blocks();
         let ns = self.n_samples;
+        let constant_block = self.set.constant_block();
         self.dt_du.iter_mut().for_each(|x| *x = 0.0);
         self.dt_dv.iter_mut().for_each(|x| *x = 0.0);
         self.dn_dv.iter_mut().for_each(|x| *x = 0.0);
-        let constant_block = self.set.constant_block();
+
+        // Indicator weights: stick → kₜ on dT/du; slip → s μ kₙ on dT/dv; closed → kₙ on dN/dv.
         for k in 0..ns {
-            let ek = self.basis.row(k);
-            let closed_k = self.normal_active[k];
-            match self.kinds[k] {
-                SampleKind::Open => {}
-                SampleKind::Slip { sign } => {
-                    if closed_k {
-                        add_normal_outer(
-                            &mut self.dt_dv,
-                            &self.basis,
-                            effects.normal_load,
-                            constant_block,
-                            k,
-                            k,
-                            sign * law.mu * law.kn,
-                        );
-                    }
-                }
-                SampleKind::Stick { anchor, sign } => {
-                    let ea = self.basis.row(anchor);
-                    for j in 0..nb {
-                        let pj = self.basis.projection[j * ns + k];
-                        if pj == 0.0 {
-                            continue;
-                        }
-                        let row = &mut self.dt_du[j * nb..(j + 1) * nb];
-                        for i in 0..nb {
-                            row[i] += pj * law.kt * (ek[i] - ea[i]);
-                        }
-                    }
-                    if sign != 0.0 && self.normal_active[anchor] {
-                        add_normal_outer(
-                            &mut self.dt_dv,
-                            &self.basis,
-                            effects.normal_load,
-                            constant_block,
-                            k,
-                            anchor,
-                            sign * law.mu * law.kn,
-                        );
-                    }
+            let (stick, slip) = match self.kinds[k] {
+                SampleKind::Stick { .. } => (law.kt, 0.0),
+                SampleKind::Slip { sign } => (0.0, sign * law.mu * law.kn),
+                SampleKind::Open => (0.0, 0.0),
+            };
+            self.gram_weights[0][k] = stick;
+            self.gram_weights[1][k] = slip;
+            self.gram_weights[2][k] = if self.normal_active[k] { law.kn } else { 0.0 };
+        }
+        for w in 0..3 {
+            self.fft_buffer.copy_from_slice(&self.gram_weights[w]);
+            self.forward
+                .process_with_scratch(
+                    &mut self.fft_buffer,
+                    &mut self.gram_spectra[w],
+                    &mut self.scratch_fwd,
+                )
+                .expect("forward real FFT of a buffer of the planned length");
+        }
+        let blocks = self.set.blocks();
+        let normal_columns = |i: usize| match effects.normal_load {
+            NormalLoad::Variable => true,
+            NormalLoad::Constant => Some(i) == constant_block,
+        };
+        for j in 0..nb {
+            let wj = if blocks[j] == Block::Constant {
+                1.0
+            } else {
+                2.0
+            } / ns as f64;
+            for i in 0..nb {
+                let stick = gram_entry(&self.gram_spectra[0], ns, blocks[j], blocks[i]);
+                self.dt_du[j * nb + i] = wj * stick;
+                if normal_columns(i) {
+                    // With a constant normal load the sensitivity is the constant block only,
+                    // whose basis function is 1: the same Gram entry with b_i = 1.
+                    let bi = match effects.normal_load {
+                        NormalLoad::Variable => blocks[i],
+                        NormalLoad::Constant => Block::Constant,
+                    };
+                    self.dt_dv[j * nb + i] =
+                        wj * gram_entry(&self.gram_spectra[1], ns, blocks[j], bi);
+                    self.dn_dv[j * nb + i] =
+                        wj * gram_entry(&self.gram_spectra[2], ns, blocks[j], bi);
                 }
             }
-            if closed_k {
-                add_normal_outer(
-                    &mut self.dn_dv,
-                    &self.basis,
-                    effects.normal_load,
-                    constant_block,
-                    k,
-                    k,
-                    law.kn,
-                );
+        }
+
+        // Anchor terms: every stick sample k anchored at a adds −kₜ P_k ⊗ E_a to dT/du and
+        // s_a μ kₙ P_k ⊗ NS_a to dT/dv; sum P_k per stick segment, then one rank-1 update.
+        let mut acc = std::mem::take(&mut self.anchor_sum);
+        acc.iter_mut().for_each(|x| *x = 0.0);
+        let mut current: Option<(usize, f64)> = None;
+        for k in 0..=ns {
+            let kind = if k < ns { Some(self.kinds[k]) } else { None };
+            let anchor = match kind {
+                Some(SampleKind::Stick { anchor, sign }) => Some((anchor, sign)),
+                _ => None,
+            };
+            if anchor != current {
+                if let Some((a, sign)) = current {
+                    self.flush_anchor(law, effects, constant_block, &acc, a, sign);
+                    acc.iter_mut().for_each(|x| *x = 0.0);
+                }
+                current = anchor;
+            }
+            if anchor.is_some() {
+                for (j, x) in acc.iter_mut().enumerate() {
+                    *x += self.basis.projection[j * ns + k];
+                }
+            }
+        }
+        self.anchor_sum = acc;
+    }
+
+    /// Rank-1 anchor update for a stick segment whose projections sum to `acc`.
+    fn flush_anchor(
+        &mut self,
+        law: &JenkinsLaw,
+        effects: ContactEffects,
+        constant_block: Option<usize>,
+        acc: &[f64],
+        anchor: usize,
+        sign: f64,
+    ) {
+        let nb = acc.len();
+        let ea = self.basis.row(anchor);
+        for j in 0..nb {
+            let pj = acc[j];
+            if pj == 0.0 {
+                continue;
+            }
+            let row = &mut self.dt_du[j * nb..(j + 1) * nb];
+            for i in 0..nb {
+                row[i] -= law.kt * pj * ea[i];
+            }
+        }
+        if sign != 0.0 && self.normal_active[anchor] {
+            let scale = sign * law.mu * law.kn;
+            for j in 0..nb {
+                let pj = acc[j];
+                let row = &mut self.dt_dv[j * nb..(j + 1) * nb];
+                match effects.normal_load {
+                    NormalLoad::Variable => {
+                        for i in 0..nb {
+                            row[i] += scale * pj * ea[i];
+                        }
+                    }
+                    NormalLoad::Constant => {
+                        if let Some(c) = constant_block {
+                            row[c] += scale * pj;
+                        }
+                    }
+                }
             }
         }
     }
@@ -460,37 +549,32 @@ impl AftWorkspace {
     }
 }
 
-/// J[j][i] += scale · P[j][k] · (∂v_at_sample_a/∂v̂_i), with the normal sensitivity of the
-/// normal-load model (variable: E row a; constant: the constant block only).
-fn add_normal_outer(
-    jac: &mut [f64],
-    basis: &SampleBasis,
-    normal_load: NormalLoad,
-    constant_block: Option<usize>,
-    k: usize,
-    a: usize,
-    scale: f64,
-) {
-    let nb = basis.n_blocks;
-    for j in 0..nb {
-        let pj = basis.projection[j * basis.n_samples + k];
-        if pj == 0.0 {
-            continue;
-        }
-        let row = &mut jac[j * nb..(j + 1) * nb];
-        match normal_load {
-            NormalLoad::Variable => {
-                let ea = basis.row(a);
-                for i in 0..nb {
-                    row[i] += scale * pj * ea[i];
-                }
-            }
-            NormalLoad::Constant => {
-                if let Some(c) = constant_block {
-                    row[c] += scale * pj;
-                }
-            }
-        }
+/// Σ_k g_k b_j(τ_k) b_i(τ_k) from the real FFT X of g (X_m = Σ_k g_k e^{−imτ_k}), using
+/// cos a cos b = ½[cos(a−b) + cos(a+b)], sin a sin b = ½[cos(a−b) − cos(a+b)],
+/// cos a sin b = ½[sin(a+b) − sin(a−b)].
+fn gram_entry(spectrum: &[Complex<f64>], n: usize, bj: Block, bi: Block) -> f64 {
+    // Σ g cos(mτ) and Σ g sin(mτ) for any integer m (aliased into 0..n).
+    let c = |m: i64| -> f64 { spectrum_at(spectrum, n, m).re };
+    let s = |m: i64| -> f64 { -spectrum_at(spectrum, n, m).im };
+    use Block::{Constant, Cos, Sin};
+    match (bj, bi) {
+        (Constant, Constant) => c(0),
+        (Constant, Cos(h)) | (Cos(h), Constant) => c(h as i64),
+        (Constant, Sin(h)) | (Sin(h), Constant) => s(h as i64),
+        (Cos(a), Cos(b)) => 0.5 * (c(a as i64 - b as i64) + c(a as i64 + b as i64)),
+        (Sin(a), Sin(b)) => 0.5 * (c(a as i64 - b as i64) - c(a as i64 + b as i64)),
+        (Cos(a), Sin(b)) => 0.5 * (s(a as i64 + b as i64) - s(a as i64 - b as i64)),
+        (Sin(a), Cos(b)) => 0.5 * (s(a as i64 + b as i64) + s(a as i64 - b as i64)),
+    }
+}
+
+/// X_m of a real signal of length n for any integer m, from the half spectrum 0..=n/2.
+fn spectrum_at(spectrum: &[Complex<f64>], n: usize, m: i64) -> Complex<f64> {
+    let r = m.rem_euclid(n as i64) as usize;
+    if r <= n / 2 {
+        spectrum[r]
+    } else {
+        spectrum[n - r].conj()
     }
 }
 

@@ -362,7 +362,8 @@ fn one_line(message: &str) -> String {
 }
 
 /// Applies one `a.b.0.c=value` override to a TOML table. The value is read as TOML (number,
-/// boolean, array, quoted string) and otherwise taken as a bare string.
+/// boolean, array, quoted string) and otherwise taken as a bare string. Missing tables on the
+/// path are created; array entries must exist. The result is not checked against the schema.
 pub fn apply_override(table: &mut toml::Table, assignment: &str) -> Result<(), String> {
     let (path, raw) = assignment
         .split_once('=')
@@ -397,8 +398,10 @@ fn set_path(
                 t.insert(head.to_string(), value);
                 return Ok(());
             }
-            t.get_mut(*head)
-                .ok_or_else(|| format!("no field `{head}` in `{full}`"))?
+            // A table the file omits (e.g. `[effects]`) is created; whether the key belongs to
+            // the schema is checked by the caller.
+            t.entry(head.to_string())
+                .or_insert_with(|| toml::Value::Table(toml::Table::new()))
         }
         toml::Value::Array(a) => {
             let i: usize = head
@@ -515,6 +518,26 @@ impl Checker<'_> {
         Ok(())
     }
 
+    /// DOF and contact names become CSV column names and parts of file names.
+    fn name(&self, field: &str, name: &str) -> Result<(), SceneError> {
+        if name.trim().is_empty() {
+            return Err(self.err(field, "must not be empty"));
+        }
+        if let Some(bad) = name
+            .chars()
+            .find(|c| matches!(c, ',' | '"' | '/' | '\\') || c.is_control())
+        {
+            return Err(self.err(
+                field,
+                format!(
+                    "`{}` contains {bad:?}, which cannot appear in CSV column or file names",
+                    name.escape_debug()
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     fn dof(&self, field: &str, name: &str, dofs: &[String]) -> Result<usize, SceneError> {
         dofs.iter().position(|d| d == name).ok_or_else(|| {
             self.err(
@@ -535,6 +558,7 @@ impl Scene {
             return Err(ck.err("model.dofs", "must name at least one DOF"));
         }
         for (i, d) in dofs.iter().enumerate() {
+            ck.name(&format!("model.dofs[{i}]"), d)?;
             if dofs[..i].contains(d) {
                 return Err(ck.err(format!("model.dofs[{i}]"), format!("duplicate DOF `{d}`")));
             }
@@ -559,9 +583,7 @@ impl Scene {
         let mut sides: Vec<DamperSide> = Vec::new();
         for (ci, c) in self.contacts.iter().enumerate() {
             let f = |name: &str| format!("contacts[{ci}].{name}");
-            if c.name.trim().is_empty() {
-                return Err(ck.err(f("name"), "must not be empty"));
-            }
+            ck.name(&f("name"), &c.name)?;
             if self.contacts[..ci].iter().any(|o| o.name == c.name) {
                 return Err(ck.err(f("name"), format!("duplicate contact name `{}`", c.name)));
             }

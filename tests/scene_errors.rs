@@ -421,6 +421,33 @@ fn contact_point_lists_a_dof_twice() {
 }
 
 #[test]
+fn dof_name_unusable_in_file_names() {
+    rejects_invalid(
+        &paper_with("\"x2\", \"y2\", \"xD\"", "\"x2\", \"y/2\", \"xD\""),
+        "model.dofs[3]",
+        "contains '/'",
+    );
+}
+
+#[test]
+fn contact_name_unusable_in_csv() {
+    rejects_invalid(
+        &paper_with("name = \"left\"", "name = \"left,1\""),
+        "contacts[0].name",
+        "contains ','",
+    );
+}
+
+#[test]
+fn empty_side_name() {
+    rejects_invalid(
+        &paper_with("side = \"left\"", "side = \"\""),
+        "contacts[0].side",
+        "must not be empty",
+    );
+}
+
+#[test]
 fn empty_contact_set() {
     rejects_invalid(
         &paper_without("[[contacts]]", "# Pre-load"),
@@ -452,7 +479,7 @@ fn override_unknown_path() {
     let file = SceneFile::new(paper_wedge_scene());
     let label = file.label();
     for (assignment, reason) in [
-        ("analysis.nothing.step=1", "no field `nothing`"),
+        ("analysis.nothing.step=1", "unknown field `nothing`"),
         ("harmonics.maxx=3", "unknown field `maxx`"),
         ("contacts.0.mus=0.3", "unknown field `mus`"),
         ("harmonics.max=abc", "invalid type"),
@@ -528,6 +555,31 @@ fn overrides_are_applied() {
     assert_eq!(problem.static_load[5], 80.0);
     assert_eq!(problem.harmonics, vec![1, 2, 3, 4, 5]);
     assert_eq!(problem.analysis.initial_step, 0.5);
+}
+
+#[test]
+fn override_creates_an_omitted_table() {
+    let o = strings(&["effects.liftoff=false", "effects.coupling=uncoupled"]);
+    let problem = scene::parse(DOC_EXAMPLE, "example", &o)
+        .expect("parse")
+        .validate("example")
+        .expect("valid");
+    assert!(!problem.effects.contact.liftoff);
+    assert_eq!(
+        problem.effects.coupling,
+        fricbound::model::Coupling::Uncoupled
+    );
+
+    let err = match scene::parse(DOC_EXAMPLE, "example", &strings(&["effect.liftoff=false"])) {
+        Ok(_) => panic!("`--set effect.liftoff=false` was accepted"),
+        Err(e) => e,
+    };
+    assert_override(
+        &err,
+        "example",
+        "effect.liftoff=false",
+        "unknown field `effect`",
+    );
 }
 
 #[test]
