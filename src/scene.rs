@@ -372,9 +372,14 @@ pub fn apply_override(table: &mut toml::Table, assignment: &str) -> Result<(), S
     if path.is_empty() {
         return Err("empty field path".into());
     }
-    let value: toml::Value = match format!("v = {}", raw.trim()).parse::<toml::Table>() {
-        Ok(mut t) => t.remove("v").expect("parsed key v"),
-        Err(_) => toml::Value::String(raw.trim().to_string()),
+    // An empty value removes the field (e.g. `harmonics.max=` before giving `harmonics.list`).
+    let value: Option<toml::Value> = if raw.trim().is_empty() {
+        None
+    } else {
+        Some(match format!("v = {}", raw.trim()).parse::<toml::Table>() {
+            Ok(mut t) => t.remove("v").expect("parsed key v"),
+            Err(_) => toml::Value::String(raw.trim().to_string()),
+        })
     };
     let segments: Vec<&str> = path.split('.').collect();
     let mut current = toml::Value::Table(std::mem::take(table));
@@ -388,14 +393,22 @@ pub fn apply_override(table: &mut toml::Table, assignment: &str) -> Result<(), S
 fn set_path(
     node: &mut toml::Value,
     segments: &[&str],
-    value: toml::Value,
+    value: Option<toml::Value>,
     full: &str,
 ) -> Result<(), String> {
     let (head, rest) = segments.split_first().expect("non-empty path");
     let child: &mut toml::Value = match node {
         toml::Value::Table(t) => {
             if rest.is_empty() {
-                t.insert(head.to_string(), value);
+                match value {
+                    Some(v) => {
+                        t.insert(head.to_string(), v);
+                    }
+                    None => {
+                        t.remove(*head)
+                            .ok_or_else(|| format!("no field `{head}` to remove in `{full}`"))?;
+                    }
+                }
                 return Ok(());
             }
             // A table the file omits (e.g. `[effects]`) is created; whether the key belongs to
@@ -412,7 +425,12 @@ fn set_path(
                 .get_mut(i)
                 .ok_or_else(|| format!("index {i} out of range (length {len}) in `{full}`"))?;
             if rest.is_empty() {
-                *slot = value;
+                match value {
+                    Some(v) => *slot = v,
+                    None => {
+                        a.remove(i);
+                    }
+                }
                 return Ok(());
             }
             slot
