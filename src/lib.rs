@@ -2,6 +2,10 @@
 //! harmonic balance with alternating frequency/time contact forces, and the limits of that
 //! response among the multiple steady states friction allows (Ferhatoglu & Zucca, JSV 2021).
 
+// Matrix and block loops index several arrays with the same DOF or block index; iterator
+// rewrites would hide the maths.
+#![allow(clippy::needless_range_loop)]
+
 pub mod aft;
 pub mod commands;
 pub mod contact;

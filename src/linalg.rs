@@ -41,7 +41,7 @@ pub fn solve_dense(a: &Mat<f64>, b: &[f64]) -> Result<Vec<f64>, LinearSolveError
         hi = hi.max(d);
     }
     let ratio = if hi > 0.0 { lo / hi } else { 0.0 };
-    if !(ratio > 1e-14) {
+    if ratio.is_nan() || ratio <= 1e-14 {
         return Err(LinearSolveError::Singular { ratio });
     }
     let rhs = Mat::from_fn(n, 1, |i, _| b[i]);

@@ -362,8 +362,9 @@ fn one_line(message: &str) -> String {
 }
 
 /// Applies one `a.b.0.c=value` override to a TOML table. The value is read as TOML (number,
-/// boolean, array, quoted string) and otherwise taken as a bare string. Missing tables on the
-/// path are created; array entries must exist. The result is not checked against the schema.
+/// boolean, array, quoted string) and otherwise taken as a bare string; an empty value removes
+/// the field or array entry. Missing tables on the path are created; array entries must exist.
+/// The result is not checked against the schema.
 pub fn apply_override(table: &mut toml::Table, assignment: &str) -> Result<(), String> {
     let (path, raw) = assignment
         .split_once('=')
@@ -410,6 +411,9 @@ fn set_path(
                     }
                 }
                 return Ok(());
+            }
+            if value.is_none() && !t.contains_key(*head) {
+                return Err(format!("no field `{head}` to remove in `{full}`"));
             }
             // A table the file omits (e.g. `[effects]`) is created; whether the key belongs to
             // the schema is checked by the caller.

@@ -177,18 +177,32 @@ fn rejects_invalid(text: &str, field: &str, reason_part: &str) {
 
 #[test]
 fn malformed_toml() {
-    let file = SceneFile::new(&paper_with("[model]", "[model"));
+    let text = paper_with("[model]", "[model");
+    let line = 1 + text[..text.find("[model").expect("edited")]
+        .matches('\n')
+        .count();
+    let at = format!("line {line}, column 7");
+    let file = SceneFile::new(&text);
     let err = library_error(&file, &[]);
-    assert_parse(&err, &file.label(), &["line 6", "unclosed table", "[model"]);
-    assert_cli_rejects(&file.label(), &[], &["line 6", "unclosed table"]);
+    assert_parse(&err, &file.label(), &[&at, "unclosed table", "| [model"]);
+    assert_cli_rejects(&file.label(), &[], &[&at, "unclosed table"]);
 }
 
 #[test]
 fn unknown_field() {
-    let file = SceneFile::new(&paper_with("mu = 0.5", "mus = 0.5"));
+    let text = paper_with("mu = 0.5", "mus = 0.5");
+    let line = 1 + text[..text.find("mus = 0.5").expect("edited")]
+        .matches('\n')
+        .count();
+    let at = format!("line {line}, column 1");
+    let file = SceneFile::new(&text);
     let err = library_error(&file, &[]);
-    assert_parse(&err, &file.label(), &["line 47", "unknown field `mus`"]);
-    assert_cli_rejects(&file.label(), &[], &["line 47", "unknown field `mus`"]);
+    assert_parse(
+        &err,
+        &file.label(),
+        &[&at, "unknown field `mus`", "| mus = 0.5"],
+    );
+    assert_cli_rejects(&file.label(), &[], &[&at, "unknown field `mus`"]);
 }
 
 #[test]
@@ -483,6 +497,8 @@ fn override_unknown_path() {
         ("harmonics.maxx=3", "unknown field `maxx`"),
         ("contacts.0.mus=0.3", "unknown field `mus`"),
         ("harmonics.max=abc", "invalid type"),
+        ("analysis.nothing=", "no field `nothing` to remove"),
+        ("contacts.0.kt=", "missing field `kt`"),
     ] {
         let err = library_error(&file, &[assignment]);
         assert_override(&err, &label, assignment, reason);
@@ -543,7 +559,7 @@ fn override_makes_the_scene_invalid() {
 fn overrides_are_applied() {
     let o = strings(&[
         "contacts.0.initial_state=-1",
-        "static_loads.0.value=80",
+        "static_loads.0.value=-80",
         "harmonics.max=5",
         "analysis.initial_step=0.5",
     ]);
@@ -552,9 +568,49 @@ fn overrides_are_applied() {
         .validate("paper")
         .expect("valid");
     assert_eq!(problem.contacts[0].law.initial_state, -1.0);
-    assert_eq!(problem.static_load[5], 80.0);
+    assert_eq!(problem.static_load[5], -80.0);
     assert_eq!(problem.harmonics, vec![1, 2, 3, 4, 5]);
     assert_eq!(problem.analysis.initial_step, 0.5);
+}
+
+#[test]
+fn override_removes_a_field() {
+    let o = strings(&[
+        "harmonics.max=",
+        "harmonics.list=[1, 3]",
+        "harmonics_loads.1=",
+    ]);
+    let err = match scene::parse(paper_wedge_scene(), "paper", &o) {
+        Ok(_) => panic!("`--set harmonics_loads.1=` was accepted"),
+        Err(e) => e,
+    };
+    assert_override(
+        &err,
+        "paper",
+        "harmonics_loads.1=",
+        "no field `harmonics_loads`",
+    );
+
+    let o = strings(&[
+        "harmonics.max=",
+        "harmonics.list=[1, 3]",
+        "harmonic_loads.1=",
+    ]);
+    let problem = scene::parse(paper_wedge_scene(), "paper", &o)
+        .expect("parse")
+        .validate("paper")
+        .expect("valid");
+    assert_eq!(problem.harmonics, vec![1, 3]);
+    assert_eq!(problem.harmonic_loads.len(), 1);
+
+    let err = library_error(&SceneFile::new(paper_wedge_scene()), &["harmonics.max="]);
+    match &err {
+        SceneError::Invalid { field, reason, .. } => {
+            assert_eq!(field, "harmonics");
+            assert!(reason.contains("exactly one of `max`"), "{err}");
+        }
+        other => panic!("expected SceneError::Invalid, got {other:?}"),
+    }
 }
 
 #[test]
