@@ -230,7 +230,9 @@ proptest! {
     fn jacobian_stick_slip_liftoff((s, m, mu) in regime_strategy()) {
         let (mut u, mut v) = coefficients(&s, 1e-4, 2e-5, 2e-5);
         u[1] += 2e-4;
-        v[2] += 4e-5; // normal oscillation larger than the mean: separates part of the period
+        // Normal oscillation larger than the mean plus all other harmonics: the contact
+        // separates for part of the period whatever the random coefficients.
+        v[2] += 1e-4;
         let (err, state) = jacobian_error(law(1e5, 1e5, mu, m), effects(false, true), &u, &v);
         prop_assert_eq!(state, ContactState::StickSlipLiftoff);
         prop_assert!(err < 1e-6, "relative error {}", err);
