@@ -448,6 +448,11 @@ fn set_path(
     set_path(child, rest, value, full)
 }
 
+/// Most AFT samples per period a scene may ask for (2²⁰).
+pub const MAX_SAMPLES: usize = 1 << 20;
+/// Most continuation points or linear-reference points a scene may ask for.
+pub const MAX_POINTS: usize = 10_000_000;
+
 /// Validation context: file name for messages.
 struct Checker<'a> {
     file: &'a str,
@@ -803,6 +808,12 @@ impl Scene {
                 ),
             ));
         }
+        if self.harmonics.samples > MAX_SAMPLES {
+            return Err(ck.err(
+                "harmonics.samples",
+                format!("must be ≤ {MAX_SAMPLES}, got {}", self.harmonics.samples),
+            ));
+        }
         if self.harmonics.max_periods < 2 {
             return Err(ck.err("harmonics.max_periods", "must be ≥ 2"));
         }
@@ -882,6 +893,14 @@ impl Scene {
         }
         if a.linear_points < 2 {
             return Err(ck.err("analysis.linear_points", "must be ≥ 2"));
+        }
+        for (field, v) in [
+            ("analysis.max_points", a.max_points),
+            ("analysis.linear_points", a.linear_points),
+        ] {
+            if v > MAX_POINTS {
+                return Err(ck.err(field, format!("must be ≤ {MAX_POINTS}, got {v}")));
+            }
         }
         let residual_tolerance =
             ck.positive("analysis.residual_tolerance", a.residual_tolerance)?;
