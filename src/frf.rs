@@ -178,3 +178,82 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
         elapsed_s: started.elapsed().as_secs_f64(),
     })
 }
+
+/// Solves single points of a problem at fixed frequencies (Newton from a given guess), reusing
+/// one harmonic-balance operator. Used to put curves on a common grid and to refine peaks.
+pub struct PointSolver<'p> {
+    system: HbmSystem<'p>,
+    continuation: Continuation,
+}
+
+impl<'p> PointSolver<'p> {
+    /// A solver for `problem`.
+    pub fn new(problem: &'p Problem) -> Result<Self, FrfError> {
+        let system = HbmSystem::new(problem)?;
+        let set = system.unknowns().clone();
+        let continuation = Continuation {
+            analysis: problem.analysis,
+            x_scale: arc_length_x_scale(problem, &set)?,
+        };
+        Ok(Self {
+            system,
+            continuation,
+        })
+    }
+
+    /// The operator (for contact time histories after a solve).
+    pub fn system(&mut self) -> &mut HbmSystem<'p> {
+        &mut self.system
+    }
+
+    /// Solves at `freq_hz` from the coefficient guess `x0`.
+    pub fn solve(&mut self, x0: &[f64], freq_hz: f64) -> Result<FrfPoint, NewtonFailure> {
+        let p = self
+            .continuation
+            .solve_fixed(&mut self.system, x0, 2.0 * PI * freq_hz)?;
+        let problem = self.system.problem();
+        let (amplitudes, peaks) = point_outputs(
+            problem,
+            self.system.unknowns(),
+            self.system.static_offset(),
+            &p.x,
+        );
+        Ok(FrfPoint {
+            freq_hz,
+            amplitudes,
+            peaks,
+            states: self.system.states.clone(),
+            newton_iterations: p.iterations,
+            residual: p.residual,
+            coefficients: p.x,
+        })
+    }
+}
+
+/// The first path segment bracketing `freq_hz` and the linearly interpolated coefficients on it.
+pub fn interpolate_on_path(points: &[FrfPoint], freq_hz: f64) -> Option<Vec<f64>> {
+    points.windows(2).find_map(|w| {
+        let (a, b) = (&w[0], &w[1]);
+        let (lo, hi) = if a.freq_hz <= b.freq_hz {
+            (a, b)
+        } else {
+            (b, a)
+        };
+        if freq_hz < lo.freq_hz || freq_hz > hi.freq_hz {
+            return None;
+        }
+        let span = hi.freq_hz - lo.freq_hz;
+        let t = if span > 0.0 {
+            (freq_hz - lo.freq_hz) / span
+        } else {
+            0.0
+        };
+        Some(
+            lo.coefficients
+                .iter()
+                .zip(&hi.coefficients)
+                .map(|(p, q)| p + t * (q - p))
+                .collect(),
+        )
+    })
+}

@@ -137,6 +137,8 @@ pub struct Problem {
     pub analysis: Analysis,
     /// DOF indices reported in outputs.
     pub outputs: Vec<usize>,
+    /// Limit analysis settings, when the scene asks for one.
+    pub limits: Option<crate::limits::LimitSettings>,
 }
 
 impl Problem {

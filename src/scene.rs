@@ -84,6 +84,75 @@ pub struct Scene {
     pub analysis: AnalysisSpec,
     /// Outputs.
     pub output: OutputSpec,
+    /// Limit analysis among multiple solutions (two-point method); absent: one FRF.
+    #[serde(default)]
+    pub limits: Option<LimitsSpec>,
+    /// Parameter sweep of the limit analysis (optimal curves); absent: no sweep.
+    #[serde(default)]
+    pub sweep: Option<SweepSpec>,
+}
+
+/// The `[limits]` table.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LimitsSpec {
+    /// m values of intermediate curves (the same m on every damper side), each in [−1, 1].
+    #[serde(default)]
+    pub intermediate: Vec<f64>,
+    /// Points of the common frequency grid used for classification and the band.
+    #[serde(default = "default_grid_points")]
+    pub grid_points: usize,
+    /// m values scanned on every side (all combinations) to test whether the limits bound the
+    /// other solutions; empty: no scan.
+    #[serde(default)]
+    pub bound_scan: Vec<f64>,
+}
+
+fn default_grid_points() -> usize {
+    201
+}
+
+/// The `[sweep]` table: one parameter mapped linearly onto scene fields.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepSpec {
+    /// Parameter name for tables and plots (e.g. "F0", "beta").
+    pub parameter: String,
+    /// Parameter unit (e.g. "N", "deg").
+    #[serde(default)]
+    pub unit: String,
+    /// Parameter values.
+    pub values: Vec<f64>,
+    /// Fields set from the parameter p: field = offset + scale · p.
+    pub targets: Vec<SweepTarget>,
+}
+
+/// One scene field driven by the sweep parameter.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepTarget {
+    /// Dotted path of the field, as for `--set` (e.g. `static_loads.0.value`).
+    pub field: String,
+    /// Factor on the parameter.
+    #[serde(default = "unit_scale")]
+    pub scale: f64,
+    /// Offset added.
+    #[serde(default)]
+    pub offset: f64,
+}
+
+fn unit_scale() -> f64 {
+    1.0
+}
+
+impl SweepSpec {
+    /// The `--set` overrides that put the parameter at `value`.
+    pub fn overrides(&self, value: f64) -> Vec<String> {
+        self.targets
+            .iter()
+            .map(|t| format!("{}={:e}", t.field, t.offset + t.scale * value))
+            .collect()
+    }
 }
 
 /// Inline dense matrices with DOF names.
@@ -956,7 +1025,9 @@ impl Scene {
                 linear_points: a.linear_points,
             },
             outputs,
+            limits: self.validate_limits(&ck)?,
         };
+        self.validate_sweep(&ck)?;
         // The structure with stuck contacts must be able to carry static loads.
         let k_stuck = {
             let mut k = problem.model.stiffness.clone();
@@ -981,6 +1052,96 @@ impl Scene {
             ));
         }
         Ok(problem)
+    }
+
+    fn validate_limits(
+        &self,
+        ck: &Checker,
+    ) -> Result<Option<crate::limits::LimitSettings>, SceneError> {
+        let Some(l) = &self.limits else {
+            return Ok(None);
+        };
+        for (name, list) in [
+            ("intermediate", &l.intermediate),
+            ("bound_scan", &l.bound_scan),
+        ] {
+            for (i, m) in list.iter().enumerate() {
+                let field = format!("limits.{name}[{i}]");
+                ck.finite(&field, *m)?;
+                if !(-1.0..=1.0).contains(m) {
+                    return Err(ck.err(
+                        field,
+                        format!("an initial state m must lie in [-1, 1], got {m}"),
+                    ));
+                }
+            }
+        }
+        if !(2..=100_000).contains(&l.grid_points) {
+            return Err(ck.err(
+                "limits.grid_points",
+                format!("must be in 2..=100000, got {}", l.grid_points),
+            ));
+        }
+        let sides = {
+            let mut names: Vec<String> = Vec::new();
+            for c in &self.contacts {
+                let s = c.side.clone().unwrap_or_else(|| c.name.clone());
+                if !names.contains(&s) {
+                    names.push(s);
+                }
+            }
+            names.len()
+        };
+        let combinations = (l.bound_scan.len() as f64).powi(sides as i32);
+        if combinations > 4096.0 {
+            return Err(ck.err(
+                "limits.bound_scan",
+                format!(
+                    "{} values on {sides} sides make {combinations} curves; at most 4096",
+                    l.bound_scan.len()
+                ),
+            ));
+        }
+        Ok(Some(crate::limits::LimitSettings {
+            intermediate: l.intermediate.clone(),
+            grid_points: l.grid_points,
+            bound_scan: l.bound_scan.clone(),
+        }))
+    }
+
+    fn validate_sweep(&self, ck: &Checker) -> Result<(), SceneError> {
+        let Some(s) = &self.sweep else {
+            return Ok(());
+        };
+        if s.parameter.trim().is_empty() {
+            return Err(ck.err("sweep.parameter", "must name the parameter"));
+        }
+        if s.values.is_empty() {
+            return Err(ck.err("sweep.values", "must hold at least one value"));
+        }
+        for (i, v) in s.values.iter().enumerate() {
+            ck.finite(&format!("sweep.values[{i}]"), *v)?;
+        }
+        if s.targets.is_empty() {
+            return Err(ck.err("sweep.targets", "must name at least one field"));
+        }
+        for (i, t) in s.targets.iter().enumerate() {
+            if t.field.trim().is_empty() || t.field.starts_with("sweep") {
+                return Err(ck.err(
+                    format!("sweep.targets[{i}].field"),
+                    "must be a scene field outside [sweep]",
+                ));
+            }
+            ck.finite(&format!("sweep.targets[{i}].scale"), t.scale)?;
+            ck.finite(&format!("sweep.targets[{i}].offset"), t.offset)?;
+        }
+        if self.limits.is_none() {
+            return Err(ck.err(
+                "sweep",
+                "a sweep runs the limit analysis: add a [limits] table",
+            ));
+        }
+        Ok(())
     }
 }
 

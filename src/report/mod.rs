@@ -1,4 +1,5 @@
 //! Result files and figures.
 
 pub mod files;
+pub mod limit_plots;
 pub mod plot;

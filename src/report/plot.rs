@@ -74,7 +74,7 @@ pub struct Series<'a> {
 /// stick-slip, stick-slip-liftoff, open). Writes both files.
 pub fn plot_frf(fig: &FrfFigure, png: &Path, svg: &Path) -> Result<(), PlotError> {
     let out = fig.output_index;
-    let nonlinear = Curve {
+    let nonlinear = Line {
         label: "nonlinear (harmonic balance)".to_string(),
         runs: valid_runs(
             fig.points.iter().map(|p| {
@@ -89,7 +89,7 @@ pub fn plot_frf(fig: &FrfFigure, png: &Path, svg: &Path) -> Result<(), PlotError
         dashed: false,
         markers: true,
     };
-    let reference = |curve: &LinearCurve, label: &str, color: RGBColor| Curve {
+    let reference = |curve: &LinearCurve, label: &str, color: RGBColor| Line {
         label: label.to_string(),
         runs: valid_runs(
             curve
@@ -124,21 +124,23 @@ pub fn plot_frf(fig: &FrfFigure, png: &Path, svg: &Path) -> Result<(), PlotError
                 .points
                 .iter()
                 .filter(|p| p.freq_hz.is_finite())
-                .filter_map(|p| p.states.get(c).map(|&s| (p.freq_hz, s)))
+                .filter_map(|p| p.states.get(c).map(|&s| (p.freq_hz, state_color(s))))
                 .collect(),
         })
         .collect();
 
-    let figure = FrfDrawing {
+    let figure = StripChart {
         title: fig.title.to_string(),
         chart: ChartSpec {
             x,
             y: YAxis::Log(y.0, y.1),
             x_desc: "frequency (Hz)".to_string(),
             y_desc: format!("{} first-harmonic amplitude (m)", fig.output_name),
+            bands: Vec::new(),
             curves,
         },
         strips,
+        state_key: true,
     };
     write_figure(&figure, png, svg)
 }
@@ -154,9 +156,9 @@ pub fn plot_lines(
     png: &Path,
     svg: &Path,
 ) -> Result<(), PlotError> {
-    let curves: Vec<Curve> = series
+    let curves: Vec<Line> = series
         .iter()
-        .map(|s| Curve {
+        .map(|s| Line {
             label: s.label.to_string(),
             runs: valid_runs(s.x.iter().copied().zip(s.y.iter().copied()), log_y),
             color: s.color,
@@ -172,16 +174,18 @@ pub fn plot_lines(
         let (lo, hi) = linear_range(curves.iter().flat_map(|c| c.ys()), 0.05);
         YAxis::Linear(lo, hi)
     };
-    let figure = FrfDrawing {
+    let figure = StripChart {
         title: title.to_string(),
         chart: ChartSpec {
             x,
             y,
             x_desc: x_label.to_string(),
             y_desc: y_label.to_string(),
+            bands: Vec::new(),
             curves,
         },
         strips: Vec::new(),
+        state_key: false,
     };
     write_figure(&figure, png, svg)
 }
@@ -195,6 +199,7 @@ const LABEL_SIZE: f64 = 18.0;
 const LEGEND_SIZE: f64 = 18.0;
 const RIGHT_MARGIN: u32 = 30;
 const X_LABELS: usize = 12;
+const BAND_ALPHA: f64 = 0.25;
 
 const NONLINEAR_COLOR: RGBColor = RGBColor(200, 30, 30);
 const OPEN_COLOR: RGBColor = RGBColor(110, 110, 110);
@@ -207,7 +212,7 @@ const STATES: [ContactState; 4] = [
     ContactState::Open,
 ];
 
-fn state_color(state: ContactState) -> RGBColor {
+pub(crate) fn state_color(state: ContactState) -> RGBColor {
     match state {
         ContactState::Stuck => STUCK_COLOR,
         ContactState::StickSlip => RGBColor(44, 160, 44),
@@ -228,11 +233,12 @@ fn font(size: f64) -> TextStyle<'static> {
 }
 
 /// A figure that can be drawn on any backend.
-trait Figure {
+pub(crate) trait Figure {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<(), DB>;
 }
 
-fn write_figure<F: Figure>(figure: &F, png: &Path, svg: &Path) -> Result<(), PlotError> {
+/// Draws `figure` into a 1200×800 PNG and an SVG of the same size.
+pub(crate) fn write_figure<F: Figure>(figure: &F, png: &Path, svg: &Path) -> Result<(), PlotError> {
     let fail = |path: &Path, reason: String| PlotError::Draw {
         path: path.display().to_string(),
         reason,
@@ -258,15 +264,18 @@ fn write_figure<F: Figure>(figure: &F, png: &Path, svg: &Path) -> Result<(), Plo
 }
 
 /// A line split into runs of drawable points.
-struct Curve {
-    label: String,
-    runs: Vec<Vec<(f64, f64)>>,
-    color: RGBColor,
-    dashed: bool,
-    markers: bool,
+pub(crate) struct Line {
+    /// Legend label (no legend entry if empty).
+    pub(crate) label: String,
+    /// Runs of consecutive drawable points, each drawn as one polyline.
+    pub(crate) runs: Vec<Vec<(f64, f64)>>,
+    pub(crate) color: RGBColor,
+    pub(crate) dashed: bool,
+    /// A filled circle at every point.
+    pub(crate) markers: bool,
 }
 
-impl Curve {
+impl Line {
     fn xs(&self) -> impl Iterator<Item = f64> + '_ {
         self.runs.iter().flatten().map(|p| p.0)
     }
@@ -282,7 +291,10 @@ impl Curve {
 }
 
 /// Splits points into runs of consecutive drawable points (finite, and positive y if `log_y`).
-fn valid_runs(points: impl Iterator<Item = (f64, f64)>, log_y: bool) -> Vec<Vec<(f64, f64)>> {
+pub(crate) fn valid_runs(
+    points: impl Iterator<Item = (f64, f64)>,
+    log_y: bool,
+) -> Vec<Vec<(f64, f64)>> {
     let mut runs = Vec::new();
     let mut run = Vec::new();
     for (x, y) in points {
@@ -300,7 +312,7 @@ fn valid_runs(points: impl Iterator<Item = (f64, f64)>, log_y: bool) -> Vec<Vec<
 
 /// Range of finite values, widened by `pad` of its span; a default or widened range when empty
 /// or degenerate.
-fn linear_range(values: impl Iterator<Item = f64>, pad: f64) -> (f64, f64) {
+pub(crate) fn linear_range(values: impl Iterator<Item = f64>, pad: f64) -> (f64, f64) {
     let (lo, hi) = values
         .filter(|v| v.is_finite())
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
@@ -319,7 +331,7 @@ fn linear_range(values: impl Iterator<Item = f64>, pad: f64) -> (f64, f64) {
 
 /// Log range of the positive finite values: padded by 4 % of the decades spanned and at least a
 /// factor 4 wide, so that the axis always carries several ticks.
-fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+pub(crate) fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values
         .filter(|v| v.is_finite() && *v > 0.0)
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
@@ -422,30 +434,51 @@ fn format_linear(v: f64, scale: f64) -> String {
     }
 }
 
-enum YAxis {
+/// Range and scale of the y axis.
+pub(crate) enum YAxis {
     Linear(f64, f64),
     Log(f64, f64),
 }
 
-struct ChartSpec {
-    x: (f64, f64),
-    y: YAxis,
-    x_desc: String,
-    y_desc: String,
-    curves: Vec<Curve>,
+/// A translucent filled region, drawn below the lines.
+pub(crate) struct Band {
+    /// Legend label (no legend entry if empty).
+    pub(crate) label: String,
+    /// Closed outlines in data coordinates.
+    pub(crate) polygons: Vec<Vec<(f64, f64)>>,
+    pub(crate) color: RGBColor,
 }
 
-/// Contact-state markers of one contact.
-struct Strip {
-    name: String,
-    marks: Vec<(f64, ContactState)>,
+impl Band {
+    fn is_empty(&self) -> bool {
+        self.polygons.iter().all(Vec::is_empty)
+    }
 }
 
-/// A line chart with an optional block of state strips below it.
-struct FrfDrawing {
-    title: String,
-    chart: ChartSpec,
-    strips: Vec<Strip>,
+/// Axes, bands and lines of one chart; the x axis is linear.
+pub(crate) struct ChartSpec {
+    pub(crate) x: (f64, f64),
+    pub(crate) y: YAxis,
+    pub(crate) x_desc: String,
+    pub(crate) y_desc: String,
+    pub(crate) bands: Vec<Band>,
+    pub(crate) curves: Vec<Line>,
+}
+
+/// One row of coloured markers below the chart, e.g. the states of one contact.
+pub(crate) struct Strip {
+    pub(crate) name: String,
+    /// Abscissa and colour of each marker.
+    pub(crate) marks: Vec<(f64, RGBColor)>,
+}
+
+/// A line chart with an optional block of marker strips below it.
+pub(crate) struct StripChart {
+    pub(crate) title: String,
+    pub(crate) chart: ChartSpec,
+    pub(crate) strips: Vec<Strip>,
+    /// Draw the colour key of the contact states below the strips.
+    pub(crate) state_key: bool,
 }
 
 /// Pixel layout of the strip block.
@@ -461,7 +494,7 @@ impl StripLayout {
     }
 }
 
-impl Figure for FrfDrawing {
+impl Figure for StripChart {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<(), DB> {
         root.fill(&WHITE)?;
         let root = root.margin(10, 10, 10, 10);
@@ -487,7 +520,7 @@ impl Figure for FrfDrawing {
         let mut layout = StripLayout {
             row: (200 / n as u32).clamp(14, 30),
             x_label_area: 65,
-            legend_row: 40,
+            legend_row: if self.state_key { 40 } else { 0 },
         };
         let max_h = body_h * 45 / 100;
         if layout.height(n) > max_h {
@@ -505,7 +538,10 @@ impl Figure for FrfDrawing {
             y_label_area,
             &layout,
         )?;
-        draw_state_legend(&legend_area, y_label_area)
+        if self.state_key {
+            draw_state_legend(&legend_area, y_label_area)?;
+        }
+        Ok(())
     }
 }
 
@@ -573,6 +609,21 @@ where
     }
     mesh.draw()?;
 
+    for band in &spec.bands {
+        let fill = band.color.mix(BAND_ALPHA).filled();
+        let drawn = chart.draw_series(
+            band.polygons
+                .iter()
+                .filter(|p| !p.is_empty())
+                .map(|p| Polygon::new(p.clone(), fill)),
+        )?;
+        if !band.label.is_empty() && !band.is_empty() {
+            drawn
+                .label(band.label.as_str())
+                .legend(move |(x, y)| Rectangle::new([(x, y - 8), (x + 40, y + 8)], fill));
+        }
+    }
+
     for curve in &spec.curves {
         let style = curve.style();
         let drawn = if curve.dashed {
@@ -625,13 +676,19 @@ where
     }
 
     let entries: Vec<&str> = spec
-        .curves
+        .bands
         .iter()
-        .filter(|c| !c.label.is_empty() && !c.is_empty())
-        .map(|c| c.label.as_str())
+        .filter(|b| !b.label.is_empty() && !b.is_empty())
+        .map(|b| b.label.as_str())
+        .chain(
+            spec.curves
+                .iter()
+                .filter(|c| !c.label.is_empty() && !c.is_empty())
+                .map(|c| c.label.as_str()),
+        )
         .collect();
     if !entries.is_empty() {
-        let position = legend_position(&chart, &spec.curves, &entries)?;
+        let position = legend_position(&chart, spec, &entries)?;
         chart
             .configure_series_labels()
             .position(position)
@@ -645,10 +702,10 @@ where
     Ok(())
 }
 
-/// The legend corner covering the fewest curve pixels.
+/// The legend corner covering the fewest curve pixels (band pixels count a quarter).
 fn legend_position<DB: DrawingBackend, Y>(
     chart: &ChartContext<DB, Cartesian2d<RangedCoordf64, Y>>,
-    curves: &[Curve],
+    spec: &ChartSpec,
     entries: &[&str],
 ) -> DrawResult<SeriesLabelPosition, DB>
 where
@@ -665,7 +722,7 @@ where
     let (xr, yr) = area.get_pixel_range();
 
     let mut samples: Vec<(i32, i32)> = Vec::new();
-    for curve in curves {
+    for curve in &spec.curves {
         for run in &curve.runs {
             let pixels: Vec<(i32, i32)> = run.iter().map(|p| chart.backend_coord(p)).collect();
             if let [only] = pixels.as_slice() {
@@ -699,20 +756,60 @@ where
         (MiddleRight, right, mid_y),
         (MiddleLeft, left, mid_y),
     ];
-    let mut best = (UpperRight, usize::MAX);
+    let polygons: Vec<Vec<(f64, f64)>> = spec
+        .bands
+        .iter()
+        .flat_map(|b| &b.polygons)
+        .filter(|p| p.len() >= 3)
+        .map(|p| {
+            p.iter()
+                .map(|q| {
+                    let (x, y) = chart.backend_coord(q);
+                    (x as f64, y as f64)
+                })
+                .collect()
+        })
+        .collect();
+    let mut best = (UpperRight, f64::INFINITY);
     for (pos, x0, y0) in candidates {
-        let count = samples
+        let on_lines = samples
             .iter()
             .filter(|p| p.0 >= x0 && p.0 <= x0 + w && p.1 >= y0 && p.1 <= y0 + h)
             .count();
-        if count < best.1 {
-            best = (pos, count);
+        let mut in_bands = 0;
+        if !polygons.is_empty() {
+            for py in (y0..=y0 + h).step_by(8) {
+                for px in (x0..=x0 + w).step_by(8) {
+                    let q = (px as f64, py as f64);
+                    if polygons.iter().any(|p| inside(p, q)) {
+                        in_bands += 1;
+                    }
+                }
+            }
+        }
+        let cost = on_lines as f64 + 0.25 * in_bands as f64;
+        if cost < best.1 {
+            best = (pos, cost);
         }
     }
     Ok(best.0)
 }
 
-/// Draws one row per contact with a marker per point coloured by its state.
+/// Whether `q` lies inside the closed polygon (even-odd rule).
+fn inside(polygon: &[(f64, f64)], q: (f64, f64)) -> bool {
+    let mut odd = false;
+    let mut j = polygon.len() - 1;
+    for i in 0..polygon.len() {
+        let (a, b) = (polygon[i], polygon[j]);
+        if (a.1 > q.1) != (b.1 > q.1) && q.0 < a.0 + (q.1 - a.1) * (b.0 - a.0) / (b.1 - a.1) {
+            odd = !odd;
+        }
+        j = i;
+    }
+    odd
+}
+
+/// Draws one row per strip (the first on top) with a coloured marker at each of its abscissae.
 fn draw_strips<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     strips: &[Strip],
@@ -757,9 +854,8 @@ fn draw_strips<DB: DrawingBackend>(
     let half_h = ((layout.row as f64 * 0.4).round() as i32).max(1);
     for (c, strip) in strips.iter().enumerate() {
         let y = row_center(n, c);
-        chart.draw_series(strip.marks.iter().map(|&(f, s)| {
-            EmptyElement::at((f, y))
-                + Rectangle::new([(-2, -half_h), (2, half_h)], state_color(s).filled())
+        chart.draw_series(strip.marks.iter().map(|&(f, color)| {
+            EmptyElement::at((f, y)) + Rectangle::new([(-2, -half_h), (2, half_h)], color.filled())
         }))?;
     }
     Ok(())
@@ -855,6 +951,14 @@ mod tests {
     }
 
     fn check_files(png: &Path, svg: &Path) {
+        if let Ok(d) = std::env::var("TMP_PLOT_DIR") {
+            let tag = if file!().contains("limit") { "L" } else { "P" };
+            std::fs::copy(
+                png,
+                format!("{d}/{tag}_{}", png.file_name().unwrap().to_str().unwrap()),
+            )
+            .unwrap();
+        }
         let png_bytes = std::fs::read(png).unwrap();
         assert!(!png_bytes.is_empty());
         assert!(png_bytes.starts_with(&[0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a]));
