@@ -134,23 +134,11 @@ pub fn plot_limits(fig: &LimitFigure, png: &Path, svg: &Path) -> Result<(), Plot
     };
     let curves = lines(fig.curves, true);
 
-    let grid = fig.band_x.iter().copied().filter(|x| x.is_finite());
-    let band_xs = band.polygons.iter().flatten().map(|p| p.0);
-    let x = linear_range(
-        grid.chain(band_xs).chain(
-            curves
-                .iter()
-                .flat_map(|c| c.runs.iter().flatten().map(|p| p.0)),
-        ),
-        0.0,
-    );
-    let y = log_range(
-        band.polygons.iter().flatten().map(|p| p.1).chain(
-            curves
-                .iter()
-                .flat_map(|c| c.runs.iter().flatten().map(|p| p.1)),
-        ),
-    );
+    let grid = fig.band_x.iter().copied();
+    let x = linear_range(grid.chain(points(&curves).map(|p| p.0)), 0.0);
+    let x = cover(x, std::slice::from_ref(&band));
+    let band_ys = band.polygons.iter().flatten().map(|p| p.1);
+    let y = log_range(band_ys.chain(points(&curves).map(|p| p.1)));
 
     let mut strips = Vec::new();
     if !fig.multiple.is_empty() {
@@ -210,18 +198,18 @@ pub fn plot_sweep(fig: &SweepFigure, png: &Path, svg: &Path) -> Result<(), PlotE
         .into_iter()
         .collect();
     let curves = lines(fig.curves, fig.log_y);
-    let points = || {
-        bands
-            .iter()
-            .flat_map(|b| b.polygons.iter().flatten())
-            .chain(curves.iter().flat_map(|c| c.runs.iter().flatten()))
+    let ys = || {
+        let band_ys = bands.iter().flat_map(|b| b.polygons.iter().flatten());
+        band_ys.map(|p| p.1).chain(points(&curves).map(|p| p.1))
     };
-    let x = linear_range(points().map(|p| p.0), 0.02);
+    let grid = fig.band.map_or(&[][..], |b| b.0).iter().copied();
+    let x = linear_range(grid.chain(points(&curves).map(|p| p.0)), 0.02);
+    let x = cover(x, &bands);
     let y = if fig.log_y {
-        let (lo, hi) = log_range(points().map(|p| p.1));
+        let (lo, hi) = log_range(ys());
         YAxis::Log(lo, hi)
     } else {
-        let (lo, hi) = linear_range(points().map(|p| p.1), 0.05);
+        let (lo, hi) = linear_range(ys(), 0.05);
         YAxis::Linear(lo, hi)
     };
     let figure = StripChart {
@@ -263,18 +251,8 @@ pub fn plot_hysteresis(
             }
         })
         .collect();
-    let x = linear_range(
-        curves
-            .iter()
-            .flat_map(|c| c.runs.iter().flatten().map(|p| p.0)),
-        0.05,
-    );
-    let (lo, hi) = linear_range(
-        curves
-            .iter()
-            .flat_map(|c| c.runs.iter().flatten().map(|p| p.1)),
-        0.05,
-    );
+    let x = linear_range(points(&curves).map(|p| p.0), 0.05);
+    let (lo, hi) = linear_range(points(&curves).map(|p| p.1), 0.05);
     let figure = StripChart {
         title: title.to_string(),
         chart: ChartSpec {
@@ -289,6 +267,19 @@ pub fn plot_hysteresis(
         state_key: false,
     };
     write_figure(&figure, png, svg)
+}
+
+/// All drawable points of the lines.
+fn points(lines: &[Line]) -> impl Iterator<Item = (f64, f64)> + '_ {
+    lines.iter().flat_map(|c| c.runs.iter().flatten().copied())
+}
+
+/// The x range `(lo, hi)` widened to cover every band.
+fn cover((lo, hi): (f64, f64), bands: &[Band]) -> (f64, f64) {
+    bands
+        .iter()
+        .flat_map(|b| b.polygons.iter().flatten())
+        .fold((lo, hi), |(lo, hi), p| (lo.min(p.0), hi.max(p.0)))
 }
 
 /// The drawable runs of each curve.
@@ -308,7 +299,7 @@ fn lines(curves: &[Curve], log_y: bool) -> Vec<Line> {
 /// Outlines of the band between `lower` and `upper` over `x` (paired up to the shortest length):
 /// one polygon per run of consecutive drawable entries (all finite, limits positive if `log_y`),
 /// along the larger limit forwards and the smaller one backwards. An isolated drawable entry
-/// becomes a narrow rectangle a quarter of the way to its neighbours.
+/// becomes a narrow rectangle reaching a quarter of the way to the nearest other abscissa.
 fn band_polygons(x: &[f64], lower: &[f64], upper: &[f64], log_y: bool) -> Vec<Vec<(f64, f64)>> {
     let n = x.len().min(lower.len()).min(upper.len());
     let ok = |i: usize| {
@@ -332,11 +323,12 @@ fn band_polygons(x: &[f64], lower: &[f64], upper: &[f64], log_y: bool) -> Vec<Ve
                 lower[start].min(upper[start]),
                 lower[start].max(upper[start]),
             );
-            let gap = [start.checked_sub(1), Some(start + 1)]
+            let left = x[..start].iter().rev().find(|v| v.is_finite());
+            let right = x[start + 1..].iter().find(|v| v.is_finite());
+            let gap = left
                 .into_iter()
-                .flatten()
-                .filter(|&j| j < x.len() && x[j].is_finite())
-                .map(|j| (x[j] - x[start]).abs())
+                .chain(right)
+                .map(|v| (v - x[start]).abs())
                 .filter(|d| *d > 0.0)
                 .fold(f64::INFINITY, f64::min);
             let half = if gap.is_finite() {
@@ -363,7 +355,6 @@ mod tests {
     use super::*;
 
     fn check_files(png: &Path, svg: &Path) {
-        if let Ok(d) = std::env::var("TMP_PLOT_DIR") {
             let tag = if file!().contains("limit") { "L" } else { "P" };
             std::fs::copy(
                 png,

@@ -1,5 +1,6 @@
 //! Result files and figures.
 
 pub mod files;
+pub mod limit_files;
 pub mod limit_plots;
 pub mod plot;

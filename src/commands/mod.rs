@@ -1,5 +1,9 @@
 //! The command-line commands (`run`, `check`), as library functions so that `main.rs` only
-//! parses arguments and dispatches.
+//! parses arguments and dispatches. `run` solves what the scene asks for: a parameter sweep of
+//! the limit analysis (`[sweep]`), a limit analysis (`[limits]`), or one FRF.
+
+mod limits_run;
+mod sweep_run;
 
 use std::path::{Path, PathBuf};
 
@@ -47,6 +51,22 @@ pub enum CommandError {
         /// Output folder.
         dir: String,
     },
+    /// A limit analysis failed.
+    #[error("{scene}: {source}")]
+    Limits {
+        /// Scene label.
+        scene: String,
+        /// Cause.
+        source: crate::limits::LimitError,
+    },
+    /// A sweep failed.
+    #[error("{scene}: {source}")]
+    Sweep {
+        /// Scene label.
+        scene: String,
+        /// Cause.
+        source: crate::sweep::SweepError,
+    },
     /// A linear reference failed.
     #[error("{scene}: linear reference: {reason}")]
     Linear {
@@ -75,14 +95,73 @@ pub struct RunOptions {
 pub struct RunReport {
     /// Output folder.
     pub dir: PathBuf,
-    /// Converged points.
-    pub points: usize,
-    /// Turning points (Hz).
-    pub turning_points: Vec<f64>,
-    /// Cut steps.
-    pub step_cuts: usize,
-    /// Solve wall time (s).
-    pub elapsed_s: f64,
+    /// What was computed, in a few lines.
+    pub summary: String,
+}
+
+/// Everything a run kind needs: the scene, the checked problem, the output folder and the
+/// linear references.
+pub struct RunContext<'a> {
+    /// Scene label (file name or the built-in default).
+    pub label: String,
+    /// The scene as solved (after overrides).
+    pub scene: Scene,
+    /// The checked problem.
+    pub problem: Problem,
+    /// Output folder.
+    pub dir: PathBuf,
+    /// Linear reference with contacts open.
+    pub open: linear::LinearCurve,
+    /// Linear reference with contacts stuck.
+    pub stuck: linear::LinearCurve,
+    /// Command-line options.
+    pub options: &'a RunOptions,
+    /// Scene text as read (before overrides), for sweeps that re-apply overrides per value.
+    pub scene_text: String,
+}
+
+impl RunContext<'_> {
+    /// Title for figures.
+    pub fn title(&self) -> &str {
+        if self.scene.title.is_empty() {
+            &self.label
+        } else {
+            &self.scene.title
+        }
+    }
+
+    /// Run info for JSON files.
+    pub fn info(&self) -> RunInfo {
+        let problem = &self.problem;
+        RunInfo {
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            scene: self.label.clone(),
+            scene_hash: scene_hash(&self.scene),
+            dofs: problem.model.dof_names.clone(),
+            blocks: block_names(problem),
+            contacts: problem.contacts.iter().map(|c| c.name.clone()).collect(),
+            outputs: problem
+                .outputs
+                .iter()
+                .map(|&d| problem.model.dof_names[d].clone())
+                .collect(),
+        }
+    }
+
+    /// Progress bar unless quiet.
+    pub fn progress(&self, len: u64) -> Option<ProgressBar> {
+        if self.options.quiet {
+            return None;
+        }
+        let bar = ProgressBar::new(len);
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} {msg}",
+            )
+            .expect("static template"),
+        );
+        Some(bar)
+    }
 }
 
 /// Loads the scene named by `path` (or the built-in default) with overrides.
@@ -197,36 +276,44 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
         files::linear_csv(&problem, &stuck).as_bytes(),
     )?;
 
-    let info = RunInfo {
-        version: env!("CARGO_PKG_VERSION").to_string(),
-        scene: label.clone(),
-        scene_hash: scene_hash(&scene),
-        dofs: problem.model.dof_names.clone(),
-        blocks: block_names(&problem),
-        contacts: problem.contacts.iter().map(|c| c.name.clone()).collect(),
-        outputs: problem
-            .outputs
-            .iter()
-            .map(|&d| problem.model.dof_names[d].clone())
-            .collect(),
+    let scene_text = match options.scene.as_deref() {
+        Some(p) => std::fs::read_to_string(p).map_err(|source| SceneError::Io {
+            file: p.display().to_string(),
+            source,
+        })?,
+        None => scene::PAPER_DEFAULT_SCENE.to_string(),
     };
-    let bar = if options.quiet {
-        None
-    } else {
-        let bar = ProgressBar::new(1000);
-        bar.set_style(
-            ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {msg}")
-                .expect("static template"),
-        );
-        Some(bar)
+    let ctx = RunContext {
+        scene_text,
+        label,
+        scene,
+        problem,
+        dir,
+        open,
+        stuck,
+        options,
     };
+    if ctx.scene.sweep.is_some() {
+        return sweep_run::run_sweep(&ctx);
+    }
+    if ctx.problem.limits.is_some() {
+        return limits_run::run_limits(&ctx);
+    }
+    run_frf(&ctx)
+}
+
+/// A single nonlinear FRF (no limit analysis asked for).
+fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
+    let problem = &ctx.problem;
+    let dir = &ctx.dir;
+    let bar = ctx.progress(1000);
     let mut observer = RunObserver {
-        writer: FrfWriter::new(&dir, &problem, info.clone()),
+        writer: FrfWriter::new(dir, problem, ctx.info()),
         bar,
-        problem: &problem,
-        quiet: options.quiet,
+        problem,
+        quiet: ctx.options.quiet,
     };
-    let result = frf::solve(&problem, &mut observer);
+    let result = frf::solve(problem, &mut observer);
     if let Some(bar) = &observer.bar {
         bar.finish_and_clear();
     }
@@ -236,7 +323,7 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
             let status = format!("failed: {source}");
             observer.writer.write_solution(&status)?;
             return Err(CommandError::Solve {
-                scene: label,
+                scene: ctx.label.clone(),
                 source,
                 points: observer.writer.points().len(),
                 dir: dir.display().to_string(),
@@ -248,22 +335,17 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
     }
     observer.writer.write_solution("complete")?;
 
-    let title = if scene.title.is_empty() {
-        label.as_str()
-    } else {
-        scene.title.as_str()
-    };
     let contact_names: Vec<String> = problem.contacts.iter().map(|c| c.name.clone()).collect();
     for (k, &d) in problem.outputs.iter().enumerate() {
         let name = &problem.model.dof_names[d];
         let fig = FrfFigure {
-            title,
+            title: ctx.title(),
             output_index: k,
             output_name: name,
             contact_names: &contact_names,
             points: &run.points,
-            open: &open,
-            stuck: &stuck,
+            open: &ctx.open,
+            stuck: &ctx.stuck,
         };
         plot::plot_frf(
             &fig,
@@ -271,12 +353,23 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
             &dir.join(format!("frf_{name}.svg")),
         )?;
     }
+    let turning = if run.turning_points.is_empty() {
+        "none".to_string()
+    } else {
+        run.turning_points
+            .iter()
+            .map(|f| format!("{f:.3} Hz"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
     Ok(RunReport {
-        dir,
-        points: run.points.len(),
-        turning_points: run.turning_points,
-        step_cuts: run.rejected_steps,
-        elapsed_s: run.elapsed_s,
+        dir: dir.clone(),
+        summary: format!(
+            "{} converged points in {:.3} s ({} step cuts); turning points: {turning}",
+            run.points.len(),
+            run.elapsed_s,
+            run.rejected_steps
+        ),
     })
 }
 
@@ -377,20 +470,5 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
 
 /// One-paragraph summary of a finished run.
 pub fn run_summary(r: &RunReport) -> String {
-    let turning = if r.turning_points.is_empty() {
-        "none".to_string()
-    } else {
-        r.turning_points
-            .iter()
-            .map(|f| format!("{f:.3} Hz"))
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    format!(
-        "{} converged points in {:.3} s ({} step cuts); turning points: {turning}\nresults in {}",
-        r.points,
-        r.elapsed_s,
-        r.step_cuts,
-        r.dir.display()
-    )
+    format!("{}\nresults in {}", r.summary, r.dir.display())
 }
