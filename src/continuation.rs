@@ -14,9 +14,8 @@
 
 use std::f64::consts::PI;
 
-use faer::Mat;
-
-use crate::linalg::{solve_dense, LinearSolveError};
+use crate::jacobian::AssembledJacobian;
+use crate::linalg::LinearSolveError;
 use crate::model::Analysis;
 
 /// An operator R(x, λ) with its Jacobian, as continuation needs it.
@@ -29,13 +28,15 @@ pub trait ParametricResidual {
     fn residual_scale(&self) -> f64;
     /// R(x, λ) into r.
     fn residual(&mut self, x: &[f64], lambda: f64, r: &mut [f64]) -> Result<(), Self::Error>;
+    /// An empty Jacobian with the operator's storage and pattern.
+    fn new_jacobian(&mut self) -> AssembledJacobian;
     /// R, ∂R/∂x and ∂R/∂λ.
     fn residual_and_jacobian(
         &mut self,
         x: &[f64],
         lambda: f64,
         r: &mut [f64],
-        jac: &mut Mat<f64>,
+        jac: &mut AssembledJacobian,
         dr_dlambda: &mut [f64],
     ) -> Result<(), Self::Error>;
 }
@@ -51,12 +52,15 @@ impl ParametricResidual for crate::hbm::HbmSystem<'_> {
     fn residual(&mut self, x: &[f64], lambda: f64, r: &mut [f64]) -> Result<(), Self::Error> {
         crate::hbm::HbmSystem::residual(self, x, lambda, r)
     }
+    fn new_jacobian(&mut self) -> AssembledJacobian {
+        crate::hbm::HbmSystem::new_jacobian(self)
+    }
     fn residual_and_jacobian(
         &mut self,
         x: &[f64],
         lambda: f64,
         r: &mut [f64],
-        jac: &mut Mat<f64>,
+        jac: &mut AssembledJacobian,
         dr_dlambda: &mut [f64],
     ) -> Result<(), Self::Error> {
         crate::hbm::HbmSystem::residual_and_jacobian(self, x, lambda, r, jac, dr_dlambda)
@@ -210,7 +214,7 @@ impl Continuation {
         let mut x = x0.to_vec();
         let mut r = vec![0.0; n];
         let mut dr = vec![0.0; n];
-        let mut jac = Mat::<f64>::zeros(n, n);
+        let mut jac = system.new_jacobian();
         let mut trial = vec![0.0; n];
         let mut rt = vec![0.0; n];
         let eval_err = |e: S::Error| NewtonFailure::Evaluation(e.to_string());
@@ -222,7 +226,7 @@ impl Continuation {
                 .map_err(eval_err)?;
             rel = norm(&r) / scale;
             let neg: Vec<f64> = r.iter().map(|v| -v).collect();
-            let dx = solve_dense(&jac, &neg)?;
+            let dx = jac.solve(&neg)?;
             let step_norm = norm(&dx) / self.x_scale;
             let mut alpha = 1.0;
             loop {
@@ -271,30 +275,22 @@ impl Continuation {
         let n = system.dim();
         let mut r = vec![0.0; n];
         let mut dr = vec![0.0; n];
-        let mut jac = Mat::<f64>::zeros(n, n);
+        let mut jac = system.new_jacobian();
         system
             .residual_and_jacobian(&point.x, point.omega, &mut r, &mut jac, &mut dr)
             .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
-        let mut aug = Mat::<f64>::zeros(n + 1, n + 1);
-        for j in 0..n {
-            for i in 0..n {
-                aug[(i, j)] = jac[(i, j)] * self.x_scale;
-            }
-        }
-        for i in 0..n {
-            aug[(i, n)] = dr[i] * OMEGA_SCALE;
-        }
+        let col: Vec<f64> = dr.iter().map(|v| v * OMEGA_SCALE).collect();
         let mut rhs = vec![0.0; n + 1];
         rhs[n] = 1.0;
-        match previous {
-            Some(p) => {
-                for j in 0..=n {
-                    aug[(n, j)] = p[j];
-                }
+        let row = match previous {
+            Some(p) => p.to_vec(),
+            None => {
+                let mut e = vec![0.0; n + 1];
+                e[n] = 1.0;
+                e
             }
-            None => aug[(n, n)] = 1.0,
-        }
-        let mut t = solve_dense(&aug, &rhs)?;
+        };
+        let mut t = jac.solve_bordered(self.x_scale, &col, &row, &rhs)?;
         let nt = norm(&t);
         t.iter_mut().for_each(|v| *v /= nt);
         let orientation = match previous {
@@ -319,8 +315,8 @@ impl Continuation {
         let mut y = predicted.to_vec();
         let mut r = vec![0.0; n];
         let mut dr = vec![0.0; n];
-        let mut jac = Mat::<f64>::zeros(n, n);
-        let mut aug = Mat::<f64>::zeros(n + 1, n + 1);
+        let mut jac = system.new_jacobian();
+        let mut col = vec![0.0; n];
         let mut x = vec![0.0; n];
         let mut first = f64::NAN;
         let mut rel = f64::INFINITY;
@@ -338,16 +334,8 @@ impl Continuation {
             } else if rel > 1e4 * first.max(self.analysis.residual_tolerance) {
                 return Err(NewtonFailure::Diverged { residual: rel });
             }
-            for j in 0..n {
-                for i in 0..n {
-                    aug[(i, j)] = jac[(i, j)] * self.x_scale;
-                }
-            }
             for i in 0..n {
-                aug[(i, n)] = dr[i] * OMEGA_SCALE;
-            }
-            for j in 0..=n {
-                aug[(n, j)] = tangent[j];
+                col[i] = dr[i] * OMEGA_SCALE;
             }
             let mut rhs: Vec<f64> = r.iter().map(|v| -v).collect();
             rhs.push(
@@ -355,7 +343,7 @@ impl Continuation {
                     .map(|j| tangent[j] * (y[j] - predicted[j]))
                     .sum::<f64>(),
             );
-            let dy = solve_dense(&aug, &rhs)?;
+            let dy = jac.solve_bordered(self.x_scale, &col, tangent, &rhs)?;
             for j in 0..=n {
                 y[j] += dy[j];
             }

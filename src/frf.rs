@@ -13,6 +13,7 @@ use crate::hbm::{HbmError, HbmSystem};
 use crate::linalg::LinearSolveError;
 use crate::linear;
 use crate::model::Problem;
+use crate::operator::HbmOperator;
 
 /// One converged point of a nonlinear frequency response.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -127,21 +128,39 @@ fn arc_length_x_scale(problem: &Problem, set: &HarmonicSet) -> Result<f64, Linea
 struct Adapter<'o, O: FrfObserver> {
     observer: &'o mut O,
     points: Vec<FrfPoint>,
+    /// A converged point whose full coefficients could not be recovered.
+    failure: Option<HbmError>,
 }
 
-impl<O: FrfObserver> Observer<HbmSystem<'_>> for Adapter<'_, O> {
-    fn accepted(&mut self, system: &mut HbmSystem<'_>, p: &PathPoint) {
-        let problem = system.problem();
-        let (amplitudes, peaks) =
-            point_outputs(problem, system.unknowns(), system.static_offset(), &p.x);
-        let point = FrfPoint {
-            freq_hz: p.freq_hz(),
-            amplitudes,
-            peaks,
-            states: system.states.clone(),
-            newton_iterations: p.iterations,
-            residual: p.residual,
-            coefficients: p.x.clone(),
+/// The outputs of a converged path point, on full coefficients.
+fn full_point(system: &mut HbmOperator<'_>, p: &PathPoint) -> Result<FrfPoint, HbmError> {
+    let coefficients = system.expand(&p.x, p.omega)?;
+    let full = system.full_ref();
+    let (amplitudes, peaks) = point_outputs(
+        full.problem(),
+        full.unknowns(),
+        full.static_offset(),
+        &coefficients,
+    );
+    Ok(FrfPoint {
+        freq_hz: p.freq_hz(),
+        amplitudes,
+        peaks,
+        states: system.states().to_vec(),
+        newton_iterations: p.iterations,
+        residual: p.residual,
+        coefficients,
+    })
+}
+
+impl<O: FrfObserver> Observer<HbmOperator<'_>> for Adapter<'_, O> {
+    fn accepted(&mut self, system: &mut HbmOperator<'_>, p: &PathPoint) {
+        let point = match full_point(system, p) {
+            Ok(point) => point,
+            Err(e) => {
+                self.failure.get_or_insert(e);
+                return;
+            }
         };
         self.observer.point(&point);
         self.points.push(point);
@@ -157,10 +176,10 @@ impl<O: FrfObserver> Observer<HbmSystem<'_>> for Adapter<'_, O> {
 /// Solves the nonlinear frequency response of a problem over its analysis range.
 pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfRun, FrfError> {
     let started = Instant::now();
-    let mut system = HbmSystem::new(problem)?;
+    let mut system = HbmOperator::new(problem)?;
     let set = system.unknowns().clone();
     let omega0 = 2.0 * PI * problem.analysis.freq_start_hz;
-    let guess = linear::stuck_guess(problem, &set, omega0)?;
+    let guess = system.restrict(&linear::stuck_guess(problem, &set, omega0)?);
     let continuation = Continuation {
         analysis: problem.analysis,
         x_scale: arc_length_x_scale(problem, &set)?,
@@ -168,8 +187,12 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
     let mut adapter = Adapter {
         observer,
         points: Vec::new(),
+        failure: None,
     };
     let summary = continuation.run(&mut system, &guess, &mut adapter)?;
+    if let Some(e) = adapter.failure {
+        return Err(FrfError::Setup(e));
+    }
     Ok(FrfRun {
         points: adapter.points,
         turning_points: summary.turning_points,
@@ -182,14 +205,14 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
 /// Solves single points of a problem at fixed frequencies (Newton from a given guess), reusing
 /// one harmonic-balance operator. Used to put curves on a common grid and to refine peaks.
 pub struct PointSolver<'p> {
-    system: HbmSystem<'p>,
+    system: HbmOperator<'p>,
     continuation: Continuation,
 }
 
 impl<'p> PointSolver<'p> {
     /// A solver for `problem`.
     pub fn new(problem: &'p Problem) -> Result<Self, FrfError> {
-        let system = HbmSystem::new(problem)?;
+        let system = HbmOperator::new(problem)?;
         let set = system.unknowns().clone();
         let continuation = Continuation {
             analysis: problem.analysis,
@@ -201,32 +224,21 @@ impl<'p> PointSolver<'p> {
         })
     }
 
-    /// The operator (for contact time histories after a solve).
+    /// The full operator (for contact time histories after a solve).
     pub fn system(&mut self) -> &mut HbmSystem<'p> {
-        &mut self.system
+        self.system.full()
     }
 
-    /// Solves at `freq_hz` from the coefficient guess `x0`.
+    /// Solves at `freq_hz` from the full-coefficient guess `x0`.
     pub fn solve(&mut self, x0: &[f64], freq_hz: f64) -> Result<FrfPoint, NewtonFailure> {
+        let guess = self.system.restrict(x0);
         let p = self
             .continuation
-            .solve_fixed(&mut self.system, x0, 2.0 * PI * freq_hz)?;
-        let problem = self.system.problem();
-        let (amplitudes, peaks) = point_outputs(
-            problem,
-            self.system.unknowns(),
-            self.system.static_offset(),
-            &p.x,
-        );
-        Ok(FrfPoint {
-            freq_hz,
-            amplitudes,
-            peaks,
-            states: self.system.states.clone(),
-            newton_iterations: p.iterations,
-            residual: p.residual,
-            coefficients: p.x,
-        })
+            .solve_fixed(&mut self.system, &guess, 2.0 * PI * freq_hz)?;
+        let mut point = full_point(&mut self.system, &p)
+            .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
+        point.freq_hz = freq_hz;
+        Ok(point)
     }
 }
 

@@ -8,15 +8,20 @@
 
 pub mod aft;
 pub mod commands;
+pub mod condensed;
 pub mod contact;
 pub mod continuation;
 pub mod frf;
 pub mod harmonic;
 pub mod hbm;
+pub mod jacobian;
 pub mod limits;
 pub mod linalg;
 pub mod linear;
+pub mod matrix;
 pub mod model;
+pub mod operator;
+pub mod pattern;
 pub mod reference;
 pub mod report;
 pub mod scene;

@@ -7,10 +7,8 @@
 //! singular; only the DOFs connected (through M, C, K) to a loaded DOF are solved, the others
 //! do not move.
 
-use faer::Mat;
-
 use crate::harmonic::Block;
-use crate::linalg::{solve_dense, LinearSolveError};
+use crate::linalg::{solve_triplets, LinearSolveError};
 use crate::model::Problem;
 
 /// Which linear reference.
@@ -22,43 +20,48 @@ pub enum LinearCase {
     Stuck,
 }
 
-/// Stiffness of all contacts as linear springs: Σ kₜ aₜaₜᵀ + kₙ aₙaₙᵀ (N/m).
-pub fn contact_stiffness(problem: &Problem) -> Mat<f64> {
-    let n = problem.model.n_dofs();
-    let mut k = Mat::<f64>::zeros(n, n);
+/// Stiffness of all contacts as linear springs: Σ kₜ aₜaₜᵀ + kₙ aₙaₙᵀ (N/m), as triplets.
+pub fn contact_stiffness(problem: &Problem) -> Vec<(usize, usize, f64)> {
+    let mut k = Vec::new();
     for c in &problem.contacts {
         for &(p, ap) in &c.tangential {
             for &(q, aq) in &c.tangential {
-                k[(p, q)] += c.law.kt * ap * aq;
+                k.push((p, q, c.law.kt * ap * aq));
             }
         }
         for &(p, ap) in &c.normal {
             for &(q, aq) in &c.normal {
-                k[(p, q)] += c.law.kn * ap * aq;
+                k.push((p, q, c.law.kn * ap * aq));
             }
         }
     }
     k
 }
 
-/// Stiffness matrix of a linear case.
-fn case_stiffness(problem: &Problem, case: LinearCase) -> Mat<f64> {
-    let mut k = problem.model.stiffness.clone();
+/// Stiffness of a linear case as triplets (duplicates to be summed).
+fn case_stiffness(problem: &Problem, case: LinearCase) -> Vec<(usize, usize, f64)> {
+    let mut k = problem.model.stiffness.triplets();
     if case == LinearCase::Stuck {
-        let kc = contact_stiffness(problem);
-        for j in 0..k.ncols() {
-            for i in 0..k.nrows() {
-                k[(i, j)] += kc[(i, j)];
-            }
-        }
+        k.extend(contact_stiffness(problem));
     }
     k
 }
 
 /// DOFs connected to a loaded DOF through nonzero entries of M, C and `k`.
-fn connected_to_loads(problem: &Problem, k: &Mat<f64>, harmonic: usize) -> Vec<usize> {
+fn connected_to_loads(problem: &Problem, k: &[(usize, usize, f64)], harmonic: usize) -> Vec<usize> {
     let n = problem.model.n_dofs();
     let m = &problem.model;
+    let mut neighbours: Vec<Vec<usize>> = vec![Vec::new(); n];
+    let mut link = |p: usize, q: usize, v: f64| {
+        if v != 0.0 && p != q {
+            neighbours[p].push(q);
+        }
+    };
+    for &(p, q, v) in k {
+        link(p, q, v);
+    }
+    m.mass.for_each_nonzero(&mut link);
+    m.damping.for_each_nonzero(&mut link);
     let mut seen = vec![false; n];
     let mut stack: Vec<usize> = problem
         .harmonic_loads
@@ -71,19 +74,16 @@ fn connected_to_loads(problem: &Problem, k: &Mat<f64>, harmonic: usize) -> Vec<u
             continue;
         }
         seen[p] = true;
-        for q in 0..n {
-            if !seen[q] && (k[(p, q)] != 0.0 || m.mass[(p, q)] != 0.0 || m.damping[(p, q)] != 0.0) {
-                stack.push(q);
-            }
-        }
+        stack.extend(neighbours[p].iter().filter(|&&q| !seen[q]));
     }
     (0..n).filter(|&p| seen[p]).collect()
 }
 
-/// Cosine and sine response (m) to the loads of harmonic `h` at ω (rad/s), for stiffness `k`.
+/// Cosine and sine response (m) to the loads of harmonic `h` at ω (rad/s), for stiffness `k`
+/// (triplets), solved on `dofs` only (the others stay at rest).
 fn harmonic_response(
     problem: &Problem,
-    k: &Mat<f64>,
+    k: &[(usize, usize, f64)],
     dofs: &[usize],
     harmonic: usize,
     omega: f64,
@@ -92,26 +92,40 @@ fn harmonic_response(
     let m = &problem.model;
     let na = dofs.len();
     let hw = harmonic as f64 * omega;
-    let mut a = Mat::<f64>::zeros(2 * na, 2 * na);
+    let mut position = vec![usize::MAX; n];
     for (i, &p) in dofs.iter().enumerate() {
-        for (j, &q) in dofs.iter().enumerate() {
-            let d = k[(p, q)] - hw * hw * m.mass[(p, q)];
-            let c = hw * m.damping[(p, q)];
-            a[(i, j)] = d;
-            a[(na + i, na + j)] = d;
-            a[(i, na + j)] = c;
-            a[(na + i, j)] = -c;
-        }
+        position[p] = i;
     }
+    // Real 2n form [[D, hωC], [−hωC, D]] with D = K − (hω)²M.
+    let mut a: Vec<(usize, usize, f64)> = Vec::new();
+    let mut push_d = |p: usize, q: usize, d: f64| {
+        let (i, j) = (position[p], position[q]);
+        if i != usize::MAX && j != usize::MAX {
+            a.push((i, j, d));
+            a.push((na + i, na + j, d));
+        }
+    };
+    for &(p, q, v) in k {
+        push_d(p, q, v);
+    }
+    m.mass
+        .for_each_nonzero(|p, q, v| push_d(p, q, -hw * hw * v));
+    m.damping.for_each_nonzero(|p, q, v| {
+        let (i, j) = (position[p], position[q]);
+        if i != usize::MAX && j != usize::MAX {
+            a.push((i, na + j, hw * v));
+            a.push((na + i, j, -hw * v));
+        }
+    });
     let mut rhs = vec![0.0; 2 * na];
     for l in problem
         .harmonic_loads
         .iter()
         .filter(|l| l.harmonic == harmonic)
     {
-        if let Some(i) = dofs.iter().position(|&d| d == l.dof) {
-            rhs[i] += l.cos;
-            rhs[na + i] += l.sin;
+        if position[l.dof] != usize::MAX {
+            rhs[position[l.dof]] += l.cos;
+            rhs[na + position[l.dof]] += l.sin;
         }
     }
     let mut qc = vec![0.0; n];
@@ -119,7 +133,7 @@ fn harmonic_response(
     if na == 0 {
         return Ok((qc, qs));
     }
-    let sol = solve_dense(&a, &rhs)?;
+    let sol = solve_triplets(2 * na, &a, &rhs, problem.model.stiffness.is_sparse())?;
     for (i, &p) in dofs.iter().enumerate() {
         qc[p] = sol[i];
         qs[p] = sol[na + i];
@@ -163,7 +177,7 @@ pub fn stuck_guess(
                     rhs[p] += c.law.kn * c.gap * a;
                 }
             }
-            let q0 = solve_dense(&k, &rhs)?;
+            let q0 = solve_triplets(n, &k, &rhs, problem.model.stiffness.is_sparse())?;
             let j = set.constant_block().expect("h = 0 is in the set");
             x[j * n..(j + 1) * n].copy_from_slice(&q0);
         } else {

@@ -5,23 +5,22 @@
 //! N·s/m, forces in N, displacements in m; frequencies are in Hz in [`Analysis`] and converted
 //! to ω (rad/s) by the solver.
 
-use faer::Mat;
-
 use crate::aft::MarchSettings;
 use crate::contact::{ContactEffects, ContactPoint, DamperSide};
 use crate::harmonic::HarmonicSet;
+use crate::matrix::StructuralMatrix;
 
-/// Dense linear structure for lumped or reduced models.
+/// Linear structure: dense for lumped or reduced models, sparse for unreduced FE models.
 #[derive(Debug, Clone)]
 pub struct LinearModel {
     /// DOF names, in matrix order.
     pub dof_names: Vec<String>,
     /// Mass matrix M (kg), symmetric positive semi-definite.
-    pub mass: Mat<f64>,
+    pub mass: StructuralMatrix,
     /// Viscous damping matrix C (N·s/m).
-    pub damping: Mat<f64>,
+    pub damping: StructuralMatrix,
     /// Stiffness matrix K (N/m), symmetric positive semi-definite (free bodies allowed).
-    pub stiffness: Mat<f64>,
+    pub stiffness: StructuralMatrix,
 }
 
 impl LinearModel {
@@ -82,6 +81,23 @@ pub enum JacobianStrategy {
     CentralDifference,
 }
 
+/// How the harmonic-balance equations are stored and solved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Formulation {
+    /// Dense for small models, sparse for large or sparse ones, condensed for dense models
+    /// whose contact DOFs are few compared with the rest (see [`Problem::formulation`]).
+    #[default]
+    Auto,
+    /// All DOFs, dense Jacobian (dense LU).
+    Dense,
+    /// All DOFs, sparse Jacobian (sparse LU, symbolic factorisation once per scene).
+    Sparse,
+    /// Contact DOFs only: the linear DOFs are eliminated per harmonic (dynamic Schur
+    /// complement), dense Jacobian on the contact DOFs.
+    Condensed,
+}
+
 /// Continuation and Newton settings. Frequencies in Hz; arc-length steps are measured in the
 /// scaled space where a unit of frequency is 1 Hz (see [`crate::continuation`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -108,6 +124,8 @@ pub struct Analysis {
     pub step_tolerance: f64,
     /// Jacobian strategy.
     pub jacobian: JacobianStrategy,
+    /// Storage and elimination of the harmonic-balance equations.
+    pub formulation: Formulation,
     /// Points of the uniform frequency grid of the linear references.
     pub linear_points: usize,
 }
@@ -157,4 +175,41 @@ impl Problem {
         h.push(0);
         HarmonicSet::new(h)
     }
+
+    /// DOFs touched by some contact (sorted, unique): the nonlinear DOFs.
+    pub fn contact_dofs(&self) -> Vec<usize> {
+        let mut dofs: Vec<usize> = self
+            .contacts
+            .iter()
+            .flat_map(|c| c.tangential.iter().chain(&c.normal).map(|&(d, _)| d))
+            .collect();
+        dofs.sort_unstable();
+        dofs.dedup();
+        dofs
+    }
+
+    /// The formulation actually used: the scene's choice, or for `auto` the sparse one on
+    /// sparse models and on dense models with more than [`DENSE_LIMIT`] unknowns, the
+    /// condensed one on dense models of that size whose contact DOFs are at most half of the
+    /// DOFs, and the dense one otherwise.
+    pub fn formulation(&self) -> Formulation {
+        match self.analysis.formulation {
+            Formulation::Auto => {
+                let unknowns = self.model.n_dofs() * self.unknown_harmonics().n_blocks();
+                if self.model.stiffness.is_sparse() {
+                    Formulation::Sparse
+                } else if unknowns <= DENSE_LIMIT {
+                    Formulation::Dense
+                } else if 2 * self.contact_dofs().len() <= self.model.n_dofs() {
+                    Formulation::Condensed
+                } else {
+                    Formulation::Sparse
+                }
+            }
+            f => f,
+        }
+    }
 }
+
+/// Most unknowns for which `auto` keeps a dense full Jacobian.
+pub const DENSE_LIMIT: usize = 600;

@@ -11,8 +11,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::aft::MarchSettings;
 use crate::contact::{ContactEffects, ContactPoint, DamperSide, JenkinsLaw, NormalLoad};
+use crate::matrix::StructuralMatrix;
 use crate::model::{
-    Analysis, Coupling, Effects, HarmonicLoad, JacobianStrategy, LinearModel, Problem,
+    Analysis, Coupling, Effects, Formulation, HarmonicLoad, JacobianStrategy, LinearModel, Problem,
 };
 
 /// A scene could not be read or is invalid.
@@ -327,6 +328,9 @@ pub struct AnalysisSpec {
     /// `analytic` (default), `forward-difference` or `central-difference`.
     #[serde(default)]
     pub jacobian: JacobianStrategy,
+    /// `auto` (default), `dense`, `sparse` or `condensed`.
+    #[serde(default)]
+    pub formulation: Formulation,
     /// Points of the uniform grid for the linear references.
     #[serde(default = "default_linear_points")]
     pub linear_points: usize,
@@ -989,9 +993,9 @@ impl Scene {
         let problem = Problem {
             model: LinearModel {
                 dof_names: dofs.clone(),
-                mass,
-                damping,
-                stiffness,
+                mass: StructuralMatrix::Dense(mass),
+                damping: StructuralMatrix::Dense(damping),
+                stiffness: StructuralMatrix::Dense(stiffness),
             },
             contacts,
             sides,
@@ -1022,6 +1026,7 @@ impl Scene {
                 residual_tolerance,
                 step_tolerance,
                 jacobian: a.jacobian,
+                formulation: a.formulation,
                 linear_points: a.linear_points,
             },
             outputs,
@@ -1030,12 +1035,9 @@ impl Scene {
         self.validate_sweep(&ck)?;
         // The structure with stuck contacts must be able to carry static loads.
         let k_stuck = {
-            let mut k = problem.model.stiffness.clone();
-            let kc = crate::linear::contact_stiffness(&problem);
-            for j in 0..n {
-                for i in 0..n {
-                    k[(i, j)] += kc[(i, j)];
-                }
+            let mut k = problem.model.stiffness.to_dense();
+            for (i, j, v) in crate::linear::contact_stiffness(&problem) {
+                k[(i, j)] += v;
             }
             k
         };

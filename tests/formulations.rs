@@ -1,0 +1,257 @@
+//! Dense, sparse and condensed formulations of the harmonic balance solve the same problem:
+//! same solutions to solver tolerance, Jacobians that match central differences, and sparse
+//! or dense storage of the structural matrices giving the same answers.
+
+use faer::Mat;
+use fricbound::frf::{self, PointSolver, Silent};
+use fricbound::hbm::{check_jacobian, check_operator_jacobian, HbmSystem};
+use fricbound::jacobian::Storage;
+use fricbound::matrix::StructuralMatrix;
+use fricbound::model::{Formulation, HarmonicLoad, JacobianStrategy, Problem};
+use fricbound::operator::HbmOperator;
+use fricbound::reference::paper_wedge_scene;
+use fricbound::scene;
+
+fn paper(overrides: &[&str]) -> Problem {
+    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    scene::parse(paper_wedge_scene(), "paper", &o)
+        .unwrap()
+        .validate("paper")
+        .unwrap()
+}
+
+/// The paper system with a flexible tip on each blade DOF: tip masses (0.3 kg) tied to the
+/// blade DOFs by springs (4e5 N/m), damped (5 N s/m), excited and observed at the tips. The
+/// tips carry no contact, so the condensed formulation eliminates them.
+fn with_blade_tips(mut p: Problem) -> Problem {
+    let n0 = p.model.n_dofs();
+    let n = n0 + 4;
+    let (m0, c0, k0) = (
+        p.model.mass.to_dense(),
+        p.model.damping.to_dense(),
+        p.model.stiffness.to_dense(),
+    );
+    let grow =
+        |a: &Mat<f64>| Mat::from_fn(n, n, |i, j| if i < n0 && j < n0 { a[(i, j)] } else { 0.0 });
+    let (mut m, mut c, mut k) = (grow(&m0), grow(&c0), grow(&k0));
+    for t in 0..4 {
+        let (tip, root) = (n0 + t, t);
+        m[(tip, tip)] = 0.3;
+        c[(tip, tip)] = 5.0;
+        let s = 4.0e5;
+        k[(tip, tip)] += s;
+        k[(root, root)] += s;
+        k[(tip, root)] -= s;
+        k[(root, tip)] -= s;
+    }
+    p.model.mass = StructuralMatrix::Dense(m);
+    p.model.damping = StructuralMatrix::Dense(c);
+    p.model.stiffness = StructuralMatrix::Dense(k);
+    for name in ["x1t", "y1t", "x2t", "y2t"] {
+        p.model.dof_names.push(name.to_string());
+    }
+    p.static_load.resize(n, 0.0);
+    p.harmonic_loads = p
+        .harmonic_loads
+        .iter()
+        .map(|l| HarmonicLoad {
+            dof: n0 + l.dof,
+            ..*l
+        })
+        .collect();
+    p.outputs = vec![n0 + 3, 3];
+    p
+}
+
+fn to_sparse(a: &StructuralMatrix) -> StructuralMatrix {
+    StructuralMatrix::sparse_from_triplets(a.n(), &a.triplets())
+}
+
+fn sparse_storage(mut p: Problem) -> Problem {
+    p.model.mass = to_sparse(&p.model.mass);
+    p.model.damping = to_sparse(&p.model.damping);
+    p.model.stiffness = to_sparse(&p.model.stiffness);
+    p
+}
+
+fn with_formulation(mut p: Problem, f: Formulation) -> Problem {
+    p.analysis.formulation = f;
+    p
+}
+
+/// Solves every variant at frequencies along the dense path and compares the coefficients.
+fn assert_variants_agree(base: &Problem, variants: &[(&str, Problem)]) {
+    let run = frf::solve(base, &mut Silent).unwrap();
+    let lo = run.points.first().unwrap().freq_hz;
+    let hi = run.points.last().unwrap().freq_hz;
+    let mut reference = PointSolver::new(base).unwrap();
+    for (name, variant) in variants {
+        let mut solver = PointSolver::new(variant).unwrap();
+        let mut compared = 0;
+        for i in 1..40 {
+            let f = lo + (hi - lo) * i as f64 / 40.0;
+            let guess = frf::interpolate_on_path(&run.points, f).unwrap();
+            let (Ok(a), Ok(b)) = (reference.solve(&guess, f), solver.solve(&guess, f)) else {
+                continue;
+            };
+            let scale = a.coefficients.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            let diff = a
+                .coefficients
+                .iter()
+                .zip(&b.coefficients)
+                .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+            assert!(
+                diff <= 1e-8 * scale,
+                "{name} at {f:.3} Hz: coefficients differ by {diff:.3e} (scale {scale:.3e})"
+            );
+            assert_eq!(a.states, b.states, "{name} at {f:.3} Hz");
+            compared += 1;
+        }
+        assert!(compared >= 30, "{name}: only {compared} points compared");
+    }
+}
+
+#[test]
+fn all_formulations_agree_on_the_paper_case_around_the_3rd_resonance() {
+    let base = paper(&[
+        "analysis.freq_start_hz=195",
+        "analysis.freq_end_hz=245",
+        "analysis.formulation=dense",
+        "contacts.0.initial_state=0.5",
+    ]);
+    let variants = [
+        (
+            "sparse",
+            with_formulation(base.clone(), Formulation::Sparse),
+        ),
+        (
+            "condensed",
+            with_formulation(base.clone(), Formulation::Condensed),
+        ),
+        (
+            "sparse storage, auto",
+            with_formulation(sparse_storage(base.clone()), Formulation::Auto),
+        ),
+    ];
+    assert_eq!(variants[2].1.formulation(), Formulation::Sparse);
+    assert_variants_agree(&base, &variants);
+}
+
+#[test]
+fn all_formulations_agree_with_eliminated_linear_dofs_and_three_harmonics() {
+    let base = with_blade_tips(paper(&[
+        "analysis.freq_start_hz=150",
+        "analysis.freq_end_hz=260",
+        "harmonics.max=3",
+        "analysis.formulation=dense",
+    ]));
+    let variants = [
+        (
+            "sparse",
+            with_formulation(base.clone(), Formulation::Sparse),
+        ),
+        (
+            "condensed",
+            with_formulation(base.clone(), Formulation::Condensed),
+        ),
+        (
+            "condensed, sparse storage",
+            with_formulation(sparse_storage(base.clone()), Formulation::Condensed),
+        ),
+        ("sparse, central differences", {
+            let mut p = with_formulation(base.clone(), Formulation::Sparse);
+            p.analysis.jacobian = JacobianStrategy::CentralDifference;
+            p
+        }),
+        ("condensed, forward differences", {
+            let mut p = with_formulation(base.clone(), Formulation::Condensed);
+            p.analysis.jacobian = JacobianStrategy::ForwardDifference;
+            p
+        }),
+    ];
+    assert_variants_agree(&base, &variants);
+}
+
+#[test]
+fn uncoupled_statics_agree_between_formulations() {
+    let base = with_blade_tips(paper(&[
+        "analysis.freq_start_hz=195",
+        "analysis.freq_end_hz=245",
+        "effects.coupling=uncoupled",
+        "analysis.formulation=dense",
+    ]));
+    let variants = [
+        ("sparse", sparse_storage(base.clone())),
+        (
+            "condensed",
+            with_formulation(base.clone(), Formulation::Condensed),
+        ),
+    ];
+    assert_variants_agree(&base, &variants);
+}
+
+#[test]
+fn sparse_and_condensed_jacobians_match_central_differences() {
+    let base = with_blade_tips(paper(&[
+        "analysis.freq_start_hz=150",
+        "analysis.freq_end_hz=260",
+        "harmonics.max=3",
+    ]));
+    let run = frf::solve(&base, &mut Silent).unwrap();
+    let sparse = with_formulation(sparse_storage(base.clone()), Formulation::Sparse);
+    let condensed = with_formulation(base.clone(), Formulation::Condensed);
+    let mut checked_slipping = 0;
+    for p in run.points.iter().step_by(7) {
+        let omega = 2.0 * std::f64::consts::PI * p.freq_hz;
+        let mut s = HbmSystem::new(&sparse).unwrap();
+        assert_eq!(s.storage(), Storage::Sparse);
+        let check = check_jacobian(&mut s, &p.coefficients, omega, 1e-7).unwrap();
+        assert!(
+            check.relative() < 1e-6,
+            "sparse at {:.3} Hz: {:.3e}",
+            p.freq_hz,
+            check.relative()
+        );
+        let mut c = HbmOperator::new(&condensed).unwrap();
+        let xc = c.restrict(&p.coefficients);
+        let check = check_operator_jacobian(&mut c, &xc, omega, 1e-7).unwrap();
+        assert!(
+            check.relative() < 1e-6,
+            "condensed at {:.3} Hz: {:.3e}",
+            p.freq_hz,
+            check.relative()
+        );
+        if p.states.iter().any(|s| s.is_unique()) {
+            checked_slipping += 1;
+        }
+    }
+    assert!(
+        checked_slipping >= 3,
+        "only {checked_slipping} slipping states checked"
+    );
+}
+
+#[test]
+fn full_continuation_runs_agree_between_formulations() {
+    let base = with_blade_tips(paper(&[
+        "analysis.freq_start_hz=195",
+        "analysis.freq_end_hz=245",
+        "analysis.formulation=dense",
+    ]));
+    // Paths differ in their steps (the arc length is measured on each formulation's own
+    // unknowns), so compare the refined peaks, which do not depend on the sampling.
+    let peak = |p: &Problem| {
+        let run = frf::solve(p, &mut Silent).unwrap();
+        fricbound::limits::refine_peak(p, &run.points, 0)
+            .unwrap()
+            .amplitude
+    };
+    let dense = peak(&base);
+    for f in [Formulation::Sparse, Formulation::Condensed] {
+        let other = peak(&with_formulation(base.clone(), f));
+        assert!(
+            (other - dense).abs() <= 1e-6 * dense,
+            "{f:?}: refined peak {other:.8e} vs dense {dense:.8e}"
+        );
+    }
+}
