@@ -1,8 +1,9 @@
 //! The Craig-Bampton reduction itself.
 
-use crate::csc::{canonical_symmetric, split, Blocks, Part};
+use crate::block::{sym_mul_rows, RowBlock};
+use crate::csc::{canonical_symmetric, split, Blocks, Part, SymView};
 use crate::eigen::{lambda_to_hz, lowest_modes, Eigen, LanczosOptions};
-use crate::factor::{PivotContext, SpdFactor};
+use crate::factor::{fill_reducing_order, PivotContext, SpdFactor};
 use crate::ordering::Ordering;
 use crate::ReductionError;
 use faer::linalg::matmul::matmul;
@@ -106,6 +107,13 @@ pub struct ReductionReport {
     pub eigen_restarts: usize,
     /// block solves of the Lanczos solver
     pub eigen_solves: usize,
+    /// where the eigen solve spent its time
+    pub eigen_timings: crate::eigen::EigenTimings,
+    /// seconds of the constraint-mode phase in solves with the factor
+    /// (summed over blocks; with several threads, over threads)
+    pub t_constraint_solve: f64,
+    /// seconds of the constraint-mode phase in products with M_II
+    pub t_constraint_mass: f64,
     /// block Lanczos block size
     pub lanczos_block: usize,
     /// constraint-mode block size
@@ -157,6 +165,17 @@ impl std::fmt::Display for ReductionReport {
             f,
             "  eigen: max residual {:.2e}, {} restarts, {} block solves (block {})",
             self.eigen_max_residual, self.eigen_restarts, self.eigen_solves, self.lanczos_block
+        )?;
+        let e = &self.eigen_timings;
+        writeln!(
+            f,
+            "  eigen seconds: solves {:.2}, M products {:.2}, orthogonalisation {:.2}, Rayleigh-Ritz/restart {:.2}, check {:.2}",
+            e.solve, e.mass, e.orthogonalise, e.restart, e.check
+        )?;
+        writeln!(
+            f,
+            "  constraint-mode seconds: solves {:.2}, M products {:.2}",
+            self.t_constraint_solve, self.t_constraint_mass
         )?;
         writeln!(
             f,
@@ -423,18 +442,34 @@ pub fn craig_bampton(
         return Ok(model);
     }
 
-    let full_index = |i: usize| interior_full[i];
+    // elimination order of K_II; the interior DOFs are renumbered in it so
+    // that the factor solves in place without permutation copies
+    let (fwd, inv, t_ordering) = fill_reducing_order(&kb.ii_lower, options.ordering)?;
+    // K_II and M_II stay in mesh order for cache-friendly products; only
+    // the coupling blocks and the factored copy of K_II are renumbered
+    let kb = permute_coupling(kb, &inv);
+    let mb = permute_coupling(mb, &inv);
+    let part: Vec<Part> = part
+        .into_iter()
+        .map(|p| match p {
+            Part::Interior(i) => Part::Interior(inv[i]),
+            b => b,
+        })
+        .collect();
+    let local_index = |i: usize| fwd[i];
+    let full_index = |i: usize| interior_full[fwd[i]];
+    let k_ii_perm = kb.ii_lower.permute_sym_lower(&inv);
     let factor = SpdFactor::new(
-        &kb.ii_lower,
-        options.ordering,
-        Par::Seq,
+        &k_ii_perm,
         &PivotContext {
             matrix: "K_II",
             context: "interior",
+            local_index: &local_index,
             full_index: &full_index,
         },
     )?;
-    report.t_ordering = factor.ordering_seconds;
+    drop(k_ii_perm);
+    report.t_ordering = t_ordering;
     report.t_symbolic = factor.symbolic_seconds;
     report.t_numeric = factor.numeric_seconds;
     report.factor_nnz = factor.factor_entries();
@@ -448,8 +483,14 @@ pub fn craig_bampton(
         (options.n_modes + extra).min(n_i)
     };
     let eig = lowest_modes(
-        &kb.ii_lower,
-        &mb.ii_lower,
+        SymView {
+            lower: &kb.ii_lower,
+            inv: Some(&inv),
+        },
+        SymView {
+            lower: &mb.ii_lower,
+            inv: Some(&inv),
+        },
         &factor,
         0.0,
         n_comp,
@@ -482,6 +523,7 @@ pub fn craig_bampton(
         max_residual,
         restarts,
         solves,
+        timings,
     } = eig;
     let next_hz = values.get(nm).map(|&l| lambda_to_hz(l));
     let lambdas: Vec<f64> = values[..nm].to_vec();
@@ -494,12 +536,15 @@ pub fn craig_bampton(
     report.eigen_max_residual = max_residual;
     report.eigen_restarts = restarts;
     report.eigen_solves = solves;
+    report.eigen_timings = timings;
     report.t_eigen = t0.elapsed().as_secs_f64();
 
     // constraint modes, block by block
     let t0 = Instant::now();
-    let cons = constraint_blocks(&kb, &mb, &factor, &phi, &part, recover, options)?;
+    let cons = constraint_blocks(&kb, &mb, &inv, &factor, &phi, &part, recover, options)?;
     report.t_constraint = t0.elapsed().as_secs_f64();
+    report.t_constraint_solve = cons.t_solve;
+    report.t_constraint_mass = cons.t_mass;
 
     let size = nb + nm;
     let mut kr = Mat::zeros(size, size);
@@ -536,6 +581,14 @@ pub fn craig_bampton(
         recovery,
         report: finish_report(report, t_start),
     })
+}
+
+fn permute_coupling(b: Blocks, inv: &[usize]) -> Blocks {
+    Blocks {
+        ii_lower: b.ii_lower,
+        ib: b.ib.permute_rows(inv),
+        bb: b.bb,
+    }
 }
 
 fn finish_report(mut r: ReductionReport, t_start: Instant) -> ReductionReport {
@@ -593,6 +646,8 @@ struct ConstraintResult {
     coupling: Mat<f64>,
     /// Ψ rows (length nb) of the recovered DOFs (empty for boundary ones)
     psi_rows: Vec<Vec<f64>>,
+    t_solve: f64,
+    t_mass: f64,
 }
 
 /// Output of one column block `a` of Ψ.
@@ -608,8 +663,11 @@ struct BlockOut {
     coupling_rows: Mat<f64>,
     /// Ψ_a rows of the recovered interior DOFs: (position in recover, values)
     psi: Vec<(usize, Vec<f64>)>,
+    t_solve: f64,
+    t_mass: f64,
 }
 
+#[allow(clippy::too_many_arguments)]
 /// Ψ = −K_II⁻¹ K_IB computed `block_size` columns at a time; only the block
 /// in hand is held (3 dense `n_I × block_size` arrays). The term Ψᵀ M_II Ψ,
 /// which pairs every block with every other, is obtained without holding Ψ
@@ -618,6 +676,7 @@ struct BlockOut {
 fn constraint_blocks(
     kb: &Blocks,
     mb: &Blocks,
+    inv: &[usize],
     factor: &SpdFactor,
     phi: &Mat<f64>,
     part: &[Part],
@@ -638,25 +697,24 @@ fn constraint_blocks(
         })
         .collect();
     // M_BI Φ (nb × nm)
-    let mut mbi_phi = Mat::zeros(nb, nm);
-    mb.ib.transpose_mul(phi.as_ref(), mbi_phi.as_mut());
+    let mbi_phi = mb.ib.transpose_mul_rows(&RowBlock::from_mat(phi.as_ref()));
 
     let starts: Vec<usize> = (0..nb).step_by(bs).collect();
     let run_block = |start: usize| -> BlockOut {
         let w = bs.min(nb - start);
-        // Ψ_a = −K_II⁻¹ K_IB[:, a]
-        let mut psi = Mat::<f64>::zeros(n_i, w);
+        // Ψ_a = −K_II⁻¹ K_IB[:, a]   (row-major n_I × w)
+        let mut psi = RowBlock::zeros(n_i, w);
         for c in 0..w {
             let (rows, vals) = kb.ib.col(start + c);
             for (&i, &v) in rows.iter().zip(vals) {
-                psi[(i, c)] = -v;
+                psi.row_mut(i)[c] = -v;
             }
         }
-        factor.solve_in_place(psi.as_mut(), Par::Seq);
-        let mut k_cols = Mat::zeros(nb, w);
-        kb.ib.transpose_mul(psi.as_ref(), k_cols.as_mut());
-        let mut p_cols = Mat::zeros(nb, w);
-        mb.ib.transpose_mul(psi.as_ref(), p_cols.as_mut());
+        let t = Instant::now();
+        factor.solve_rows(&mut psi);
+        let mut t_solve = t.elapsed().as_secs_f64();
+        let mut k_cols = kb.ib.transpose_mul_rows(&psi);
+        let p_cols = mb.ib.transpose_mul_rows(&psi);
         for c in 0..w {
             for i in 0..nb {
                 k_cols[(i, c)] += kb.bb[(i, start + c)];
@@ -664,17 +722,19 @@ fn constraint_blocks(
         }
         let psi_rec: Vec<(usize, Vec<f64>)> = rec_int
             .iter()
-            .map(|&(pos, i)| (pos, (0..w).map(|c| psi[(i, c)]).collect()))
+            .map(|&(pos, i)| (pos, psi.row(i).to_vec()))
             .collect();
         // Z = M_II Ψ_a
-        let mut z = Mat::<f64>::zeros(n_i, w);
-        mb.ii_lower.sym_lower_mul(psi.as_ref(), z.as_mut());
+        let mut z = RowBlock::zeros(n_i, w);
+        let t = Instant::now();
+        sym_mul_rows(&mb.ii_lower, Some(inv), &psi, &mut z);
+        let t_mass = t.elapsed().as_secs_f64();
         drop(psi);
         let mut coupling_rows = Mat::zeros(w, nm);
         matmul(
             coupling_rows.as_mut(),
             Accum::Replace,
-            z.transpose(),
+            z.view().transpose(),
             phi.as_ref(),
             1.0,
             Par::Seq,
@@ -685,9 +745,10 @@ fn constraint_blocks(
             }
         }
         // Y = K_II⁻¹ Z; Ψᵀ M_II Ψ_a = −K_BI Y
-        factor.solve_in_place(z.as_mut(), Par::Seq);
-        let mut g_cols = Mat::zeros(nb, w);
-        kb.ib.transpose_mul(z.as_ref(), g_cols.as_mut());
+        let t = Instant::now();
+        factor.solve_rows(&mut z);
+        t_solve += t.elapsed().as_secs_f64();
+        let mut g_cols = kb.ib.transpose_mul_rows(&z);
         for c in 0..w {
             for i in 0..nb {
                 g_cols[(i, c)] = -g_cols[(i, c)];
@@ -700,6 +761,8 @@ fn constraint_blocks(
             g_cols,
             coupling_rows,
             psi: psi_rec,
+            t_solve,
+            t_mass,
         }
     };
     let threads = options.threads.max(1);
@@ -720,7 +783,10 @@ fn constraint_blocks(
     for &(pos, _) in &rec_int {
         psi_rows[pos] = vec![0.0; nb];
     }
+    let (mut t_solve, mut t_mass) = (0.0, 0.0);
     for o in outs {
+        t_solve += o.t_solve;
+        t_mass += o.t_mass;
         let w = o.k_cols.ncols();
         k_bb.as_mut().subcols_mut(o.start, w).copy_from(&o.k_cols);
         p.as_mut().subcols_mut(o.start, w).copy_from(&o.p_cols);
@@ -742,5 +808,7 @@ fn constraint_blocks(
         m_bb,
         coupling,
         psi_rows,
+        t_solve,
+        t_mass,
     })
 }

@@ -4,7 +4,6 @@
 
 use crate::ReductionError;
 use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat};
-use faer::{MatMut, MatRef};
 
 /// Plain CSC matrix with sorted row indices and no duplicates.
 #[derive(Debug, Clone)]
@@ -29,7 +28,7 @@ impl Csc {
 
     /// Transpose by counting sort: rows of the result come out sorted.
     /// Duplicated entries of `self` stay adjacent in the result.
-    fn transpose(&self) -> Csc {
+    pub fn transpose(&self) -> Csc {
         let mut count = vec![0usize; self.nrows + 1];
         for &i in &self.row_idx {
             count[i + 1] += 1;
@@ -85,69 +84,93 @@ impl Csc {
         self.col_ptr = new_ptr;
     }
 
-    /// Symmetric product `y = A x` where `self` holds the lower triangle
-    /// (diagonal included) of a symmetric `A`; `x`, `y` are `n × p`.
-    /// Runs on a row-interleaved copy so that each stored entry touches
-    /// contiguous memory; deterministic (sequential).
-    pub fn sym_lower_mul(&self, x: MatRef<'_, f64>, mut y: MatMut<'_, f64>) {
-        let n = self.nrows;
-        let p = x.ncols();
-        debug_assert_eq!(x.nrows(), n);
-        debug_assert_eq!(y.nrows(), n);
-        let mut xt = vec![0.0; n * p];
-        for c in 0..p {
-            let col = x.col(c);
-            for i in 0..n {
-                xt[i * p + c] = col[i];
+    /// Lower triangle of `P A Pᵀ` (new index `inv[old]`) for `self` the
+    /// lower triangle of a symmetric `A`; rows sorted.
+    pub fn permute_sym_lower(&self, inv: &[usize]) -> Csc {
+        let n = self.ncols;
+        let mut count = vec![0usize; n + 1];
+        for j in 0..n {
+            for &i in self.col(j).0 {
+                let c = inv[i].min(inv[j]);
+                count[c + 1] += 1;
             }
         }
-        let mut yt = vec![0.0; n * p];
-        let mut acc = vec![0.0; p];
-        for j in 0..self.ncols {
+        for c in 0..n {
+            count[c + 1] += count[c];
+        }
+        let col_ptr = count.clone();
+        let mut next = count;
+        let mut row_idx = vec![0usize; self.nnz()];
+        let mut val = vec![0.0; self.nnz()];
+        for j in 0..n {
             let (rows, vals) = self.col(j);
-            let xj = &xt[j * p..(j + 1) * p];
-            acc.iter_mut().for_each(|a| *a = 0.0);
             for (&i, &v) in rows.iter().zip(vals) {
-                if i == j {
-                    for c in 0..p {
-                        acc[c] += v * xj[c];
-                    }
-                } else {
-                    let xi = &xt[i * p..(i + 1) * p];
-                    let yi = &mut yt[i * p..(i + 1) * p];
-                    for c in 0..p {
-                        yi[c] += v * xj[c];
-                        acc[c] += v * xi[c];
-                    }
-                }
-            }
-            let yj = &mut yt[j * p..(j + 1) * p];
-            for c in 0..p {
-                yj[c] += acc[c];
+                let (a, b) = (inv[i], inv[j]);
+                let (r, c) = (a.max(b), a.min(b));
+                row_idx[next[c]] = r;
+                val[next[c]] = v;
+                next[c] += 1;
             }
         }
-        for c in 0..p {
-            let mut col = y.as_mut().col_mut(c);
-            for i in 0..n {
-                col[i] = yt[i * p + c];
+        let mut out = Csc {
+            nrows: n,
+            ncols: n,
+            col_ptr,
+            row_idx,
+            val,
+        };
+        out.sort_columns();
+        out
+    }
+
+    /// Rows renumbered: row `i` becomes `inv[i]`; rows sorted.
+    pub fn permute_rows(&self, inv: &[usize]) -> Csc {
+        let mut out = self.clone();
+        for r in out.row_idx.iter_mut() {
+            *r = inv[*r];
+        }
+        out.sort_columns();
+        out
+    }
+
+    fn sort_columns(&mut self) {
+        let mut pairs: Vec<(usize, f64)> = Vec::new();
+        for j in 0..self.ncols {
+            let r = self.col_ptr[j]..self.col_ptr[j + 1];
+            pairs.clear();
+            pairs.extend(
+                self.row_idx[r.clone()]
+                    .iter()
+                    .copied()
+                    .zip(self.val[r.clone()].iter().copied()),
+            );
+            pairs.sort_unstable_by_key(|&(i, _)| i);
+            for (k, (i, v)) in pairs.iter().enumerate() {
+                self.row_idx[r.start + k] = *i;
+                self.val[r.start + k] = *v;
             }
         }
     }
 
-    /// `y (ncols × p) = selfᵀ x` for a general (rectangular) CSC, `x` is `nrows × p`.
-    pub fn transpose_mul(&self, x: MatRef<'_, f64>, mut y: MatMut<'_, f64>) {
-        let p = x.ncols();
-        for c in 0..p {
-            let xc = x.col(c);
-            for j in 0..self.ncols {
-                let (rows, vals) = self.col(j);
-                let mut s = 0.0;
-                for (&i, &v) in rows.iter().zip(vals) {
-                    s += v * xc[i];
+    /// `selfᵀ x` for a general CSC and a row-major `x` (`nrows × k`):
+    /// returns `ncols × k` (column-major).
+    pub fn transpose_mul_rows(&self, x: &crate::block::RowBlock) -> faer::Mat<f64> {
+        let k = x.k;
+        let mut out = faer::Mat::zeros(self.ncols, k);
+        let mut acc = vec![0.0; k];
+        for j in 0..self.ncols {
+            let (rows, vals) = self.col(j);
+            acc.iter_mut().for_each(|a| *a = 0.0);
+            for (&i, &v) in rows.iter().zip(vals) {
+                for (a, xv) in acc.iter_mut().zip(x.row(i)) {
+                    *a += v * xv;
                 }
-                y[(j, c)] = s;
+            }
+            for (c, a) in acc.iter().enumerate() {
+                out[(j, c)] = *a;
             }
         }
+        out
     }
 
     /// The lower triangle as a faer matrix (sorted, for the factorisation).
@@ -160,6 +183,40 @@ impl Csc {
             self.row_idx.clone(),
         );
         SparseColMat::new(symbolic, self.val.clone())
+    }
+}
+
+/// A symmetric matrix stored as its lower triangle in natural order, seen
+/// in a permuted numbering (`inv[natural] = permuted`).
+#[derive(Clone, Copy)]
+pub(crate) struct SymView<'a> {
+    pub lower: &'a Csc,
+    pub inv: Option<&'a [usize]>,
+}
+
+impl SymView<'_> {
+    pub fn n(&self) -> usize {
+        self.lower.ncols
+    }
+
+    /// `y = A x` on row-major blocks.
+    pub fn mul_rows(&self, x: &crate::block::RowBlock, y: &mut crate::block::RowBlock) {
+        crate::block::sym_mul_rows(self.lower, self.inv, x, y)
+    }
+
+    /// Dense copy in the permuted numbering.
+    pub fn dense(&self) -> faer::Mat<f64> {
+        let n = self.n();
+        let map = |i: usize| self.inv.map(|v| v[i]).unwrap_or(i);
+        let mut a = faer::Mat::zeros(n, n);
+        for j in 0..n {
+            let (rows, vals) = self.lower.col(j);
+            for (&i, &v) in rows.iter().zip(vals) {
+                a[(map(i), map(j))] = v;
+                a[(map(j), map(i))] = v;
+            }
+        }
+        a
     }
 }
 
@@ -406,11 +463,24 @@ mod tests {
         let c = canonical_symmetric(a.as_ref(), "A", 4).unwrap();
         let l = lower(&c);
         let x = Mat::from_fn(4, 3, |i, j| (i * 3 + j) as f64 - 2.5);
-        let mut y = Mat::zeros(4, 3);
-        l.sym_lower_mul(x.as_ref(), y.as_mut());
         let dense = a.to_dense();
         let y_ref = &dense * &x;
-        assert!((&y - &y_ref).norm_max() < 1e-14);
+        let xr = crate::block::RowBlock::from_mat(x.as_ref());
+        let mut yr = crate::block::RowBlock::zeros(4, 3);
+        crate::block::sym_mul_rows(&l, None, &xr, &mut yr);
+        assert!((yr.view() - &y_ref).norm_max() < 1e-14);
+        // permuted numbering: y_p = P A Pᵀ x_p
+        let inv = [2usize, 0, 3, 1];
+        let xp = Mat::from_fn(4, 3, |i, j| {
+            x[(inv.iter().position(|&v| v == i).unwrap(), j)]
+        });
+        let xr = crate::block::RowBlock::from_mat(xp.as_ref());
+        crate::block::sym_mul_rows(&l, Some(&inv), &xr, &mut yr);
+        for i in 0..4 {
+            for j in 0..3 {
+                assert!((yr.view()[(inv[i], j)] - y_ref[(i, j)]).abs() < 1e-14);
+            }
+        }
     }
 
     #[test]

@@ -16,11 +16,13 @@
 //!   fallback of the sparse solver for small problems), and the reduced-model
 //!   solver [`dense_generalized_eigenvalues`] (Cholesky of `M_r`).
 
-use crate::csc::Csc;
+use crate::block::RowBlock;
+use crate::csc::SymView;
 use crate::factor::SpdFactor;
 use crate::ReductionError;
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
+use std::time::Instant;
 
 /// Eigenpairs of `K φ = λ M φ`: values ascending (rad²/s² for SI models),
 /// vectors mass-normalised (`φᵀ M φ = 1`), one per column.
@@ -36,6 +38,23 @@ pub struct Eigen {
     pub restarts: usize,
     /// number of block solves with the factor of `K − σM`
     pub solves: usize,
+    /// where the time of the Lanczos process went
+    pub timings: EigenTimings,
+}
+
+/// Seconds spent in the parts of the block Lanczos process.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EigenTimings {
+    /// solves with the factor of `K − σM`
+    pub solve: f64,
+    /// sparse products with `M`
+    pub mass: f64,
+    /// Gram-Schmidt and block orthonormalisation (dense)
+    pub orthogonalise: f64,
+    /// Rayleigh-Ritz and thick restarts
+    pub restart: f64,
+    /// final residual check and normalisation
+    pub check: f64,
 }
 
 impl Eigen {
@@ -95,15 +114,15 @@ impl Rng {
 /// The lowest `nev` eigenpairs of `K φ = λ M φ` above `sigma`, given the
 /// factor of `K − σM`. `k_lower`, `m_lower`: lower triangles.
 pub(crate) fn lowest_modes(
-    k_lower: &Csc,
-    m_lower: &Csc,
+    k_lower: SymView<'_>,
+    m_lower: SymView<'_>,
     factor: &SpdFactor,
     sigma: f64,
     nev: usize,
     opts: &LanczosOptions,
     par: Par,
 ) -> Result<Eigen, ReductionError> {
-    let n = k_lower.ncols;
+    let n = k_lower.n();
     if nev > n {
         return Err(ReductionError::TooManyModes {
             asked: nev,
@@ -118,6 +137,7 @@ pub(crate) fn lowest_modes(
             max_residual: 0.0,
             restarts: 0,
             solves: 0,
+            timings: EigenTimings::default(),
         });
     }
     let p = opts.block.max(1);
@@ -127,7 +147,9 @@ pub(crate) fn lowest_modes(
     } else {
         block_lanczos(m_lower, factor, sigma, nev, ncv, opts, par)?
     };
+    let t0 = std::time::Instant::now();
     normalise_and_check(k_lower, m_lower, sigma, &mut eig)?;
+    eig.timings.check = t0.elapsed().as_secs_f64();
     Ok(eig)
 }
 
@@ -137,22 +159,22 @@ fn round_up(x: usize, p: usize) -> usize {
 
 /// Mass-normalise, replace λ by the Rayleigh quotient, compute residuals.
 fn normalise_and_check(
-    k_lower: &Csc,
-    m_lower: &Csc,
+    k_lower: SymView<'_>,
+    m_lower: SymView<'_>,
     sigma: f64,
     eig: &mut Eigen,
 ) -> Result<(), ReductionError> {
-    let n = k_lower.ncols;
+    let n = k_lower.n();
     let q = eig.values.len();
-    let mut kx = Mat::zeros(n, q);
-    let mut mx = Mat::zeros(n, q);
-    k_lower.sym_lower_mul(eig.vectors.as_ref(), kx.as_mut());
-    m_lower.sym_lower_mul(eig.vectors.as_ref(), mx.as_mut());
+    let kx = m_mul(k_lower, eig.vectors.as_ref());
+    let mx = m_mul(m_lower, eig.vectors.as_ref());
     let mut worst = 0.0f64;
     for c in 0..q {
-        let x = eig.vectors.col(c);
-        let xmx: f64 = (0..n).map(|i| x[i] * mx[(i, c)]).sum();
-        let xkx: f64 = (0..n).map(|i| x[i] * kx[(i, c)]).sum();
+        let x = eig.vectors.col_as_slice(c);
+        let kc = kx.col_as_slice(c);
+        let mc = mx.col_as_slice(c);
+        let xmx: f64 = x.iter().zip(mc).map(|(a, b)| a * b).sum();
+        let xkx: f64 = x.iter().zip(kc).map(|(a, b)| a * b).sum();
         if xmx <= 0.0 || !xmx.is_finite() {
             return Err(ReductionError::MassNotPositive {
                 matrix: "M",
@@ -162,21 +184,29 @@ fn normalise_and_check(
         let lambda = xkx / xmx;
         let s = 1.0 / xmx.sqrt();
         let (mut r2, mut k2, mut a2) = (0.0, 0.0, 0.0);
-        for i in 0..n {
-            let r = kx[(i, c)] - lambda * mx[(i, c)];
-            let a = kx[(i, c)] - sigma * mx[(i, c)];
+        for (kv, mv) in kc.iter().zip(mc) {
+            let r = kv - lambda * mv;
+            let a = kv - sigma * mv;
             r2 += r * r;
-            k2 += kx[(i, c)] * kx[(i, c)];
+            k2 += kv * kv;
             a2 += a * a;
         }
         let denom = k2.max(a2).sqrt();
         let res = if denom > 0.0 { r2.sqrt() / denom } else { 0.0 };
         worst = worst.max(res);
         eig.values[c] = lambda;
-        let mut col = eig.vectors.col_mut(c);
-        for i in 0..n {
-            col[i] *= s;
-        }
+        // sign: the first (in natural order) largest component is positive
+        let col = eig.vectors.col(c);
+        let big = (0..n).map(|i| col[i].abs()).fold(0.0, f64::max);
+        let first = (0..n)
+            .map(|i| k_lower.inv.map(|v| v[i]).unwrap_or(i))
+            .find(|&r| col[r].abs() >= (1.0 - 1e-6) * big)
+            .unwrap_or(0);
+        let s = if col[first] < 0.0 { -s } else { s };
+        eig.vectors
+            .col_as_slice_mut(c)
+            .iter_mut()
+            .for_each(|v| *v *= s);
     }
     eig.max_residual = worst;
     // keep ascending order after the Rayleigh-quotient update
@@ -191,29 +221,16 @@ fn normalise_and_check(
     Ok(())
 }
 
-fn to_dense_sym(lower: &Csc) -> Mat<f64> {
-    let n = lower.ncols;
-    let mut a = Mat::zeros(n, n);
-    for j in 0..n {
-        let (rows, vals) = lower.col(j);
-        for (&i, &v) in rows.iter().zip(vals) {
-            a[(i, j)] = v;
-            a[(j, i)] = v;
-        }
-    }
-    a
-}
-
 /// Dense path: `K − σM = L Lᵀ`, `C = L⁻¹ M L⁻ᵀ`, `θ = 1/(λ − σ)`.
 fn dense_lowest(
-    k_lower: &Csc,
-    m_lower: &Csc,
+    k_lower: SymView<'_>,
+    m_lower: SymView<'_>,
     sigma: f64,
     nev: usize,
 ) -> Result<Eigen, ReductionError> {
-    let n = k_lower.ncols;
-    let k = to_dense_sym(k_lower);
-    let m = to_dense_sym(m_lower);
+    let n = k_lower.n();
+    let k = k_lower.dense();
+    let m = m_lower.dense();
     let a = &k - sigma * &m;
     let llt = a
         .llt(Side::Lower)
@@ -225,11 +242,7 @@ fn dense_lowest(
     let mut c = x.transpose().to_owned();
     faer::linalg::triangular_solve::solve_lower_triangular_in_place(l, c.as_mut(), Par::Seq);
     let c = symmetrise(c.as_ref());
-    let evd = c
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| ReductionError::LinearAlgebra(format!("dense eigen solver ({e:?})")))?;
-    let s = evd.S().column_vector();
-    let u = evd.U();
+    let (s, u) = sym_eigen(c.as_ref())?;
     // largest θ first
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by(|&a, &b| s[b].total_cmp(&s[a]));
@@ -253,7 +266,44 @@ fn dense_lowest(
         max_residual: 0.0,
         restarts: 0,
         solves: 0,
+        timings: EigenTimings::default(),
     })
+}
+
+/// Eigen-decomposition of a small dense symmetric matrix (lower triangle
+/// read): values ascending, orthonormal vectors. Uses faer's tridiagonal QR
+/// algorithm at every size: in faer 0.24.4 the divide-and-conquer path
+/// (taken by `self_adjoint_eigen` from n = 128 on) returned eigenvectors with
+/// relative residuals near 1e-3 on our reduced matrices.
+pub(crate) fn sym_eigen(a: MatRef<'_, f64>) -> Result<(Vec<f64>, Mat<f64>), ReductionError> {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::linalg::evd::{
+        self_adjoint_evd, self_adjoint_evd_scratch, ComputeEigenvectors, SelfAdjointEvdParams,
+    };
+    let n = a.nrows();
+    let mut params: faer::Spec<SelfAdjointEvdParams, f64> = Default::default();
+    params.config.recursion_threshold = usize::MAX;
+    let req = self_adjoint_evd_scratch::<f64>(n, ComputeEigenvectors::Yes, Par::Seq, params);
+    let mut mem = MemBuffer::try_new(req).map_err(|_| {
+        ReductionError::LinearAlgebra("out of memory for a dense eigen solve".into())
+    })?;
+    let mut s = faer::diag::Diag::<f64>::zeros(n);
+    let mut u = Mat::<f64>::zeros(n, n);
+    self_adjoint_evd(
+        a,
+        s.as_mut(),
+        Some(u.as_mut()),
+        Par::Seq,
+        MemStack::new(&mut mem),
+        params,
+    )
+    .map_err(|e| ReductionError::LinearAlgebra(format!("dense symmetric eigen solver ({e:?})")))?;
+    let sv = s.column_vector();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&x, &y| sv[x].total_cmp(&sv[y]));
+    let values = order.iter().map(|&i| sv[i]).collect();
+    let vectors = Mat::from_fn(n, n, |i, c| u[(i, order[c])]);
+    Ok((values, vectors))
 }
 
 fn symmetrise(a: MatRef<'_, f64>) -> Mat<f64> {
@@ -268,10 +318,12 @@ fn gs_pass(v: MatRef<'_, f64>, z: MatRef<'_, f64>, w: MatMut<'_, f64>, par: Par)
     c
 }
 
-fn m_mul(m_lower: &Csc, x: MatRef<'_, f64>) -> Mat<f64> {
-    let mut z = Mat::zeros(x.nrows(), x.ncols());
-    m_lower.sym_lower_mul(x, z.as_mut());
-    z
+/// `A x` for a column-major block (through a row-major copy).
+fn m_mul(a: SymView<'_>, x: MatRef<'_, f64>) -> Mat<f64> {
+    let xr = RowBlock::from_mat(x);
+    let mut z = RowBlock::zeros(x.nrows(), x.ncols());
+    a.mul_rows(&xr, &mut z);
+    z.view().to_owned()
 }
 
 /// `(V_new, M V_new, R)`
@@ -282,7 +334,7 @@ type OrthoBlock = (Mat<f64>, Mat<f64>, Mat<f64>);
 /// are replaced by random vectors M-orthogonal to everything (their row of
 /// `R` is zero).
 fn orthonormalise(
-    m_lower: &Csc,
+    m_lower: SymView<'_>,
     v_prev: MatRef<'_, f64>,
     w: Mat<f64>,
     norm_ref: f64,
@@ -302,11 +354,7 @@ fn orthonormalise(
         par,
     );
     let g = symmetrise(g.as_ref());
-    let evd = g
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| ReductionError::LinearAlgebra(format!("Gram eigen ({e:?})")))?;
-    let d = evd.S().column_vector().to_owned();
-    let q = evd.U().to_owned();
+    let (d, q) = sym_eigen(g.as_ref())?;
     let mut vnew = Mat::zeros(n, p);
     let mut mvnew = Mat::zeros(n, p);
     let mut r = Mat::zeros(p, p);
@@ -385,7 +433,7 @@ fn orthonormalise(
 }
 
 fn block_lanczos(
-    m_lower: &Csc,
+    m_lower: SymView<'_>,
     factor: &SpdFactor,
     sigma: f64,
     nev: usize,
@@ -393,36 +441,107 @@ fn block_lanczos(
     opts: &LanczosOptions,
     par: Par,
 ) -> Result<Eigen, ReductionError> {
-    let n = m_lower.ncols;
+    let n = m_lower.n();
     let p = opts.block.max(1);
     let mut rng = Rng::new(opts.seed);
     let mut v = Mat::<f64>::zeros(n, ncv + p);
     let mut h = Mat::<f64>::zeros(ncv + p, ncv);
     // start block
-    let w0 = Mat::from_fn(n, p, |_, _| rng.next());
+    // random start block drawn in the natural numbering, so that the Krylov
+    // space does not depend on the fill-reducing ordering
+    let mut w0 = Mat::zeros(n, p);
+    for c in 0..p {
+        for i in 0..n {
+            let r = m_lower.inv.map(|v| v[i]).unwrap_or(i);
+            w0[(r, c)] = rng.next();
+        }
+    }
     let (b0, mut mv_cur, _) = orthonormalise(m_lower, v.subcols(0, 0), w0, 0.0, &mut rng, par)?;
     v.subcols_mut(0, p).copy_from(&b0);
     let mut cur = p;
+    // first column of the block preceding the current one (the kept Ritz
+    // vectors after a restart)
+    let mut prev_start = 0usize;
     let mut restarts = 0usize;
     let mut solves = 0usize;
+    let mut tm = EigenTimings::default();
     // number of Ritz vectors kept at a restart
     let keep = ncv - round_up((ncv - nev).div_ceil(2), p).min(ncv - nev).max(p);
     let keep = keep.min(ncv - p);
     loop {
         while cur < ncv + p {
             let j0 = cur - p;
-            let mut w = mv_cur.clone();
-            factor.solve_in_place(w.as_mut(), par);
+            let t = Instant::now();
+            let mut wr = RowBlock::from_mat(mv_cur.as_ref());
+            factor.solve_rows(&mut wr);
+            let mut w = wr.view().to_owned();
+            drop(wr);
+            tm.solve += t.elapsed().as_secs_f64();
             solves += 1;
-            let mut norm_ref = 0.0f64;
-            for pass in 0..2 {
-                let z = m_mul(m_lower, w.as_ref());
-                if pass == 0 {
-                    for c in 0..p {
-                        let nn: f64 = (0..n).map(|i| w[(i, c)] * z[(i, c)]).sum();
-                        norm_ref = norm_ref.max(nn);
+            // local block recurrence first (uses M V_j, known): removes the
+            // large components along the current and previous blocks
+            let t = Instant::now();
+            let mut a_loc = Mat::zeros(p, p);
+            matmul(
+                a_loc.as_mut(),
+                Accum::Replace,
+                mv_cur.transpose(),
+                w.as_ref(),
+                1.0,
+                par,
+            );
+            let a_loc = symmetrise(a_loc.as_ref());
+            let norm_ref = (0..p)
+                .map(|c| {
+                    (0..n)
+                        .map(|i| w[(i, c)] * mv_cur[(i, c)])
+                        .sum::<f64>()
+                        .abs()
+                })
+                .fold(0.0, f64::max);
+            matmul(
+                w.as_mut(),
+                Accum::Add,
+                v.subcols(j0, p),
+                a_loc.as_ref(),
+                -1.0,
+                par,
+            );
+            let (ps, pw) = (prev_start, j0 - prev_start);
+            let mut b_loc = Mat::zeros(pw, p);
+            for c in 0..p {
+                for r in 0..pw {
+                    b_loc[(r, c)] = h[(j0 + c, ps + r)];
+                }
+            }
+            if pw > 0 {
+                matmul(
+                    w.as_mut(),
+                    Accum::Add,
+                    v.subcols(ps, pw),
+                    b_loc.as_ref(),
+                    -1.0,
+                    par,
+                );
+            }
+            {
+                let mut hb = h.as_mut().submatrix_mut(0, j0, cur, p);
+                for jj in 0..p {
+                    for ii in 0..p {
+                        hb[(j0 + ii, jj)] += a_loc[(ii, jj)];
+                    }
+                    for ii in 0..pw {
+                        hb[(ps + ii, jj)] += b_loc[(ii, jj)];
                     }
                 }
+            }
+            tm.orthogonalise += t.elapsed().as_secs_f64();
+            // one full re-orthogonalisation pass against the whole basis
+            {
+                let t = Instant::now();
+                let z = m_mul(m_lower, w.as_ref());
+                tm.mass += t.elapsed().as_secs_f64();
+                let t = Instant::now();
                 let c = gs_pass(v.subcols(0, cur), z.as_ref(), w.as_mut(), par);
                 let mut hb = h.as_mut().submatrix_mut(0, j0, cur, p);
                 for jj in 0..p {
@@ -430,21 +549,22 @@ fn block_lanczos(
                         hb[(ii, jj)] += c[(ii, jj)];
                     }
                 }
+                tm.orthogonalise += t.elapsed().as_secs_f64();
             }
+            let t = Instant::now();
             let (vn, mvn, r) =
                 orthonormalise(m_lower, v.subcols(0, cur), w, norm_ref, &mut rng, par)?;
             v.subcols_mut(cur, p).copy_from(&vn);
             h.as_mut().submatrix_mut(cur, j0, p, p).copy_from(&r);
             mv_cur = mvn;
+            prev_start = j0;
             cur += p;
+            tm.orthogonalise += t.elapsed().as_secs_f64();
         }
+        let t_rr = Instant::now();
         // Rayleigh-Ritz on the symmetric part of the projected matrix
         let t = symmetrise(h.submatrix(0, 0, ncv, ncv));
-        let evd = t
-            .self_adjoint_eigen(Side::Lower)
-            .map_err(|e| ReductionError::LinearAlgebra(format!("projected eigen ({e:?})")))?;
-        let theta = evd.S().column_vector().to_owned();
-        let s = evd.U().to_owned();
+        let (theta, s) = sym_eigen(t.as_ref())?;
         let mut order: Vec<usize> = (0..ncv).collect();
         order.sort_by(|&a, &b| theta[b].total_cmp(&theta[a]));
         let r_last = h.submatrix(ncv, ncv - p, p, p).to_owned();
@@ -475,6 +595,7 @@ fn block_lanczos(
                 par,
             );
             let values = sel.iter().map(|&i| sigma + 1.0 / theta[i]).collect();
+            tm.restart += t_rr.elapsed().as_secs_f64();
             // ascending λ = descending θ already
             return Ok(Eigen {
                 values,
@@ -482,6 +603,7 @@ fn block_lanczos(
                 max_residual: 0.0,
                 restarts,
                 solves,
+                timings: tm,
             });
         }
         if restarts >= opts.max_restarts {
@@ -527,7 +649,9 @@ fn block_lanczos(
             }
         }
         cur = keep + p;
+        prev_start = 0;
         restarts += 1;
+        tm.restart += t_rr.elapsed().as_secs_f64();
     }
 }
 
@@ -576,14 +700,7 @@ pub fn dense_generalized_eigenvalues(
     let mut c = x.transpose().to_owned();
     faer::linalg::triangular_solve::solve_lower_triangular_in_place(l, c.as_mut(), Par::Seq);
     let c = symmetrise(c.as_ref());
-    let evd = c
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| ReductionError::LinearAlgebra(format!("dense eigen solver ({e:?})")))?;
-    let s = evd.S().column_vector();
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by(|&a, &b| s[a].total_cmp(&s[b]));
-    let values: Vec<f64> = order.iter().map(|&j| s[j]).collect();
-    let mut y = Mat::from_fn(n, n, |i, c| evd.U()[(i, order[c])]);
+    let (values, mut y) = sym_eigen(c.as_ref())?;
     faer::linalg::triangular_solve::solve_upper_triangular_in_place(
         l.transpose(),
         y.as_mut(),

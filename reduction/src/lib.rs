@@ -55,6 +55,7 @@
 //! (`Par::Seq`) and only whole constraint-mode blocks run in parallel
 //! ([`CbOptions::threads`]), each written to its own columns.
 
+mod block;
 mod cb;
 mod csc;
 pub mod eigen;
@@ -125,17 +126,25 @@ pub fn lowest_eigenpairs_with(
     } else {
         kl.clone()
     };
-    let ident = |i: usize| i;
+    let (fwd, inv, _) = factor::fill_reducing_order(&a, ordering)?;
+    let a = a.permute_sym_lower(&inv);
+    let orig = |i: usize| fwd[i];
     let factor = factor::SpdFactor::new(
         &a,
-        ordering,
-        Par::Seq,
         &factor::PivotContext {
             matrix: "K − σM",
             context: "model",
-            full_index: &ident,
+            local_index: &orig,
+            full_index: &orig,
         },
     )?;
     drop(a);
-    eigen::lowest_modes(&kl, &ml, &factor, shift, n, options, Par::Seq)
+    let view = |lower| csc::SymView {
+        lower,
+        inv: Some(&inv),
+    };
+    let mut eig = eigen::lowest_modes(view(&kl), view(&ml), &factor, shift, n, options, Par::Seq)?;
+    let q = eig.values.len();
+    eig.vectors = faer::Mat::from_fn(size, q, |old, c| eig.vectors[(inv[old], c)]);
+    Ok(eig)
 }
