@@ -1,0 +1,304 @@
+//! Row-major blocks of vectors (`n × k`, each row contiguous) and the two
+//! sparse kernels that dominate the reduction on them: the supernodal
+//! triangular solves with the Cholesky factor, and symmetric sparse products.
+//! With rows contiguous, the scatter/gather of a supernode's pattern and the
+//! entries of a sparse matrix each touch one contiguous `k`-vector.
+
+use crate::csc::Csc;
+use faer::linalg::matmul::matmul;
+use faer::linalg::triangular_solve::{
+    solve_lower_triangular_in_place, solve_upper_triangular_in_place,
+};
+use faer::sparse::linalg::cholesky::supernodal::{SupernodalLltRef, SymbolicSupernodalCholesky};
+use faer::{Accum, MatMut, MatRef, Par};
+
+/// `n × k` block stored row by row.
+#[derive(Clone, Debug)]
+pub(crate) struct RowBlock {
+    pub n: usize,
+    pub k: usize,
+    pub data: Vec<f64>,
+}
+
+impl RowBlock {
+    pub fn zeros(n: usize, k: usize) -> Self {
+        RowBlock {
+            n,
+            k,
+            data: vec![0.0; n * k],
+        }
+    }
+
+    /// Copy of a (column-major or any) matrix view.
+    pub fn from_mat(a: MatRef<'_, f64>) -> Self {
+        let mut b = Self::zeros(a.nrows(), a.ncols());
+        b.view_mut().copy_from(a);
+        b
+    }
+
+    /// `n × k` view (row stride `k`).
+    pub fn view(&self) -> MatRef<'_, f64> {
+        MatRef::from_column_major_slice(&self.data, self.k, self.n).transpose()
+    }
+
+    pub fn view_mut(&mut self) -> MatMut<'_, f64> {
+        MatMut::from_column_major_slice_mut(&mut self.data, self.k, self.n).transpose_mut()
+    }
+
+    #[inline(always)]
+    pub fn row(&self, i: usize) -> &[f64] {
+        &self.data[i * self.k..(i + 1) * self.k]
+    }
+
+    #[inline(always)]
+    pub fn row_mut(&mut self, i: usize) -> &mut [f64] {
+        &mut self.data[i * self.k..(i + 1) * self.k]
+    }
+}
+
+#[inline(always)]
+fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
+    for (yv, xv) in y.iter_mut().zip(x) {
+        *yv += a * xv;
+    }
+}
+
+/// Supernodes with at most this many columns are solved with plain loops
+/// (dense kernels have a fixed cost per call).
+const SMALL_SUPERNODE: usize = 8;
+
+/// Solve `L Lᵀ X = B` in place (`x` holds B on entry), `L` the supernodal
+/// Cholesky factor, no permutation (the matrix was factored in its
+/// elimination order). Sequential and deterministic.
+pub(crate) fn supernodal_solve_rows(
+    symbolic: &SymbolicSupernodalCholesky<usize>,
+    values: &[f64],
+    x: &mut RowBlock,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked just above).
+        unsafe { supernodal_solve_rows_avx2(symbolic, values, x) };
+        return;
+    }
+    supernodal_solve_rows_impl(symbolic, values, x)
+}
+
+/// The same code compiled for AVX2 (wider vectors, same operations, so the
+/// same results bit for bit).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn supernodal_solve_rows_avx2(
+    symbolic: &SymbolicSupernodalCholesky<usize>,
+    values: &[f64],
+    x: &mut RowBlock,
+) {
+    supernodal_solve_rows_impl(symbolic, values, x)
+}
+
+#[inline(always)]
+fn supernodal_solve_rows_impl(
+    symbolic: &SymbolicSupernodalCholesky<usize>,
+    values: &[f64],
+    x: &mut RowBlock,
+) {
+    let l = SupernodalLltRef::new(symbolic, values);
+    let k = x.k;
+    if k == 0 {
+        return;
+    }
+    let ns = symbolic.n_supernodes();
+    let max_pat = (0..ns)
+        .map(|s| l.supernode(s).pattern().len())
+        .max()
+        .unwrap_or(0);
+    let mut tmp = RowBlock::zeros(max_pat, k);
+    let mut acc = vec![0.0; k];
+    // forward: L y = b
+    for s in 0..ns {
+        let node = l.supernode(s);
+        let start = node.start();
+        let pat = node.pattern();
+        let lv = node.val();
+        let size = lv.ncols();
+        if size <= SMALL_SUPERNODE {
+            for c in 0..size {
+                let col = lv
+                    .col(c)
+                    .try_as_col_major()
+                    .expect("supernode columns are contiguous");
+                let col = col.as_slice();
+                let j = start + c;
+                let d = 1.0 / col[c];
+                acc.copy_from_slice(x.row(j));
+                acc.iter_mut().for_each(|v| *v *= d);
+                x.row_mut(j).copy_from_slice(&acc);
+                for (r, &l_rc) in col.iter().enumerate().take(size).skip(c + 1) {
+                    axpy(x.row_mut(start + r), -l_rc, &acc);
+                }
+                for (idx, &i) in pat.iter().enumerate() {
+                    axpy(x.row_mut(i), -col[size + idx], &acc);
+                }
+            }
+        } else {
+            let (ltop, lbot) = lv.split_at_row(size);
+            solve_lower_triangular_in_place(ltop, x.view_mut().subrows_mut(start, size), Par::Seq);
+            let np = pat.len();
+            if np > 0 {
+                let xtop = x.view().subrows(start, size);
+                let tv = tmp.view_mut();
+                matmul(
+                    tv.subrows_mut(0, np),
+                    Accum::Replace,
+                    lbot,
+                    xtop,
+                    1.0,
+                    Par::Seq,
+                );
+                for (idx, &i) in pat.iter().enumerate() {
+                    let t = &tmp.data[idx * k..(idx + 1) * k];
+                    for (xv, tv) in x.data[i * k..(i + 1) * k].iter_mut().zip(t) {
+                        *xv -= tv;
+                    }
+                }
+            }
+        }
+    }
+    // backward: Lᵀ x = y
+    for s in (0..ns).rev() {
+        let node = l.supernode(s);
+        let start = node.start();
+        let pat = node.pattern();
+        let lv = node.val();
+        let size = lv.ncols();
+        if size <= SMALL_SUPERNODE {
+            for c in (0..size).rev() {
+                let col = lv
+                    .col(c)
+                    .try_as_col_major()
+                    .expect("supernode columns are contiguous");
+                let col = col.as_slice();
+                let j = start + c;
+                acc.copy_from_slice(x.row(j));
+                for (r, &l_rc) in col.iter().enumerate().take(size).skip(c + 1) {
+                    axpy(&mut acc, -l_rc, x.row(start + r));
+                }
+                for (idx, &i) in pat.iter().enumerate() {
+                    axpy(&mut acc, -col[size + idx], x.row(i));
+                }
+                let d = 1.0 / col[c];
+                for (xv, a) in x.row_mut(j).iter_mut().zip(&acc) {
+                    *xv = a * d;
+                }
+            }
+        } else {
+            let (ltop, lbot) = lv.split_at_row(size);
+            let np = pat.len();
+            if np > 0 {
+                for (idx, &i) in pat.iter().enumerate() {
+                    tmp.data[idx * k..(idx + 1) * k].copy_from_slice(&x.data[i * k..(i + 1) * k]);
+                }
+                let tv = tmp.view();
+                matmul(
+                    x.view_mut().subrows_mut(start, size),
+                    Accum::Add,
+                    lbot.transpose(),
+                    tv.subrows(0, np),
+                    -1.0,
+                    Par::Seq,
+                );
+            }
+            solve_upper_triangular_in_place(
+                ltop.transpose(),
+                x.view_mut().subrows_mut(start, size),
+                Par::Seq,
+            );
+        }
+    }
+}
+
+/// `y = A x` for `A` symmetric stored as its lower triangle in natural
+/// order, `x`, `y` in the permuted numbering (`inv[natural] = permuted`).
+/// The rows are gathered into natural order (one contiguous copy per row),
+/// multiplied there (neighbouring entries, cache-friendly) and scattered back.
+pub(crate) fn sym_mul_rows(a: &Csc, inv: Option<&[usize]>, x: &RowBlock, y: &mut RowBlock) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked just above).
+        unsafe { sym_mul_rows_avx2(a, inv, x, y) };
+        return;
+    }
+    sym_mul_rows_impl(a, inv, x, y)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn sym_mul_rows_avx2(a: &Csc, inv: Option<&[usize]>, x: &RowBlock, y: &mut RowBlock) {
+    sym_mul_rows_impl(a, inv, x, y)
+}
+
+#[inline(always)]
+fn sym_mul_rows_impl(a: &Csc, inv: Option<&[usize]>, x: &RowBlock, y: &mut RowBlock) {
+    const W: usize = 8;
+    let n = a.ncols;
+    let k = x.k;
+    debug_assert_eq!(x.n, n);
+    debug_assert_eq!(y.n, n);
+    debug_assert_eq!(y.k, k);
+    let pp = k.div_ceil(W) * W;
+    if pp == 0 {
+        return;
+    }
+    let map = |i: usize| inv.map(|v| v[i]).unwrap_or(i);
+    let mut xt = vec![0.0; n * pp];
+    for i in 0..n {
+        xt[i * pp..i * pp + k].copy_from_slice(x.row(map(i)));
+    }
+    let mut yt = vec![0.0; n * pp];
+    let mut acc = vec![0.0; pp];
+    for j in 0..n {
+        let (rows, vals) = a.col(j);
+        acc.iter_mut().for_each(|v| *v = 0.0);
+        let xj = &xt[j * pp..(j + 1) * pp];
+        for (&i, &v) in rows.iter().zip(vals) {
+            if i == j {
+                axpy(&mut acc, v, xj);
+                continue;
+            }
+            let xi = &xt[i * pp..(i + 1) * pp];
+            let yi = &mut yt[i * pp..(i + 1) * pp];
+            for ((yc, ac), (xjc, xic)) in yi
+                .chunks_exact_mut(W)
+                .zip(acc.chunks_exact_mut(W))
+                .zip(xj.chunks_exact(W).zip(xi.chunks_exact(W)))
+            {
+                for q in 0..W {
+                    yc[q] += v * xjc[q];
+                    ac[q] += v * xic[q];
+                }
+            }
+        }
+        let yj = &mut yt[j * pp..(j + 1) * pp];
+        for (yv, av) in yj.iter_mut().zip(&acc) {
+            *yv += av;
+        }
+    }
+    drop(xt);
+    for i in 0..n {
+        y.row_mut(map(i)).copy_from_slice(&yt[i * pp..i * pp + k]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::Mat;
+
+    #[test]
+    fn views_are_row_major() {
+        let a = Mat::from_fn(5, 3, |i, j| (10 * i + j) as f64);
+        let b = RowBlock::from_mat(a.as_ref());
+        assert_eq!(b.row(2), &[20.0, 21.0, 22.0]);
+        assert_eq!(b.view()[(4, 1)], 41.0);
+    }
+}
