@@ -22,6 +22,7 @@ pub mod matrix;
 pub mod model;
 pub mod operator;
 pub mod pattern;
+pub mod reduce;
 pub mod reference;
 pub mod report;
 pub mod scene;
