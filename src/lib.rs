@@ -10,6 +10,7 @@ pub mod aft;
 pub mod commands;
 pub mod contact;
 pub mod continuation;
+pub mod fe;
 pub mod frf;
 pub mod harmonic;
 pub mod hbm;
