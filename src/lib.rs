@@ -11,6 +11,7 @@ pub mod commands;
 pub mod condensed;
 pub mod contact;
 pub mod continuation;
+pub mod fe;
 pub mod frf;
 pub mod harmonic;
 pub mod hbm;

@@ -37,6 +37,11 @@ enum Command {
         #[arg(long = "set", value_name = "FIELD=VALUE")]
         overrides: Vec<String>,
     },
+    /// Generate or inspect FE meshes.
+    Mesh {
+        #[command(subcommand)]
+        command: fricbound::commands::mesh::MeshCommand,
+    },
 }
 
 fn main() -> ExitCode {
@@ -63,6 +68,16 @@ fn main() -> ExitCode {
         Command::Check { scene, overrides } => {
             fricbound::commands::check(scene.as_deref(), &overrides).map(|s| print!("{s}"))
         }
+        Command::Mesh { command } => match fricbound::commands::mesh::run(&command) {
+            Ok(text) => {
+                print!("{text}");
+                Ok(())
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::FAILURE;
+            }
+        },
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -3,6 +3,7 @@
 //! the limit analysis (`[sweep]`), a limit analysis (`[limits]`), or one FRF.
 
 mod limits_run;
+pub mod mesh;
 mod sweep_run;
 
 use std::path::{Path, PathBuf};

@@ -1,0 +1,37 @@
+//! Finite-element input and output: meshes, element assembly, Matrix Market models, contact
+//! patches, VTU output and the blade-pair mesh generator.
+//!
+//! Two ways lead to a linear FE model ([`FeModel`] / [`FeMatrices`]: sparse K and M in full
+//! symmetric storage with a [`DofMap`] naming every row by node id and direction):
+//! - a Gmsh mesh ([`read_msh`]) assembled with a material per physical group ([`assemble`]),
+//!   clamped by group ([`FeModel::clamp_group`]);
+//! - K and M exported by another FE code as Matrix Market files with a DOF map
+//!   ([`read_fe_matrices`]).
+//!
+//! Contacts between a damper and the bodies it touches are node-to-node pairs between two
+//! facing physical groups with a local frame per pair ([`pair_patch`]). Results go to ParaView
+//! as VTU ([`write_vtu`]). Units are SI throughout (m, kg, N, Pa).
+
+pub mod assembly;
+pub mod blade_pair;
+pub mod contact_patch;
+pub mod dof;
+pub mod element;
+pub mod material;
+pub mod matrix_market;
+pub mod mesh;
+pub mod msh_read;
+pub mod msh_write;
+pub mod sparse;
+pub mod vtu;
+
+pub use assembly::{assemble, AssemblyError, FeModel, GroupMaterial};
+pub use contact_patch::{pair_patch, ContactPair, ContactPatch, ContactPatchError, PatchSpec};
+pub use dof::{Direction, Dof, DofMap};
+pub use material::{Material, PlaneAssumption};
+pub use matrix_market::{read_fe_matrices, FeMatrices, FeMatrixError};
+pub use mesh::{ElementKind, Mesh, MeshError, PhysicalGroup};
+pub use msh_read::{read_msh, MshReadError};
+pub use msh_write::{write_msh, MshFormat, MshWriteError};
+pub use sparse::SparseMatrix;
+pub use vtu::{write_vtu, PointField, VtuError};
