@@ -12,6 +12,7 @@ pub mod condensed;
 pub mod contact;
 pub mod continuation;
 pub mod fe;
+pub mod fe_scene;
 pub mod frf;
 pub mod harmonic;
 pub mod hbm;

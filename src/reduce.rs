@@ -1,12 +1,18 @@
 //! Craig-Bampton reduction of a problem on a large (sparse) FE model to a small dense one.
 //!
 //! The boundary set is every DOF the friction problem needs as a physical coordinate: the
-//! contact DOFs, the DOFs carrying static or harmonic loads and the output DOFs. Everything
-//! else is condensed into constraint modes and the lowest fixed-interface modes by the
-//! `fricbound-reduction` crate, so the reduced coordinates are q = [u_B; η]: the boundary
-//! displacements (named as in the full model) then the modal amplitudes (`mode1`, `mode2`, ...).
-//! Contacts, loads and outputs keep their meaning on u_B exactly, since Craig-Bampton keeps
-//! boundary DOFs as physical coordinates.
+//! contact DOFs and the output DOFs. Everything else is condensed into constraint modes and the
+//! lowest fixed-interface modes by the `fricbound-reduction` crate, so the reduced coordinates
+//! are q = [u_B; η]: the boundary displacements (named as in the full model) then the modal
+//! amplitudes (`mode1`, `mode2`, ...). Contacts and outputs keep their meaning on u_B exactly,
+//! since Craig-Bampton keeps boundary DOFs as physical coordinates.
+//!
+//! Loads on other DOFs (a pre-load spread over the damper's body, an excitation at a blade tip)
+//! do not enlarge the boundary: they are projected on the reduced basis, f_r = Tᵀf, with the
+//! recovery rows of the loaded DOFs (row d of T). The projection does the same virtual work as
+//! f on every displacement of the basis; in particular the rigid-body motions of a free damper
+//! are in the basis, so the resultant of its pre-load, which the contacts must balance (paper
+//! Eq. 11), is kept exactly.
 //!
 //! Damping: Rayleigh damping C = αM + βK of the full model reduces exactly to αM_r + βK_r
 //! (the Craig-Bampton basis T is applied congruently, TᵀCT); modal damping ratios ζ act on the
@@ -41,22 +47,28 @@ pub struct Reduction {
     pub model: ReducedModel,
 }
 
-/// The boundary DOFs of a problem: contact, loaded and output DOFs, sorted.
+/// The boundary DOFs of a problem: contact and output DOFs, sorted.
 pub fn boundary_dofs(problem: &Problem) -> Vec<usize> {
     let mut b = problem.contact_dofs();
-    b.extend(
-        problem
-            .static_load
-            .iter()
-            .enumerate()
-            .filter(|(_, v)| **v != 0.0)
-            .map(|(d, _)| d),
-    );
-    b.extend(problem.harmonic_loads.iter().map(|l| l.dof));
     b.extend(problem.outputs.iter().copied());
     b.sort_unstable();
     b.dedup();
     b
+}
+
+/// The DOFs carrying a static or harmonic load, sorted.
+fn loaded_dofs(problem: &Problem) -> Vec<usize> {
+    let mut d: Vec<usize> = problem
+        .static_load
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| **v != 0.0)
+        .map(|(d, _)| d)
+        .collect();
+    d.extend(problem.harmonic_loads.iter().map(|l| l.dof));
+    d.sort_unstable();
+    d.dedup();
+    d
 }
 
 /// Reduces a problem whose structural matrices are sparse. The problem's damping matrix is
@@ -79,15 +91,19 @@ pub fn reduce(
     let k = to_sparse(&problem.model.stiffness);
     let m = to_sparse(&problem.model.mass);
     let boundary = boundary_dofs(problem);
+    let loaded = loaded_dofs(problem);
+    let mut recover = loaded.clone();
+    recover.extend_from_slice(&settings.recover);
     let mut options = CbOptions::with_modes(settings.modes);
     options.ordering = settings.ordering;
-    let reduced = craig_bampton(
-        k.as_ref(),
-        m.as_ref(),
-        &boundary,
-        &settings.recover,
-        &options,
-    )?;
+    let mut reduced = craig_bampton(k.as_ref(), m.as_ref(), &boundary, &recover, &options)?;
+    // Rows of T of the loaded DOFs (the first `loaded.len()` recovery rows).
+    let load_rows: Vec<Vec<f64>> = reduced
+        .recovery
+        .drain(..loaded.len())
+        .map(|r| r.row)
+        .collect();
+    let row_of = |d: usize| &load_rows[loaded.binary_search(&d).expect("listed as loaded")];
     let nb = boundary.len();
     let nr = reduced.size();
     let mut position = vec![usize::MAX; problem.model.n_dofs()];
@@ -110,8 +126,12 @@ pub fn reduce(
         }
     }
     let mut static_load = vec![0.0; nr];
-    for (i, &d) in boundary.iter().enumerate() {
-        static_load[i] = problem.static_load[d];
+    for (d, &f) in problem.static_load.iter().enumerate() {
+        if f != 0.0 {
+            for (i, t) in row_of(d).iter().enumerate() {
+                static_load[i] += t * f;
+            }
+        }
     }
     let mut out = problem.clone();
     out.model = LinearModel {
@@ -125,12 +145,24 @@ pub fn reduce(
         c.normal = remap(&c.normal);
     }
     out.static_load = static_load;
-    out.harmonic_loads = problem
-        .harmonic_loads
-        .iter()
-        .map(|l| HarmonicLoad {
-            dof: position[l.dof],
-            ..*l
+    // f_r = Tᵀ f per harmonic load, merged per (coordinate, harmonic).
+    let mut harmonic: std::collections::BTreeMap<(usize, usize), (f64, f64)> = Default::default();
+    for l in &problem.harmonic_loads {
+        for (i, t) in row_of(l.dof).iter().enumerate() {
+            if *t != 0.0 {
+                let e = harmonic.entry((l.harmonic, i)).or_insert((0.0, 0.0));
+                e.0 += t * l.cos;
+                e.1 += t * l.sin;
+            }
+        }
+    }
+    out.harmonic_loads = harmonic
+        .into_iter()
+        .map(|((harmonic, dof), (cos, sin))| HarmonicLoad {
+            dof,
+            harmonic,
+            cos,
+            sin,
         })
         .collect();
     out.outputs = problem.outputs.iter().map(|&d| position[d]).collect();

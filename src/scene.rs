@@ -11,6 +11,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::aft::MarchSettings;
 use crate::contact::{ContactEffects, ContactPoint, DamperSide, JenkinsLaw, NormalLoad};
+use crate::fe_scene::{
+    self, ContactPatchSpec, FeStructure, MaterialSpec, MatrixMarketSpec, PlaneSpec, ReductionSpec,
+};
 use crate::matrix::StructuralMatrix;
 use crate::model::{
     Analysis, Coupling, Effects, Formulation, HarmonicLoad, JacobianStrategy, LinearModel, Problem,
@@ -67,9 +70,15 @@ pub struct Scene {
     pub title: String,
     /// Linear structure.
     pub model: ModelSpec,
+    /// Craig-Bampton reduction of an FE model; absent: the full model is solved.
+    #[serde(default)]
+    pub reduction: Option<ReductionSpec>,
     /// Contact points.
     #[serde(default)]
     pub contacts: Vec<ContactSpec>,
+    /// Contact patches of FE meshes (node-to-node pairs between facing groups).
+    #[serde(default)]
+    pub contact_patches: Vec<ContactPatchSpec>,
     /// Static loads (N).
     #[serde(default)]
     pub static_loads: Vec<StaticLoadSpec>,
@@ -160,15 +169,43 @@ impl SweepSpec {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ModelSpec {
-    /// DOF names, in matrix order.
+    /// DOF names, in matrix order (inline models).
+    #[serde(default)]
     pub dofs: Vec<String>,
-    /// Mass matrix (kg), rows.
+    /// Mass matrix (kg), rows (inline models).
+    #[serde(default)]
     pub mass: Vec<Vec<f64>>,
-    /// Stiffness matrix (N/m), rows.
+    /// Stiffness matrix (N/m), rows (inline models).
+    #[serde(default)]
     pub stiffness: Vec<Vec<f64>>,
-    /// Viscous damping matrix (N·s/m), rows; zero when absent.
+    /// Viscous damping matrix (N·s/m), rows; zero when absent (inline models).
     #[serde(default)]
     pub damping: Option<Vec<Vec<f64>>>,
+    /// Gmsh `.msh` 4.1 mesh (FE models), relative to the scene file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<PathBuf>,
+    /// Materials per physical group of the mesh.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub materials: Vec<MaterialSpec>,
+    /// Plane assumption of 2D meshes.
+    #[serde(default)]
+    pub plane: PlaneSpec,
+    /// Physical groups clamped (all their DOFs removed).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub clamp: Vec<String>,
+    /// K and M from Matrix Market files with a DOF map (FE models).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub matrix_market: Option<MatrixMarketSpec>,
+    /// Rayleigh damping C = αM + βK of an FE model: [α (1/s), β (s)].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rayleigh: Option<[f64; 2]>,
+}
+
+impl ModelSpec {
+    /// Whether the model comes from a mesh or Matrix Market files.
+    pub fn is_fe(&self) -> bool {
+        self.mesh.is_some() || self.matrix_market.is_some()
+    }
 }
 
 /// One contact point.
@@ -212,9 +249,16 @@ pub struct ContactSpec {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StaticLoadSpec {
-    /// DOF name.
-    pub dof: String,
-    /// Force (N).
+    /// DOF name; or give `group` and `direction`.
+    #[serde(default)]
+    pub dof: Option<String>,
+    /// Physical group of an FE mesh whose nodes share the force (by mass).
+    #[serde(default)]
+    pub group: Option<String>,
+    /// Direction of a group force: `x`, `y` or `z`.
+    #[serde(default)]
+    pub direction: Option<String>,
+    /// Force (N); the total over the group for group loads.
     pub value: f64,
 }
 
@@ -222,8 +266,15 @@ pub struct StaticLoadSpec {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HarmonicLoadSpec {
-    /// DOF name.
-    pub dof: String,
+    /// DOF name; or give `group` and `direction`.
+    #[serde(default)]
+    pub dof: Option<String>,
+    /// Physical group of an FE mesh whose nodes share the force (by mass).
+    #[serde(default)]
+    pub group: Option<String>,
+    /// Direction of a group force: `x`, `y` or `z`.
+    #[serde(default)]
+    pub direction: Option<String>,
     /// Harmonic h ≥ 1.
     #[serde(default = "one")]
     pub harmonic: usize,
@@ -360,7 +411,22 @@ fn default_linear_points() -> usize {
 #[serde(deny_unknown_fields)]
 pub struct OutputSpec {
     /// Response DOFs reported in `frf.csv` and plotted.
+    #[serde(default)]
     pub dofs: Vec<String>,
+    /// Response DOFs by physical group of an FE mesh: every node of the group in one
+    /// direction.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub groups: Vec<GroupDirectionSpec>,
+}
+
+/// A physical group and a direction.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GroupDirectionSpec {
+    /// Physical group name.
+    pub group: String,
+    /// `x`, `y` or `z`.
+    pub direction: String,
 }
 
 /// Reads a scene file, applying `--set` overrides (`path=value`).
@@ -638,21 +704,122 @@ impl Checker<'_> {
         Ok(())
     }
 
-    fn dof(&self, field: &str, name: &str, dofs: &[String]) -> Result<usize, SceneError> {
-        dofs.iter().position(|d| d == name).ok_or_else(|| {
+    fn dof(&self, field: &str, name: &str, dofs: &DofNames) -> Result<usize, SceneError> {
+        dofs.index.get(name).copied().ok_or_else(|| {
+            let listed = if dofs.names.len() <= 24 {
+                dofs.names.join(", ")
+            } else {
+                format!(
+                    "{} DOFs named <node>.<direction>, e.g. {}, ...",
+                    dofs.names.len(),
+                    dofs.names[..3].join(", ")
+                )
+            };
             self.err(
                 field,
-                format!("unknown DOF `{name}` (the model has {})", dofs.join(", ")),
+                format!("unknown DOF `{name}` (the model has {listed})"),
             )
         })
+    }
+
+    /// The DOFs and weights of a load given by `dof` or by `group` and `direction`.
+    fn load_targets(
+        &self,
+        field: &str,
+        dof: Option<&str>,
+        group: Option<&str>,
+        direction: Option<&str>,
+        dofs: &DofNames,
+        fe: Option<&FeStructure>,
+    ) -> Result<Vec<(usize, f64)>, SceneError> {
+        match (dof, group, direction) {
+            (Some(d), None, None) => Ok(vec![(self.dof(&format!("{field}.dof"), d, dofs)?, 1.0)]),
+            (None, Some(g), Some(dir)) => match fe {
+                Some(fe) => fe_scene::group_load(self.file, field, fe, g, dir),
+                None => Err(self.err(
+                    format!("{field}.group"),
+                    "loads on groups need an FE mesh (`model.mesh`)",
+                )),
+            },
+            _ => Err(self.err(field, "give either `dof`, or `group` and `direction`")),
+        }
+    }
+}
+
+/// DOF names with a look-up index.
+struct DofNames<'a> {
+    names: &'a [String],
+    index: std::collections::HashMap<&'a str, usize>,
+}
+
+impl<'a> DofNames<'a> {
+    fn new(names: &'a [String]) -> Self {
+        Self {
+            names,
+            index: names
+                .iter()
+                .enumerate()
+                .map(|(i, s)| (s.as_str(), i))
+                .collect(),
+        }
+    }
+}
+
+impl std::ops::Index<usize> for DofNames<'_> {
+    type Output = String;
+    fn index(&self, i: usize) -> &String {
+        &self.names[i]
     }
 }
 
 impl Scene {
-    /// Checks every value and builds the problem. `file` names the scene in errors.
-    pub fn validate(&self, file: &str) -> Result<Problem, SceneError> {
-        let ck = Checker { file };
-        let dofs = &self.model.dofs;
+    /// The linear structure: inline dense matrices, or an FE model (mesh or Matrix Market).
+    fn build_model(&self, ck: &Checker) -> Result<(LinearModel, Option<FeStructure>), SceneError> {
+        let m = &self.model;
+        if m.is_fe() {
+            if !m.dofs.is_empty()
+                || !m.mass.is_empty()
+                || !m.stiffness.is_empty()
+                || m.damping.is_some()
+            {
+                return Err(ck.err(
+                    "model",
+                    "give inline matrices (`dofs`, `mass`, `stiffness`, `damping`) or an FE model \
+                     (`mesh` or `matrix_market`), not both",
+                ));
+            }
+            let [alpha, beta] = m.rayleigh.unwrap_or([0.0, 0.0]);
+            for (i, v) in [alpha, beta].iter().enumerate() {
+                let f = format!("model.rayleigh[{i}]");
+                ck.finite(&f, *v)?;
+                if *v < 0.0 {
+                    return Err(ck.err(f, format!("must be ≥ 0, got {v}")));
+                }
+            }
+            let fe = fe_scene::build_structure(
+                ck.file,
+                m.mesh.as_deref(),
+                &m.materials,
+                m.plane,
+                &m.clamp,
+                m.matrix_market.as_ref(),
+                (alpha, beta),
+            )?;
+            return Ok((fe.model.clone(), Some(fe)));
+        }
+        for (field, set) in [
+            ("model.materials", !m.materials.is_empty()),
+            ("model.clamp", !m.clamp.is_empty()),
+            ("model.rayleigh", m.rayleigh.is_some()),
+        ] {
+            if set {
+                return Err(ck.err(
+                    field,
+                    "applies to FE models only (`mesh` or `matrix_market`)",
+                ));
+            }
+        }
+        let dofs = &m.dofs;
         let n = dofs.len();
         if n == 0 {
             return Err(ck.err("model.dofs", "must name at least one DOF"));
@@ -663,20 +830,39 @@ impl Scene {
                 return Err(ck.err(format!("model.dofs[{i}]"), format!("duplicate DOF `{d}`")));
             }
         }
-        let mass = ck.matrix("model.mass", &self.model.mass, n)?;
-        let stiffness = ck.matrix("model.stiffness", &self.model.stiffness, n)?;
-        let damping = match &self.model.damping {
+        let mass = ck.matrix("model.mass", &m.mass, n)?;
+        let stiffness = ck.matrix("model.stiffness", &m.stiffness, n)?;
+        let damping = match &m.damping {
             Some(c) => ck.matrix("model.damping", c, n)?,
             None => Mat::zeros(n, n),
         };
         ck.semidefinite("model.mass", &mass)?;
         ck.semidefinite("model.stiffness", &stiffness)?;
         ck.semidefinite("model.damping", &damping)?;
+        Ok((
+            LinearModel {
+                dof_names: dofs.clone(),
+                mass: StructuralMatrix::Dense(mass),
+                damping: StructuralMatrix::Dense(damping),
+                stiffness: StructuralMatrix::Dense(stiffness),
+            },
+            None,
+        ))
+    }
 
-        if self.contacts.is_empty() {
+    /// Checks every value and builds the problem. `file` names the scene in errors.
+    pub fn validate(&self, file: &str) -> Result<Problem, SceneError> {
+        let ck = Checker { file };
+        let (model, fe) = self.build_model(&ck)?;
+        let dofs = DofNames::new(&model.dof_names);
+        let dofs = &dofs;
+        let n = model.n_dofs();
+
+        if self.contacts.is_empty() && self.contact_patches.is_empty() {
             return Err(ck.err(
                 "contacts",
-                "the contact set is empty: a friction analysis needs at least one [[contacts]] entry",
+                "the contact set is empty: a friction analysis needs at least one [[contacts]] \
+                 entry or [[contact_patches]] entry",
             ));
         }
         let mut contacts = Vec::new();
@@ -842,10 +1028,75 @@ impl Scene {
             });
         }
 
+        for (pi, p) in self.contact_patches.iter().enumerate() {
+            let f = |name: &str| format!("contact_patches[{pi}].{name}");
+            ck.name(&f("side"), &p.side)?;
+            ck.positive(&f("kt"), p.kt)?;
+            ck.positive(&f("kn"), p.kn)?;
+            let mu = ck.finite(&f("mu"), p.mu)?;
+            if mu < 0.0 {
+                return Err(ck.err(
+                    f("mu"),
+                    format!("friction coefficient must be ≥ 0, got {mu}"),
+                ));
+            }
+            ck.finite(&f("gap"), p.gap)?;
+            ck.positive(&f("tolerance"), p.tolerance)?;
+            let m = ck.finite(&f("initial_state"), p.initial_state)?;
+            if !(-1.0..=1.0).contains(&m) {
+                return Err(ck.err(
+                    f("initial_state"),
+                    format!("must lie in [-1, 1] (T(0) = m·μN(0)), got {m}"),
+                ));
+            }
+            let Some(structure) = fe.as_ref() else {
+                return Err(ck.err(
+                    format!("contact_patches[{pi}]"),
+                    "contact patches need an FE mesh (`model.mesh`)",
+                ));
+            };
+            let side = match sides.iter().position(|s| s.name == p.side) {
+                Some(s) => s,
+                None => {
+                    sides.push(DamperSide {
+                        name: p.side.clone(),
+                        contacts: Vec::new(),
+                    });
+                    sides.len() - 1
+                }
+            };
+            let points = fe_scene::patch_contacts(
+                file,
+                &format!("contact_patches[{pi}]"),
+                structure,
+                p,
+                side,
+            )?;
+            for point in points {
+                if contacts.iter().any(|c: &ContactPoint| c.name == point.name) {
+                    return Err(ck.err(
+                        f("side"),
+                        format!("contact point name `{}` is already used", point.name),
+                    ));
+                }
+                sides[side].contacts.push(contacts.len());
+                contacts.push(point);
+            }
+        }
+
         let mut static_load = vec![0.0; n];
         for (i, l) in self.static_loads.iter().enumerate() {
-            let d = ck.dof(&format!("static_loads[{i}].dof"), &l.dof, dofs)?;
-            static_load[d] += ck.finite(&format!("static_loads[{i}].value"), l.value)?;
+            let value = ck.finite(&format!("static_loads[{i}].value"), l.value)?;
+            for (d, w) in ck.load_targets(
+                &format!("static_loads[{i}]"),
+                l.dof.as_deref(),
+                l.group.as_deref(),
+                l.direction.as_deref(),
+                dofs,
+                fe.as_ref(),
+            )? {
+                static_load[d] += w * value;
+            }
         }
 
         let h_max = match (&self.harmonics.max, &self.harmonics.list) {
@@ -902,7 +1153,14 @@ impl Scene {
 
         let mut harmonic_loads = Vec::new();
         for (i, l) in self.harmonic_loads.iter().enumerate() {
-            let dof = ck.dof(&format!("harmonic_loads[{i}].dof"), &l.dof, dofs)?;
+            let targets = ck.load_targets(
+                &format!("harmonic_loads[{i}]"),
+                l.dof.as_deref(),
+                l.group.as_deref(),
+                l.direction.as_deref(),
+                dofs,
+                fe.as_ref(),
+            )?;
             if l.harmonic == 0 {
                 return Err(ck.err(
                     format!("harmonic_loads[{i}].harmonic"),
@@ -918,12 +1176,16 @@ impl Scene {
                     ),
                 ));
             }
-            harmonic_loads.push(HarmonicLoad {
-                dof,
-                harmonic: l.harmonic,
-                cos: ck.finite(&format!("harmonic_loads[{i}].cos"), l.cos)?,
-                sin: ck.finite(&format!("harmonic_loads[{i}].sin"), l.sin)?,
-            });
+            let cos = ck.finite(&format!("harmonic_loads[{i}].cos"), l.cos)?;
+            let sin = ck.finite(&format!("harmonic_loads[{i}].sin"), l.sin)?;
+            for (dof, w) in targets {
+                harmonic_loads.push(HarmonicLoad {
+                    dof,
+                    harmonic: l.harmonic,
+                    cos: w * cos,
+                    sin: w * sin,
+                });
+            }
         }
         if harmonic_loads.iter().all(|l| l.cos == 0.0 && l.sin == 0.0) {
             return Err(ck.err(
@@ -979,24 +1241,31 @@ impl Scene {
             ck.positive("analysis.residual_tolerance", a.residual_tolerance)?;
         let step_tolerance = ck.positive("analysis.step_tolerance", a.step_tolerance)?;
 
-        if self.output.dofs.is_empty() {
+        if self.output.dofs.is_empty() && self.output.groups.is_empty() {
             return Err(ck.err("output.dofs", "name at least one response DOF"));
         }
-        let outputs = self
+        let mut outputs = self
             .output
             .dofs
             .iter()
             .enumerate()
             .map(|(i, d)| ck.dof(&format!("output.dofs[{i}]"), d, dofs))
             .collect::<Result<Vec<_>, _>>()?;
+        for (i, g) in self.output.groups.iter().enumerate() {
+            let field = format!("output.groups[{i}]");
+            let targets = ck.load_targets(
+                &field,
+                None,
+                Some(&g.group),
+                Some(&g.direction),
+                dofs,
+                fe.as_ref(),
+            )?;
+            outputs.extend(targets.into_iter().map(|(d, _)| d));
+        }
 
         let problem = Problem {
-            model: LinearModel {
-                dof_names: dofs.clone(),
-                mass: StructuralMatrix::Dense(mass),
-                damping: StructuralMatrix::Dense(damping),
-                stiffness: StructuralMatrix::Dense(stiffness),
-            },
+            model,
             contacts,
             sides,
             static_load,
@@ -1033,26 +1302,33 @@ impl Scene {
             limits: self.validate_limits(&ck)?,
         };
         self.validate_sweep(&ck)?;
-        // The structure with stuck contacts must be able to carry static loads.
-        let k_stuck = {
-            let mut k = problem.model.stiffness.to_dense();
-            for (i, j, v) in crate::linear::contact_stiffness(&problem) {
-                k[(i, j)] += v;
+        let problem = match &self.reduction {
+            None => problem,
+            Some(r) => {
+                if r.modes == 0 {
+                    return Err(ck.err("reduction.modes", "must be ≥ 1"));
+                }
+                let zeta = ck.finite("reduction.modal_damping", r.modal_damping)?;
+                if zeta < 0.0 {
+                    return Err(ck.err(
+                        "reduction.modal_damping",
+                        format!("must be ≥ 0, got {zeta}"),
+                    ));
+                }
+                let [alpha, beta] = self.model.rayleigh.unwrap_or([0.0, 0.0]);
+                let settings = crate::reduce::ReductionSettings {
+                    modes: r.modes,
+                    modal_damping: zeta,
+                    rayleigh: (alpha, beta),
+                    ordering: r.ordering.ordering(),
+                    recover: Vec::new(),
+                };
+                crate::reduce::reduce(&problem, &settings)
+                    .map_err(|e| ck.err("reduction", e.to_string()))?
+                    .problem
             }
-            k
         };
-        let eig = k_stuck
-            .self_adjoint_eigenvalues(faer::Side::Lower)
-            .map_err(|_| ck.err("model.stiffness", "eigenvalues could not be computed"))?;
-        let max = eig.iter().fold(0.0_f64, |acc, v| acc.max(v.abs()));
-        let min = eig.iter().cloned().fold(f64::INFINITY, f64::min);
-        if min <= 1e-12 * max {
-            return Err(ck.err(
-                "model.stiffness",
-                "the structure is singular even with all contacts stuck (a body is free: \
-                 ground it or connect it through a contact)",
-            ));
-        }
+        check_stuck_structure(&ck, &problem)?;
         Ok(problem)
     }
 
@@ -1145,6 +1421,47 @@ impl Scene {
         }
         Ok(())
     }
+}
+
+/// The structure with all contacts stuck must carry static loads: K + contact springs must be
+/// positive definite (a free body, or an indefinite K, is refused). Dense models: eigenvalues;
+/// sparse ones: a sparse Cholesky factorisation.
+fn check_stuck_structure(ck: &Checker, problem: &Problem) -> Result<(), SceneError> {
+    let singular = || {
+        ck.err(
+            "model.stiffness",
+            "the structure is singular or indefinite even with all contacts stuck (a body is \
+             free, or K has a negative eigenvalue: ground the body or connect it through a \
+             contact, and check K)",
+        )
+    };
+    match &problem.model.stiffness {
+        StructuralMatrix::Dense(k) => {
+            let mut k = k.clone();
+            for (i, j, v) in crate::linear::contact_stiffness(problem) {
+                k[(i, j)] += v;
+            }
+            let eig = k
+                .self_adjoint_eigenvalues(faer::Side::Lower)
+                .map_err(|_| ck.err("model.stiffness", "eigenvalues could not be computed"))?;
+            let max = eig.iter().fold(0.0_f64, |acc, v| acc.max(v.abs()));
+            let min = eig.iter().cloned().fold(f64::INFINITY, f64::min);
+            if min <= 1e-12 * max {
+                return Err(singular());
+            }
+        }
+        StructuralMatrix::Sparse(_) => {
+            let mut t = problem.model.stiffness.triplets();
+            t.extend(crate::linear::contact_stiffness(problem));
+            let StructuralMatrix::Sparse(k) =
+                StructuralMatrix::sparse_from_triplets(problem.model.n_dofs(), &t)
+            else {
+                unreachable!("sparse_from_triplets builds sparse storage")
+            };
+            k.sp_cholesky(faer::Side::Lower).map_err(|_| singular())?;
+        }
+    }
+    Ok(())
 }
 
 fn push_coefficient(row: &mut Vec<(usize, f64)>, dof: usize, value: f64) {
