@@ -211,22 +211,65 @@ impl<'p> PointSolver<'p> {
         let p = self
             .continuation
             .solve_fixed(&mut self.system, x0, 2.0 * PI * freq_hz)?;
-        let problem = self.system.problem();
+        Ok(self.point(p.x, freq_hz, p.iterations, p.residual))
+    }
+
+    /// Solves the path point on the hyperplane through `a + t (b − a)` normal to the chord
+    /// from `a` to `b` (two nearby points of a path; t ∈ [0, 1] moves along the chord), in the
+    /// continuation's scaled space. Unlike [`Self::solve`] it does not fix the frequency, so it
+    /// stays on the branch of the chord at folds (turning points) of the path.
+    pub fn solve_on_chord(
+        &mut self,
+        a: &FrfPoint,
+        b: &FrfPoint,
+        t: f64,
+    ) -> Result<FrfPoint, NewtonFailure> {
+        let scale = self.continuation.x_scale;
+        let scaled = |p: &FrfPoint| -> Vec<f64> {
+            p.coefficients
+                .iter()
+                .map(|v| v / scale)
+                .chain(std::iter::once(p.freq_hz))
+                .collect()
+        };
+        let (ya, yb) = (scaled(a), scaled(b));
+        let mut chord: Vec<f64> = ya.iter().zip(&yb).map(|(p, q)| q - p).collect();
+        let length = crate::continuation::norm(&chord);
+        if length == 0.0 {
+            return self.solve(&a.coefficients, a.freq_hz);
+        }
+        chord.iter_mut().for_each(|v| *v /= length);
+        let predicted: Vec<f64> = ya.iter().zip(&yb).map(|(p, q)| p + t * (q - p)).collect();
+        let (y, iterations, residual) =
+            self.continuation
+                .correct(&mut self.system, &predicted, &chord)?;
+        let n = y.len() - 1;
+        let x: Vec<f64> = y[..n].iter().map(|v| v * scale).collect();
+        let freq_hz = y[n];
+        // Leave the operator (and its contact states) evaluated at the returned point.
+        let mut r = vec![0.0; n];
+        self.system
+            .residual(&x, 2.0 * PI * freq_hz, &mut r)
+            .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
+        Ok(self.point(x, freq_hz, iterations, residual))
+    }
+
+    fn point(&self, x: Vec<f64>, freq_hz: f64, iterations: usize, residual: f64) -> FrfPoint {
         let (amplitudes, peaks) = point_outputs(
-            problem,
+            self.system.problem(),
             self.system.unknowns(),
             self.system.static_offset(),
-            &p.x,
+            &x,
         );
-        Ok(FrfPoint {
+        FrfPoint {
             freq_hz,
             amplitudes,
             peaks,
             states: self.system.states.clone(),
-            newton_iterations: p.iterations,
-            residual: p.residual,
-            coefficients: p.x,
-        })
+            newton_iterations: iterations,
+            residual,
+            coefficients: x,
+        }
     }
 }
 

@@ -4,7 +4,7 @@ use fricbound::contact::ContactState;
 use fricbound::limits::{self, LimitCase, LimitLabel, LimitSettings, Regime};
 use fricbound::model::Problem;
 use fricbound::reference::paper_wedge_scene;
-use fricbound::scene::{self, SweepSpec, SweepTarget};
+use fricbound::scene::{self, SweepOutput, SweepSpec, SweepTarget};
 use fricbound::sweep;
 
 fn overrides(lo: f64, hi: f64, extra: &[String]) -> Vec<String> {
@@ -41,6 +41,7 @@ fn settings(intermediate: &[f64]) -> LimitSettings {
         intermediate: intermediate.to_vec(),
         grid_points: 61,
         bound_scan: vec![],
+        ..LimitSettings::default()
     }
 }
 
@@ -49,7 +50,7 @@ fn limit_peaks_agree_at_the_2nd_resonance_and_differ_at_the_3rd() {
     let second = paper(150.0, 175.0, &[]);
     let peaks: Vec<_> = limits::two_point_cases(&second)
         .iter()
-        .map(|c| limits::solve_case(&second, c).unwrap().peak)
+        .map(|c| limits::solve_case(&second, c, None).unwrap().peak)
         .collect();
     let rel = (peaks[0].amplitude - peaks[1].amplitude).abs() / peaks[0].amplitude;
     assert!(peaks[0].refined && peaks[1].refined);
@@ -58,7 +59,7 @@ fn limit_peaks_agree_at_the_2nd_resonance_and_differ_at_the_3rd() {
     let third = paper(200.0, 235.0, &[]);
     let peaks: Vec<_> = limits::two_point_cases(&third)
         .iter()
-        .map(|c| limits::solve_case(&third, c).unwrap().peak)
+        .map(|c| limits::solve_case(&third, c, None).unwrap().peak)
         .collect();
     let (hi, lo) = (
         peaks[0].amplitude.max(peaks[1].amplitude),
@@ -81,14 +82,19 @@ fn intermediate_peaks_lie_between_the_limit_peaks_at_high_preloads() {
         let problem = paper(195.0, 240.0, &[preload(f0)]);
         let limit_peaks: Vec<f64> = limits::two_point_cases(&problem)
             .iter()
-            .map(|c| limits::solve_case(&problem, c).unwrap().peak.amplitude)
+            .map(|c| {
+                limits::solve_case(&problem, c, None)
+                    .unwrap()
+                    .peak
+                    .amplitude
+            })
             .collect();
         let (hi, lo) = (
             limit_peaks[0].max(limit_peaks[1]),
             limit_peaks[0].min(limit_peaks[1]),
         );
         for m in [-0.5, 0.0, 0.5] {
-            let peak = limits::solve_case(&problem, &LimitCase::uniform(&problem, m))
+            let peak = limits::solve_case(&problem, &LimitCase::uniform(&problem, m), None)
                 .unwrap()
                 .peak;
             let slack = 1e-6 * hi;
@@ -213,6 +219,8 @@ fn sweeps_are_identical_with_one_and_two_threads() {
             scale: -1.0,
             offset: 0.0,
         }],
+        output: SweepOutput::Peaks,
+        series: None,
     };
     let mut text = paper_wedge_scene().to_string();
     text.push_str("\n[limits]\nintermediate = [0.0]\n");
