@@ -292,6 +292,22 @@ pub fn refine_peak(
     Ok(Some(Peak::from_point(&best_point, output, true)))
 }
 
+/// The resonance of a linear reference: its largest local maximum of output `output` inside
+/// `window` (Hz; anywhere when `None`), as (frequency in Hz, amplitude in m), at the reference's
+/// grid resolution.
+pub fn linear_resonance(
+    curve: &crate::linear::LinearCurve,
+    output: usize,
+    window: Option<(f64, f64)>,
+) -> Option<(f64, f64)> {
+    let a: Vec<f64> = curve.amplitudes.iter().map(|r| r[output]).collect();
+    (1..a.len().saturating_sub(1))
+        .filter(|&i| a[i] > a[i - 1] && a[i] >= a[i + 1])
+        .filter(|&i| window.is_none_or(|(lo, hi)| (lo..=hi).contains(&curve.freqs_hz[i])))
+        .map(|i| (curve.freqs_hz[i], a[i]))
+        .max_by(|x, y| x.1.total_cmp(&y.1))
+}
+
 /// One solved curve.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CaseCurve {
@@ -630,6 +646,20 @@ pub struct BoundCheck {
     pub peak_excess_below: f64,
     /// Grid points compared.
     pub compared: usize,
+    /// Contact states where the excess above the upper limit is largest.
+    pub above_states: Option<ExcessStates>,
+    /// Contact states where the excess below the lower limit is largest.
+    pub below_states: Option<ExcessStates>,
+}
+
+/// Contact states at the point of a largest excess: they tell why the limits do not bound
+/// there (e.g. a limit curve fully stuck while the scanned state slips).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ExcessStates {
+    /// States of the scanned curve.
+    pub scanned: Vec<ContactState>,
+    /// States of each limit curve at that grid frequency.
+    pub limits: Vec<Vec<ContactState>>,
 }
 
 /// Compares scanned curves (on the grid) and their peaks with the limits.
@@ -646,6 +676,8 @@ pub fn check_bounds(
         peak_excess_above: 0.0,
         peak_excess_below: 0.0,
         compared: 0,
+        above_states: None,
+        below_states: None,
     };
     let peak_hi = limit_peaks
         .iter()
@@ -661,14 +693,20 @@ pub fn check_bounds(
             b.compared += 1;
             let a = p.amplitudes[0];
             let above = (a - g.upper) / g.upper;
+            let states = || ExcessStates {
+                scanned: p.states.clone(),
+                limits: g.states.clone(),
+            };
             if above > b.max_excess_above {
                 b.max_excess_above = above;
                 b.above_at = Some((g.freq_hz, case.name.clone()));
+                b.above_states = Some(states());
             }
             let below = (g.lower - a) / g.lower;
             if below > b.max_excess_below {
                 b.max_excess_below = below;
                 b.below_at = Some((g.freq_hz, case.name.clone()));
+                b.below_states = Some(states());
             }
         }
         b.peak_excess_above = b

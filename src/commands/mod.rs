@@ -518,6 +518,40 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
             .collect::<Vec<_>>()
             .join(", ")
     );
+    if let Some(l) = &problem.limits {
+        let cases: Vec<String> = crate::limits::two_point_cases(&problem)
+            .into_iter()
+            .chain(l.intermediate_cases(&problem))
+            .map(|c| c.name)
+            .collect();
+        let _ = writeln!(
+            s,
+            "limits       curves {}; grid {} points; bound scan {:?}; peak window {}",
+            cases.join(", "),
+            l.grid_points,
+            l.bound_scan,
+            l.peak_window_hz
+                .map(|(a, b)| format!("{a} .. {b} Hz"))
+                .unwrap_or_else(|| "the range".to_string())
+        );
+    }
+    if let Some(sw) = &scene.sweep {
+        let mut line = format!(
+            "sweep        {} over {} values ({:?} each)",
+            sw.parameter,
+            sw.values.len(),
+            sw.output
+        );
+        if let Some(series) = &sw.series {
+            let _ = write!(
+                line,
+                ", for each of {} values of {}",
+                series.values.len(),
+                series.parameter
+            );
+        }
+        let _ = writeln!(s, "{line}");
+    }
     Ok(s)
 }
 

@@ -366,7 +366,7 @@ fn plot_peaks(
                 specs.push((gi, c));
             }
         }
-        let curves: Vec<Curve> = specs
+        let mut curves: Vec<Curve> = specs
             .iter()
             .zip(&labels)
             .map(|(&(gi, c), label)| Curve {
@@ -378,6 +378,53 @@ fn plot_peaks(
                 markers: true,
             })
             .collect();
+        // The linear references' resonance in the peak window, as levels the limits start
+        // from and tend to (valid for every value when only static loads are swept).
+        let window = ctx.problem.limits.as_ref().and_then(|l| l.peak_window_hz);
+        let x_span: Vec<f64> = {
+            let xs = data.iter().flat_map(|g| g.x.iter().copied());
+            let lo = xs.clone().fold(f64::INFINITY, f64::min);
+            let hi = xs.fold(f64::NEG_INFINITY, f64::max);
+            vec![lo, hi]
+        };
+        let references: Vec<(String, Vec<f64>, plotters::style::RGBColor)> =
+            if only_static_loads(spec) {
+                [
+                    (
+                        &ctx.open,
+                        "linear, contacts open",
+                        plotters::style::RGBColor(140, 140, 140),
+                    ),
+                    (
+                        &ctx.stuck,
+                        "linear, contacts stuck",
+                        plotters::style::RGBColor(40, 40, 40),
+                    ),
+                ]
+                .into_iter()
+                .filter_map(|(curve, name, color)| {
+                    let (f, a) = crate::limits::linear_resonance(curve, 0, window)?;
+                    let (v, text) = if amplitude {
+                        (a, format!("{name}: resonance peak"))
+                    } else {
+                        (f, format!("{name}: resonance"))
+                    };
+                    Some((text, vec![v, v], color))
+                })
+                .collect()
+            } else {
+                Vec::new()
+            };
+        for (label, y, color) in &references {
+            curves.push(Curve {
+                label,
+                x: &x_span,
+                y,
+                color: *color,
+                dashed: true,
+                markers: false,
+            });
+        }
         let title = format!(
             "{}: {} vs {}",
             ctx.title(),
