@@ -150,7 +150,8 @@ impl LimitCase {
     }
 }
 
-fn signed(m: f64) -> String {
+/// m as it appears in case names: `+0.5`, `-1`, `0`.
+pub fn signed(m: f64) -> String {
     if m == 0.0 {
         "0".to_string()
     } else {

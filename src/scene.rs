@@ -1190,13 +1190,7 @@ impl Scene {
         }
 
         // Intermediate cases per side or point; names must not clash with the uniform ones.
-        let signed = |m: f64| {
-            if m == 0.0 {
-                "0".to_string()
-            } else {
-                format!("{m:+}")
-            }
-        };
+        let signed = crate::limits::signed;
         let mut names: Vec<String> = [1.0, -1.0]
             .iter()
             .chain(&l.intermediate)

@@ -459,120 +459,113 @@ fn plot_bands(
     spec: &SweepSpec,
     points: &[SweepPoint],
 ) -> Result<(), CommandError> {
+    // The band on the grid is of the first output DOF (as the peaks).
     let problem = &ctx.problem;
-    for (k, &d) in problem.outputs.iter().enumerate() {
-        let output = &problem.model.dof_names[d];
-        for (s, pts) in by_series(spec, points) {
-            struct Data {
-                x: Vec<f64>,
-                lower: Vec<f64>,
-                upper: Vec<f64>,
-                curves: Vec<(String, Vec<f64>, Vec<f64>)>,
-            }
-            let data: Vec<Data> = pts
-                .iter()
-                .filter_map(|p| {
-                    let a = p.analysis.as_ref()?;
-                    let label = point_label(spec, None, p.value);
-                    let curves = a
-                        .limits
-                        .iter()
-                        .map(|c| {
-                            (
-                                format!("{label}: limit {}", c.case.name),
-                                c.run.points.iter().map(|q| q.freq_hz).collect(),
-                                c.run.points.iter().map(|q| q.amplitudes[k]).collect(),
-                            )
-                        })
-                        .collect();
-                    // The band of this output: min and max of the limit curves on the grid.
-                    let on_grid: Vec<(f64, f64, f64)> = a
-                        .grid
-                        .iter()
-                        .map(|g| (g.freq_hz, g.lower, g.upper))
-                        .collect();
-                    Some(Data {
-                        x: on_grid.iter().map(|g| g.0).collect(),
-                        lower: on_grid.iter().map(|g| g.1).collect(),
-                        upper: on_grid.iter().map(|g| g.2).collect(),
-                        curves,
-                    })
-                })
-                .collect();
-            if data.is_empty() || k > 0 {
-                // The grid band is of the first output DOF only.
-                continue;
-            }
-            // The limit lines carry the legend; each band shares its lines' colour.
-            let band_labels: Vec<String> = data.iter().map(|_| String::new()).collect();
-            let bands: Vec<BandSpec> = data
-                .iter()
-                .zip(&band_labels)
-                .enumerate()
-                .map(|(i, (d, label))| BandSpec {
-                    label,
-                    x: &d.x,
-                    lower: &d.lower,
-                    upper: &d.upper,
-                    color: palette(i),
-                })
-                .collect();
-            let mut curves: Vec<Curve> = Vec::new();
-            for (i, d) in data.iter().enumerate() {
-                for (j, (label, x, y)) in d.curves.iter().enumerate() {
-                    curves.push(Curve {
-                        label,
-                        x,
-                        y,
-                        color: palette(i),
-                        dashed: j == 1,
-                        markers: false,
-                    });
-                }
-            }
-            let open_y: Vec<f64> = ctx.open.amplitudes.iter().map(|r| r[k]).collect();
-            let stuck_y: Vec<f64> = ctx.stuck.amplitudes.iter().map(|r| r[k]).collect();
-            if only_static_loads(spec) {
-                curves.push(Curve {
-                    label: "linear, contacts stuck",
-                    x: &ctx.stuck.freqs_hz,
-                    y: &stuck_y,
-                    color: plotters::style::RGBColor(40, 40, 40),
-                    dashed: true,
-                    markers: false,
-                });
-                curves.push(Curve {
-                    label: "linear, contacts open",
-                    x: &ctx.open.freqs_hz,
-                    y: &open_y,
-                    color: plotters::style::RGBColor(140, 140, 140),
-                    dashed: true,
-                    markers: false,
-                });
-            }
-            let (suffix, series_label) = match (&spec.series, s) {
-                (Some(sp), Some(v)) => (
-                    format!("_{}_{}", sp.parameter, value_text(v)),
-                    format!(", {} = {} {}", sp.parameter, value_text(v), sp.unit),
-                ),
-                _ => (String::new(), String::new()),
-            };
-            let title = format!("{}{series_label}", ctx.title());
-            let y_label = format!("{output} first-harmonic amplitude (m)");
-            let fig = SweepFigure {
-                title: &title,
-                x_label: "frequency (Hz)",
-                y_label: &y_label,
-                log_y: true,
-                bands: &bands,
-                curves: &curves,
-            };
-            limit_plots::plot_sweep(
-                &fig,
-                &ctx.dir.join(format!("bands_{output}{suffix}.png")),
-                &ctx.dir.join(format!("bands_{output}{suffix}.svg")),
-            )?;
+    let k = 0;
+    let output = &problem.model.dof_names[problem.outputs[k]];
+    for (s, pts) in by_series(spec, points) {
+        struct Data {
+            x: Vec<f64>,
+            lower: Vec<f64>,
+            upper: Vec<f64>,
+            curves: Vec<(String, Vec<f64>, Vec<f64>)>,
         }
+        let data: Vec<Data> = pts
+            .iter()
+            .filter_map(|p| {
+                let a = p.analysis.as_ref()?;
+                let label = point_label(spec, None, p.value);
+                let curves = a
+                    .limits
+                    .iter()
+                    .map(|c| {
+                        (
+                            format!("{label}: limit {}", c.case.name),
+                            c.run.points.iter().map(|q| q.freq_hz).collect(),
+                            c.run.points.iter().map(|q| q.amplitudes[k]).collect(),
+                        )
+                    })
+                    .collect();
+                Some(Data {
+                    x: a.grid.iter().map(|g| g.freq_hz).collect(),
+                    lower: a.grid.iter().map(|g| g.lower).collect(),
+                    upper: a.grid.iter().map(|g| g.upper).collect(),
+                    curves,
+                })
+            })
+            .collect();
+        if data.is_empty() {
+            continue;
+        }
+        // The limit lines carry the legend; each band shares its lines' colour.
+        let band_labels: Vec<String> = data.iter().map(|_| String::new()).collect();
+        let bands: Vec<BandSpec> = data
+            .iter()
+            .zip(&band_labels)
+            .enumerate()
+            .map(|(i, (d, label))| BandSpec {
+                label,
+                x: &d.x,
+                lower: &d.lower,
+                upper: &d.upper,
+                color: palette(i),
+            })
+            .collect();
+        let mut curves: Vec<Curve> = Vec::new();
+        for (i, d) in data.iter().enumerate() {
+            for (j, (label, x, y)) in d.curves.iter().enumerate() {
+                curves.push(Curve {
+                    label,
+                    x,
+                    y,
+                    color: palette(i),
+                    dashed: j == 1,
+                    markers: false,
+                });
+            }
+        }
+        let open_y: Vec<f64> = ctx.open.amplitudes.iter().map(|r| r[k]).collect();
+        let stuck_y: Vec<f64> = ctx.stuck.amplitudes.iter().map(|r| r[k]).collect();
+        if only_static_loads(spec) {
+            curves.push(Curve {
+                label: "linear, contacts stuck",
+                x: &ctx.stuck.freqs_hz,
+                y: &stuck_y,
+                color: plotters::style::RGBColor(40, 40, 40),
+                dashed: true,
+                markers: false,
+            });
+            curves.push(Curve {
+                label: "linear, contacts open",
+                x: &ctx.open.freqs_hz,
+                y: &open_y,
+                color: plotters::style::RGBColor(140, 140, 140),
+                dashed: true,
+                markers: false,
+            });
+        }
+        let (suffix, series_label) = match (&spec.series, s) {
+            (Some(sp), Some(v)) => (
+                format!("_{}_{}", sp.parameter, value_text(v)),
+                format!(", {} = {} {}", sp.parameter, value_text(v), sp.unit),
+            ),
+            _ => (String::new(), String::new()),
+        };
+        let title = format!("{}{series_label}", ctx.title());
+        let y_label = format!("{output} first-harmonic amplitude (m)");
+        let fig = SweepFigure {
+            title: &title,
+            x_label: "frequency (Hz)",
+            y_label: &y_label,
+            log_y: true,
+            bands: &bands,
+            curves: &curves,
+        };
+        limit_plots::plot_sweep(
+            &fig,
+            &ctx.dir.join(format!("bands_{output}{suffix}.png")),
+            &ctx.dir.join(format!("bands_{output}{suffix}.svg")),
+        )?;
     }
     Ok(())
 }
