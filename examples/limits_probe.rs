@@ -22,6 +22,7 @@ fn main() {
         intermediate: vec![-0.5, 0.0, 0.5],
         grid_points: 71,
         bound_scan: vec![-0.5, 0.0, 0.5],
+        ..Default::default()
     };
     let t = std::time::Instant::now();
     let a =

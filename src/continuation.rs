@@ -323,8 +323,10 @@ impl Continuation {
         Ok(t)
     }
 
-    /// Corrector: Newton on R = 0 and tᵀ(y − y_p) = 0 in scaled space.
-    fn correct<S: ParametricResidual>(
+    /// Corrector: Newton on R = 0 and tᵀ(y − y_p) = 0 in scaled space (y = (x / x_scale,
+    /// ω / 2π), `tangent` a unit vector); returns the corrected y, the iterations and the
+    /// relative residual.
+    pub fn correct<S: ParametricResidual>(
         &self,
         system: &mut S,
         predicted: &[f64],

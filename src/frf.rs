@@ -6,7 +6,8 @@ use std::time::Instant;
 
 use crate::contact::ContactState;
 use crate::continuation::{
-    Continuation, ContinuationError, NewtonFailure, Observer, PathEnd, PathPoint,
+    Continuation, ContinuationError, NewtonFailure, Observer, ParametricResidual, PathEnd,
+    PathPoint,
 };
 use crate::harmonic::HarmonicSet;
 use crate::hbm::{HbmError, HbmSystem};
@@ -238,6 +239,58 @@ impl<'p> PointSolver<'p> {
         let mut point = full_point(&mut self.system, &p)
             .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
         point.freq_hz = freq_hz;
+        Ok(point)
+    }
+
+    /// Solves the path point on the hyperplane through `a + t (b − a)` normal to the chord
+    /// from `a` to `b` (two nearby points of a path; t ∈ [0, 1] moves along the chord), in the
+    /// continuation's scaled space. Unlike [`Self::solve`] it does not fix the frequency, so it
+    /// stays on the branch of the chord at folds (turning points) of the path.
+    pub fn solve_on_chord(
+        &mut self,
+        a: &FrfPoint,
+        b: &FrfPoint,
+        t: f64,
+    ) -> Result<FrfPoint, NewtonFailure> {
+        let scale = self.continuation.x_scale;
+        let system = &self.system;
+        let scaled = |p: &FrfPoint| -> Vec<f64> {
+            system
+                .restrict(&p.coefficients)
+                .iter()
+                .map(|v| v / scale)
+                .chain(std::iter::once(p.freq_hz))
+                .collect()
+        };
+        let (ya, yb) = (scaled(a), scaled(b));
+        let mut chord: Vec<f64> = ya.iter().zip(&yb).map(|(p, q)| q - p).collect();
+        let length = crate::continuation::norm(&chord);
+        if length == 0.0 {
+            return self.solve(&a.coefficients, a.freq_hz);
+        }
+        chord.iter_mut().for_each(|v| *v /= length);
+        let predicted: Vec<f64> = ya.iter().zip(&yb).map(|(p, q)| p + t * (q - p)).collect();
+        let (y, iterations, residual) =
+            self.continuation
+                .correct(&mut self.system, &predicted, &chord)?;
+        let n = y.len() - 1;
+        let x: Vec<f64> = y[..n].iter().map(|v| v * scale).collect();
+        let omega = 2.0 * PI * y[n];
+        // Leave the operator (and its contact states) evaluated at the returned point.
+        let mut r = vec![0.0; n];
+        self.system
+            .residual(&x, omega, &mut r)
+            .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
+        let path_point = PathPoint {
+            omega,
+            x,
+            iterations,
+            residual,
+            step: 0.0,
+        };
+        let mut point = full_point(&mut self.system, &path_point)
+            .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
+        point.freq_hz = y[n];
         Ok(point)
     }
 }

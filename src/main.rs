@@ -29,6 +29,18 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Regenerate the data and figures of the paper's §4 study (Figs. 12-19) and a summary.
+    Paper {
+        /// Output folder (default: out/paper).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Coarser sweeps and grids: seconds instead of minutes.
+        #[arg(long)]
+        quick: bool,
+        /// No progress bars or messages.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Validate a scene and print a summary.
     Check {
         /// Scene file (TOML).
@@ -58,10 +70,19 @@ fn main() -> ExitCode {
                 out,
                 overrides,
                 quiet,
+                ..Default::default()
             };
             fricbound::commands::run(&options).map(|r| {
                 if !quiet {
                     println!("{}", fricbound::commands::run_summary(&r));
+                }
+            })
+        }
+        Command::Paper { out, quick, quiet } => {
+            let options = fricbound::commands::paper::PaperOptions { out, quick, quiet };
+            fricbound::commands::paper::paper(&options).map(|r| {
+                if !quiet {
+                    println!("{}", fricbound::commands::paper::paper_summary_line(&r));
                 }
             })
         }

@@ -116,10 +116,47 @@ pub struct LimitsSpec {
     /// other solutions; empty: no scan.
     #[serde(default)]
     pub bound_scan: Vec<f64>,
+    /// Intermediate cases with m given per damper side and/or per contact point.
+    #[serde(default)]
+    pub cases: Vec<LimitCaseSpec>,
+    /// Frequency window [start, end] (Hz) in which each curve's resonance peak is sought;
+    /// absent: the whole range.
+    #[serde(default)]
+    pub peak_window_hz: Option<[f64; 2]>,
+    /// Hysteresis loops to write; absent: at every curve's peak.
+    #[serde(default)]
+    pub hysteresis: Option<HysteresisSpec>,
 }
 
 fn default_grid_points() -> usize {
     201
+}
+
+/// One `[[limits.cases]]` entry: an intermediate case with m per side and/or per point.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LimitCaseSpec {
+    /// Name in files and legends; default built from the entries (e.g. `left+0.5`).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// m ∈ [−1, 1] per damper side name.
+    #[serde(default)]
+    pub sides: std::collections::BTreeMap<String, f64>,
+    /// m ∈ [−1, 1] per contact name (wins over its side's value).
+    #[serde(default)]
+    pub contacts: std::collections::BTreeMap<String, f64>,
+}
+
+/// The `[limits.hysteresis]` table.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HysteresisSpec {
+    /// Loops at each limit and intermediate curve's resonance peak (default true).
+    #[serde(default = "yes")]
+    pub at_peaks: bool,
+    /// Loops at these frequencies (Hz) on each limit and intermediate curve.
+    #[serde(default)]
+    pub freqs_hz: Vec<f64>,
 }
 
 /// The `[sweep]` table: one parameter mapped linearly onto scene fields.
@@ -135,6 +172,47 @@ pub struct SweepSpec {
     pub values: Vec<f64>,
     /// Fields set from the parameter p: field = offset + scale · p.
     pub targets: Vec<SweepTarget>,
+    /// What each value computes: `peaks` (default; resonance peaks of the limit and
+    /// intermediate cases: optimal curves) or `limits` (the whole limit analysis: FRF bands).
+    #[serde(default)]
+    pub output: SweepOutput,
+    /// A second parameter: the sweep is repeated at each of its values (one curve family per
+    /// value, e.g. one optimal curve per apical angle).
+    #[serde(default)]
+    pub series: Option<SeriesSpec>,
+}
+
+/// What each sweep value computes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SweepOutput {
+    /// Resonance peaks of the limit and intermediate cases.
+    #[default]
+    Peaks,
+    /// The whole limit analysis (bands, classification, bound scan, loops).
+    Limits,
+}
+
+/// The `[sweep.series]` table: the second parameter of a sweep.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SeriesSpec {
+    /// Parameter name (e.g. "beta").
+    pub parameter: String,
+    /// Parameter unit (e.g. "deg").
+    #[serde(default)]
+    pub unit: String,
+    /// Parameter values.
+    pub values: Vec<f64>,
+    /// Fields set from the parameter: field = offset + scale · p.
+    pub targets: Vec<SweepTarget>,
+}
+
+impl SeriesSpec {
+    /// The `--set` overrides that put the series parameter at `value`.
+    pub fn overrides(&self, value: f64) -> Vec<String> {
+        target_overrides(&self.targets, value)
+    }
 }
 
 /// One scene field driven by the sweep parameter.
@@ -158,11 +236,15 @@ fn unit_scale() -> f64 {
 impl SweepSpec {
     /// The `--set` overrides that put the parameter at `value`.
     pub fn overrides(&self, value: f64) -> Vec<String> {
-        self.targets
-            .iter()
-            .map(|t| format!("{}={:e}", t.field, t.offset + t.scale * value))
-            .collect()
+        target_overrides(&self.targets, value)
     }
+}
+
+fn target_overrides(targets: &[SweepTarget], value: f64) -> Vec<String> {
+    targets
+        .iter()
+        .map(|t| format!("{}={:e}", t.field, t.offset + t.scale * value))
+        .collect()
 }
 
 /// Inline dense matrices with DOF names.
@@ -1339,19 +1421,22 @@ impl Scene {
         let Some(l) = &self.limits else {
             return Ok(None);
         };
+        let check_m = |field: String, m: f64| -> Result<f64, SceneError> {
+            ck.finite(&field, m)?;
+            if !(-1.0..=1.0).contains(&m) {
+                return Err(ck.err(
+                    field,
+                    format!("an initial state m must lie in [-1, 1], got {m}"),
+                ));
+            }
+            Ok(m)
+        };
         for (name, list) in [
             ("intermediate", &l.intermediate),
             ("bound_scan", &l.bound_scan),
         ] {
             for (i, m) in list.iter().enumerate() {
-                let field = format!("limits.{name}[{i}]");
-                ck.finite(&field, *m)?;
-                if !(-1.0..=1.0).contains(m) {
-                    return Err(ck.err(
-                        field,
-                        format!("an initial state m must lie in [-1, 1], got {m}"),
-                    ));
-                }
+                check_m(format!("limits.{name}[{i}]"), *m)?;
             }
         }
         if !(2..=100_000).contains(&l.grid_points) {
@@ -1360,7 +1445,7 @@ impl Scene {
                 format!("must be in 2..=100000, got {}", l.grid_points),
             ));
         }
-        let sides = {
+        let side_names = {
             let mut names: Vec<String> = Vec::new();
             for c in &self.contacts {
                 let s = c.side.clone().unwrap_or_else(|| c.name.clone());
@@ -1368,8 +1453,9 @@ impl Scene {
                     names.push(s);
                 }
             }
-            names.len()
+            names
         };
+        let sides = side_names.len();
         let combinations = (l.bound_scan.len() as f64).powi(sides as i32);
         if combinations > 4096.0 {
             return Err(ck.err(
@@ -1380,10 +1466,136 @@ impl Scene {
                 ),
             ));
         }
+
+        // Intermediate cases per side or point; names must not clash with the uniform ones.
+        let signed = crate::limits::signed;
+        let mut names: Vec<String> = [1.0, -1.0]
+            .iter()
+            .chain(&l.intermediate)
+            .map(|&m| format!("m{}", signed(m)))
+            .collect();
+        let mut cases = Vec::new();
+        for (i, c) in l.cases.iter().enumerate() {
+            let f = |name: &str| format!("limits.cases[{i}].{name}");
+            if c.sides.is_empty() && c.contacts.is_empty() {
+                return Err(ck.err(
+                    format!("limits.cases[{i}]"),
+                    "give m for at least one damper side (`sides`) or contact (`contacts`)",
+                ));
+            }
+            let mut side_states = Vec::new();
+            for (name, &m) in &c.sides {
+                let field = format!("{}.{name}", f("sides"));
+                let side = side_names.iter().position(|s| s == name).ok_or_else(|| {
+                    ck.err(
+                        field.clone(),
+                        format!(
+                            "unknown damper side `{name}` (the scene has {})",
+                            side_names.join(", ")
+                        ),
+                    )
+                })?;
+                side_states.push((side, check_m(field, m)?));
+            }
+            let mut contact_states = Vec::new();
+            for (name, &m) in &c.contacts {
+                let field = format!("{}.{name}", f("contacts"));
+                let contact = self
+                    .contacts
+                    .iter()
+                    .position(|k| &k.name == name)
+                    .ok_or_else(|| {
+                        ck.err(
+                            field.clone(),
+                            format!(
+                                "unknown contact `{name}` (the scene has {})",
+                                self.contacts
+                                    .iter()
+                                    .map(|k| k.name.as_str())
+                                    .collect::<Vec<_>>()
+                                    .join(", ")
+                            ),
+                        )
+                    })?;
+                contact_states.push((contact, check_m(field, m)?));
+            }
+            let name = match &c.name {
+                Some(n) => {
+                    ck.name(&f("name"), n)?;
+                    n.clone()
+                }
+                None => c
+                    .sides
+                    .iter()
+                    .chain(&c.contacts)
+                    .map(|(k, m)| format!("{k}{}", signed(*m)))
+                    .collect::<Vec<_>>()
+                    .join("_"),
+            };
+            if names.contains(&name) {
+                return Err(ck.err(
+                    f("name"),
+                    format!("case name `{name}` is already used by another curve"),
+                ));
+            }
+            names.push(name.clone());
+            cases.push(crate::limits::CaseSpec {
+                name,
+                sides: side_states,
+                contacts: contact_states,
+            });
+        }
+
+        let (f_lo, f_hi) = (self.analysis.freq_start_hz, self.analysis.freq_end_hz);
+        let peak_window_hz = match l.peak_window_hz {
+            None => None,
+            Some([lo, hi]) => {
+                ck.finite("limits.peak_window_hz[0]", lo)?;
+                ck.finite("limits.peak_window_hz[1]", hi)?;
+                if lo >= hi {
+                    return Err(ck.err(
+                        "limits.peak_window_hz",
+                        format!("the window is reversed or empty: {lo} .. {hi} Hz"),
+                    ));
+                }
+                if hi <= f_lo || lo >= f_hi {
+                    return Err(ck.err(
+                        "limits.peak_window_hz",
+                        format!(
+                            "the window {lo} .. {hi} Hz lies outside the analysis range \
+                             {f_lo} .. {f_hi} Hz"
+                        ),
+                    ));
+                }
+                Some((lo, hi))
+            }
+        };
+        let hysteresis = match &l.hysteresis {
+            None => crate::limits::HysteresisRequest::default(),
+            Some(h) => {
+                for (i, &f) in h.freqs_hz.iter().enumerate() {
+                    let field = format!("limits.hysteresis.freqs_hz[{i}]");
+                    ck.finite(&field, f)?;
+                    if f < f_lo || f > f_hi {
+                        return Err(ck.err(
+                            field,
+                            format!("{f} Hz lies outside the analysis range {f_lo} .. {f_hi} Hz"),
+                        ));
+                    }
+                }
+                crate::limits::HysteresisRequest {
+                    at_peaks: h.at_peaks,
+                    freqs_hz: h.freqs_hz.clone(),
+                }
+            }
+        };
         Ok(Some(crate::limits::LimitSettings {
             intermediate: l.intermediate.clone(),
+            cases,
             grid_points: l.grid_points,
             bound_scan: l.bound_scan.clone(),
+            peak_window_hz,
+            hysteresis,
         }))
     }
 
@@ -1391,27 +1603,45 @@ impl Scene {
         let Some(s) = &self.sweep else {
             return Ok(());
         };
-        if s.parameter.trim().is_empty() {
-            return Err(ck.err("sweep.parameter", "must name the parameter"));
+        let mut parameters = vec![("sweep", &s.parameter, &s.values, &s.targets)];
+        if let Some(series) = &s.series {
+            parameters.push((
+                "sweep.series",
+                &series.parameter,
+                &series.values,
+                &series.targets,
+            ));
         }
-        if s.values.is_empty() {
-            return Err(ck.err("sweep.values", "must hold at least one value"));
-        }
-        for (i, v) in s.values.iter().enumerate() {
-            ck.finite(&format!("sweep.values[{i}]"), *v)?;
-        }
-        if s.targets.is_empty() {
-            return Err(ck.err("sweep.targets", "must name at least one field"));
-        }
-        for (i, t) in s.targets.iter().enumerate() {
-            if t.field.trim().is_empty() || t.field.starts_with("sweep") {
-                return Err(ck.err(
-                    format!("sweep.targets[{i}].field"),
-                    "must be a scene field outside [sweep]",
-                ));
+        for (table, parameter, values, targets) in parameters {
+            if parameter.trim().is_empty() {
+                return Err(ck.err(format!("{table}.parameter"), "must name the parameter"));
             }
-            ck.finite(&format!("sweep.targets[{i}].scale"), t.scale)?;
-            ck.finite(&format!("sweep.targets[{i}].offset"), t.offset)?;
+            if values.is_empty() {
+                return Err(ck.err(format!("{table}.values"), "must hold at least one value"));
+            }
+            for (i, v) in values.iter().enumerate() {
+                ck.finite(&format!("{table}.values[{i}]"), *v)?;
+            }
+            if targets.is_empty() {
+                return Err(ck.err(format!("{table}.targets"), "must name at least one field"));
+            }
+            for (i, t) in targets.iter().enumerate() {
+                if t.field.trim().is_empty() || t.field.starts_with("sweep") {
+                    return Err(ck.err(
+                        format!("{table}.targets[{i}].field"),
+                        "must be a scene field outside [sweep]",
+                    ));
+                }
+                ck.finite(&format!("{table}.targets[{i}].scale"), t.scale)?;
+                ck.finite(&format!("{table}.targets[{i}].offset"), t.offset)?;
+            }
+        }
+        let runs = s.values.len() * s.series.as_ref().map_or(1, |x| x.values.len());
+        if runs > 100_000 {
+            return Err(ck.err(
+                "sweep.values",
+                format!("{runs} sweep points; at most 100000"),
+            ));
         }
         if self.limits.is_none() {
             return Err(ck.err(

@@ -242,8 +242,9 @@ fn full_continuation_runs_agree_between_formulations() {
     // unknowns), so compare the refined peaks, which do not depend on the sampling.
     let peak = |p: &Problem| {
         let run = frf::solve(p, &mut Silent).unwrap();
-        fricbound::limits::refine_peak(p, &run.points, 0)
+        fricbound::limits::refine_peak(p, &run.points, 0, None)
             .unwrap()
+            .expect("a peak inside the range")
             .amplitude
     };
     let dense = peak(&base);

@@ -3,7 +3,7 @@
 
 use std::sync::Mutex;
 
-use super::{CommandError, RunContext, RunReport};
+use super::{CommandError, RunContext, RunOutcome, RunReport};
 use crate::frf::FrfPoint;
 use crate::limits::{self, CaseCurve, LimitAnalysis, Regime};
 use crate::report::files::{self, frf_header, frf_row};
@@ -11,7 +11,7 @@ use crate::report::limit_files;
 use crate::report::limit_plots::{self, palette, Curve, LimitFigure, Loop};
 
 /// Writes one curve's path as `curve_<name>.csv` (same columns as `frf.csv`).
-fn write_curve(ctx: &RunContext<'_>, curve: &CaseCurve) -> Result<(), CommandError> {
+pub(super) fn write_curve(ctx: &RunContext<'_>, curve: &CaseCurve) -> Result<(), CommandError> {
     let mut text = frf_header(&ctx.problem);
     for p in &curve.run.points {
         text.push_str(&frf_row(p));
@@ -30,8 +30,10 @@ pub fn run_limits(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
         .limits
         .clone()
         .expect("called for scenes with [limits]");
-    let n_curves =
-        2 + settings.intermediate.len() + settings.bound_scan.len().pow(problem.sides.len() as u32);
+    let n_curves = 2
+        + settings.intermediate.len()
+        + settings.cases.len()
+        + settings.bound_scan.len().pow(problem.sides.len() as u32);
     let bar = ctx.progress(n_curves as u64);
     let write_error: Mutex<Option<CommandError>> = Mutex::new(None);
     let started = std::time::Instant::now();
@@ -58,14 +60,27 @@ pub fn run_limits(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
         return Err(e);
     }
     let elapsed = started.elapsed().as_secs_f64();
-    write_tables(ctx, &analysis)?;
-    let loops = write_hysteresis(ctx, &analysis)?;
-    write_json(ctx, &analysis, elapsed)?;
-    plot(ctx, &analysis, &loops)?;
+    write_analysis(ctx, &analysis, elapsed)?;
     Ok(RunReport {
         dir: ctx.dir.clone(),
-        summary: summary(ctx, &analysis, elapsed),
+        summary: summary(&analysis, elapsed),
+        outcome: RunOutcome::Limits(Box::new(analysis)),
+        open: ctx.open.clone(),
+        stuck: ctx.stuck.clone(),
     })
+}
+
+/// Writes the tables, hysteresis loops, JSON and figures of a finished analysis (the curve
+/// files are written as the curves come, by [`write_curve`]).
+pub(super) fn write_analysis(
+    ctx: &RunContext<'_>,
+    analysis: &LimitAnalysis,
+    elapsed: f64,
+) -> Result<(), CommandError> {
+    write_tables(ctx, analysis)?;
+    write_hysteresis(ctx, analysis)?;
+    write_json(ctx, analysis, elapsed)?;
+    plot(ctx, analysis)
 }
 
 fn write_tables(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandError> {
@@ -91,35 +106,28 @@ fn write_tables(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandEr
     Ok(())
 }
 
-/// Hysteresis loops at the peak of every limit and intermediate curve.
-fn write_hysteresis(
-    ctx: &RunContext<'_>,
-    a: &LimitAnalysis,
-) -> Result<Vec<(String, Vec<limits::HysteresisLoop>)>, CommandError> {
-    let mut out = Vec::new();
-    for c in a.limits.iter().chain(&a.intermediate) {
-        let p = c.case.apply(&ctx.problem);
-        let loops =
-            limits::hysteresis(&p, &c.peak.coefficients).map_err(|e| CommandError::Limits {
-                scene: ctx.label.clone(),
-                source: limits::LimitError::Contacts {
-                    case: c.case.name.clone(),
-                    source: e,
-                },
-            })?;
+/// File-name part of a loop set: `m+1_peak`, `m0_214.5Hz`.
+fn loop_file_stem(set: &limits::LoopSet) -> String {
+    format!("{}_{}", set.case, set.at.replace(' ', ""))
+}
+
+/// One `hysteresis_<curve>_<where>.csv` per requested loop set.
+fn write_hysteresis(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandError> {
+    for set in &a.loops {
         files::write_atomic(
-            &ctx.dir.join(format!("hysteresis_{}.csv", c.case.name)),
-            limit_files::hysteresis_csv(&loops).as_bytes(),
+            &ctx.dir
+                .join(format!("hysteresis_{}.csv", loop_file_stem(set))),
+            limit_files::hysteresis_csv(&set.loops).as_bytes(),
         )?;
-        out.push((c.case.name.clone(), loops));
     }
-    Ok(out)
+    Ok(())
 }
 
 #[derive(serde::Serialize)]
 struct CurveJson<'a> {
     case: &'a limits::LimitCase,
     peak: &'a limits::Peak,
+    continuation_retries: usize,
     points: &'a [FrfPoint],
     turning_points_hz: &'a [f64],
 }
@@ -129,6 +137,7 @@ fn write_json(ctx: &RunContext<'_>, a: &LimitAnalysis, elapsed: f64) -> Result<(
         serde_json::to_value(CurveJson {
             case: &c.case,
             peak: &c.peak,
+            continuation_retries: c.retries,
             points: &c.run.points,
             turning_points_hz: &c.run.turning_points,
         })
@@ -143,17 +152,15 @@ fn write_json(ctx: &RunContext<'_>, a: &LimitAnalysis, elapsed: f64) -> Result<(
         "grid": a.grid,
         "bound_check": a.bounds,
         "scan_peaks": a.scan_peaks,
+        "hysteresis": a.loops,
+        "hysteresis_missing": a.loops_missing,
     });
     let bytes = serde_json::to_vec_pretty(&json).expect("JSON values serialise");
     files::write_atomic(&ctx.dir.join("limits.json"), &bytes)?;
     Ok(())
 }
 
-fn plot(
-    ctx: &RunContext<'_>,
-    a: &LimitAnalysis,
-    loops: &[(String, Vec<limits::HysteresisLoop>)],
-) -> Result<(), CommandError> {
+fn plot(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandError> {
     let problem = &ctx.problem;
     let grid_x: Vec<f64> = a.grid.iter().map(|g| g.freq_hz).collect();
     let lower: Vec<f64> = a.grid.iter().map(|g| g.lower).collect();
@@ -247,19 +254,35 @@ fn plot(
             &ctx.dir.join(format!("limits_{name}.svg")),
         )?;
     }
+    if a.loops.is_empty() {
+        return Ok(());
+    }
+    let labels: Vec<String> = a
+        .loops
+        .iter()
+        .map(|set| {
+            if set.at == "peak" {
+                format!("{} at its peak ({:.2} Hz)", set.case, set.freq_hz)
+            } else {
+                format!("{} at {}", set.case, set.at)
+            }
+        })
+        .collect();
     for (ci, contact) in problem.contacts.iter().enumerate() {
-        let series: Vec<Loop> = loops
+        let series: Vec<Loop> = a
+            .loops
             .iter()
+            .zip(&labels)
             .enumerate()
-            .map(|(i, (name, l))| Loop {
-                label: name,
-                u: &l[ci].u,
-                t: &l[ci].t,
+            .map(|(i, (set, label))| Loop {
+                label,
+                u: &set.loops[ci].u,
+                t: &set.loops[ci].t,
                 color: palette(i),
             })
             .collect();
         limit_plots::plot_hysteresis(
-            &format!("contact `{}`: T(u) at each curve's peak", contact.name),
+            &format!("{}: hysteresis of contact `{}`", ctx.title(), contact.name),
             &series,
             &ctx.dir.join(format!("hysteresis_{}.png", contact.name)),
             &ctx.dir.join(format!("hysteresis_{}.svg", contact.name)),
@@ -268,14 +291,27 @@ fn plot(
     Ok(())
 }
 
-fn summary(ctx: &RunContext<'_>, a: &LimitAnalysis, elapsed: f64) -> String {
+/// A few lines on a finished analysis: peaks, regime, bound scan, retries, missing loops.
+pub(super) fn summary(a: &LimitAnalysis, elapsed: f64) -> String {
     use std::fmt::Write as _;
     let mut s = format!("limit analysis in {elapsed:.2} s\n");
     for c in a.limits.iter().chain(&a.intermediate) {
         let _ = writeln!(
             s,
-            "  {:<24} peak {:.5e} m at {:.4} Hz",
-            c.case.name, c.peak.amplitude, c.peak.freq_hz
+            "  {:<24} peak {:.5e} m at {:.4} Hz{}{}",
+            c.case.name,
+            c.peak.amplitude,
+            c.peak.freq_hz,
+            if c.peak.refined {
+                ""
+            } else {
+                " (no local maximum in the peak window)"
+            },
+            if c.retries > 0 {
+                format!(" ({} continuation retries)", c.retries)
+            } else {
+                String::new()
+            }
         );
     }
     let multiple = a
@@ -298,6 +334,8 @@ fn summary(ctx: &RunContext<'_>, a: &LimitAnalysis, elapsed: f64) -> String {
             b.below_at.as_ref().map(|(f, c)| format!("({c} at {f:.3} Hz)")).unwrap_or_default(),
         );
     }
-    let _ = ctx;
+    for m in &a.loops_missing {
+        let _ = writeln!(s, "  hysteresis not computed: {m}");
+    }
     s.trim_end().to_string()
 }

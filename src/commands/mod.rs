@@ -1,9 +1,12 @@
-//! The command-line commands (`run`, `check`), as library functions so that `main.rs` only
-//! parses arguments and dispatches. `run` solves what the scene asks for: a parameter sweep of
-//! the limit analysis (`[sweep]`), a limit analysis (`[limits]`), or one FRF.
+//! The command-line commands (`run`, `check`, `paper`), as library functions so that `main.rs`
+//! only parses arguments and dispatches. `run` solves what the scene asks for: a parameter
+//! sweep of the limit analysis (`[sweep]`), a limit analysis (`[limits]`), or one FRF. `paper`
+//! runs the scenes of the paper's §4 study (`meshes/paper-wedge/fig*.toml`, built into the
+//! binary) and writes a summary of the key numbers next to the paper's statements.
 
 mod limits_run;
 pub mod mesh;
+pub mod paper;
 mod sweep_run;
 
 use std::path::{Path, PathBuf};
@@ -65,8 +68,16 @@ pub enum CommandError {
     Sweep {
         /// Scene label.
         scene: String,
-        /// Cause.
-        source: crate::sweep::SweepError,
+        /// Cause (boxed: a scene error is large).
+        source: Box<crate::sweep::SweepError>,
+    },
+    /// Figures of `fricbound paper` failed; the others' results and the summary are written.
+    #[error("paper study: figure(s) {failed} failed (see {dir}/summary.md)")]
+    Paper {
+        /// Identifiers of the failed figures.
+        failed: String,
+        /// Output folder.
+        dir: String,
     },
     /// A linear reference failed.
     #[error("{scene}: linear reference: {reason}")]
@@ -83,6 +94,9 @@ pub enum CommandError {
 pub struct RunOptions {
     /// Scene file; `None` runs the built-in paper scene.
     pub scene: Option<PathBuf>,
+    /// Scene text to solve instead of reading `scene` (which then only names it in messages
+    /// and gives the default output folder).
+    pub scene_text: Option<String>,
     /// Output folder; default `out/<scene stem>`.
     pub out: Option<PathBuf>,
     /// `FIELD=VALUE` overrides.
@@ -98,6 +112,23 @@ pub struct RunReport {
     pub dir: PathBuf,
     /// What was computed, in a few lines.
     pub summary: String,
+    /// The results themselves.
+    pub outcome: RunOutcome,
+    /// Linear reference with contacts open.
+    pub open: linear::LinearCurve,
+    /// Linear reference with contacts stuck.
+    pub stuck: linear::LinearCurve,
+}
+
+/// The results of a run, by kind.
+#[derive(Debug, Clone)]
+pub enum RunOutcome {
+    /// One nonlinear FRF.
+    Frf(Box<frf::FrfRun>),
+    /// A limit analysis.
+    Limits(Box<crate::limits::LimitAnalysis>),
+    /// A parameter sweep, points in [`crate::sweep::sweep_points`] order.
+    Sweep(Vec<crate::sweep::SweepPoint>),
 }
 
 /// Everything a run kind needs: the scene, the checked problem, the output folder and the
@@ -245,7 +276,20 @@ impl FrfObserver for RunObserver<'_> {
 
 /// `fricbound run`: solves the scene and writes results, linear references and figures.
 pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
-    let (label, scene, problem) = load_scene(options.scene.as_deref(), &options.overrides)?;
+    let label = match &options.scene {
+        Some(p) => p.display().to_string(),
+        None => scene::default_scene_label().display().to_string(),
+    };
+    let scene_text = match (&options.scene_text, &options.scene) {
+        (Some(text), _) => text.clone(),
+        (None, Some(p)) => std::fs::read_to_string(p).map_err(|source| SceneError::Io {
+            file: label.clone(),
+            source,
+        })?,
+        (None, None) => scene::PAPER_DEFAULT_SCENE.to_string(),
+    };
+    let scene = scene::parse(&scene_text, &label, &options.overrides)?;
+    let problem = scene.validate(&label)?;
     let stem = options
         .scene
         .as_deref()
@@ -256,34 +300,8 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(stem));
-    std::fs::create_dir_all(&dir).map_err(|source| CommandError::OutputDir {
-        path: dir.display().to_string(),
-        source,
-    })?;
-
-    let linear_err = |e: crate::linalg::LinearSolveError| CommandError::Linear {
-        scene: label.clone(),
-        reason: e.to_string(),
-    };
-    let points = problem.analysis.linear_points;
-    let open = linear::reference_curve(&problem, LinearCase::Open, points).map_err(linear_err)?;
-    let stuck = linear::reference_curve(&problem, LinearCase::Stuck, points).map_err(linear_err)?;
-    files::write_atomic(
-        &dir.join("linear_open.csv"),
-        files::linear_csv(&problem, &open).as_bytes(),
-    )?;
-    files::write_atomic(
-        &dir.join("linear_stuck.csv"),
-        files::linear_csv(&problem, &stuck).as_bytes(),
-    )?;
-
-    let scene_text = match options.scene.as_deref() {
-        Some(p) => std::fs::read_to_string(p).map_err(|source| SceneError::Io {
-            file: p.display().to_string(),
-            source,
-        })?,
-        None => scene::PAPER_DEFAULT_SCENE.to_string(),
-    };
+    create_dir(&dir)?;
+    let (open, stuck) = linear_references(&label, &problem, &dir)?;
     let ctx = RunContext {
         scene_text,
         label,
@@ -301,6 +319,38 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
         return limits_run::run_limits(&ctx);
     }
     run_frf(&ctx)
+}
+
+fn create_dir(dir: &Path) -> Result<(), CommandError> {
+    std::fs::create_dir_all(dir).map_err(|source| CommandError::OutputDir {
+        path: dir.display().to_string(),
+        source,
+    })
+}
+
+/// The linear references with contacts open and stuck, written to `linear_open.csv` and
+/// `linear_stuck.csv` in `dir`.
+fn linear_references(
+    label: &str,
+    problem: &Problem,
+    dir: &Path,
+) -> Result<(linear::LinearCurve, linear::LinearCurve), CommandError> {
+    let linear_err = |e: crate::linalg::LinearSolveError| CommandError::Linear {
+        scene: label.to_string(),
+        reason: e.to_string(),
+    };
+    let points = problem.analysis.linear_points;
+    let open = linear::reference_curve(problem, LinearCase::Open, points).map_err(linear_err)?;
+    let stuck = linear::reference_curve(problem, LinearCase::Stuck, points).map_err(linear_err)?;
+    files::write_atomic(
+        &dir.join("linear_open.csv"),
+        files::linear_csv(problem, &open).as_bytes(),
+    )?;
+    files::write_atomic(
+        &dir.join("linear_stuck.csv"),
+        files::linear_csv(problem, &stuck).as_bytes(),
+    )?;
+    Ok((open, stuck))
 }
 
 /// A single nonlinear FRF (no limit analysis asked for).
@@ -371,6 +421,9 @@ fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
             run.elapsed_s,
             run.rejected_steps
         ),
+        outcome: RunOutcome::Frf(Box::new(run)),
+        open: ctx.open.clone(),
+        stuck: ctx.stuck.clone(),
     })
 }
 
@@ -466,6 +519,40 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
             .collect::<Vec<_>>()
             .join(", ")
     );
+    if let Some(l) = &problem.limits {
+        let cases: Vec<String> = crate::limits::two_point_cases(&problem)
+            .into_iter()
+            .chain(l.intermediate_cases(&problem))
+            .map(|c| c.name)
+            .collect();
+        let _ = writeln!(
+            s,
+            "limits       curves {}; grid {} points; bound scan {:?}; peak window {}",
+            cases.join(", "),
+            l.grid_points,
+            l.bound_scan,
+            l.peak_window_hz
+                .map(|(a, b)| format!("{a} .. {b} Hz"))
+                .unwrap_or_else(|| "the range".to_string())
+        );
+    }
+    if let Some(sw) = &scene.sweep {
+        let mut line = format!(
+            "sweep        {} over {} values ({:?} each)",
+            sw.parameter,
+            sw.values.len(),
+            sw.output
+        );
+        if let Some(series) = &sw.series {
+            let _ = write!(
+                line,
+                ", for each of {} values of {}",
+                series.values.len(),
+                series.parameter
+            );
+        }
+        let _ = writeln!(s, "{line}");
+    }
     Ok(s)
 }
 

@@ -4,11 +4,17 @@
 //!   `upper_amp`, `regime` (`unique`, `multiple`, `unknown`), `stuck_sides`, `slipping_sides`,
 //!   per limit case `<case>_N0_slipping` (N) and `<case>_label`, per limit case and contact
 //!   `<case>_<contact>_state`.
-//! * `peaks.csv`: one row per curve: `curve`, `kind` (limit, intermediate, scan), m per side,
-//!   `peak_freq_hz`, `peak_amp`, `refined`.
-//! * `hysteresis_<curve>.csv`: per contact `u`, `T`, `v`, `N` samples over one period.
-//! * `sweep.csv`: `<parameter>`, per case `<case>_peak_amp` and `<case>_peak_freq_hz`, then
-//!   `limit_amp_ratio` (larger over smaller limit peak) and `limit_freq_change_pct`.
+//! * `peaks.csv`: one row per curve: `curve`, `kind` (limit, intermediate, scan), `m_<contact>`
+//!   per contact point, `peak_freq_hz`, `peak_amp`, `refined`.
+//! * `hysteresis_<curve>_<where>.csv`: `tau`, then per contact `u` (m), `T` (N), `v` (m), `N`
+//!   (N) samples over one period.
+//! * `sweep.csv`: `[<series>,]<parameter>`, per case `<case>_peak_amp` (m) and
+//!   `<case>_peak_freq_hz`, then `limit_amp_ratio` (larger over smaller limit peak),
+//!   `limit_freq_change_pct` (100·(higher − lower)/lower resonance frequency), `refined`
+//!   (both limit peaks are interior maxima) and `failures`. Empty cells where a case failed.
+//! * `variability.csv` (sweeps of whole limit analyses): per sweep point the limit peaks, their
+//!   ratio and frequency change, the widest band, the multiple-solution share and the bound
+//!   scan's largest excesses.
 
 use std::fmt::Write as _;
 
@@ -93,13 +99,13 @@ pub fn limits_csv(problem: &Problem, cases: &[LimitCase], grid: &[GridPoint]) ->
 /// `peaks.csv` text from (case, kind, peak) rows.
 pub fn peaks_csv(problem: &Problem, rows: &[(&LimitCase, &str, &Peak)]) -> String {
     let mut s = String::from("curve,kind");
-    for side in &problem.sides {
-        let _ = write!(s, ",m_{}", side.name);
+    for contact in &problem.contacts {
+        let _ = write!(s, ",m_{}", contact.name);
     }
     s.push_str(",peak_freq_hz,peak_amp,refined\n");
     for (case, kind, peak) in rows {
         let _ = write!(s, "{},{kind}", case.name);
-        for m in &case.side_states {
+        for m in &case.contact_states {
             let _ = write!(s, ",{m}");
         }
         let _ = writeln!(
@@ -137,25 +143,97 @@ pub fn hysteresis_csv(loops: &[HysteresisLoop]) -> String {
     s
 }
 
-/// `sweep.csv` text for finished points (sorted by parameter value).
-pub fn sweep_csv(parameter: &str, points: &[SweepPoint]) -> String {
+/// `sweep.csv` text for finished points (sorted by series, then parameter value).
+pub fn sweep_csv(series: Option<&str>, parameter: &str, points: &[SweepPoint]) -> String {
     let mut sorted: Vec<&SweepPoint> = points.iter().collect();
-    sorted.sort_by(|a, b| a.value.total_cmp(&b.value));
-    let mut s = parameter.to_string();
+    sorted.sort_by(|a, b| {
+        a.series
+            .unwrap_or(0.0)
+            .total_cmp(&b.series.unwrap_or(0.0))
+            .then(a.value.total_cmp(&b.value))
+    });
+    let mut s = String::new();
+    if let Some(name) = series {
+        let _ = write!(s, "{name},");
+    }
+    s.push_str(parameter);
     if let Some(first) = sorted.first() {
         for c in &first.cases {
             let _ = write!(s, ",{c}_peak_amp,{c}_peak_freq_hz");
         }
     }
-    s.push_str(",limit_amp_ratio,limit_freq_change_pct\n");
+    s.push_str(",limit_amp_ratio,limit_freq_change_pct,refined,failures\n");
     for p in sorted {
+        if series.is_some() {
+            let _ = write!(s, "{:.10e},", p.series.unwrap_or(f64::NAN));
+        }
         let _ = write!(s, "{:.10e}", p.value);
         for peak in &p.peaks {
-            let _ = write!(s, ",{:.10e},{:.10e}", peak.amplitude, peak.freq_hz);
+            match peak {
+                Some(peak) => {
+                    let _ = write!(s, ",{:.10e},{:.10e}", peak.amplitude, peak.freq_hz);
+                }
+                None => s.push_str(",,"),
+            }
         }
-        let (hi, lo) = p.limit_amplitudes();
-        let (fhi, flo) = p.limit_frequencies();
-        let _ = writeln!(s, ",{:.10e},{:.10e}", hi / lo, 100.0 * (fhi - flo) / flo);
+        match (p.limit_amplitudes(), p.limit_frequencies()) {
+            (Some((hi, lo)), Some((fhi, flo))) => {
+                let _ = write!(s, ",{:.10e},{:.10e}", hi / lo, 100.0 * (fhi - flo) / flo);
+            }
+            _ => s.push_str(",,"),
+        }
+        let _ = writeln!(
+            s,
+            ",{},\"{}\"",
+            p.limits_refined(),
+            p.failures.join("; ").replace('"', "'")
+        );
+    }
+    s
+}
+
+/// `variability.csv` text: one row per sweep point with a limit analysis.
+pub fn variability_csv(series: Option<&str>, parameter: &str, points: &[SweepPoint]) -> String {
+    let mut s = String::new();
+    if let Some(name) = series {
+        let _ = write!(s, "{name},");
+    }
+    s.push_str(parameter);
+    s.push_str(
+        ",upper_peak_amp,lower_peak_amp,limit_amp_ratio,limit_freq_change_pct,widest_band_amp,\
+         widest_band_freq_hz,multiple_points,grid_points,bound_excess_above_pct,\
+         bound_excess_below_pct\n",
+    );
+    for p in points {
+        let Some(a) = &p.analysis else { continue };
+        let v = a.variability();
+        if series.is_some() {
+            let _ = write!(s, "{:.10e},", p.series.unwrap_or(f64::NAN));
+        }
+        let _ = write!(
+            s,
+            "{:.10e},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e},{},{}",
+            p.value,
+            v.upper_peak,
+            v.lower_peak,
+            v.peak_ratio,
+            v.peak_freq_change_pct,
+            v.widest_band,
+            v.widest_band_hz,
+            v.multiple_points,
+            v.grid_points
+        );
+        match &a.bounds {
+            Some(b) => {
+                let _ = writeln!(
+                    s,
+                    ",{:.6e},{:.6e}",
+                    100.0 * b.max_excess_above,
+                    100.0 * b.max_excess_below
+                );
+            }
+            None => s.push_str(",,\n"),
+        }
     }
     s
 }

@@ -5,7 +5,8 @@
 //! intermediate and reference curves on top, and below the chart optional marker rows: one
 //! marking the frequencies with multiple solutions, and one per contact showing its state.
 //! [`plot_sweep`] draws quantities against a swept parameter (for example the peak amplitude or
-//! the resonance frequency against the pre-load) with an optional shaded band.
+//! the resonance frequency against the pre-load), or several FRF bands on one chart, over
+//! shaded bands ([`BandSpec`]).
 //! [`plot_hysteresis`] draws closed tangential force–displacement loops over one period.
 //! [`palette`] gives distinct line colours.
 //!
@@ -71,10 +72,37 @@ pub struct SweepFigure<'a> {
     pub y_label: &'a str,
     /// Log y axis (non-positive values are then skipped).
     pub log_y: bool,
-    /// Band as (x, lower, upper); entries with a non-drawable value are skipped.
-    pub band: Option<(&'a [f64], &'a [f64], &'a [f64])>,
-    /// Lines drawn over the band.
+    /// Translucent bands; entries with a non-drawable value are skipped.
+    pub bands: &'a [BandSpec<'a>],
+    /// Lines drawn over the bands.
     pub curves: &'a [Curve<'a>],
+}
+
+/// A translucent band between two curves over shared abscissae (paired up to the shortest).
+pub struct BandSpec<'a> {
+    /// Legend label (no legend entry if empty).
+    pub label: &'a str,
+    /// Abscissae.
+    pub x: &'a [f64],
+    /// One limit.
+    pub lower: &'a [f64],
+    /// The other limit (the two may cross).
+    pub upper: &'a [f64],
+    /// Fill colour (drawn translucent).
+    pub color: RGBColor,
+}
+
+impl BandSpec<'_> {
+    /// The default variability-band label and colour.
+    pub fn variability<'a>(x: &'a [f64], lower: &'a [f64], upper: &'a [f64]) -> BandSpec<'a> {
+        BandSpec {
+            label: BAND_LABEL,
+            x,
+            lower,
+            upper,
+            color: BAND_COLOR,
+        }
+    }
 }
 
 /// One closed hysteresis loop; `u` and `t` are paired up to the shorter length.
@@ -185,24 +213,24 @@ pub fn plot_limits(fig: &LimitFigure, png: &Path, svg: &Path) -> Result<(), Plot
     write_figure(&figure, png, svg)
 }
 
-/// Draws the curves against the swept parameter over the optional translucent band, on a linear
-/// x axis and a linear or log y axis, with a legend. Writes both files.
+/// Draws the curves against the swept parameter (or any x quantity) over the translucent bands,
+/// on a linear x axis and a linear or log y axis, with a legend. Writes both files.
 pub fn plot_sweep(fig: &SweepFigure, png: &Path, svg: &Path) -> Result<(), PlotError> {
     let bands: Vec<Band> = fig
-        .band
-        .map(|(x, lower, upper)| Band {
-            label: BAND_LABEL.to_string(),
-            polygons: band_polygons(x, lower, upper, fig.log_y),
-            color: BAND_COLOR,
+        .bands
+        .iter()
+        .map(|b| Band {
+            label: b.label.to_string(),
+            polygons: band_polygons(b.x, b.lower, b.upper, fig.log_y),
+            color: b.color,
         })
-        .into_iter()
         .collect();
     let curves = lines(fig.curves, fig.log_y);
     let ys = || {
         let band_ys = bands.iter().flat_map(|b| b.polygons.iter().flatten());
         band_ys.map(|p| p.1).chain(points(&curves).map(|p| p.1))
     };
-    let grid = fig.band.map_or(&[][..], |b| b.0).iter().copied();
+    let grid = fig.bands.iter().flat_map(|b| b.x.iter().copied());
     let x = linear_range(grid.chain(points(&curves).map(|p| p.0)), 0.02);
     let x = cover(x, &bands);
     let y = if fig.log_y {
@@ -633,7 +661,7 @@ mod tests {
                 x_label: "normal pre-load N0 (N)",
                 y_label: "peak amplitude (m)",
                 log_y,
-                band: Some((&n0, &lower, &upper)),
+                bands: &[BandSpec::variability(&n0, &lower, &upper)],
                 curves: &curves,
             };
             let (png, svg) = (
@@ -659,7 +687,7 @@ mod tests {
             x_label: "normal pre-load N0 (N)",
             y_label: "resonance frequency (Hz)",
             log_y: false,
-            band: None,
+            bands: &[],
             curves: &freq_curve,
         };
         let (png, svg) = (dir.path().join("freq.png"), dir.path().join("freq.svg"));
@@ -674,7 +702,7 @@ mod tests {
                 x_label: "",
                 y_label: "",
                 log_y: true,
-                band: None,
+                bands: &[],
                 curves: &[],
             },
             SweepFigure {
@@ -682,7 +710,7 @@ mod tests {
                 x_label: "x",
                 y_label: "y",
                 log_y: true,
-                band: Some((&negative, &negative, &negative)),
+                bands: &[BandSpec::variability(&negative, &negative, &negative)],
                 curves: &[Curve {
                     label: "negative",
                     x: &negative,
@@ -697,7 +725,7 @@ mod tests {
                 x_label: "x",
                 y_label: "y",
                 log_y: false,
-                band: Some((&[], &[], &[])),
+                bands: &[BandSpec::variability(&[], &[], &[])],
                 curves: &[],
             },
         ]

@@ -3,4 +3,5 @@
 pub mod files;
 pub mod limit_files;
 pub mod limit_plots;
+pub mod paper_summary;
 pub mod plot;

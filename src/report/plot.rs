@@ -501,7 +501,13 @@ impl Figure for StripChart {
         let body = if self.title.trim().is_empty() {
             root
         } else {
-            root.titled(&self.title, font(TITLE_SIZE))?
+            // Long titles shrink to fit the width rather than run off the figure.
+            let width = root.dim_in_pixel().0;
+            let mut size = TITLE_SIZE;
+            while size > 14.0 && root.estimate_text_size(&self.title, &font(size))?.0 + 10 > width {
+                size -= 1.0;
+            }
+            root.titled(&self.title, font(size))?
         };
         let (_, body_h) = body.dim_in_pixel();
 
