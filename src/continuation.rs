@@ -6,9 +6,7 @@
 //!
 //! R(x, ω) = 0,   tᵀ (y − y_p) = 0.
 //!
-//! A point converges when ‖R‖ ≤ tol_R·‖F_ex‖ and the scaled Newton step ≤ tol_y, or when
-//! ‖R‖ ≤ tol_R·‖F_ex‖ has stopped decreasing (the step is then round-off amplified by an
-//! ill-conditioned Jacobian near a lightly damped resonance, not a lack of convergence). A failed
+//! A point converges when ‖R‖ ≤ tol_R·‖F_ex‖ and the scaled Newton step ≤ tol_y. A failed
 //! corrector (iteration limit, divergence, singular Jacobian, failed AFT) is not a result: the
 //! step is cut and the reason reported to the observer; below the minimum step the run ends
 //! with [`ContinuationError::Stalled`]. Turning points (sign changes of dω/ds) are reported and
@@ -200,8 +198,6 @@ pub struct Continuation {
 }
 
 const OMEGA_SCALE: f64 = 2.0 * PI;
-/// A residual at tolerance that falls by less than this factor in one iteration stagnates.
-const STAGNATION: f64 = 0.5;
 /// Largest turn of the tangent in one step before the step is cut (unless it is a corner).
 const MAX_TURN_DEGREES: f64 = 45.0;
 
@@ -211,16 +207,6 @@ impl Continuation {
     fn converged(&self, relative_residual: f64, step: f64) -> bool {
         relative_residual <= self.analysis.residual_tolerance
             && step <= self.analysis.step_tolerance.max(1e-14)
-    }
-
-    /// Whether a residual already at tolerance has stopped decreasing (by less than
-    /// [`STAGNATION`] from the previous iterate): near a lightly damped resonance the
-    /// Jacobian's condition number (10⁹ and more) turns round-off in the residual into step
-    /// noise that no further iteration removes, while the equations hold as asked. Such an
-    /// iterate is accepted rather than failed for its step.
-    fn stagnated(&self, relative_residual: f64, previous: f64) -> bool {
-        relative_residual <= self.analysis.residual_tolerance
-            && relative_residual >= STAGNATION * previous
     }
 
     /// Newton at fixed ω from `x0`, with backtracking on the residual norm.
@@ -246,7 +232,6 @@ impl Continuation {
                 .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
                 .map_err(eval_err)?;
             rel = norm(&r) / scale;
-            let before = rel;
             let neg: Vec<f64> = r.iter().map(|v| -v).collect();
             let dx = jac.solve(&neg)?;
             let step_norm = norm(&dx) / self.x_scale;
@@ -264,7 +249,7 @@ impl Continuation {
                 alpha *= 0.5;
             }
             x.copy_from_slice(&trial);
-            if self.converged(rel, alpha * step_norm) || self.stagnated(rel, before) {
+            if self.converged(rel, alpha * step_norm) {
                 // Leave the operator evaluated at the returned point.
                 system
                     .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
@@ -343,7 +328,6 @@ impl Continuation {
         let mut trial = vec![0.0; n];
         let mut first = f64::NAN;
         let mut rel = f64::INFINITY;
-        let mut previous = f64::INFINITY;
         for it in 1..=self.analysis.max_iterations {
             for i in 0..n {
                 x[i] = y[i] * self.x_scale;
@@ -358,10 +342,6 @@ impl Continuation {
             } else if rel > 1e4 * first.max(self.analysis.residual_tolerance) {
                 return Err(NewtonFailure::Diverged { residual: rel });
             }
-            if self.stagnated(rel, previous) {
-                return Ok((y, it, rel));
-            }
-            previous = rel;
             for i in 0..n {
                 col[i] = dr[i] * OMEGA_SCALE;
             }
@@ -384,7 +364,7 @@ impl Continuation {
                     system
                         .residual(&trial, (y[n] + alpha * dy[n]) * OMEGA_SCALE, &mut r)
                         .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
-                    if norm(&r) / scale < rel || alpha < 1.0 / 16.0 {
+                    if norm(&r) / scale < rel || alpha < 1e-3 {
                         break;
                     }
                     alpha *= 0.5;
