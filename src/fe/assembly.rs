@@ -141,14 +141,6 @@ pub enum AssemblyError {
         /// Group.
         group: String,
     },
-    /// faer could not build a matrix (index overflow or out of memory).
-    #[error("{mesh}: cannot build sparse matrix: {reason}")]
-    Sparse {
-        /// Mesh source.
-        mesh: String,
-        /// faer's reason.
-        reason: String,
-    },
 }
 
 /// An assembled linear FE model.
@@ -184,27 +176,19 @@ impl FeModel {
                 group: group.to_string(),
             });
         }
-        self.without_dofs(&mesh.source, |d| nodes.contains(&d.node))
+        Ok(self.without_dofs(|d| nodes.contains(&d.node)))
     }
 
     /// The model with the DOFs for which `remove` is true deleted.
-    pub fn without_dofs(
-        &self,
-        source: &str,
-        remove: impl Fn(super::dof::Dof) -> bool,
-    ) -> Result<FeModel, AssemblyError> {
+    pub fn without_dofs(&self, remove: impl Fn(super::dof::Dof) -> bool) -> FeModel {
         let (dofs, new_of_old) = self.dofs.retain(|d| !remove(d));
         let n = dofs.len();
-        let err = |e: faer::sparse::CreationError| AssemblyError::Sparse {
-            mesh: source.to_string(),
-            reason: format!("{e:?}"),
-        };
-        Ok(FeModel {
-            stiffness: sparse::keep_rows_cols(&self.stiffness, &new_of_old, n).map_err(err)?,
-            mass: sparse::keep_rows_cols(&self.mass, &new_of_old, n).map_err(err)?,
+        FeModel {
+            stiffness: sparse::keep_rows_cols(&self.stiffness, &new_of_old, n),
+            mass: sparse::keep_rows_cols(&self.mass, &new_of_old, n),
             dofs,
             dimension: self.dimension,
-        })
+        }
     }
 
     /// Expands a vector over the model's DOFs to one 3-vector per mesh node (zeros where a
@@ -317,16 +301,12 @@ pub fn assemble(
             .collect();
         for (&e, result) in chunk.iter().zip(computed) {
             let em = result?;
-            let el = &mesh.elements[e];
-            let rows: Vec<usize> = el
+            let nodes: Vec<usize> = mesh.elements[e]
                 .nodes
                 .iter()
-                .flat_map(|&n| {
-                    let base = dof_node[n].unwrap_or(0) * dim;
-                    (0..dim).map(move |d| base + d)
-                })
+                .map(|&n| dof_node[n].unwrap_or(0))
                 .collect();
-            pattern.scatter(&rows, &em, &mut kval, &mut mval);
+            pattern.scatter(&nodes, &em, &mut kval, &mut mval);
         }
     }
 
@@ -422,8 +402,11 @@ fn element_matrices(
 }
 
 /// CSC sparsity pattern of K and M: DOF (node a, dir) couples to every DOF of every node that
-/// shares an element with a.
+/// shares an element with a. Columns of one node share its sorted neighbour list, so the rows
+/// of neighbour b in any column of a start at `col_ptr + position(b) · dim`.
 struct Pattern {
+    dim: usize,
+    adjacency: Vec<Vec<usize>>,
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
 }
@@ -466,20 +449,32 @@ impl Pattern {
                 col_ptr.push(row_idx.len());
             }
         }
-        Pattern { col_ptr, row_idx }
+        Pattern {
+            dim,
+            adjacency,
+            col_ptr,
+            row_idx,
+        }
     }
 
-    /// Adds an element's matrices at its global rows.
-    fn scatter(&self, rows: &[usize], em: &ElementMatrices, k: &mut [f64], m: &mut [f64]) {
-        let n = em.size;
-        for (b, &col) in rows.iter().enumerate() {
-            let start = self.col_ptr[col];
-            let column = &self.row_idx[start..self.col_ptr[col + 1]];
-            for (a, &row) in rows.iter().enumerate() {
-                // The pattern holds every pair of DOFs sharing an element.
-                if let Ok(pos) = column.binary_search(&row) {
-                    k[start + pos] += em.stiffness[a * n + b];
-                    m[start + pos] += em.mass[a * n + b];
+    /// Adds an element's matrices; `nodes` are the element's nodes as DOF-node numbers.
+    fn scatter(&self, nodes: &[usize], em: &ElementMatrices, k: &mut [f64], m: &mut [f64]) {
+        let (n, dim) = (em.size, self.dim);
+        for (a, &ga) in nodes.iter().enumerate() {
+            let neighbours = &self.adjacency[ga];
+            for (b, &gb) in nodes.iter().enumerate() {
+                // The pattern holds every pair of nodes sharing an element.
+                let Ok(position) = neighbours.binary_search(&gb) else {
+                    continue;
+                };
+                for dc in 0..dim {
+                    let base = self.col_ptr[ga * dim + dc] + position * dim;
+                    let col = a * dim + dc;
+                    for dr in 0..dim {
+                        let row = b * dim + dr;
+                        k[base + dr] += em.stiffness[row * n + col];
+                        m[base + dr] += em.mass[row * n + col];
+                    }
                 }
             }
         }

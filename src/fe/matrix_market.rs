@@ -471,6 +471,8 @@ struct GuardedLines<R> {
     has_lower: bool,
     has_upper: bool,
     failure: Option<FeMatrixError>,
+    /// Replacement for the line just checked (the header of an integer file).
+    rewrite: Option<String>,
 }
 
 impl<R: BufRead> GuardedLines<R> {
@@ -489,6 +491,7 @@ impl<R: BufRead> GuardedLines<R> {
             has_lower: false,
             has_upper: false,
             failure: None,
+            rewrite: None,
         }
     }
 
@@ -548,6 +551,14 @@ impl<R: BufRead> GuardedLines<R> {
                         )))
                     }
                 };
+                if words[3] == "integer" {
+                    // sprs reads integer files only into integer matrices; the values are
+                    // exact as f64, so sprs is told the field is real.
+                    self.rewrite = Some(format!(
+                        "%%MatrixMarket matrix coordinate real {}\n",
+                        words[4]
+                    ));
+                }
                 self.section = Section::Size;
             }
             Section::Size => {
@@ -658,7 +669,7 @@ impl<R: BufRead> GuardedLines<R> {
         self.line += 1;
         let text = std::mem::take(&mut self.line_text);
         let checked = self.check(&text, n == 0);
-        self.line_text = text;
+        self.line_text = self.rewrite.take().unwrap_or(text);
         if let Err(failure) = checked {
             let message = failure.to_string();
             self.failure = Some(failure);

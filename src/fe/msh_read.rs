@@ -213,7 +213,7 @@ fn parse_error(bytes: &[u8], file: &str, error: &MshParserError<&[u8]>) -> MshRe
         .iter()
         .rev()
         .filter(|(_, kind)| !kind.is_nom_error())
-        .map(|(_, kind)| kind.to_string())
+        .map(|(_, kind)| kind.to_string().trim_end_matches('.').to_string())
         .collect::<Vec<_>>()
         .join(": ");
     MshReadError::Parse {
