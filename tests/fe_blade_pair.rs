@@ -503,3 +503,32 @@ fn mesh_command_writes_a_readable_file() {
     let info = run(&MeshCommand::Info { file: out }).unwrap();
     assert!(info.contains("damper_left"), "{info}");
 }
+
+#[test]
+fn committed_meshes_are_what_the_generator_writes() {
+    use fricbound::fe::msh_write::{msh_bytes, MshFormat};
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("meshes/blade-pair");
+    for (file, params) in [
+        (
+            "blade-pair-2d.msh",
+            BladePairParams {
+                refine: 2,
+                ..BladePairParams::default()
+            },
+        ),
+        (
+            "blade-pair-3d.msh",
+            BladePairParams {
+                three_d: true,
+                ..BladePairParams::default()
+            },
+        ),
+    ] {
+        let committed = std::fs::read(dir.join(file)).unwrap();
+        let fresh = msh_bytes(&generate(&params).unwrap(), MshFormat::Ascii).unwrap();
+        assert!(
+            committed == fresh,
+            "{file} differs from the generator's output: regenerate it (see meshes/blade-pair/README.md)"
+        );
+    }
+}
