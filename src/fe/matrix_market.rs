@@ -12,7 +12,7 @@
 //! Parsing and the symmetric expansion are done by `sprs::io::read_matrix_market_from_bufread`.
 //! sprs panics on an index outside the declared size, loops forever on a file that ends before
 //! its size line, and reports every other problem as "Bad matrix market file" without a line.
-//! The file is therefore fed to sprs through [`GuardedLines`], a line-by-line reader that checks
+//! The file is therefore fed to sprs through `GuardedLines`, a line-by-line reader that checks
 //! each line first (indices in range, finite values, entry count, one triangle) and stops with
 //! the file, line and reason; sprs never sees a line it could panic on.
 //!
