@@ -155,7 +155,12 @@ fn contact_pairs_on_both_sides_2d() {
         );
         for (k, pair) in patch.pairs.iter().enumerate() {
             assert_eq!(pair.name, format!("{}-{}", spec.side, k + 1));
-            assert!(pair.gap < 1e-15, "pair {} gap {}", pair.name, pair.gap);
+            assert!(
+                pair.node_distance < 1e-15,
+                "pair {} distance {}",
+                pair.name,
+                pair.node_distance
+            );
             assert_ne!(pair.damper_node, pair.body_node);
             // Normal outward from the damper into the platform: up and away from the centre.
             let n = [sign * alpha.sin(), alpha.cos(), 0.0];
