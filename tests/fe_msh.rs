@@ -279,6 +279,21 @@ fn malformed_and_old_files_are_rejected_with_position() {
         "{msg}"
     );
 
+    for header in ["4.1 0 3", "4.1 2 8", "4.1 0 99999999999999999999999"] {
+        let text = TET.replace("4.1 0 8", header);
+        let msg = read_msh_bytes(text.as_bytes(), "odd.msh")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.contains(&format!("$MeshFormat line `{header}`: expected `4.1 0 8`")),
+            "{msg}"
+        );
+    }
+    let msg = read_msh_bytes(b"hello", "text.msh")
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("does not start with $MeshFormat"), "{msg}");
+
     let broken = TET.replace("0 1 0\n", "0 one 0\n");
     let msg = read_msh_bytes(broken.as_bytes(), "broken.msh")
         .unwrap_err()
@@ -314,4 +329,19 @@ $Elements\n1 1 1 1\n1 1 1 1\n1 1 2\n$EndElements\n";
         err.to_string(),
         "lines.msh: no physical group named `clamp` (groups: group_1_7)"
     );
+}
+
+#[test]
+fn truncated_files_are_errors_not_panics() {
+    for name in ["plate-ascii.msh", "plate-binary.msh", "box-hex-binary.msh"] {
+        let bytes = std::fs::read(data(name)).unwrap();
+        for cut in (0..bytes.len()).step_by(7) {
+            if let Err(e) = read_msh_bytes(&bytes[..cut], name) {
+                assert!(
+                    !e.to_string().contains("(mshio) failed"),
+                    "{name} cut at {cut}: the parser panicked"
+                );
+            }
+        }
+    }
 }
