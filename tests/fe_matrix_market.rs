@@ -83,6 +83,12 @@ fn symmetric_and_general_files_with_one_based_map() {
     assert_eq!(fe.dofs.row(10, Direction::Y), Some(1));
     assert_eq!(fe.dofs.row(11, Direction::X), Some(2));
     assert_eq!(fe.dofs.dof(0).unwrap().to_string(), "10.x");
+    // Clamping node 10 leaves the last DOF.
+    let clamped = fe.without_dofs(|d| d.node == 10);
+    assert_eq!(clamped.dofs.len(), 1);
+    assert_eq!(clamped.dofs.row(11, Direction::X), Some(0));
+    assert_eq!(sparse::get(&clamped.stiffness, 0, 0), 1000.0);
+    assert_eq!(sparse::get(&clamped.mass, 0, 0), 0.75);
 }
 
 #[test]

@@ -187,6 +187,20 @@ pub struct FeMatrices {
     pub dofs: DofMap,
 }
 
+impl FeMatrices {
+    /// The matrices with the DOFs for which `remove` is true deleted (e.g. a clamp given as a
+    /// list of nodes), rows, columns and DOF map renumbered consistently.
+    pub fn without_dofs(&self, remove: impl Fn(Dof) -> bool) -> FeMatrices {
+        let (dofs, new_of_old) = self.dofs.retain(|d| !remove(d));
+        let n = dofs.len();
+        FeMatrices {
+            stiffness: sparse::keep_rows_cols(&self.stiffness, &new_of_old, n),
+            mass: sparse::keep_rows_cols(&self.mass, &new_of_old, n),
+            dofs,
+        }
+    }
+}
+
 /// Reads K, M and the DOF map and checks that they fit: both matrices square, of one size,
 /// symmetric (relative `symmetry_tolerance` for `general` files), finite; the map names every
 /// row once.
