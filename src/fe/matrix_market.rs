@@ -14,7 +14,9 @@
 //! its size line, and reports every other problem as "Bad matrix market file" without a line.
 //! The file is therefore fed to sprs through `GuardedLines`, a line-by-line reader that checks
 //! each line first (indices in range, finite values, entry count, one triangle) and stops with
-//! the file, line and reason; sprs never sees a line it could panic on.
+//! the file, line and reason; sprs never sees a line it could panic on. sprs reads `integer`
+//! files only into integer matrices, so their header reaches it as `real` (the values are exact
+//! as f64).
 //!
 //! # DOF map
 //! A CSV file, one DOF per line: `node,direction,row`. `#` starts a comment line; blank lines

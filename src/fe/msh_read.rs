@@ -10,6 +10,10 @@
 //!   so [`node_tags_in_file_order`] reads the tag lists of the `$Nodes` section again (a light
 //!   scan that skips the coordinates) instead of guessing.
 //!
+//! mshio still has `unimplemented!`/`expect` calls on some malformed headers (its own TODOs),
+//! so the `$MeshFormat` line is checked first, and any panic left inside mshio is turned into
+//! an error rather than taking the program down.
+//!
 //! Supported element types: points, 2-node lines, 3-node triangles, 4-node quadrangles,
 //! 8-node hexahedra; any other type in the file is an error naming it. Physical groups without
 //! a name in `$PhysicalNames` are named `group_<dim>_<tag>`.
