@@ -5,8 +5,12 @@
 //! element must be in exactly one material group. Lower-dimensional elements (lines, points,
 //! boundary faces) only serve as groups.
 //!
+//! 2D meshes lie in the x-y plane (z is ignored); their triangles and quadrangles may be
+//! ordered either way round (clockwise ones are reversed), while hexahedra must have a positive
+//! volume in Gmsh's node order. Inverted or degenerate elements are errors naming the element.
+//!
 //! DOF numbering (one [`DofMap`]): the nodes of the assembled elements in mesh order, node-major,
-//! directions x, y (2D) or x, y, z (3D). 2D meshes lie in the x-y plane (z is ignored).
+//! directions x, y (2D) or x, y, z (3D).
 //!
 //! K and M share one sparsity pattern, built from the node adjacency before any value is
 //! computed, and element matrices are added in place. This keeps memory at the size of the
@@ -133,6 +137,28 @@ pub enum AssemblyError {
         /// Mesh source.
         mesh: String,
     },
+    /// A group node without the DOF asked for.
+    #[error("{mesh}: node {node} of group `{group}` has no {direction} DOF in the model")]
+    NoDof {
+        /// Mesh source.
+        mesh: String,
+        /// Group.
+        group: String,
+        /// Node id.
+        node: u64,
+        /// Direction.
+        direction: Direction,
+    },
+    /// A load that cannot be applied.
+    #[error("{mesh}: load on group `{group}`: {reason}")]
+    Load {
+        /// Mesh source.
+        mesh: String,
+        /// Group.
+        group: String,
+        /// Why.
+        reason: String,
+    },
     /// A clamp group whose nodes carry no DOF of the model.
     #[error("{mesh}: clamp group `{group}` has no node with a DOF in the model")]
     ClampEmpty {
@@ -140,14 +166,6 @@ pub enum AssemblyError {
         mesh: String,
         /// Group.
         group: String,
-    },
-    /// faer could not build a matrix (index overflow or out of memory).
-    #[error("{mesh}: cannot build sparse matrix: {reason}")]
-    Sparse {
-        /// Mesh source.
-        mesh: String,
-        /// faer's reason.
-        reason: String,
     },
 }
 
@@ -184,27 +202,103 @@ impl FeModel {
                 group: group.to_string(),
             });
         }
-        self.without_dofs(&mesh.source, |d| nodes.contains(&d.node))
+        Ok(self.without_dofs(|d| nodes.contains(&d.node)))
     }
 
     /// The model with the DOFs for which `remove` is true deleted.
-    pub fn without_dofs(
-        &self,
-        source: &str,
-        remove: impl Fn(super::dof::Dof) -> bool,
-    ) -> Result<FeModel, AssemblyError> {
+    pub fn without_dofs(&self, remove: impl Fn(super::dof::Dof) -> bool) -> FeModel {
         let (dofs, new_of_old) = self.dofs.retain(|d| !remove(d));
         let n = dofs.len();
-        let err = |e: faer::sparse::CreationError| AssemblyError::Sparse {
-            mesh: source.to_string(),
-            reason: format!("{e:?}"),
-        };
-        Ok(FeModel {
-            stiffness: sparse::keep_rows_cols(&self.stiffness, &new_of_old, n).map_err(err)?,
-            mass: sparse::keep_rows_cols(&self.mass, &new_of_old, n).map_err(err)?,
+        FeModel {
+            stiffness: sparse::keep_rows_cols(&self.stiffness, &new_of_old, n),
+            mass: sparse::keep_rows_cols(&self.mass, &new_of_old, n),
             dofs,
             dimension: self.dimension,
-        })
+        }
+    }
+
+    /// Rows of the named group's nodes in one direction, in node order; an error if a node of
+    /// the group has no such DOF (clamped, or not on an assembled element).
+    pub fn group_rows(
+        &self,
+        mesh: &Mesh,
+        group: &str,
+        direction: Direction,
+    ) -> Result<Vec<usize>, AssemblyError> {
+        mesh.group_nodes(group)?
+            .into_iter()
+            .map(|n| {
+                let id = mesh.nodes[n].id;
+                self.dofs
+                    .row(id, direction)
+                    .ok_or_else(|| AssemblyError::NoDof {
+                        mesh: mesh.source.clone(),
+                        group: group.to_string(),
+                        node: id,
+                        direction,
+                    })
+            })
+            .collect()
+    }
+
+    /// Nodal forces (N, one per model row) equivalent to a uniform body force on the named
+    /// group (e.g. the centrifugal pre-load of a damper): total force `total` (N) along the
+    /// unit vector `direction`, distributed as f = (total / m_g) · M u, where u is the unit
+    /// translation along `direction` of the group's nodes and m_g the group's mass. M u is
+    /// ∫ ρ N_i dV per node, so this is the consistent load of a uniform acceleration.
+    pub fn body_force(
+        &self,
+        mesh: &Mesh,
+        group: &str,
+        direction: [f64; 3],
+        total: f64,
+    ) -> Result<Vec<f64>, AssemblyError> {
+        let len = direction.iter().map(|c| c * c).sum::<f64>().sqrt();
+        let bad = |reason: String| AssemblyError::Load {
+            mesh: mesh.source.clone(),
+            group: group.to_string(),
+            reason,
+        };
+        if !(len.is_finite() && len > 0.0 && total.is_finite()) {
+            return Err(bad(format!(
+                "body force {total} N along {direction:?} needs a finite total and a non-zero \
+                 direction"
+            )));
+        }
+        let nodes: std::collections::HashSet<u64> = mesh
+            .group_nodes(group)?
+            .into_iter()
+            .map(|n| mesh.nodes[n].id)
+            .collect();
+        let u: Vec<f64> = self
+            .dofs
+            .dofs()
+            .iter()
+            .map(|d| {
+                if nodes.contains(&d.node) && d.direction.is_translation() {
+                    direction[d.direction.axis()] / len
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let mu = sparse::mul_vec(&self.mass, &u);
+        // Keep only the group's rows (a body coupled to others through shared nodes would
+        // otherwise leak load onto them).
+        let f: Vec<f64> = self
+            .dofs
+            .dofs()
+            .iter()
+            .zip(&mu)
+            .map(|(d, &v)| if nodes.contains(&d.node) { v } else { 0.0 })
+            .collect();
+        let mass: f64 = f.iter().zip(&u).map(|(a, b)| a * b).sum();
+        if mass.is_nan() || mass <= 0.0 {
+            return Err(bad(
+                "the group has no mass in the model (density 0 or clamped)".into(),
+            ));
+        }
+        Ok(f.iter().map(|v| v * total / mass).collect())
     }
 
     /// Expands a vector over the model's DOFs to one 3-vector per mesh node (zeros where a
@@ -317,16 +411,11 @@ pub fn assemble(
             .collect();
         for (&e, result) in chunk.iter().zip(computed) {
             let em = result?;
-            let el = &mesh.elements[e];
-            let rows: Vec<usize> = el
-                .nodes
+            let nodes: Vec<usize> = oriented_nodes(mesh, e)
                 .iter()
-                .flat_map(|&n| {
-                    let base = dof_node[n].unwrap_or(0) * dim;
-                    (0..dim).map(move |d| base + d)
-                })
+                .map(|&n| dof_node[n].unwrap_or(0))
                 .collect();
-            pattern.scatter(&rows, &em, &mut kval, &mut mval);
+            pattern.scatter(&nodes, &em, &mut kval, &mut mval);
         }
     }
 
@@ -392,15 +481,16 @@ fn element_matrices(
     plane: PlaneAssumption,
 ) -> Result<ElementMatrices, AssemblyError> {
     let el = &mesh.elements[e];
+    let nodes = oriented_nodes(mesh, e);
     let xy = |k: usize| {
-        let c = mesh.nodes[el.nodes[k]].coords;
+        let c = mesh.nodes[nodes[k]].coords;
         [c[0], c[1]]
     };
     let result = match el.kind {
         ElementKind::Triangle3 => element::triangle3(&[xy(0), xy(1), xy(2)], &gm.material, plane),
         ElementKind::Quad4 => element::quad4(&[xy(0), xy(1), xy(2), xy(3)], &gm.material, plane),
         ElementKind::Hexahedron8 => {
-            let xyz: [[f64; 3]; 8] = std::array::from_fn(|k| mesh.nodes[el.nodes[k]].coords);
+            let xyz: [[f64; 3]; 8] = std::array::from_fn(|k| mesh.nodes[nodes[k]].coords);
             element::hexahedron8(&xyz, &gm.material)
         }
         other => {
@@ -421,9 +511,37 @@ fn element_matrices(
     })
 }
 
+/// The element's nodes in the order its matrices use. 2D elements have no intrinsic
+/// orientation (Gmsh orders them by the surface's normal, which may point along −z), so a
+/// clockwise triangle or quadrangle (negative signed area) is taken in reverse order.
+/// Hexahedra keep their order: a negative volume there is a real error.
+fn oriented_nodes(mesh: &Mesh, e: usize) -> Vec<usize> {
+    let el = &mesh.elements[e];
+    let mut nodes = el.nodes.clone();
+    if matches!(el.kind, ElementKind::Triangle3 | ElementKind::Quad4) {
+        let k = nodes.len();
+        let twice_area: f64 = (0..k)
+            .map(|i| {
+                let (a, b) = (
+                    mesh.nodes[nodes[i]].coords,
+                    mesh.nodes[nodes[(i + 1) % k]].coords,
+                );
+                a[0] * b[1] - b[0] * a[1]
+            })
+            .sum();
+        if twice_area < 0.0 {
+            nodes[1..].reverse();
+        }
+    }
+    nodes
+}
+
 /// CSC sparsity pattern of K and M: DOF (node a, dir) couples to every DOF of every node that
-/// shares an element with a.
+/// shares an element with a. Columns of one node share its sorted neighbour list, so the rows
+/// of neighbour b in any column of a start at `col_ptr + position(b) · dim`.
 struct Pattern {
+    dim: usize,
+    adjacency: Vec<Vec<usize>>,
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
 }
@@ -466,20 +584,32 @@ impl Pattern {
                 col_ptr.push(row_idx.len());
             }
         }
-        Pattern { col_ptr, row_idx }
+        Pattern {
+            dim,
+            adjacency,
+            col_ptr,
+            row_idx,
+        }
     }
 
-    /// Adds an element's matrices at its global rows.
-    fn scatter(&self, rows: &[usize], em: &ElementMatrices, k: &mut [f64], m: &mut [f64]) {
-        let n = em.size;
-        for (b, &col) in rows.iter().enumerate() {
-            let start = self.col_ptr[col];
-            let column = &self.row_idx[start..self.col_ptr[col + 1]];
-            for (a, &row) in rows.iter().enumerate() {
-                // The pattern holds every pair of DOFs sharing an element.
-                if let Ok(pos) = column.binary_search(&row) {
-                    k[start + pos] += em.stiffness[a * n + b];
-                    m[start + pos] += em.mass[a * n + b];
+    /// Adds an element's matrices; `nodes` are the element's nodes as DOF-node numbers.
+    fn scatter(&self, nodes: &[usize], em: &ElementMatrices, k: &mut [f64], m: &mut [f64]) {
+        let (n, dim) = (em.size, self.dim);
+        for (a, &ga) in nodes.iter().enumerate() {
+            let neighbours = &self.adjacency[ga];
+            for (b, &gb) in nodes.iter().enumerate() {
+                // The pattern holds every pair of nodes sharing an element.
+                let Ok(position) = neighbours.binary_search(&gb) else {
+                    continue;
+                };
+                for dc in 0..dim {
+                    let base = self.col_ptr[ga * dim + dc] + position * dim;
+                    let col = a * dim + dc;
+                    for dr in 0..dim {
+                        let row = b * dim + dr;
+                        k[base + dr] += em.stiffness[row * n + col];
+                        m[base + dr] += em.mass[row * n + col];
+                    }
                 }
             }
         }

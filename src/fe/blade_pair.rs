@@ -26,19 +26,21 @@
 //!
 //! # Mesh size
 //! The element size is h = b / (5 · refine). With the default dimensions (b = 10 mm,
-//! L = 100 mm) the model has (free DOFs before clamping, from [`BladePairParams`] defaults):
+//! L = 100 mm, thickness 10 mm) the models have these DOF counts (before clamping):
 //!
-//! | refine | 2D DOFs | 3D DOFs |
+//! | model | `--refine` | DOFs |
 //! | --- | --- | --- |
-//! | 1 | ≈ 1.4 k | ≈ 14 k |
-//! | 2 | ≈ 5 k | ≈ 90 k |
-//! | 3 | ≈ 11 k | ≈ 290 k |
-//! | 9 | ≈ 96 k | — |
-//! | 5 (3D) | | ≈ 1.3 M |
-//! | 28 | ≈ 0.9 M | — |
+//! | 2D | 1 | 1 586 |
+//! | 2D | 2 | 5 046 |
+//! | 2D | 3 | 11 474 (≈ 10 k) |
+//! | 2D | 10 | 114 158 (≈ 100 k) |
+//! | 2D | 30 | 1 008 794 (≈ 1 M) |
+//! | 3D | 1 | 16 653 (≈ 10 k) |
+//! | 3D | 2 | 83 259 (≈ 100 k) |
+//! | 3D | 5 | 1 212 327 (≈ 1 M) |
 //!
-//! (exact counts: `fricbound mesh blade-pair --refine N [--3d]` prints them; the table is
-//! checked by a test at refine 1 and 2).
+//! `fricbound mesh blade-pair --refine N [--3d]` prints the counts of any mesh; a test checks
+//! the small ones.
 
 use super::contact_patch::PatchSpec;
 use super::mesh::{ElementKind, Mesh, MeshBuilder};

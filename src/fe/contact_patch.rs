@@ -69,8 +69,9 @@ pub struct ContactPair {
     pub normal: [f64; 3],
     /// Tributary area of the damper node on the face (m²).
     pub area_weight: f64,
-    /// Distance between the two nodes (m) as meshed.
-    pub gap: f64,
+    /// Distance between the two nodes (m) as meshed (0 for coincident nodes; not an initial
+    /// contact gap, which the scene sets).
+    pub node_distance: f64,
 }
 
 impl ContactPair {
@@ -568,7 +569,7 @@ pub fn pair_patch(
             tangent,
             normal,
             area_weight,
-            gap: dist,
+            node_distance: dist,
         });
     }
     // Order along the mean tangent, then name.

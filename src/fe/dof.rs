@@ -174,11 +174,6 @@ impl DofMap {
         directions.iter().map(|&d| self.row(node, d)).collect()
     }
 
-    /// Whether any DOF of the node is in the map.
-    pub fn has_node(&self, node: u64) -> bool {
-        self.dofs.iter().any(|d| d.node == node)
-    }
-
     /// The map after keeping only the DOFs for which `keep` is true, in their old order, and
     /// for every old row its new row (`None` where removed).
     pub fn retain(&self, mut keep: impl FnMut(Dof) -> bool) -> (DofMap, Vec<Option<usize>>) {

@@ -12,9 +12,11 @@
 //! Parsing and the symmetric expansion are done by `sprs::io::read_matrix_market_from_bufread`.
 //! sprs panics on an index outside the declared size, loops forever on a file that ends before
 //! its size line, and reports every other problem as "Bad matrix market file" without a line.
-//! The file is therefore fed to sprs through [`GuardedLines`], a line-by-line reader that checks
+//! The file is therefore fed to sprs through `GuardedLines`, a line-by-line reader that checks
 //! each line first (indices in range, finite values, entry count, one triangle) and stops with
-//! the file, line and reason; sprs never sees a line it could panic on.
+//! the file, line and reason; sprs never sees a line it could panic on. sprs reads `integer`
+//! files only into integer matrices, so their header reaches it as `real` (the values are exact
+//! as f64).
 //!
 //! # DOF map
 //! A CSV file, one DOF per line: `node,direction,row`. `#` starts a comment line; blank lines
@@ -185,6 +187,20 @@ pub struct FeMatrices {
     pub mass: SparseMatrix,
     /// DOF of each row.
     pub dofs: DofMap,
+}
+
+impl FeMatrices {
+    /// The matrices with the DOFs for which `remove` is true deleted (e.g. a clamp given as a
+    /// list of nodes), rows, columns and DOF map renumbered consistently.
+    pub fn without_dofs(&self, remove: impl Fn(Dof) -> bool) -> FeMatrices {
+        let (dofs, new_of_old) = self.dofs.retain(|d| !remove(d));
+        let n = dofs.len();
+        FeMatrices {
+            stiffness: sparse::keep_rows_cols(&self.stiffness, &new_of_old, n),
+            mass: sparse::keep_rows_cols(&self.mass, &new_of_old, n),
+            dofs,
+        }
+    }
 }
 
 /// Reads K, M and the DOF map and checks that they fit: both matrices square, of one size,
@@ -471,6 +487,8 @@ struct GuardedLines<R> {
     has_lower: bool,
     has_upper: bool,
     failure: Option<FeMatrixError>,
+    /// Replacement for the line just checked (the header of an integer file).
+    rewrite: Option<String>,
 }
 
 impl<R: BufRead> GuardedLines<R> {
@@ -489,6 +507,7 @@ impl<R: BufRead> GuardedLines<R> {
             has_lower: false,
             has_upper: false,
             failure: None,
+            rewrite: None,
         }
     }
 
@@ -548,6 +567,14 @@ impl<R: BufRead> GuardedLines<R> {
                         )))
                     }
                 };
+                if words[3] == "integer" {
+                    // sprs reads integer files only into integer matrices; the values are
+                    // exact as f64, so sprs is told the field is real.
+                    self.rewrite = Some(format!(
+                        "%%MatrixMarket matrix coordinate real {}\n",
+                        words[4]
+                    ));
+                }
                 self.section = Section::Size;
             }
             Section::Size => {
@@ -658,7 +685,7 @@ impl<R: BufRead> GuardedLines<R> {
         self.line += 1;
         let text = std::mem::take(&mut self.line_text);
         let checked = self.check(&text, n == 0);
-        self.line_text = text;
+        self.line_text = self.rewrite.take().unwrap_or(text);
         if let Err(failure) = checked {
             let message = failure.to_string();
             self.failure = Some(failure);

@@ -11,6 +11,30 @@
 //! Contacts between a damper and the bodies it touches are node-to-node pairs between two
 //! facing physical groups with a local frame per pair ([`pair_patch`]). Results go to ParaView
 //! as VTU ([`write_vtu`]). Units are SI throughout (m, kg, N, Pa).
+//!
+//! ```
+//! use std::path::Path;
+//! use fricbound::fe::{self, blade_pair::BladePairParams, GroupMaterial, Material};
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let mesh = fe::read_msh(Path::new("meshes/blade-pair/blade-pair-2d.msh"))?;
+//! let steel = Material::steel(0.01); // 10 mm thick plane-stress plates
+//! let materials = ["blade1", "blade2", "damper"].map(|g| GroupMaterial::new(g, steel));
+//! let model = fe::assemble(&mesh, &materials, fe::PlaneAssumption::Stress)?
+//!     .clamp_group(&mesh, "clamp")?;
+//! // Contact pairs of the two damper sides, with the DOF rows of the clamped model.
+//! for spec in BladePairParams::default().patch_specs()? {
+//!     let patch = fe::pair_patch(&mesh, &model.dofs, &spec)?;
+//!     assert_eq!(patch.pairs.len(), 7);
+//! }
+//! // Centrifugal pre-load of 120 N on the damper, and the excitation row.
+//! let preload = model.body_force(&mesh, "damper", [0.0, 1.0, 0.0], 120.0)?;
+//! let tip_x = model.group_rows(&mesh, "excitation", fe::Direction::X)?[0];
+//! assert_eq!(preload.len(), model.dofs.len());
+//! assert!(tip_x < model.dofs.len());
+//! # Ok(())
+//! # }
+//! ```
 
 pub mod assembly;
 pub mod blade_pair;
