@@ -6,7 +6,9 @@
 //!
 //! R(x, ω) = 0,   tᵀ (y − y_p) = 0.
 //!
-//! A point converges when ‖R‖ ≤ tol_R·‖F_ex‖ and the scaled Newton step ≤ tol_y. A failed
+//! A point converges when ‖R‖ ≤ tol_R·‖F_ex‖ and the scaled Newton step ≤ tol_y, or when
+//! ‖R‖ ≤ tol_R·‖F_ex‖ and the full Newton step no longer lowers it (the step is then round-off
+//! amplified by an ill-conditioned Jacobian near a lightly damped resonance). A failed
 //! corrector (iteration limit, divergence, singular Jacobian, failed AFT) is not a result: the
 //! step is cut and the reason reported to the observer; below the minimum step the run ends
 //! with [`ContinuationError::Stalled`]. Turning points (sign changes of dω/ds) are reported and
@@ -232,24 +234,33 @@ impl Continuation {
                 .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
                 .map_err(eval_err)?;
             rel = norm(&r) / scale;
+            let at_tolerance = rel <= self.analysis.residual_tolerance;
             let neg: Vec<f64> = r.iter().map(|v| -v).collect();
             let dx = jac.solve(&neg)?;
             let step_norm = norm(&dx) / self.x_scale;
             let mut alpha = 1.0;
-            loop {
+            let improved = loop {
                 for i in 0..n {
                     trial[i] = x[i] + alpha * dx[i];
                 }
                 system.residual(&trial, omega, &mut rt).map_err(eval_err)?;
                 let rel_t = norm(&rt) / scale;
-                if rel_t < rel || alpha < 1e-3 {
-                    rel = rel_t;
-                    break;
+                let improved = rel_t < rel;
+                if improved || alpha < 1e-3 || at_tolerance {
+                    if improved || !at_tolerance {
+                        rel = rel_t;
+                    }
+                    break improved;
                 }
                 alpha *= 0.5;
+            };
+            // At tolerance, a step that does not lower the residual only moves through
+            // round-off: keep the current point (see `correct`).
+            let stalled_at_tolerance = at_tolerance && !improved;
+            if !stalled_at_tolerance {
+                x.copy_from_slice(&trial);
             }
-            x.copy_from_slice(&trial);
-            if self.converged(rel, alpha * step_norm) {
+            if stalled_at_tolerance || self.converged(rel, alpha * step_norm) {
                 // Leave the operator evaluated at the returned point.
                 system
                     .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
@@ -352,10 +363,24 @@ impl Continuation {
                     .sum::<f64>(),
             );
             let mut dy = jac.solve_bordered(self.x_scale, &col, tangent, &rhs)?;
-            // Backtracking: halve the step while it does not reduce the residual (the contact
-            // law is only piecewise smooth, and full steps can cycle between contact states).
-            // The arc-length equation is linear, so every fraction of the step keeps it.
-            if rel > self.analysis.residual_tolerance {
+            if rel <= self.analysis.residual_tolerance {
+                // At tolerance, a Newton step that does not lower the residual only moves
+                // through round-off (amplified by the Jacobian's condition number near a
+                // lightly damped resonance): the point is converged.
+                for j in 0..n {
+                    trial[j] = (y[j] + dy[j]) * self.x_scale;
+                }
+                system
+                    .residual(&trial, (y[n] + dy[n]) * OMEGA_SCALE, &mut r)
+                    .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
+                if norm(&r) / scale >= rel {
+                    return Ok((y, it, rel));
+                }
+            } else {
+                // Backtracking: halve the step while it does not reduce the residual (the
+                // contact law is only piecewise smooth, and full steps can cycle between
+                // contact states). The arc-length equation is linear, so every fraction of
+                // the step keeps it.
                 let mut alpha = 1.0;
                 loop {
                     for j in 0..n {
