@@ -27,6 +27,7 @@ struct Args {
     orderings: Vec<Ordering>,
     threads: usize,
     block_size: usize,
+    lanczos_block: usize,
 }
 
 fn parse() -> Result<Args, String> {
@@ -39,6 +40,7 @@ fn parse() -> Result<Args, String> {
         orderings: vec![Ordering::Metis],
         threads: 1,
         block_size: 64,
+        lanczos_block: 8,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -56,6 +58,11 @@ fn parse() -> Result<Args, String> {
                     .parse()
                     .map_err(|e| format!("--block-size: {e}"))?
             }
+            "--lanczos-block" => {
+                a.lanczos_block = value()?
+                    .parse()
+                    .map_err(|e| format!("--lanczos-block: {e}"))?
+            }
             "--hex" => a.hex = true,
             "--ordering" => {
                 a.orderings = match value()?.as_str() {
@@ -66,7 +73,7 @@ fn parse() -> Result<Args, String> {
                 }
             }
             "-h" | "--help" => {
-                return Err("usage: scale --dofs N --modes M --boundary B [--hex] [--aspect A] [--ordering metis|amd|both] [--threads T] [--block-size S]".into())
+                return Err("usage: scale --dofs N --modes M --boundary B [--hex] [--aspect A] [--ordering metis|amd|both] [--threads T] [--block-size S] [--lanczos-block P]".into())
             }
             f => return Err(format!("unknown argument {f}")),
         }
@@ -131,7 +138,7 @@ fn main() {
         .filter_map(|k| bd.dof(k * (nx - 1) / 10, ny / 2, nz / 2, 0))
         .collect();
     println!(
-        "{:>9} {:>5} {:>5} {:>6} {:>12} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>9} {:>9} {:>9}",
+        "{:>9} {:>5} {:>5} {:>6} {:>12} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>9} {:>9} {:>9}",
         "DOFs",
         "nb",
         "modes",
@@ -144,6 +151,7 @@ fn main() {
         "eigen",
         "constr",
         "total",
+        "cpu",
         "cutoffHz",
         "peak GiB",
         "maxres"
@@ -156,13 +164,17 @@ fn main() {
             ordering,
             threads: args.threads,
             block_size: args.block_size,
+            lanczos: fricbound_reduction::LanczosOptions {
+                block: args.lanczos_block,
+                ..Default::default()
+            },
             ..Default::default()
         };
         match craig_bampton(mesh.k.as_ref(), mesh.m.as_ref(), &boundary, &recover, &opts) {
             Ok(r) => {
                 let p = &r.report;
                 println!(
-                    "{:>9} {:>5} {:>5} {:>6} {:>12} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>9.1} {:>9} {:>9.1e}",
+                    "{:>9} {:>5} {:>5} {:>6} {:>12} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.1} {:>9.1} {:>9} {:>9.1e}",
                     p.n_full,
                     p.n_boundary,
                     p.n_modes,
@@ -175,6 +187,7 @@ fn main() {
                     p.t_eigen,
                     p.t_constraint,
                     p.t_total,
+                    p.cpu_seconds.unwrap_or(f64::NAN),
                     p.cutoff_hz,
                     gib(p.peak_memory_bytes),
                     p.eigen_max_residual

@@ -134,8 +134,12 @@ pub struct ReductionReport {
     pub t_eigen: f64,
     /// seconds: constraint modes and reduced matrices
     pub t_constraint: f64,
-    /// seconds in all
+    /// seconds in all (wall clock)
     pub t_total: f64,
+    /// CPU seconds of the process during the reduction (user + system, all
+    /// threads; from /proc/self/stat, `None` elsewhere). Compared with
+    /// `t_total` it shows how much the machine was shared.
+    pub cpu_seconds: Option<f64>,
     /// peak resident memory of the process (VmHWM of /proc/self/status),
     /// bytes; `None` where it cannot be read
     pub peak_memory_bytes: Option<u64>,
@@ -179,7 +183,7 @@ impl std::fmt::Display for ReductionReport {
         )?;
         writeln!(
             f,
-            "  seconds: validate {:.2}, partition {:.2}, ordering {:.2}, symbolic {:.2}, numeric {:.2}, eigen {:.2}, constraint modes {:.2}, total {:.2}",
+            "  seconds: validate {:.2}, partition {:.2}, ordering {:.2}, symbolic {:.2}, numeric {:.2}, eigen {:.2}, constraint modes {:.2}, total {:.2} (CPU {})",
             self.t_validate,
             self.t_partition,
             self.t_ordering,
@@ -187,7 +191,10 @@ impl std::fmt::Display for ReductionReport {
             self.t_numeric,
             self.t_eigen,
             self.t_constraint,
-            self.t_total
+            self.t_total,
+            self.cpu_seconds
+                .map(|c| format!("{c:.2}"))
+                .unwrap_or_else(|| "n/a".into())
         )?;
         match self.peak_memory_bytes {
             Some(b) => write!(f, "  peak memory {:.2} GiB", b as f64 / (1u64 << 30) as f64),
@@ -289,6 +296,18 @@ impl ReducedModel {
     }
 }
 
+/// CPU time (user + system) of this process so far, seconds; `None` off Linux.
+pub fn process_cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // fields after the command name (which is in parentheses)
+    let rest = &s[s.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let utime: f64 = f.get(11)?.parse().ok()?;
+    let stime: f64 = f.get(12)?.parse().ok()?;
+    // clock ticks: 100 per second on Linux
+    Some((utime + stime) / 100.0)
+}
+
 /// Peak resident memory of this process (VmHWM), bytes; `None` off Linux.
 pub fn peak_memory_bytes() -> Option<u64> {
     let s = std::fs::read_to_string("/proc/self/status").ok()?;
@@ -362,6 +381,7 @@ pub fn craig_bampton(
     options: &CbOptions,
 ) -> Result<ReducedModel, ReductionError> {
     let t_start = Instant::now();
+    let cpu_start = process_cpu_seconds();
     let n = k.nrows();
     if options.block_size == 0 {
         return Err(ReductionError::InvalidArgument(
@@ -437,7 +457,7 @@ pub fn craig_bampton(
             modal_frequencies_hz: Vec::new(),
             modal_eigenvalues: Vec::new(),
             recovery: recovery_rows(recover, &part, nb, 0, &[], &[]),
-            report: finish_report(report, t_start),
+            report: finish_report(report, t_start, cpu_start),
         };
         return Ok(model);
     }
@@ -579,7 +599,7 @@ pub fn craig_bampton(
         modal_frequencies_hz: lambdas.iter().map(|&l| lambda_to_hz(l)).collect(),
         modal_eigenvalues: lambdas,
         recovery,
-        report: finish_report(report, t_start),
+        report: finish_report(report, t_start, cpu_start),
     })
 }
 
@@ -591,8 +611,16 @@ fn permute_coupling(b: Blocks, inv: &[usize]) -> Blocks {
     }
 }
 
-fn finish_report(mut r: ReductionReport, t_start: Instant) -> ReductionReport {
+fn finish_report(
+    mut r: ReductionReport,
+    t_start: Instant,
+    cpu_start: Option<f64>,
+) -> ReductionReport {
     r.t_total = t_start.elapsed().as_secs_f64();
+    r.cpu_seconds = match (cpu_start, process_cpu_seconds()) {
+        (Some(a), Some(b)) => Some(b - a),
+        _ => None,
+    };
     r.peak_memory_bytes = peak_memory_bytes();
     r
 }

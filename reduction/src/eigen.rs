@@ -386,10 +386,8 @@ fn orthonormalise(
     for i in 0..p {
         if d[i] > thresh {
             let s = d[i].sqrt();
-            for row in 0..n {
-                vnew[(row, i)] /= s;
-                mvnew[(row, i)] /= s;
-            }
+            vnew.col_as_slice_mut(i).iter_mut().for_each(|v| *v /= s);
+            mvnew.col_as_slice_mut(i).iter_mut().for_each(|v| *v /= s);
             for c in 0..p {
                 r[(i, c)] = s * q[(c, i)];
             }
@@ -491,14 +489,11 @@ fn block_lanczos(
                 par,
             );
             let a_loc = symmetrise(a_loc.as_ref());
+            // scale of ‖W‖²_M for the rank test: ‖W_c‖_M ≥ |(V_c, W_c)_M| = |a_cc|
             let norm_ref = (0..p)
-                .map(|c| {
-                    (0..n)
-                        .map(|i| w[(i, c)] * mv_cur[(i, c)])
-                        .sum::<f64>()
-                        .abs()
-                })
-                .fold(0.0, f64::max);
+                .map(|c| a_loc[(c, c)].abs())
+                .fold(0.0, f64::max)
+                .powi(2);
             matmul(
                 w.as_mut(),
                 Accum::Add,
