@@ -243,6 +243,11 @@ std::thread_local! {
     static SCRATCH: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
+/// Free this thread's scratch of the sparse products.
+pub(crate) fn release_scratch() {
+    SCRATCH.with(|cell| *cell.borrow_mut() = Vec::new());
+}
+
 /// Columns of the right-hand side processed together in a sparse product:
 /// the rows touched by neighbouring matrix columns then stay in L2.
 const CW: usize = 16;

@@ -21,7 +21,8 @@ pub struct CbOptions {
     /// Fill-reducing ordering of the Cholesky factorisation of `K_II`.
     pub ordering: Ordering,
     /// Number of constraint modes computed at once (columns of a block of Ψ).
-    /// Memory of a block: about `4 × n_I × block_size × 8` bytes.
+    /// Memory of a block: about `2 × n_I × block_size × 8` bytes (Ψ_a and
+    /// M_II Ψ_a), plus the products' scratch `2 × n_I × 16 × 8` bytes.
     pub block_size: usize,
     /// Worker threads for the constraint-mode blocks (1: sequential). Each
     /// block is computed sequentially and written to its own rows/columns,
@@ -40,6 +41,12 @@ pub struct CbOptions {
     /// Largest accepted relative residual `‖Kφ − λMφ‖/‖Kφ‖` of a
     /// fixed-interface mode.
     pub max_residual: f64,
+    /// Check with a Sturm-sequence count that no fixed-interface mode below
+    /// the cut-off was missed: the inertia of `K_II − σ M_II`, σ halfway
+    /// between the last kept and the next computed eigenvalue, from one more
+    /// (indefinite, supernodal `LDLᵀ`) factorisation. Costs about one
+    /// numeric factorisation; an error if modes were missed.
+    pub sturm_check: bool,
 }
 
 impl Default for CbOptions {
@@ -54,6 +61,7 @@ impl Default for CbOptions {
             complete_clusters: true,
             cluster_rtol: 1e-6,
             max_residual: 1e-6,
+            sturm_check: true,
         }
     }
 }
@@ -134,6 +142,11 @@ pub struct ReductionReport {
     pub t_eigen: f64,
     /// seconds: constraint modes and reduced matrices
     pub t_constraint: f64,
+    /// Sturm count: fixed-interface eigenvalues below the check shift
+    /// (should equal `n_modes`); `None` if not done
+    pub sturm_count: Option<usize>,
+    /// seconds: Sturm-sequence check
+    pub t_sturm: f64,
     /// seconds in all (wall clock)
     pub t_total: f64,
     /// CPU seconds of the process during the reduction (user + system, all
@@ -181,6 +194,13 @@ impl std::fmt::Display for ReductionReport {
             "  constraint-mode seconds: solves {:.2}, M products {:.2}",
             self.t_constraint_solve, self.t_constraint_mass
         )?;
+        if let Some(c) = self.sturm_count {
+            writeln!(
+                f,
+                "  Sturm check: {c} eigenvalues below the check shift ({:.2} s)",
+                self.t_sturm
+            )?;
+        }
         writeln!(
             f,
             "  seconds: validate {:.2}, partition {:.2}, ordering {:.2}, symbolic {:.2}, numeric {:.2}, eigen {:.2}, constraint modes {:.2}, total {:.2} (CPU {})",
@@ -545,7 +565,8 @@ pub fn craig_bampton(
         solves,
         timings,
     } = eig;
-    let next_hz = values.get(nm).map(|&l| lambda_to_hz(l));
+    let next_lambda = values.get(nm).copied();
+    let next_hz = next_lambda.map(lambda_to_hz);
     let lambdas: Vec<f64> = values[..nm].to_vec();
     let phi = vectors.subcols(0, nm).to_owned();
     drop(vectors);
@@ -565,6 +586,31 @@ pub fn craig_bampton(
     report.t_constraint = t0.elapsed().as_secs_f64();
     report.t_constraint_solve = cons.t_solve;
     report.t_constraint_mass = cons.t_mass;
+
+    drop(factor);
+    if options.sturm_check && nm > 0 {
+        let t0 = Instant::now();
+        let last = lambdas[nm - 1];
+        let sigma = match next_lambda {
+            Some(next) if next > last => 0.5 * (last + next),
+            _ => last * (1.0 + 1e-3),
+        };
+        let shifted =
+            crate::csc::add_scaled(&kb.ii_lower, &mb.ii_lower, -sigma).permute_sym_lower(&inv);
+        let count = crate::factor::negative_pivots(&shifted)?;
+        drop(shifted);
+        report.t_sturm = t0.elapsed().as_secs_f64();
+        report.sturm_count = count;
+        if let Some(c) = count {
+            if c > nm {
+                return Err(ReductionError::MissedEigenvalues {
+                    computed: nm,
+                    found: c,
+                    shift_hz: lambda_to_hz(sigma),
+                });
+            }
+        }
+    }
 
     let size = nb + nm;
     let mut kr = Mat::zeros(size, size);
@@ -616,6 +662,7 @@ fn finish_report(
     t_start: Instant,
     cpu_start: Option<f64>,
 ) -> ReductionReport {
+    crate::block::release_scratch();
     r.t_total = t_start.elapsed().as_secs_f64();
     r.cpu_seconds = match (cpu_start, process_cpu_seconds()) {
         (Some(a), Some(b)) => Some(b - a),

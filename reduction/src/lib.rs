@@ -147,5 +147,6 @@ pub fn lowest_eigenpairs_with(
     let mut eig = eigen::lowest_modes(view(&kl), view(&ml), &factor, shift, n, options, Par::Seq)?;
     let q = eig.values.len();
     eig.vectors = faer::Mat::from_fn(size, q, |old, c| eig.vectors[(inv[old], c)]);
+    block::release_scratch();
     Ok(eig)
 }

@@ -357,6 +357,7 @@ fn reduced_matrices_are_symmetric_and_structured() {
     assert_eq!(rep.n_boundary, nb);
     assert_eq!(rep.n_interior, mesh.n() - nb);
     assert!(rep.factor_nnz >= rep.k_ii_nnz);
+    assert_eq!(rep.sturm_count, Some(8), "Sturm count = modes kept");
     assert!(rep.t_total > 0.0);
     if cfg!(target_os = "linux") {
         assert!(rep.peak_memory_bytes.unwrap() > 0);
