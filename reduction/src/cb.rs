@@ -86,6 +86,51 @@ pub struct RecoveryRow {
     pub row: Vec<f64>,
 }
 
+/// CPU seconds of the calling thread per phase of a reduction.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CpuPhases {
+    /// validation, canonicalisation, partition
+    pub validate: f64,
+    /// ordering, symbolic and numeric Cholesky
+    pub factor: f64,
+    /// fixed-interface modes
+    pub eigen: f64,
+    /// constraint modes and reduced matrices
+    pub constraint: f64,
+    /// Sturm-sequence check
+    pub sturm: f64,
+}
+
+/// CPU time of the calling thread, seconds (`/proc/thread-self/schedstat`).
+fn thread_cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: f64 = s.split_whitespace().next()?.parse().ok()?;
+    Some(ns * 1e-9)
+}
+
+/// Marks phase boundaries on the calling thread's CPU clock.
+struct CpuClock {
+    last: Option<f64>,
+}
+
+impl CpuClock {
+    fn new() -> Self {
+        CpuClock {
+            last: thread_cpu_seconds(),
+        }
+    }
+    /// CPU seconds since the previous mark.
+    fn lap(&mut self) -> f64 {
+        let now = thread_cpu_seconds();
+        let d = match (self.last, now) {
+            (Some(a), Some(b)) => b - a,
+            _ => 0.0,
+        };
+        self.last = now;
+        d
+    }
+}
+
 /// Sizes, times and memory of a reduction.
 #[derive(Clone, Debug, Default)]
 pub struct ReductionReport {
@@ -153,6 +198,10 @@ pub struct ReductionReport {
     /// threads; from /proc/self/stat, `None` elsewhere). Compared with
     /// `t_total` it shows how much the machine was shared.
     pub cpu_seconds: Option<f64>,
+    /// CPU seconds of the calling thread per phase (Linux), independent of
+    /// how busy the machine is; with `threads > 1` the constraint-mode
+    /// blocks run on other threads and are not counted here
+    pub cpu_phases: Option<CpuPhases>,
     /// peak resident memory of the process (VmHWM of /proc/self/status),
     /// bytes; `None` where it cannot be read
     pub peak_memory_bytes: Option<u64>,
@@ -216,6 +265,13 @@ impl std::fmt::Display for ReductionReport {
                 .map(|c| format!("{c:.2}"))
                 .unwrap_or_else(|| "n/a".into())
         )?;
+        if let Some(c) = &self.cpu_phases {
+            writeln!(
+                f,
+                "  CPU seconds (calling thread): validate {:.2}, factor {:.2}, eigen {:.2}, constraint modes {:.2}, Sturm {:.2}",
+                c.validate, c.factor, c.eigen, c.constraint, c.sturm
+            )?;
+        }
         match self.peak_memory_bytes {
             Some(b) => write!(f, "  peak memory {:.2} GiB", b as f64 / (1u64 << 30) as f64),
             None => write!(f, "  peak memory unknown"),
@@ -402,6 +458,8 @@ pub fn craig_bampton(
 ) -> Result<ReducedModel, ReductionError> {
     let t_start = Instant::now();
     let cpu_start = process_cpu_seconds();
+    let mut clock = CpuClock::new();
+    let mut cpu = CpuPhases::default();
     let n = k.nrows();
     if options.block_size == 0 {
         return Err(ReductionError::InvalidArgument(
@@ -452,6 +510,7 @@ pub fn craig_bampton(
         .filter(|&d| matches!(part[d], Part::Interior(_)))
         .collect();
     let t_partition = t0.elapsed().as_secs_f64();
+    cpu.validate = clock.lap();
 
     let mut report = ReductionReport {
         n_full: n,
@@ -512,6 +571,7 @@ pub fn craig_bampton(
     report.t_ordering = t_ordering;
     report.t_symbolic = factor.symbolic_seconds;
     report.t_numeric = factor.numeric_seconds;
+    cpu.factor = clock.lap();
     report.factor_nnz = factor.factor_entries();
 
     // fixed-interface modes
@@ -579,11 +639,13 @@ pub fn craig_bampton(
     report.eigen_solves = solves;
     report.eigen_timings = timings;
     report.t_eigen = t0.elapsed().as_secs_f64();
+    cpu.eigen = clock.lap();
 
     // constraint modes, block by block
     let t0 = Instant::now();
     let cons = constraint_blocks(&kb, &mb, &inv, &factor, &phi, &part, recover, options)?;
     report.t_constraint = t0.elapsed().as_secs_f64();
+    cpu.constraint = clock.lap();
     report.t_constraint_solve = cons.t_solve;
     report.t_constraint_mass = cons.t_mass;
 
@@ -600,6 +662,7 @@ pub fn craig_bampton(
         let count = crate::factor::negative_pivots(&shifted)?;
         drop(shifted);
         report.t_sturm = t0.elapsed().as_secs_f64();
+        cpu.sturm = clock.lap();
         report.sturm_count = count;
         if let Some(c) = count {
             if c > nm {
@@ -610,6 +673,10 @@ pub fn craig_bampton(
                 });
             }
         }
+    }
+
+    if clock.last.is_some() {
+        report.cpu_phases = Some(cpu);
     }
 
     let size = nb + nm;

@@ -65,8 +65,8 @@ mod ordering;
 pub mod testmodels;
 
 pub use cb::{
-    craig_bampton, peak_memory_bytes, process_cpu_seconds, CbOptions, RecoveryRow, ReducedModel,
-    ReductionReport,
+    craig_bampton, peak_memory_bytes, process_cpu_seconds, CbOptions, CpuPhases, RecoveryRow,
+    ReducedModel, ReductionReport,
 };
 pub use eigen::{dense_generalized_eigenvalues, Eigen, LanczosOptions};
 pub use error::ReductionError;
