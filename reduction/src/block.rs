@@ -12,12 +12,60 @@ use faer::linalg::triangular_solve::{
 use faer::sparse::linalg::cholesky::supernodal::{SupernodalLltRef, SymbolicSupernodalCholesky};
 use faer::{Accum, MatMut, MatRef, Par};
 
+/// 64 bytes, 64-byte aligned.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct Line([f64; 8]);
+
+/// A zero-initialised `f64` buffer starting on a 64-byte boundary. The SIMD
+/// kernels of faer split their loops by alignment; with a fixed alignment the
+/// results do not depend on where the allocator placed the buffer (nor on
+/// which thread made it), so they are reproducible bit for bit.
+#[derive(Clone, Debug)]
+pub(crate) struct AlignedVec {
+    lines: Vec<Line>,
+    len: usize,
+}
+
+impl AlignedVec {
+    pub fn zeros(len: usize) -> Self {
+        AlignedVec {
+            lines: vec![Line([0.0; 8]); len.div_ceil(8)],
+            len,
+        }
+    }
+
+    /// `zeros`, or `None` if the memory cannot be had.
+    pub fn try_zeros(len: usize) -> Option<Self> {
+        let mut lines = Vec::new();
+        lines.try_reserve_exact(len.div_ceil(8)).ok()?;
+        lines.resize(len.div_ceil(8), Line([0.0; 8]));
+        Some(AlignedVec { lines, len })
+    }
+}
+
+impl std::ops::Deref for AlignedVec {
+    type Target = [f64];
+    fn deref(&self) -> &[f64] {
+        // SAFETY: `lines` holds at least `len` contiguous, initialised f64
+        // (Line is repr(C) over [f64; 8], no padding).
+        unsafe { std::slice::from_raw_parts(self.lines.as_ptr().cast::<f64>(), self.len) }
+    }
+}
+
+impl std::ops::DerefMut for AlignedVec {
+    fn deref_mut(&mut self) -> &mut [f64] {
+        // SAFETY: as in `deref`, with unique access through `&mut self`.
+        unsafe { std::slice::from_raw_parts_mut(self.lines.as_mut_ptr().cast::<f64>(), self.len) }
+    }
+}
+
 /// `n × k` block stored row by row.
 #[derive(Clone, Debug)]
 pub(crate) struct RowBlock {
     pub n: usize,
     pub k: usize,
-    pub data: Vec<f64>,
+    pub data: AlignedVec,
 }
 
 impl RowBlock {
@@ -25,7 +73,7 @@ impl RowBlock {
         RowBlock {
             n,
             k,
-            data: vec![0.0; n * k],
+            data: AlignedVec::zeros(n * k),
         }
     }
 

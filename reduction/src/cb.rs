@@ -26,7 +26,7 @@ pub struct CbOptions {
     pub block_size: usize,
     /// Worker threads for the constraint-mode blocks (1: sequential). Each
     /// block is computed sequentially and written to its own rows/columns,
-    /// so results do not depend on this number.
+    /// so results do not depend on this number (beyond round-off).
     pub threads: usize,
     /// Settings of the block Lanczos eigen solver.
     pub lanczos: LanczosOptions,

@@ -1,7 +1,7 @@
 //! Sparse Cholesky `A = P Lᵀ L Pᵀ` of a symmetric positive definite matrix
 //! with faer's low-level supernodal factorisation and a METIS or AMD ordering.
 
-use crate::block::{supernodal_solve_rows, RowBlock};
+use crate::block::{supernodal_solve_rows, AlignedVec, RowBlock};
 use crate::csc::Csc;
 use crate::ordering::{metis_nd, Ordering};
 use crate::ReductionError;
@@ -22,7 +22,7 @@ pub(crate) const PIVOT_RATIO_TOL: f64 = 1e-11;
 
 pub(crate) struct SpdFactor {
     symbolic: SymbolicCholesky<usize>,
-    values: Vec<f64>,
+    values: AlignedVec,
     pub symbolic_seconds: f64,
     pub numeric_seconds: f64,
 }
@@ -98,14 +98,14 @@ impl SpdFactor {
         let symbolic_seconds = t0.elapsed().as_secs_f64();
         let a = lower.to_faer();
         let t1 = Instant::now();
-        let mut values = Vec::new();
-        values.try_reserve_exact(symbolic.len_val()).map_err(|_| {
+        // 64-byte aligned: faer's kernels then split their loops the same
+        // way at every run, and the factor is reproducible bit for bit
+        let mut values = AlignedVec::try_zeros(symbolic.len_val()).ok_or_else(|| {
             ReductionError::LinearAlgebra(format!(
                 "out of memory for a Cholesky factor of {} entries",
                 symbolic.len_val()
             ))
         })?;
-        values.resize(symbolic.len_val(), 0.0);
         let req = symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
         let mut mem = MemBuffer::try_new(req).map_err(|_| {
             ReductionError::LinearAlgebra("out of memory for Cholesky scratch".into())
@@ -230,14 +230,12 @@ pub(crate) fn negative_pivots(lower: &Csc) -> Result<Option<usize>, ReductionErr
     .map_err(|e| la("symbolic LDLᵀ", &e))?;
     drop(upper);
     let a = lower.to_faer();
-    let mut values = Vec::new();
-    values.try_reserve_exact(symbolic.len_val()).map_err(|_| {
+    let mut values = AlignedVec::try_zeros(symbolic.len_val()).ok_or_else(|| {
         ReductionError::LinearAlgebra(format!(
             "out of memory for an LDLᵀ factor of {} entries",
             symbolic.len_val()
         ))
     })?;
-    values.resize(symbolic.len_val(), 0.0);
     let req = symbolic.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default());
     let mut mem = MemBuffer::try_new(req)
         .map_err(|_| ReductionError::LinearAlgebra("out of memory for LDLᵀ scratch".into()))?;
