@@ -9,7 +9,8 @@
 //! ```
 //!
 //! The boundary DOFs are the nodes of the top edge (face) nearest the free
-//! end, all components, as a contact patch would be. The peak memory of the
+//! end, all components, as a contact patch would be (then the bottom edge
+//! if the top one is too short). The peak memory of the
 //! reduction alone is measured by resetting the kernel's high-water mark
 //! (`/proc/self/clear_refs`) after the mesh is built; the mesh itself (K and
 //! M) stays resident and is included.
@@ -81,18 +82,22 @@ fn parse() -> Result<Args, String> {
     Ok(a)
 }
 
-/// Contact patch: nodes of the top edge/face, from the free end inwards.
+/// Contact patch: nodes of the top edge/face, from the free end inwards
+/// (then of the bottom edge/face).
 fn boundary_dofs(mesh: &Mesh, want: usize) -> Vec<usize> {
     let bd = &mesh.bodies[0];
     let [nx, ny, nz] = bd.nodes;
     let mut out = Vec::new();
-    'outer: for ix in (1..nx).rev() {
-        for iz in 0..nz {
-            for d in bd.node_dofs(ix, ny - 1, iz) {
-                if out.len() == want {
-                    break 'outer;
+    // top edge/face first, then the bottom one if more DOFs are asked
+    'outer: for iy in [ny - 1, 0] {
+        for ix in (1..nx).rev() {
+            for iz in 0..nz {
+                for d in bd.node_dofs(ix, iy, iz) {
+                    if out.len() == want {
+                        break 'outer;
+                    }
+                    out.push(d);
                 }
-                out.push(d);
             }
         }
     }
