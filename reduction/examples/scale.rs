@@ -29,6 +29,7 @@ struct Args {
     threads: usize,
     block_size: usize,
     lanczos_block: usize,
+    basis_factor: f64,
 }
 
 fn parse() -> Result<Args, String> {
@@ -42,6 +43,7 @@ fn parse() -> Result<Args, String> {
         threads: 1,
         block_size: 64,
         lanczos_block: 8,
+        basis_factor: 2.0,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -64,6 +66,11 @@ fn parse() -> Result<Args, String> {
                     .parse()
                     .map_err(|e| format!("--lanczos-block: {e}"))?
             }
+            "--basis-factor" => {
+                a.basis_factor = value()?
+                    .parse()
+                    .map_err(|e| format!("--basis-factor: {e}"))?
+            }
             "--hex" => a.hex = true,
             "--ordering" => {
                 a.orderings = match value()?.as_str() {
@@ -74,7 +81,7 @@ fn parse() -> Result<Args, String> {
                 }
             }
             "-h" | "--help" => {
-                return Err("usage: scale --dofs N --modes M --boundary B [--hex] [--aspect A] [--ordering metis|amd|both] [--threads T] [--block-size S] [--lanczos-block P]".into())
+                return Err("usage: scale --dofs N --modes M --boundary B [--hex] [--aspect A] [--ordering metis|amd|both] [--threads T] [--block-size S] [--lanczos-block P] [--basis-factor F]".into())
             }
             f => return Err(format!("unknown argument {f}")),
         }
@@ -171,6 +178,7 @@ fn main() {
             block_size: args.block_size,
             lanczos: fricbound_reduction::LanczosOptions {
                 block: args.lanczos_block,
+                basis_factor: args.basis_factor,
                 ..Default::default()
             },
             ..Default::default()

@@ -81,6 +81,9 @@ pub struct LanczosOptions {
     pub seed: u64,
     /// problems with at most this many DOFs are solved densely
     pub dense_below: usize,
+    /// size of the Lanczos basis as a multiple of the wanted pairs
+    /// (at least `nev + 3·block`)
+    pub basis_factor: f64,
 }
 
 impl Default for LanczosOptions {
@@ -91,6 +94,7 @@ impl Default for LanczosOptions {
             max_restarts: 200,
             seed: 0x5eed_cb01,
             dense_below: 400,
+            basis_factor: 2.0,
         }
     }
 }
@@ -141,7 +145,10 @@ pub(crate) fn lowest_modes(
         });
     }
     let p = opts.block.max(1);
-    let ncv = round_up((2 * nev).max(nev + 3 * p), p);
+    let ncv = round_up(
+        ((opts.basis_factor.max(1.0) * nev as f64).ceil() as usize).max(nev + 3 * p),
+        p,
+    );
     let mut eig = if n <= opts.dense_below || ncv + p > n / 2 {
         dense_lowest(k_lower, m_lower, sigma, nev)?
     } else {
