@@ -77,6 +77,34 @@ impl RowBlock {
         }
     }
 
+    /// A block whose contents are unspecified (to be overwritten), reusing
+    /// a buffer of this thread's pool when one of the same size is there:
+    /// large fresh allocations are mapped lazily and fault on every page.
+    pub fn take(n: usize, k: usize) -> Self {
+        let data = POOL.with(|pool| {
+            let mut pool = pool.borrow_mut();
+            pool.iter()
+                .position(|b| b.len == n * k)
+                .map(|pos| pool.swap_remove(pos))
+        });
+        match data {
+            Some(data) => RowBlock { n, k, data },
+            None => RowBlock::zeros(n, k),
+        }
+    }
+
+    /// Return the buffer to this thread's pool (the four most recent are
+    /// kept).
+    pub fn give_back(self) {
+        POOL.with(|pool| {
+            let mut pool = pool.borrow_mut();
+            if pool.len() >= 4 {
+                pool.remove(0);
+            }
+            pool.push(self.data);
+        });
+    }
+
     /// Copy of a (column-major or any) matrix view.
     pub fn from_mat(a: MatRef<'_, f64>) -> Self {
         let mut b = Self::zeros(a.nrows(), a.ncols());
@@ -289,11 +317,14 @@ std::thread_local! {
     /// Scratch of the sparse products, kept between calls: fresh large
     /// allocations are mapped lazily and every first touch of a page faults.
     static SCRATCH: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
+    /// Reusable block buffers (see [`RowBlock::take`]).
+    static POOL: std::cell::RefCell<Vec<AlignedVec>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
-/// Free this thread's scratch of the sparse products.
+/// Free this thread's scratch of the sparse products and its block pool.
 pub(crate) fn release_scratch() {
     SCRATCH.with(|cell| *cell.borrow_mut() = Vec::new());
+    POOL.with(|cell| cell.borrow_mut().clear());
 }
 
 /// Columns of the right-hand side processed together in a sparse product:

@@ -845,7 +845,8 @@ fn constraint_blocks(
     let run_block = |start: usize| -> BlockOut {
         let w = bs.min(nb - start);
         // Ψ_a = −K_II⁻¹ K_IB[:, a]   (row-major n_I × w)
-        let mut psi = RowBlock::zeros(n_i, w);
+        let mut psi = RowBlock::take(n_i, w);
+        psi.data.fill(0.0);
         for c in 0..w {
             let (rows, vals) = kb.ib.col(start + c);
             for (&i, &v) in rows.iter().zip(vals) {
@@ -867,11 +868,11 @@ fn constraint_blocks(
             .map(|&(pos, i)| (pos, psi.row(i).to_vec()))
             .collect();
         // Z = M_II Ψ_a
-        let mut z = RowBlock::zeros(n_i, w);
+        let mut z = RowBlock::take(n_i, w);
         let t = Instant::now();
         sym_mul_rows(&mb.ii_lower, Some(inv), &psi, &mut z);
         let t_mass = t.elapsed().as_secs_f64();
-        drop(psi);
+        psi.give_back();
         let mut coupling_rows = Mat::zeros(w, nm);
         matmul(
             coupling_rows.as_mut(),
@@ -891,6 +892,7 @@ fn constraint_blocks(
         factor.solve_rows(&mut z);
         t_solve += t.elapsed().as_secs_f64();
         let mut g_cols = kb.ib.transpose_mul_rows(&z);
+        z.give_back();
         for c in 0..w {
             for i in 0..nb {
                 g_cols[(i, c)] = -g_cols[(i, c)];

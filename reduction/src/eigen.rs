@@ -327,10 +327,14 @@ fn gs_pass(v: MatRef<'_, f64>, z: MatRef<'_, f64>, w: MatMut<'_, f64>, par: Par)
 
 /// `A x` for a column-major block (through a row-major copy).
 fn m_mul(a: SymView<'_>, x: MatRef<'_, f64>) -> Mat<f64> {
-    let xr = RowBlock::from_mat(x);
-    let mut z = RowBlock::zeros(x.nrows(), x.ncols());
+    let mut xr = RowBlock::take(x.nrows(), x.ncols());
+    xr.view_mut().copy_from(x);
+    let mut z = RowBlock::take(x.nrows(), x.ncols());
     a.mul_rows(&xr, &mut z);
-    z.view().to_owned()
+    let out = z.view().to_owned();
+    xr.give_back();
+    z.give_back();
+    out
 }
 
 /// `(V_new, M V_new, R)`
@@ -477,10 +481,11 @@ fn block_lanczos(
         while cur < ncv + p {
             let j0 = cur - p;
             let t = Instant::now();
-            let mut wr = RowBlock::from_mat(mv_cur.as_ref());
+            let mut wr = RowBlock::take(n, p);
+            wr.view_mut().copy_from(&mv_cur);
             factor.solve_rows(&mut wr);
             let mut w = wr.view().to_owned();
-            drop(wr);
+            wr.give_back();
             tm.solve += t.elapsed().as_secs_f64();
             solves += 1;
             // local block recurrence first (uses M V_j, known): removes the
