@@ -36,6 +36,11 @@
 //!   written by hand in [`eigen`] (see there); a few more modes than asked
 //!   are computed, and a repeated eigenvalue cut by `n_modes` is kept whole.
 //!   Residuals `‖Kφ − λMφ‖/‖Kφ‖` are checked.
+//! * **Sturm check** ([`CbOptions::sturm_check`], on by default): the
+//!   inertia of `K_II − σ M_II` (σ between the last kept and the next
+//!   fixed-interface eigenvalue, from a supernodal `LDLᵀ`) must count the
+//!   kept modes; a larger count means a missed mode
+//!   ([`ReductionError::MissedEigenvalues`]). One more numeric factorisation.
 //! * **Constraint modes, block by block**: Ψ is never held whole (for 10⁶
 //!   DOFs and 400 boundary DOFs it would be 3.2 GB): `block_size` columns
 //!   are solved at a time and folded into `K_r`, `M_r`. The term `Ψᵀ M_II Ψ`
