@@ -373,3 +373,47 @@ fn reduced_matrices_are_symmetric_and_structured() {
     }
     assert!(format!("{rep}").contains("Craig-Bampton"));
 }
+
+#[test]
+fn guyan_and_pure_modal_limits() {
+    let (mesh, contact) = stuck_model();
+    let boundary = boundary_of(&mesh, &contact);
+    // no modes: Guyan reduction, K_r = K_BB + K_BI Ψ only
+    let g = craig_bampton(
+        mesh.k.as_ref(),
+        mesh.m.as_ref(),
+        &boundary,
+        &[10],
+        &CbOptions::with_modes(0),
+    )
+    .unwrap();
+    assert_eq!(g.n_modes, 0);
+    assert_eq!(g.size(), boundary.len());
+    assert_eq!(g.recovery[0].row.len(), boundary.len());
+    let r = craig_bampton(
+        mesh.k.as_ref(),
+        mesh.m.as_ref(),
+        &boundary,
+        &[10],
+        &CbOptions::with_modes(5),
+    )
+    .unwrap();
+    let nb = boundary.len();
+    let d = (g.stiffness.as_ref() - r.stiffness.submatrix(0, 0, nb, nb)).norm_max();
+    assert!(d <= 1e-12 * g.stiffness.norm_max());
+    // no boundary: K_r = Λ, M_r = I, the lowest modes of the clamped model
+    let strip = fricbound_reduction::testmodels::cantilever_2d(1500, 3.0);
+    let m = craig_bampton(
+        strip.k.as_ref(),
+        strip.m.as_ref(),
+        &[],
+        &[],
+        &CbOptions::with_modes(6),
+    )
+    .unwrap();
+    let full = lowest_eigenpairs(strip.k.as_ref(), strip.m.as_ref(), 6, 0.0).unwrap();
+    for i in 0..6 {
+        assert_eq!(m.mass[(i, i)], 1.0);
+        assert!((m.stiffness[(i, i)] - full.values[i]).abs() < 1e-9 * full.values[i]);
+    }
+}
