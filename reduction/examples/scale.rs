@@ -9,7 +9,8 @@
 //! ```
 //!
 //! The boundary DOFs are the nodes of the top edge (face) nearest the free
-//! end, all components, as a contact patch would be. The peak memory of the
+//! end, all components, as a contact patch would be (then the bottom edge
+//! if the top one is too short). The peak memory of the
 //! reduction alone is measured by resetting the kernel's high-water mark
 //! (`/proc/self/clear_refs`) after the mesh is built; the mesh itself (K and
 //! M) stays resident and is included.
@@ -27,6 +28,8 @@ struct Args {
     orderings: Vec<Ordering>,
     threads: usize,
     block_size: usize,
+    lanczos_block: usize,
+    basis_factor: f64,
 }
 
 fn parse() -> Result<Args, String> {
@@ -39,6 +42,8 @@ fn parse() -> Result<Args, String> {
         orderings: vec![Ordering::Metis],
         threads: 1,
         block_size: 64,
+        lanczos_block: 8,
+        basis_factor: 2.0,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -56,6 +61,16 @@ fn parse() -> Result<Args, String> {
                     .parse()
                     .map_err(|e| format!("--block-size: {e}"))?
             }
+            "--lanczos-block" => {
+                a.lanczos_block = value()?
+                    .parse()
+                    .map_err(|e| format!("--lanczos-block: {e}"))?
+            }
+            "--basis-factor" => {
+                a.basis_factor = value()?
+                    .parse()
+                    .map_err(|e| format!("--basis-factor: {e}"))?
+            }
             "--hex" => a.hex = true,
             "--ordering" => {
                 a.orderings = match value()?.as_str() {
@@ -66,7 +81,7 @@ fn parse() -> Result<Args, String> {
                 }
             }
             "-h" | "--help" => {
-                return Err("usage: scale --dofs N --modes M --boundary B [--hex] [--aspect A] [--ordering metis|amd|both] [--threads T] [--block-size S]".into())
+                return Err("usage: scale --dofs N --modes M --boundary B [--hex] [--aspect A] [--ordering metis|amd|both] [--threads T] [--block-size S] [--lanczos-block P] [--basis-factor F]".into())
             }
             f => return Err(format!("unknown argument {f}")),
         }
@@ -74,18 +89,22 @@ fn parse() -> Result<Args, String> {
     Ok(a)
 }
 
-/// Contact patch: nodes of the top edge/face, from the free end inwards.
+/// Contact patch: nodes of the top edge/face, from the free end inwards
+/// (then of the bottom edge/face).
 fn boundary_dofs(mesh: &Mesh, want: usize) -> Vec<usize> {
     let bd = &mesh.bodies[0];
     let [nx, ny, nz] = bd.nodes;
     let mut out = Vec::new();
-    'outer: for ix in (1..nx).rev() {
-        for iz in 0..nz {
-            for d in bd.node_dofs(ix, ny - 1, iz) {
-                if out.len() == want {
-                    break 'outer;
+    // top edge/face first, then the bottom one if more DOFs are asked
+    'outer: for iy in [ny - 1, 0] {
+        for ix in (1..nx).rev() {
+            for iz in 0..nz {
+                for d in bd.node_dofs(ix, iy, iz) {
+                    if out.len() == want {
+                        break 'outer;
+                    }
+                    out.push(d);
                 }
-                out.push(d);
             }
         }
     }
@@ -131,23 +150,24 @@ fn main() {
         .filter_map(|k| bd.dof(k * (nx - 1) / 10, ny / 2, nz / 2, 0))
         .collect();
     println!(
-        "{:>9} {:>5} {:>5} {:>6} {:>12} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>9} {:>9} {:>9}",
+        "{:>9} {:>5} {:>5} {:>6} {:>11} | {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} | {:>7} | {:>8} {:>8} {:>9}",
         "DOFs",
         "nb",
         "modes",
         "order",
         "factor nnz",
         "valid",
-        "order",
-        "symb",
-        "numer",
+        "factor",
         "eigen",
         "constr",
-        "total",
-        "cutoffHz",
+        "sturm",
+        "cpu",
+        "wall",
         "peak GiB",
-        "maxres"
+        "maxres",
+        "cutoff Hz"
     );
+    println!("{:>42} | {:^55} |", "", "CPU seconds (one thread)");
     for &ordering in &args.orderings {
         // reset the high-water mark so that the peak is that of this reduction
         let _ = std::fs::write("/proc/self/clear_refs", "5");
@@ -156,28 +176,34 @@ fn main() {
             ordering,
             threads: args.threads,
             block_size: args.block_size,
+            lanczos: fricbound_reduction::LanczosOptions {
+                block: args.lanczos_block,
+                basis_factor: args.basis_factor,
+                ..Default::default()
+            },
             ..Default::default()
         };
         match craig_bampton(mesh.k.as_ref(), mesh.m.as_ref(), &boundary, &recover, &opts) {
             Ok(r) => {
                 let p = &r.report;
+                let c = p.cpu_phases.unwrap_or_default();
                 println!(
-                    "{:>9} {:>5} {:>5} {:>6} {:>12} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>9.1} {:>9} {:>9.1e}",
+                    "{:>9} {:>5} {:>5} {:>6} {:>11} | {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.1} | {:>7.1} | {:>8} {:>8.1e} {:>9.1}",
                     p.n_full,
                     p.n_boundary,
                     p.n_modes,
                     p.ordering.to_string(),
                     p.factor_nnz,
-                    p.t_validate + p.t_partition,
-                    p.t_ordering,
-                    p.t_symbolic,
-                    p.t_numeric,
-                    p.t_eigen,
-                    p.t_constraint,
+                    c.validate,
+                    c.factor,
+                    c.eigen,
+                    c.constraint,
+                    c.sturm,
+                    p.cpu_seconds.unwrap_or(f64::NAN),
                     p.t_total,
-                    p.cutoff_hz,
                     gib(p.peak_memory_bytes),
-                    p.eigen_max_residual
+                    p.eigen_max_residual,
+                    p.cutoff_hz
                 );
                 eprintln!("{p}");
             }

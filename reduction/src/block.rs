@@ -12,12 +12,60 @@ use faer::linalg::triangular_solve::{
 use faer::sparse::linalg::cholesky::supernodal::{SupernodalLltRef, SymbolicSupernodalCholesky};
 use faer::{Accum, MatMut, MatRef, Par};
 
+/// 64 bytes, 64-byte aligned.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct Line([f64; 8]);
+
+/// A zero-initialised `f64` buffer starting on a 64-byte boundary. The SIMD
+/// kernels of faer split their loops by alignment; with a fixed alignment the
+/// results do not depend on where the allocator placed the buffer (nor on
+/// which thread made it), so they are reproducible bit for bit.
+#[derive(Clone, Debug)]
+pub(crate) struct AlignedVec {
+    lines: Vec<Line>,
+    len: usize,
+}
+
+impl AlignedVec {
+    pub fn zeros(len: usize) -> Self {
+        AlignedVec {
+            lines: vec![Line([0.0; 8]); len.div_ceil(8)],
+            len,
+        }
+    }
+
+    /// `zeros`, or `None` if the memory cannot be had.
+    pub fn try_zeros(len: usize) -> Option<Self> {
+        let mut lines = Vec::new();
+        lines.try_reserve_exact(len.div_ceil(8)).ok()?;
+        lines.resize(len.div_ceil(8), Line([0.0; 8]));
+        Some(AlignedVec { lines, len })
+    }
+}
+
+impl std::ops::Deref for AlignedVec {
+    type Target = [f64];
+    fn deref(&self) -> &[f64] {
+        // SAFETY: `lines` holds at least `len` contiguous, initialised f64
+        // (Line is repr(C) over [f64; 8], no padding).
+        unsafe { std::slice::from_raw_parts(self.lines.as_ptr().cast::<f64>(), self.len) }
+    }
+}
+
+impl std::ops::DerefMut for AlignedVec {
+    fn deref_mut(&mut self) -> &mut [f64] {
+        // SAFETY: as in `deref`, with unique access through `&mut self`.
+        unsafe { std::slice::from_raw_parts_mut(self.lines.as_mut_ptr().cast::<f64>(), self.len) }
+    }
+}
+
 /// `n × k` block stored row by row.
 #[derive(Clone, Debug)]
 pub(crate) struct RowBlock {
     pub n: usize,
     pub k: usize,
-    pub data: Vec<f64>,
+    pub data: AlignedVec,
 }
 
 impl RowBlock {
@@ -25,8 +73,36 @@ impl RowBlock {
         RowBlock {
             n,
             k,
-            data: vec![0.0; n * k],
+            data: AlignedVec::zeros(n * k),
         }
+    }
+
+    /// A block whose contents are unspecified (to be overwritten), reusing
+    /// a buffer of this thread's pool when one of the same size is there:
+    /// large fresh allocations are mapped lazily and fault on every page.
+    pub fn take(n: usize, k: usize) -> Self {
+        let data = POOL.with(|pool| {
+            let mut pool = pool.borrow_mut();
+            pool.iter()
+                .position(|b| b.len == n * k)
+                .map(|pos| pool.swap_remove(pos))
+        });
+        match data {
+            Some(data) => RowBlock { n, k, data },
+            None => RowBlock::zeros(n, k),
+        }
+    }
+
+    /// Return the buffer to this thread's pool (the four most recent are
+    /// kept).
+    pub fn give_back(self) {
+        POOL.with(|pool| {
+            let mut pool = pool.borrow_mut();
+            if pool.len() >= 4 {
+                pool.remove(0);
+            }
+            pool.push(self.data);
+        });
     }
 
     /// Copy of a (column-major or any) matrix view.
@@ -237,56 +313,83 @@ unsafe fn sym_mul_rows_avx2(a: &Csc, inv: Option<&[usize]>, x: &RowBlock, y: &mu
     sym_mul_rows_impl(a, inv, x, y)
 }
 
+std::thread_local! {
+    /// Scratch of the sparse products, kept between calls: fresh large
+    /// allocations are mapped lazily and every first touch of a page faults.
+    static SCRATCH: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
+    /// Reusable block buffers (see [`RowBlock::take`]).
+    static POOL: std::cell::RefCell<Vec<AlignedVec>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// Free this thread's scratch of the sparse products and its block pool.
+pub(crate) fn release_scratch() {
+    SCRATCH.with(|cell| *cell.borrow_mut() = Vec::new());
+    POOL.with(|cell| cell.borrow_mut().clear());
+}
+
+/// Columns of the right-hand side processed together in a sparse product:
+/// the rows touched by neighbouring matrix columns then stay in L2.
+const CW: usize = 16;
+
 #[inline(always)]
 fn sym_mul_rows_impl(a: &Csc, inv: Option<&[usize]>, x: &RowBlock, y: &mut RowBlock) {
-    const W: usize = 8;
     let n = a.ncols;
     let k = x.k;
     debug_assert_eq!(x.n, n);
     debug_assert_eq!(y.n, n);
     debug_assert_eq!(y.k, k);
-    let pp = k.div_ceil(W) * W;
-    if pp == 0 {
+    if k == 0 {
         return;
     }
     let map = |i: usize| inv.map(|v| v[i]).unwrap_or(i);
-    let mut xt = vec![0.0; n * pp];
-    for i in 0..n {
-        xt[i * pp..i * pp + k].copy_from_slice(x.row(map(i)));
-    }
-    let mut yt = vec![0.0; n * pp];
-    let mut acc = vec![0.0; pp];
-    for j in 0..n {
-        let (rows, vals) = a.col(j);
-        acc.iter_mut().for_each(|v| *v = 0.0);
-        let xj = &xt[j * pp..(j + 1) * pp];
-        for (&i, &v) in rows.iter().zip(vals) {
-            if i == j {
-                axpy(&mut acc, v, xj);
-                continue;
+    SCRATCH.with(|cell| {
+        let mut scratch = cell.borrow_mut();
+        if scratch.len() < 2 * n * CW {
+            scratch.resize(2 * n * CW, 0.0);
+        }
+        let (xt, yt) = scratch.split_at_mut(n * CW);
+        let yt = &mut yt[..n * CW];
+        for c0 in (0..k).step_by(CW) {
+            let w = CW.min(k - c0);
+            for i in 0..n {
+                let src = &x.row(map(i))[c0..c0 + w];
+                let dst = &mut xt[i * CW..(i + 1) * CW];
+                dst[..w].copy_from_slice(src);
+                dst[w..].fill(0.0);
             }
-            let xi = &xt[i * pp..(i + 1) * pp];
-            let yi = &mut yt[i * pp..(i + 1) * pp];
-            for ((yc, ac), (xjc, xic)) in yi
-                .chunks_exact_mut(W)
-                .zip(acc.chunks_exact_mut(W))
-                .zip(xj.chunks_exact(W).zip(xi.chunks_exact(W)))
-            {
-                for q in 0..W {
-                    yc[q] += v * xjc[q];
-                    ac[q] += v * xic[q];
+            yt.fill(0.0);
+            let mut acc = [0.0f64; CW];
+            for j in 0..n {
+                let (rows, vals) = a.col(j);
+                acc = [0.0; CW];
+                let xj: &[f64; CW] = xt[j * CW..(j + 1) * CW].try_into().expect("CW");
+                let xj = *xj;
+                for (&i, &v) in rows.iter().zip(vals) {
+                    if i == j {
+                        for q in 0..CW {
+                            acc[q] += v * xj[q];
+                        }
+                        continue;
+                    }
+                    let xi: &[f64; CW] = xt[i * CW..(i + 1) * CW].try_into().expect("CW");
+                    let yi: &mut [f64; CW] =
+                        (&mut yt[i * CW..(i + 1) * CW]).try_into().expect("CW");
+                    for q in 0..CW {
+                        yi[q] += v * xj[q];
+                        acc[q] += v * xi[q];
+                    }
+                }
+                let yj: &mut [f64; CW] = (&mut yt[j * CW..(j + 1) * CW]).try_into().expect("CW");
+                for q in 0..CW {
+                    yj[q] += acc[q];
                 }
             }
+            let _ = acc;
+            for i in 0..n {
+                y.row_mut(map(i))[c0..c0 + w].copy_from_slice(&yt[i * CW..i * CW + w]);
+            }
         }
-        let yj = &mut yt[j * pp..(j + 1) * pp];
-        for (yv, av) in yj.iter_mut().zip(&acc) {
-            *yv += av;
-        }
-    }
-    drop(xt);
-    for i in 0..n {
-        y.row_mut(map(i)).copy_from_slice(&yt[i * pp..i * pp + k]);
-    }
+    });
 }
 
 #[cfg(test)]

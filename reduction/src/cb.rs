@@ -21,11 +21,12 @@ pub struct CbOptions {
     /// Fill-reducing ordering of the Cholesky factorisation of `K_II`.
     pub ordering: Ordering,
     /// Number of constraint modes computed at once (columns of a block of Ψ).
-    /// Memory of a block: about `4 × n_I × block_size × 8` bytes.
+    /// Memory of a block: about `2 × n_I × block_size × 8` bytes (Ψ_a and
+    /// M_II Ψ_a), plus the products' scratch `2 × n_I × 16 × 8` bytes.
     pub block_size: usize,
     /// Worker threads for the constraint-mode blocks (1: sequential). Each
     /// block is computed sequentially and written to its own rows/columns,
-    /// so results do not depend on this number.
+    /// so results do not depend on this number (beyond round-off).
     pub threads: usize,
     /// Settings of the block Lanczos eigen solver.
     pub lanczos: LanczosOptions,
@@ -40,6 +41,12 @@ pub struct CbOptions {
     /// Largest accepted relative residual `‖Kφ − λMφ‖/‖Kφ‖` of a
     /// fixed-interface mode.
     pub max_residual: f64,
+    /// Check with a Sturm-sequence count that no fixed-interface mode below
+    /// the cut-off was missed: the inertia of `K_II − σ M_II`, σ halfway
+    /// between the last kept and the next computed eigenvalue, from one more
+    /// (indefinite, supernodal `LDLᵀ`) factorisation. Costs about one
+    /// numeric factorisation; an error if modes were missed.
+    pub sturm_check: bool,
 }
 
 impl Default for CbOptions {
@@ -54,6 +61,7 @@ impl Default for CbOptions {
             complete_clusters: true,
             cluster_rtol: 1e-6,
             max_residual: 1e-6,
+            sturm_check: true,
         }
     }
 }
@@ -76,6 +84,51 @@ pub struct RecoveryRow {
     pub dof: usize,
     /// length `n_boundary + n_modes`
     pub row: Vec<f64>,
+}
+
+/// CPU seconds of the calling thread per phase of a reduction.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CpuPhases {
+    /// validation, canonicalisation, partition
+    pub validate: f64,
+    /// ordering, symbolic and numeric Cholesky
+    pub factor: f64,
+    /// fixed-interface modes
+    pub eigen: f64,
+    /// constraint modes and reduced matrices
+    pub constraint: f64,
+    /// Sturm-sequence check
+    pub sturm: f64,
+}
+
+/// CPU time of the calling thread, seconds (`/proc/thread-self/schedstat`).
+fn thread_cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: f64 = s.split_whitespace().next()?.parse().ok()?;
+    Some(ns * 1e-9)
+}
+
+/// Marks phase boundaries on the calling thread's CPU clock.
+struct CpuClock {
+    last: Option<f64>,
+}
+
+impl CpuClock {
+    fn new() -> Self {
+        CpuClock {
+            last: thread_cpu_seconds(),
+        }
+    }
+    /// CPU seconds since the previous mark.
+    fn lap(&mut self) -> f64 {
+        let now = thread_cpu_seconds();
+        let d = match (self.last, now) {
+            (Some(a), Some(b)) => b - a,
+            _ => 0.0,
+        };
+        self.last = now;
+        d
+    }
 }
 
 /// Sizes, times and memory of a reduction.
@@ -134,8 +187,21 @@ pub struct ReductionReport {
     pub t_eigen: f64,
     /// seconds: constraint modes and reduced matrices
     pub t_constraint: f64,
-    /// seconds in all
+    /// Sturm count: fixed-interface eigenvalues below the check shift
+    /// (should equal `n_modes`); `None` if not done
+    pub sturm_count: Option<usize>,
+    /// seconds: Sturm-sequence check
+    pub t_sturm: f64,
+    /// seconds in all (wall clock)
     pub t_total: f64,
+    /// CPU seconds of the process during the reduction (user + system, all
+    /// threads; from /proc/self/stat, `None` elsewhere). Compared with
+    /// `t_total` it shows how much the machine was shared.
+    pub cpu_seconds: Option<f64>,
+    /// CPU seconds of the calling thread per phase (Linux), independent of
+    /// how busy the machine is; with `threads > 1` the constraint-mode
+    /// blocks run on other threads and are not counted here
+    pub cpu_phases: Option<CpuPhases>,
     /// peak resident memory of the process (VmHWM of /proc/self/status),
     /// bytes; `None` where it cannot be read
     pub peak_memory_bytes: Option<u64>,
@@ -177,9 +243,16 @@ impl std::fmt::Display for ReductionReport {
             "  constraint-mode seconds: solves {:.2}, M products {:.2}",
             self.t_constraint_solve, self.t_constraint_mass
         )?;
+        if let Some(c) = self.sturm_count {
+            writeln!(
+                f,
+                "  Sturm check: {c} eigenvalues below the check shift ({:.2} s)",
+                self.t_sturm
+            )?;
+        }
         writeln!(
             f,
-            "  seconds: validate {:.2}, partition {:.2}, ordering {:.2}, symbolic {:.2}, numeric {:.2}, eigen {:.2}, constraint modes {:.2}, total {:.2}",
+            "  seconds: validate {:.2}, partition {:.2}, ordering {:.2}, symbolic {:.2}, numeric {:.2}, eigen {:.2}, constraint modes {:.2}, total {:.2} (CPU {})",
             self.t_validate,
             self.t_partition,
             self.t_ordering,
@@ -187,8 +260,18 @@ impl std::fmt::Display for ReductionReport {
             self.t_numeric,
             self.t_eigen,
             self.t_constraint,
-            self.t_total
+            self.t_total,
+            self.cpu_seconds
+                .map(|c| format!("{c:.2}"))
+                .unwrap_or_else(|| "n/a".into())
         )?;
+        if let Some(c) = &self.cpu_phases {
+            writeln!(
+                f,
+                "  CPU seconds (calling thread): validate {:.2}, factor {:.2}, eigen {:.2}, constraint modes {:.2}, Sturm {:.2}",
+                c.validate, c.factor, c.eigen, c.constraint, c.sturm
+            )?;
+        }
         match self.peak_memory_bytes {
             Some(b) => write!(f, "  peak memory {:.2} GiB", b as f64 / (1u64 << 30) as f64),
             None => write!(f, "  peak memory unknown"),
@@ -289,6 +372,18 @@ impl ReducedModel {
     }
 }
 
+/// CPU time (user + system) of this process so far, seconds; `None` off Linux.
+pub fn process_cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // fields after the command name (which is in parentheses)
+    let rest = &s[s.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let utime: f64 = f.get(11)?.parse().ok()?;
+    let stime: f64 = f.get(12)?.parse().ok()?;
+    // clock ticks: 100 per second on Linux
+    Some((utime + stime) / 100.0)
+}
+
 /// Peak resident memory of this process (VmHWM), bytes; `None` off Linux.
 pub fn peak_memory_bytes() -> Option<u64> {
     let s = std::fs::read_to_string("/proc/self/status").ok()?;
@@ -362,6 +457,9 @@ pub fn craig_bampton(
     options: &CbOptions,
 ) -> Result<ReducedModel, ReductionError> {
     let t_start = Instant::now();
+    let cpu_start = process_cpu_seconds();
+    let mut clock = CpuClock::new();
+    let mut cpu = CpuPhases::default();
     let n = k.nrows();
     if options.block_size == 0 {
         return Err(ReductionError::InvalidArgument(
@@ -412,6 +510,7 @@ pub fn craig_bampton(
         .filter(|&d| matches!(part[d], Part::Interior(_)))
         .collect();
     let t_partition = t0.elapsed().as_secs_f64();
+    cpu.validate = clock.lap();
 
     let mut report = ReductionReport {
         n_full: n,
@@ -437,7 +536,7 @@ pub fn craig_bampton(
             modal_frequencies_hz: Vec::new(),
             modal_eigenvalues: Vec::new(),
             recovery: recovery_rows(recover, &part, nb, 0, &[], &[]),
-            report: finish_report(report, t_start),
+            report: finish_report(report, t_start, cpu_start),
         };
         return Ok(model);
     }
@@ -472,6 +571,7 @@ pub fn craig_bampton(
     report.t_ordering = t_ordering;
     report.t_symbolic = factor.symbolic_seconds;
     report.t_numeric = factor.numeric_seconds;
+    cpu.factor = clock.lap();
     report.factor_nnz = factor.factor_entries();
 
     // fixed-interface modes
@@ -525,7 +625,8 @@ pub fn craig_bampton(
         solves,
         timings,
     } = eig;
-    let next_hz = values.get(nm).map(|&l| lambda_to_hz(l));
+    let next_lambda = values.get(nm).copied();
+    let next_hz = next_lambda.map(lambda_to_hz);
     let lambdas: Vec<f64> = values[..nm].to_vec();
     let phi = vectors.subcols(0, nm).to_owned();
     drop(vectors);
@@ -538,13 +639,45 @@ pub fn craig_bampton(
     report.eigen_solves = solves;
     report.eigen_timings = timings;
     report.t_eigen = t0.elapsed().as_secs_f64();
+    cpu.eigen = clock.lap();
 
     // constraint modes, block by block
     let t0 = Instant::now();
     let cons = constraint_blocks(&kb, &mb, &inv, &factor, &phi, &part, recover, options)?;
     report.t_constraint = t0.elapsed().as_secs_f64();
+    cpu.constraint = clock.lap();
     report.t_constraint_solve = cons.t_solve;
     report.t_constraint_mass = cons.t_mass;
+
+    drop(factor);
+    if options.sturm_check && nm > 0 {
+        let t0 = Instant::now();
+        let last = lambdas[nm - 1];
+        let sigma = match next_lambda {
+            Some(next) if next > last => 0.5 * (last + next),
+            _ => last * (1.0 + 1e-3),
+        };
+        let shifted =
+            crate::csc::add_scaled(&kb.ii_lower, &mb.ii_lower, -sigma).permute_sym_lower(&inv);
+        let count = crate::factor::negative_pivots(&shifted)?;
+        drop(shifted);
+        report.t_sturm = t0.elapsed().as_secs_f64();
+        cpu.sturm = clock.lap();
+        report.sturm_count = count;
+        if let Some(c) = count {
+            if c > nm {
+                return Err(ReductionError::MissedEigenvalues {
+                    computed: nm,
+                    found: c,
+                    shift_hz: lambda_to_hz(sigma),
+                });
+            }
+        }
+    }
+
+    if clock.last.is_some() {
+        report.cpu_phases = Some(cpu);
+    }
 
     let size = nb + nm;
     let mut kr = Mat::zeros(size, size);
@@ -579,7 +712,7 @@ pub fn craig_bampton(
         modal_frequencies_hz: lambdas.iter().map(|&l| lambda_to_hz(l)).collect(),
         modal_eigenvalues: lambdas,
         recovery,
-        report: finish_report(report, t_start),
+        report: finish_report(report, t_start, cpu_start),
     })
 }
 
@@ -591,8 +724,17 @@ fn permute_coupling(b: Blocks, inv: &[usize]) -> Blocks {
     }
 }
 
-fn finish_report(mut r: ReductionReport, t_start: Instant) -> ReductionReport {
+fn finish_report(
+    mut r: ReductionReport,
+    t_start: Instant,
+    cpu_start: Option<f64>,
+) -> ReductionReport {
+    crate::block::release_scratch();
     r.t_total = t_start.elapsed().as_secs_f64();
+    r.cpu_seconds = match (cpu_start, process_cpu_seconds()) {
+        (Some(a), Some(b)) => Some(b - a),
+        _ => None,
+    };
     r.peak_memory_bytes = peak_memory_bytes();
     r
 }
@@ -703,7 +845,8 @@ fn constraint_blocks(
     let run_block = |start: usize| -> BlockOut {
         let w = bs.min(nb - start);
         // Ψ_a = −K_II⁻¹ K_IB[:, a]   (row-major n_I × w)
-        let mut psi = RowBlock::zeros(n_i, w);
+        let mut psi = RowBlock::take(n_i, w);
+        psi.data.fill(0.0);
         for c in 0..w {
             let (rows, vals) = kb.ib.col(start + c);
             for (&i, &v) in rows.iter().zip(vals) {
@@ -725,11 +868,11 @@ fn constraint_blocks(
             .map(|&(pos, i)| (pos, psi.row(i).to_vec()))
             .collect();
         // Z = M_II Ψ_a
-        let mut z = RowBlock::zeros(n_i, w);
+        let mut z = RowBlock::take(n_i, w);
         let t = Instant::now();
         sym_mul_rows(&mb.ii_lower, Some(inv), &psi, &mut z);
         let t_mass = t.elapsed().as_secs_f64();
-        drop(psi);
+        psi.give_back();
         let mut coupling_rows = Mat::zeros(w, nm);
         matmul(
             coupling_rows.as_mut(),
@@ -749,6 +892,7 @@ fn constraint_blocks(
         factor.solve_rows(&mut z);
         t_solve += t.elapsed().as_secs_f64();
         let mut g_cols = kb.ib.transpose_mul_rows(&z);
+        z.give_back();
         for c in 0..w {
             for i in 0..nb {
                 g_cols[(i, c)] = -g_cols[(i, c)];

@@ -81,6 +81,9 @@ pub struct LanczosOptions {
     pub seed: u64,
     /// problems with at most this many DOFs are solved densely
     pub dense_below: usize,
+    /// size of the Lanczos basis as a multiple of the wanted pairs
+    /// (at least `nev + 3·block`)
+    pub basis_factor: f64,
 }
 
 impl Default for LanczosOptions {
@@ -91,6 +94,7 @@ impl Default for LanczosOptions {
             max_restarts: 200,
             seed: 0x5eed_cb01,
             dense_below: 400,
+            basis_factor: 2.0,
         }
     }
 }
@@ -141,7 +145,10 @@ pub(crate) fn lowest_modes(
         });
     }
     let p = opts.block.max(1);
-    let ncv = round_up((2 * nev).max(nev + 3 * p), p);
+    let ncv = round_up(
+        ((opts.basis_factor.max(1.0) * nev as f64).ceil() as usize).max(nev + 3 * p),
+        p,
+    );
     let mut eig = if n <= opts.dense_below || ncv + p > n / 2 {
         dense_lowest(k_lower, m_lower, sigma, nev)?
     } else {
@@ -320,10 +327,14 @@ fn gs_pass(v: MatRef<'_, f64>, z: MatRef<'_, f64>, w: MatMut<'_, f64>, par: Par)
 
 /// `A x` for a column-major block (through a row-major copy).
 fn m_mul(a: SymView<'_>, x: MatRef<'_, f64>) -> Mat<f64> {
-    let xr = RowBlock::from_mat(x);
-    let mut z = RowBlock::zeros(x.nrows(), x.ncols());
+    let mut xr = RowBlock::take(x.nrows(), x.ncols());
+    xr.view_mut().copy_from(x);
+    let mut z = RowBlock::take(x.nrows(), x.ncols());
     a.mul_rows(&xr, &mut z);
-    z.view().to_owned()
+    let out = z.view().to_owned();
+    xr.give_back();
+    z.give_back();
+    out
 }
 
 /// `(V_new, M V_new, R)`
@@ -386,10 +397,8 @@ fn orthonormalise(
     for i in 0..p {
         if d[i] > thresh {
             let s = d[i].sqrt();
-            for row in 0..n {
-                vnew[(row, i)] /= s;
-                mvnew[(row, i)] /= s;
-            }
+            vnew.col_as_slice_mut(i).iter_mut().for_each(|v| *v /= s);
+            mvnew.col_as_slice_mut(i).iter_mut().for_each(|v| *v /= s);
             for c in 0..p {
                 r[(i, c)] = s * q[(c, i)];
             }
@@ -472,10 +481,11 @@ fn block_lanczos(
         while cur < ncv + p {
             let j0 = cur - p;
             let t = Instant::now();
-            let mut wr = RowBlock::from_mat(mv_cur.as_ref());
+            let mut wr = RowBlock::take(n, p);
+            wr.view_mut().copy_from(&mv_cur);
             factor.solve_rows(&mut wr);
             let mut w = wr.view().to_owned();
-            drop(wr);
+            wr.give_back();
             tm.solve += t.elapsed().as_secs_f64();
             solves += 1;
             // local block recurrence first (uses M V_j, known): removes the
@@ -491,14 +501,11 @@ fn block_lanczos(
                 par,
             );
             let a_loc = symmetrise(a_loc.as_ref());
+            // scale of ‖W‖²_M for the rank test: ‖W_c‖_M ≥ |(V_c, W_c)_M| = |a_cc|
             let norm_ref = (0..p)
-                .map(|c| {
-                    (0..n)
-                        .map(|i| w[(i, c)] * mv_cur[(i, c)])
-                        .sum::<f64>()
-                        .abs()
-                })
-                .fold(0.0, f64::max);
+                .map(|c| a_loc[(c, c)].abs())
+                .fold(0.0, f64::max)
+                .powi(2);
             matmul(
                 w.as_mut(),
                 Accum::Add,

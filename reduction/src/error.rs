@@ -112,6 +112,19 @@ pub enum ReductionError {
         /// largest residual among wanted pairs
         residual: f64,
     },
+    /// The Sturm-sequence count shows eigenvalues the eigen solver missed.
+    #[error(
+        "eigen solver missed eigenvalues: {found} eigenvalues of the fixed-interface problem lie \
+         below {shift_hz} Hz (Sturm count), only {computed} were found"
+    )]
+    MissedEigenvalues {
+        /// eigenvalues found below the shift
+        computed: usize,
+        /// eigenvalues below the shift by the inertia of K − σM
+        found: usize,
+        /// the shift, Hz
+        shift_hz: f64,
+    },
     /// The mass matrix (or its interior part) is not positive definite on the
     /// subspace where it is needed.
     #[error("{matrix} is not positive definite ({detail})")]

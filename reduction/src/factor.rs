@@ -1,7 +1,7 @@
 //! Sparse Cholesky `A = P Lᵀ L Pᵀ` of a symmetric positive definite matrix
 //! with faer's low-level supernodal factorisation and a METIS or AMD ordering.
 
-use crate::block::{supernodal_solve_rows, RowBlock};
+use crate::block::{supernodal_solve_rows, AlignedVec, RowBlock};
 use crate::csc::Csc;
 use crate::ordering::{metis_nd, Ordering};
 use crate::ReductionError;
@@ -22,7 +22,7 @@ pub(crate) const PIVOT_RATIO_TOL: f64 = 1e-11;
 
 pub(crate) struct SpdFactor {
     symbolic: SymbolicCholesky<usize>,
-    values: Vec<f64>,
+    values: AlignedVec,
     pub symbolic_seconds: f64,
     pub numeric_seconds: f64,
 }
@@ -98,14 +98,14 @@ impl SpdFactor {
         let symbolic_seconds = t0.elapsed().as_secs_f64();
         let a = lower.to_faer();
         let t1 = Instant::now();
-        let mut values = Vec::new();
-        values.try_reserve_exact(symbolic.len_val()).map_err(|_| {
+        // 64-byte aligned: faer's kernels then split their loops the same
+        // way at every run, and the factor is reproducible bit for bit
+        let mut values = AlignedVec::try_zeros(symbolic.len_val()).ok_or_else(|| {
             ReductionError::LinearAlgebra(format!(
                 "out of memory for a Cholesky factor of {} entries",
                 symbolic.len_val()
             ))
         })?;
-        values.resize(symbolic.len_val(), 0.0);
         let req = symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
         let mut mem = MemBuffer::try_new(req).map_err(|_| {
             ReductionError::LinearAlgebra("out of memory for Cholesky scratch".into())
@@ -206,6 +206,73 @@ impl SpdFactor {
     }
 }
 
+/// Number of negative pivots of `L D Lᵀ` (supernodal, no pivoting) of the
+/// symmetric matrix whose lower triangle, in its elimination order, is
+/// `lower`; by Sylvester's law of inertia, its number of negative
+/// eigenvalues (a Sturm-sequence count). `None` if a zero pivot occurred.
+pub(crate) fn negative_pivots(lower: &Csc) -> Result<Option<usize>, ReductionError> {
+    use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+    use faer::sparse::linalg::cholesky::supernodal::SupernodalLdltRef;
+    let la = |what: &str, e: &dyn std::fmt::Debug| {
+        ReductionError::LinearAlgebra(format!("{what} ({e:?})"))
+    };
+    let params = CholeskySymbolicParams {
+        supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+        ..Default::default()
+    };
+    let upper = lower.transpose().to_faer();
+    let symbolic = factorize_symbolic_cholesky(
+        upper.symbolic(),
+        Side::Upper,
+        SymmetricOrdering::Identity,
+        params,
+    )
+    .map_err(|e| la("symbolic LDLᵀ", &e))?;
+    drop(upper);
+    let a = lower.to_faer();
+    let mut values = AlignedVec::try_zeros(symbolic.len_val()).ok_or_else(|| {
+        ReductionError::LinearAlgebra(format!(
+            "out of memory for an LDLᵀ factor of {} entries",
+            symbolic.len_val()
+        ))
+    })?;
+    let req = symbolic.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default());
+    let mut mem = MemBuffer::try_new(req)
+        .map_err(|_| ReductionError::LinearAlgebra("out of memory for LDLᵀ scratch".into()))?;
+    let result = symbolic.factorize_numeric_ldlt(
+        &mut values,
+        a.as_ref(),
+        Side::Lower,
+        LdltRegularization::default(),
+        Par::Seq,
+        MemStack::new(&mut mem),
+        Default::default(),
+    );
+    if result.is_err() {
+        return Ok(None);
+    }
+    let SymbolicCholeskyRaw::Supernodal(s) = symbolic.raw() else {
+        return Err(ReductionError::LinearAlgebra(
+            "LDLᵀ factor is not supernodal".into(),
+        ));
+    };
+    let l = SupernodalLdltRef::new(s, &values);
+    let mut count = 0usize;
+    for k in 0..s.n_supernodes() {
+        let v = l.supernode(k).val();
+        for c in 0..v.ncols() {
+            let d = v[(c, c)];
+            if !d.is_finite() {
+                return Ok(None);
+            }
+            if d < 0.0 {
+                count += 1;
+            }
+        }
+    }
+    Ok(Some(count))
+}
+
 fn lower_diagonal(lower: &Csc) -> Vec<f64> {
     (0..lower.ncols)
         .map(|j| {
@@ -216,4 +283,36 @@ fn lower_diagonal(lower: &Csc) -> Vec<f64> {
             }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::csc::{add_scaled, canonical_symmetric, lower};
+    use crate::testmodels::cantilever_2d;
+
+    #[test]
+    fn sturm_count_matches_dense_eigenvalues() {
+        let mesh = cantilever_2d(600, 3.0);
+        let n = mesh.n();
+        let k = lower(&canonical_symmetric(mesh.k.as_ref(), "K", n).unwrap());
+        let m = lower(&canonical_symmetric(mesh.m.as_ref(), "M", n).unwrap());
+        let (vals, _) = crate::dense_generalized_eigenvalues(
+            mesh.k.to_dense().as_ref(),
+            mesh.m.to_dense().as_ref(),
+        )
+        .unwrap();
+        for below in [1usize, 7, 30] {
+            let sigma = 0.5 * (vals[below - 1] + vals[below]);
+            let a = add_scaled(&k, &m, -sigma);
+            let (_, inv, _) = fill_reducing_order(&a, Ordering::Metis).unwrap();
+            let count = negative_pivots(&a.permute_sym_lower(&inv)).unwrap();
+            assert_eq!(
+                count,
+                Some(below),
+                "shift between eigenvalues {below} and {}",
+                below + 1
+            );
+        }
+    }
 }
