@@ -161,6 +161,8 @@ pub trait Observer<S: ParametricResidual> {
     fn rejected(&mut self, _freq_hz: f64, _step: f64, _new_step: f64, _reason: &NewtonFailure) {}
     /// dω/ds changed sign between the previous and this point.
     fn turning_point(&mut self, _freq_hz: f64) {}
+    /// The path could not be followed from `from_hz` and was resumed at `to_hz` (Hz).
+    fn leap(&mut self, _from_hz: f64, _to_hz: f64) {}
 }
 
 /// An observer that does nothing.
@@ -176,6 +178,8 @@ pub struct PathSummary {
     pub turning_points: Vec<f64>,
     /// Rejected steps.
     pub rejected_steps: usize,
+    /// Stretches of the path leapt over: (last point before, first point after), Hz.
+    pub leaps: Vec<(f64, f64)>,
     /// Why the run stopped.
     pub end: PathEnd,
 }
@@ -200,6 +204,8 @@ pub struct Continuation {
 }
 
 const OMEGA_SCALE: f64 = 2.0 * PI;
+/// Leaps tried past a spot the corrector cannot pass, as fractions of the largest step.
+const LEAPS: &[f64] = &[0.02, 0.1, 0.5];
 /// Largest turn of the tangent in one step before the step is cut (unless it is a corner).
 const MAX_TURN_DEGREES: f64 = 45.0;
 
@@ -423,6 +429,79 @@ impl Continuation {
         })
     }
 
+    /// Tries to continue past a spot where the corrector fails at every step down to the
+    /// minimum: predictions [`LEAPS`] of the largest step ahead along the tangent, each
+    /// corrected to full tolerance; the first whose correction stays within the leap and whose
+    /// tangent keeps the direction of travel is returned with its tangent. Steps that land
+    /// beyond the end frequency are not tried (the end point is solved separately).
+    fn leap<S: ParametricResidual>(
+        &self,
+        system: &mut S,
+        y: &[f64],
+        tangent: &[f64],
+    ) -> Result<Option<(PathPoint, Vec<f64>)>, ContinuationError> {
+        let n = y.len() - 1;
+        let omega_end = self.analysis.freq_end_hz * OMEGA_SCALE;
+        for &fraction in LEAPS {
+            let ds = fraction * self.analysis.max_step;
+            let predicted: Vec<f64> = (0..=n).map(|j| y[j] + ds * tangent[j]).collect();
+            if predicted[n] * OMEGA_SCALE >= omega_end {
+                continue;
+            }
+            let Ok((yc, it, rel)) = self.correct(system, &predicted, tangent) else {
+                continue;
+            };
+            let Ok((point, t_new, _)) =
+                self.corrected_point(system, &yc, it, rel, ds, &predicted, tangent)
+            else {
+                continue;
+            };
+            let distance = norm(
+                &yc.iter()
+                    .zip(&predicted)
+                    .map(|(a, b)| a - b)
+                    .collect::<Vec<_>>(),
+            );
+            if distance <= ds && dot(&t_new, tangent) > 0.0 {
+                return Ok(Some((point, t_new)));
+            }
+        }
+        Ok(None)
+    }
+
+    /// The path point of a corrected y, its tangent, and the step quality (> 1: the corrector
+    /// went farther than the step or the tangent turned by more than [`MAX_TURN_DEGREES`]).
+    #[allow(clippy::too_many_arguments)]
+    fn corrected_point<S: ParametricResidual>(
+        &self,
+        system: &mut S,
+        yc: &[f64],
+        iterations: usize,
+        residual: f64,
+        ds: f64,
+        predicted: &[f64],
+        tangent: &[f64],
+    ) -> Result<(PathPoint, Vec<f64>, f64), NewtonFailure> {
+        let n = yc.len() - 1;
+        let distance = norm(
+            &yc.iter()
+                .zip(predicted)
+                .map(|(a, b)| a - b)
+                .collect::<Vec<_>>(),
+        );
+        let point = PathPoint {
+            omega: yc[n] * OMEGA_SCALE,
+            x: yc[..n].iter().map(|v| v * self.x_scale).collect(),
+            iterations,
+            residual,
+            step: ds,
+        };
+        let t_new = self.tangent(system, &point, Some(tangent))?;
+        let degrees = dot(&t_new, tangent).clamp(-1.0, 1.0).acos().to_degrees();
+        let quality = (distance / ds).max(degrees / MAX_TURN_DEGREES);
+        Ok((point, t_new, quality))
+    }
+
     /// Follows the path from `x_guess` at the start frequency to the end frequency.
     pub fn run<S: ParametricResidual, O: Observer<S>>(
         &self,
@@ -451,6 +530,7 @@ impl Continuation {
             points: vec![first],
             turning_points: Vec::new(),
             rejected_steps: 0,
+            leaps: Vec::new(),
             end: PathEnd::MaxPoints,
         };
         let mut ds = a.initial_step.clamp(a.min_step, a.max_step);
@@ -555,11 +635,38 @@ impl Continuation {
                     observer.rejected(last.freq_hz(), ds, new_ds, &reason);
                     summary.rejected_steps += 1;
                     if new_ds < a.min_step {
-                        return Err(ContinuationError::Stalled {
-                            freq_hz: last.freq_hz(),
-                            step: ds,
-                            reason,
-                        });
+                        // The path cannot be followed through this spot (Newton cycles between
+                        // the pieces of the sampled, piecewise-smooth contact law): try to land
+                        // on it further on, with a fully converged point, before giving up.
+                        let from = last.freq_hz();
+                        match self.leap(system, &y, &tangent)? {
+                            Some((point, t_new)) => {
+                                observer.leap(from, point.freq_hz());
+                                summary.leaps.push((from, point.freq_hz()));
+                                if t_new[n] * tangent[n] < 0.0 {
+                                    summary.turning_points.push(point.freq_hz());
+                                    observer.turning_point(point.freq_hz());
+                                }
+                                observer.accepted(system, &point);
+                                let below = point.omega < omega_start;
+                                summary.points.push(point);
+                                tangent = t_new;
+                                previous_quality = None;
+                                if below {
+                                    summary.end = PathEnd::LeftRangeBelow;
+                                    return Ok(summary);
+                                }
+                                ds = a.initial_step.clamp(a.min_step, a.max_step);
+                                continue;
+                            }
+                            None => {
+                                return Err(ContinuationError::Stalled {
+                                    freq_hz: from,
+                                    step: ds,
+                                    reason,
+                                })
+                            }
+                        }
                     }
                     ds = new_ds;
                 }

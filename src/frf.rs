@@ -43,6 +43,8 @@ pub trait FrfObserver {
     fn step_cut(&mut self, _freq_hz: f64, _step: f64, _new_step: f64, _reason: &NewtonFailure) {}
     /// A turning point was passed (Hz).
     fn turning_point(&mut self, _freq_hz: f64) {}
+    /// The path could not be followed from `from_hz` and was resumed at `to_hz` (Hz).
+    fn leap(&mut self, _from_hz: f64, _to_hz: f64) {}
 }
 
 /// Observer that ignores everything.
@@ -58,6 +60,8 @@ pub struct FrfRun {
     pub turning_points: Vec<f64>,
     /// Number of cut steps.
     pub rejected_steps: usize,
+    /// Stretches leapt over: (last point before, first point after), Hz.
+    pub leaps: Vec<(f64, f64)>,
     /// Why the run ended.
     pub end: PathEnd,
     /// Wall time of the run (s).
@@ -172,6 +176,9 @@ impl<O: FrfObserver> Observer<HbmOperator<'_>> for Adapter<'_, O> {
     fn turning_point(&mut self, freq_hz: f64) {
         self.observer.turning_point(freq_hz);
     }
+    fn leap(&mut self, from_hz: f64, to_hz: f64) {
+        self.observer.leap(from_hz, to_hz);
+    }
 }
 
 /// Solves the nonlinear frequency response of a problem over its analysis range.
@@ -198,6 +205,7 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
         points: adapter.points,
         turning_points: summary.turning_points,
         rejected_steps: summary.rejected_steps,
+        leaps: summary.leaps,
         end: summary.end,
         elapsed_s: started.elapsed().as_secs_f64(),
     })

@@ -27,5 +27,6 @@ pub mod pattern;
 pub mod reduce;
 pub mod reference;
 pub mod report;
+pub mod scaling;
 pub mod scene;
 pub mod sweep;

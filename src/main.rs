@@ -54,6 +54,11 @@ enum Command {
         #[command(subcommand)]
         command: fricbound::commands::mesh::MeshCommand,
     },
+    /// Scaling study of FE size, contact points, harmonics and solver strategies.
+    Bench {
+        #[command(subcommand)]
+        command: fricbound::commands::bench::BenchCommand,
+    },
 }
 
 fn main() -> ExitCode {
@@ -89,6 +94,16 @@ fn main() -> ExitCode {
         Command::Check { scene, overrides } => {
             fricbound::commands::check(scene.as_deref(), &overrides).map(|s| print!("{s}"))
         }
+        Command::Bench { command } => match fricbound::commands::bench::run(&command) {
+            Ok(text) => {
+                print!("{text}");
+                Ok(())
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::FAILURE;
+            }
+        },
         Command::Mesh { command } => match fricbound::commands::mesh::run(&command) {
             Ok(text) => {
                 print!("{text}");

@@ -4,6 +4,7 @@
 //! runs the scenes of the paper's §4 study (`meshes/paper-wedge/fig*.toml`, built into the
 //! binary) and writes a summary of the key numbers next to the paper's statements.
 
+pub mod bench;
 mod limits_run;
 pub mod mesh;
 pub mod paper;
@@ -271,6 +272,19 @@ impl FrfObserver for RunObserver<'_> {
     }
     fn turning_point(&mut self, freq_hz: f64) {
         self.writer.turning_point(freq_hz);
+    }
+    fn leap(&mut self, from_hz: f64, to_hz: f64) {
+        self.writer.leap(from_hz, to_hz);
+        if !self.quiet {
+            let msg = format!(
+                "the path could not be followed past {from_hz:.4} Hz and resumed at \
+                 {to_hz:.4} Hz (no points in between)"
+            );
+            match &self.bar {
+                Some(bar) if !bar.is_hidden() => bar.println(msg),
+                _ => eprintln!("{msg}"),
+            }
+        }
     }
 }
 

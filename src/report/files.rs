@@ -111,6 +111,7 @@ struct SolutionFile<'a> {
     mean_point_ms: f64,
     turning_points_hz: &'a [f64],
     step_cuts: &'a [StepCut],
+    leaps_hz: &'a [(f64, f64)],
     points: &'a [FrfPoint],
 }
 
@@ -134,6 +135,7 @@ pub struct FrfWriter {
     points: Vec<FrfPoint>,
     turning_points: Vec<f64>,
     step_cuts: Vec<StepCut>,
+    leaps: Vec<(f64, f64)>,
     started: Instant,
     last_json: Option<Instant>,
     /// First write error met (writing stops being attempted after it).
@@ -152,6 +154,7 @@ impl FrfWriter {
             points: Vec::new(),
             turning_points: Vec::new(),
             step_cuts: Vec::new(),
+            leaps: Vec::new(),
             started: Instant::now(),
             last_json: None,
             error: None,
@@ -182,6 +185,7 @@ impl FrfWriter {
             },
             turning_points_hz: &self.turning_points,
             step_cuts: &self.step_cuts,
+            leaps_hz: &self.leaps,
             points: &self.points,
         };
         let json = serde_json::to_vec_pretty(&file).expect("result types serialise");
@@ -226,5 +230,9 @@ impl FrfObserver for FrfWriter {
 
     fn turning_point(&mut self, freq_hz: f64) {
         self.turning_points.push(freq_hz);
+    }
+
+    fn leap(&mut self, from_hz: f64, to_hz: f64) {
+        self.leaps.push((from_hz, to_hz));
     }
 }

@@ -1,0 +1,305 @@
+//! The scaling study: what FE size, contact count, harmonic count and solver strategy cost.
+//!
+//! Every case is the blade-pair model of `meshes/blade-pair/` made by the generator at a given
+//! refinement (2D quadrangles or 3D hexahedra): assembled, clamped, its contact patches paired,
+//! reduced by Craig-Bampton, and solved by continuation over a frequency window around the
+//! first bending pair. Nothing is synthetic: the contact count per side grows with the
+//! refinement of the contact faces (3·refine + 1 pairs per side in 2D).
+//!
+//! Two measurements:
+//! - [`measure_reduction`]: mesh generation, assembly and clamping, then Craig-Bampton, with
+//!   the reduction's own report (phase times, factor size, peak resident memory). Peak memory
+//!   is a per-process figure, so the command runs each size in its own process.
+//! - [`measure_solve`]: one FRF of a reduced (or unreduced) problem with a given formulation and
+//!   Jacobian strategy: wall time per continuation point and per Newton iteration (FRF time
+//!   divided by the Newton iterations of the run, tangent solves included), or, for the
+//!   finite-difference strategies on large problems, the time of one Newton iteration only.
+
+use std::path::Path;
+use std::time::Instant;
+
+use crate::continuation::ParametricResidual;
+use crate::fe::blade_pair::{self, BladePairParams};
+use crate::fe::msh_write::{write_msh, MshFormat};
+use crate::frf;
+use crate::model::{Formulation, JacobianStrategy, Problem};
+use crate::operator::HbmOperator;
+use crate::reduce::{self, ReductionSettings};
+use crate::scene;
+
+/// Errors of a scaling case.
+#[derive(Debug, thiserror::Error)]
+pub enum ScalingError {
+    /// The generator, a file or the scene failed.
+    #[error("{0}")]
+    Setup(String),
+}
+
+fn setup<E: std::fmt::Display>(e: E) -> ScalingError {
+    ScalingError::Setup(e.to_string())
+}
+
+/// One blade-pair model size.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct ModelSize {
+    /// 3D hexahedra (else 2D quadrangles).
+    pub three_d: bool,
+    /// Generator refinement.
+    pub refine: usize,
+}
+
+/// The blade-pair scene text for a mesh file (the physics of `meshes/blade-pair/`).
+pub fn blade_pair_scene(mesh_file: &Path, three_d: bool, harmonics: usize) -> String {
+    let thickness = if three_d { "" } else { "thickness = 0.01\n" };
+    let tangents = if three_d {
+        (
+            "tangent = [0.8660254037844387, 0.5, 0.0]\n",
+            "tangent = [0.8660254037844387, -0.5, 0.0]\n",
+        )
+    } else {
+        ("", "")
+    };
+    let materials: String = ["blade1", "blade2", "damper"]
+        .iter()
+        .map(|g| {
+            format!(
+                "[[model.materials]]\ngroup = \"{g}\"\nyoung = 2.1e11\npoisson = 0.3\ndensity = 7850.0\n{thickness}\n"
+            )
+        })
+        .collect();
+    let patch = |side: &str, tangent: &str| {
+        format!(
+            "[[contact_patches]]\nside = \"{side}\"\ndamper = \"damper_{side}\"\nbody = \"platform_{side}\"\n\
+             kt = 2.0e7\nkn = 2.0e7\nmu = 0.3\ntolerance = 1e-6\n{tangent}\n"
+        )
+    };
+    format!(
+        "title = \"blade pair scaling case\"\n\n[model]\nmesh = \"{}\"\nclamp = [\"clamp\"]\n\n{materials}\
+         {}{}\
+         [[static_loads]]\ngroup = \"damper\"\ndirection = \"y\"\nvalue = 500.0\n\n\
+         [[harmonic_loads]]\ngroup = \"excitation\"\ndirection = \"x\"\nharmonic = 1\ncos = 0.5\n\n\
+         [harmonics]\nmax = {harmonics}\nsamples = {}\n\n\
+         [analysis]\nfreq_start_hz = 800.0\nfreq_end_hz = 900.0\n\n\
+         [output]\ngroups = [{{ group = \"response\", direction = \"x\" }}]\n",
+        mesh_file.display(),
+        patch("left", tangents.0),
+        patch("right", tangents.1),
+        (32 * harmonics).max(128),
+    )
+}
+
+/// The unreduced problem of a model size (mesh written into `dir`).
+pub fn full_problem(
+    size: ModelSize,
+    harmonics: usize,
+    dir: &Path,
+) -> Result<Problem, ScalingError> {
+    let params = BladePairParams {
+        refine: size.refine,
+        three_d: size.three_d,
+        ..Default::default()
+    };
+    let mesh = blade_pair::generate(&params).map_err(setup)?;
+    let file = dir.join(format!(
+        "blade-pair-{}-r{}.msh",
+        if size.three_d { "3d" } else { "2d" },
+        size.refine
+    ));
+    write_msh(&file, &mesh, MshFormat::Binary).map_err(setup)?;
+    let text = blade_pair_scene(&file, size.three_d, harmonics);
+    let label = dir.join("scaling.toml").display().to_string();
+    scene::parse(&text, &label, &[])
+        .and_then(|s| s.validate(&label))
+        .map_err(setup)
+}
+
+/// Sizes, times and memory of one reduction.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct ReductionMeasure {
+    /// 3D model.
+    pub three_d: bool,
+    /// Generator refinement.
+    pub refine: usize,
+    /// Free DOFs of the FE model (after clamping).
+    pub dofs: usize,
+    /// Contact pairs per damper side.
+    pub pairs_per_side: usize,
+    /// Boundary DOFs kept.
+    pub boundary: usize,
+    /// Fixed-interface modes kept.
+    pub modes: usize,
+    /// Mesh generation, assembly, clamping, pairing and scene checks (s).
+    pub model_s: f64,
+    /// Craig-Bampton (s).
+    pub reduction_s: f64,
+    /// Of which the interior Cholesky factorisation, symbolic and numeric (s).
+    pub factor_s: f64,
+    /// Of which the fixed-interface eigen solve (s).
+    pub eigen_s: f64,
+    /// Of which the constraint modes and reduced matrices (s).
+    pub constraint_s: f64,
+    /// Stored entries of the Cholesky factor.
+    pub factor_entries: usize,
+    /// Peak resident memory of the process (bytes), where known.
+    pub peak_memory_bytes: Option<u64>,
+}
+
+/// Builds and reduces one model size, with `modes` fixed-interface modes.
+pub fn measure_reduction(
+    size: ModelSize,
+    modes: usize,
+    dir: &Path,
+) -> Result<(ReductionMeasure, Problem), ScalingError> {
+    let started = Instant::now();
+    let full = full_problem(size, 1, dir)?;
+    let model_s = started.elapsed().as_secs_f64();
+    let settings = ReductionSettings {
+        modes,
+        modal_damping: 0.002,
+        rayleigh: (0.0, 0.0),
+        ordering: fricbound_reduction::Ordering::Metis,
+        recover: Vec::new(),
+    };
+    let started = Instant::now();
+    let reduction = reduce::reduce(&full, &settings).map_err(setup)?;
+    let reduction_s = started.elapsed().as_secs_f64();
+    let report = &reduction.model.report;
+    let measure = ReductionMeasure {
+        three_d: size.three_d,
+        refine: size.refine,
+        dofs: full.model.n_dofs(),
+        pairs_per_side: full.contacts.len() / full.sides.len().max(1),
+        boundary: report.n_boundary,
+        modes: report.n_modes,
+        model_s,
+        reduction_s,
+        factor_s: report.t_ordering + report.t_symbolic + report.t_numeric,
+        eigen_s: report.t_eigen,
+        constraint_s: report.t_constraint,
+        factor_entries: report.factor_nnz,
+        peak_memory_bytes: fricbound_reduction::peak_memory_bytes(),
+    };
+    Ok((measure, reduction.problem))
+}
+
+/// Cost of one solver configuration.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SolveMeasure {
+    /// Case label (model, reduced or not).
+    pub case: String,
+    /// Contact pairs per side.
+    pub pairs_per_side: usize,
+    /// Harmonics 1..H.
+    pub harmonics: usize,
+    /// Formulation used.
+    pub formulation: String,
+    /// Jacobian strategy.
+    pub jacobian: String,
+    /// Unknowns of the operator solved.
+    pub unknowns: usize,
+    /// Whether a whole FRF was run (else one Newton iteration was timed).
+    pub frf: bool,
+    /// Continuation points (FRF runs).
+    pub points: usize,
+    /// Newton iterations (FRF runs).
+    pub iterations: usize,
+    /// Whether the FRF reached the end of its window.
+    pub complete: bool,
+    /// Wall time of the FRF (s; FRF runs).
+    pub frf_s: f64,
+    /// Wall time per continuation point (ms; FRF runs).
+    pub per_point_ms: f64,
+    /// Wall time per Newton iteration (ms): FRF time over its iterations, or one timed
+    /// iteration (residual, Jacobian, linear solve).
+    pub per_iteration_ms: f64,
+}
+
+/// Label of a formulation.
+pub fn formulation_name(f: Formulation) -> &'static str {
+    match f {
+        Formulation::Auto => "auto",
+        Formulation::Dense => "dense",
+        Formulation::Sparse => "sparse",
+        Formulation::Condensed => "condensed",
+    }
+}
+
+/// Label of a Jacobian strategy.
+pub fn jacobian_name(j: JacobianStrategy) -> &'static str {
+    match j {
+        JacobianStrategy::Analytic => "analytic",
+        JacobianStrategy::ForwardDifference => "forward-difference",
+        JacobianStrategy::CentralDifference => "central-difference",
+    }
+}
+
+/// Measures one configuration of `base` (harmonics 1..H, formulation, Jacobian strategy).
+/// With `frf` a whole FRF over the window is run; otherwise one Newton iteration at the
+/// linear (stuck) guess at the window's centre is timed.
+pub fn measure_solve(
+    case: &str,
+    base: &Problem,
+    harmonics: usize,
+    formulation: Formulation,
+    jacobian: JacobianStrategy,
+    frf: bool,
+) -> Result<SolveMeasure, ScalingError> {
+    let mut p = base.clone();
+    p.harmonics = (1..=harmonics).collect();
+    p.samples = p.samples.max(32 * harmonics).max(128);
+    p.analysis.formulation = formulation;
+    p.analysis.jacobian = jacobian;
+    let mut operator = HbmOperator::new(&p).map_err(setup)?;
+    let unknowns = operator.dim();
+    let mut m = SolveMeasure {
+        case: case.to_string(),
+        pairs_per_side: p.contacts.len() / p.sides.len().max(1),
+        harmonics,
+        formulation: formulation_name(p.formulation()).to_string(),
+        jacobian: jacobian_name(jacobian).to_string(),
+        unknowns,
+        frf,
+        points: 0,
+        iterations: 0,
+        complete: false,
+        frf_s: 0.0,
+        per_point_ms: 0.0,
+        per_iteration_ms: 0.0,
+    };
+    if frf {
+        let started = Instant::now();
+        let mut points = Vec::new();
+        let outcome = frf::solve(&p, &mut Collect(&mut points));
+        m.frf_s = started.elapsed().as_secs_f64();
+        m.complete = outcome.is_ok();
+        m.points = points.len();
+        m.iterations = points.iter().map(|q| q.newton_iterations).sum();
+        m.per_point_ms = 1e3 * m.frf_s / m.points.max(1) as f64;
+        m.per_iteration_ms = 1e3 * m.frf_s / m.iterations.max(1) as f64;
+    } else {
+        let f = 0.5 * (p.analysis.freq_start_hz + p.analysis.freq_end_hz);
+        let omega = 2.0 * std::f64::consts::PI * f;
+        let guess = crate::linear::stuck_guess(&p, operator.unknowns(), omega).map_err(setup)?;
+        let x = operator.restrict(&guess);
+        let mut r = vec![0.0; unknowns];
+        let mut dr = vec![0.0; unknowns];
+        let mut jac = operator.new_jacobian();
+        let started = Instant::now();
+        operator
+            .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
+            .map_err(setup)?;
+        let neg: Vec<f64> = r.iter().map(|v| -v).collect();
+        jac.solve(&neg).map_err(setup)?;
+        m.per_iteration_ms = 1e3 * started.elapsed().as_secs_f64();
+    }
+    Ok(m)
+}
+
+/// Collects FRF points (also when the run fails part-way).
+struct Collect<'a>(&'a mut Vec<frf::FrfPoint>);
+
+impl frf::FrfObserver for Collect<'_> {
+    fn point(&mut self, point: &frf::FrfPoint) {
+        self.0.push(point.clone());
+    }
+}
