@@ -10,13 +10,18 @@
 //!
 //! with the column scale s of the arc-length space, b = ∂R/∂ω (scaled) and c the tangent.
 //!
-//! Storage is chosen once per problem ([`JacobianLayout`]): dense column-major values for
-//! lumped and reduced models, or a faer sparse matrix whose pattern already holds the border
-//! row and column. The sparse pattern is fixed for a scene, so its symbolic LU (fill-reducing
-//! column ordering, elimination structure) is computed once, with the pattern, and shared by
-//! every copy of the Jacobian; each solve is a numeric refactorisation only. The fixed-frequency solve reuses the same
-//! bordered pattern with the border set to the identity row, so one symbolic factorisation
-//! serves both.
+//! Storage is chosen once per problem ([`crate::pattern::JacobianLayout`]): dense column-major
+//! values for lumped and reduced models (the bordered matrix is then factored whole), or a faer
+//! sparse matrix of J alone. The sparse pattern is fixed for a scene, so its symbolic LU
+//! (fill-reducing column ordering, elimination structure) is computed once, with the pattern,
+//! and shared by every copy of the Jacobian; each solve is a numeric refactorisation only.
+//!
+//! The border is kept out of the sparse matrix on purpose: its dense row would make the
+//! elimination structure that partial pivoting must allow for (that of AᵀA) completely dense.
+//! The bordered system is solved instead by block elimination with the one LU of s·J,
+//! s·J [a b] = [f c], z = (g − r·a)/(d − r·b), Δy = a − b z, followed by refinement steps on
+//! the full bordered residual (block elimination alone loses accuracy near folds, where J is
+//! nearly singular).
 //!
 //! The harmonic-balance Jacobian couples cosine and sine blocks antisymmetrically and the
 //! complex dynamic stiffness K + iωC − ω²M is complex-symmetric, not Hermitian: Cholesky or
@@ -33,7 +38,7 @@ use crate::linalg::{solve_dense, LinearSolveError};
 pub enum Storage {
     /// Dense column-major n × n.
     Dense,
-    /// Sparse (faer CSC) with the continuation border in the pattern.
+    /// Sparse (faer CSC) of J alone; the border is eliminated by blocks.
     Sparse,
 }
 
@@ -42,13 +47,10 @@ pub enum Storage {
 pub struct AssembledJacobian {
     n: usize,
     storage: Storage,
-    /// Dense: n² values, column-major. Sparse: the values of `matrix` (border included).
+    /// Dense: n² values, column-major. Sparse: the values of the pattern's entries.
     values: Vec<f64>,
-    /// Sparse only: pattern of the (n + 1) × (n + 1) bordered matrix.
+    /// Sparse only: pattern of J.
     pattern: Option<SymbolicSparseColMat<usize>>,
-    /// Sparse only: slot of each border entry (row n, columns 0..=n) and (rows 0..n, column n).
-    border_row_slots: Vec<usize>,
-    border_col_slots: Vec<usize>,
     /// Sparse only: symbolic LU of the pattern (shared by clones).
     symbolic_lu: Option<faer::sparse::linalg::solvers::SymbolicLu<usize>>,
     /// Numeric factorisations made (for reports and tests).
@@ -63,51 +65,33 @@ impl AssembledJacobian {
             storage: Storage::Dense,
             values: vec![0.0; n * n],
             pattern: None,
-            border_row_slots: Vec::new(),
-            border_col_slots: Vec::new(),
             symbolic_lu: None,
             factorisations: 0,
         }
     }
 
-    /// A sparse n × n Jacobian whose pattern holds `entries` (duplicates allowed), the whole
-    /// diagonal, and the continuation border.
+    /// A sparse n × n Jacobian whose pattern holds `entries` (duplicates allowed) and the whole
+    /// diagonal.
     pub fn sparse(n: usize, entries: impl IntoIterator<Item = (usize, usize)>) -> Self {
         use faer::sparse::Pair;
         let mut idx: Vec<Pair<usize, usize>> = entries
             .into_iter()
             .map(|(row, col)| Pair { row, col })
             .collect();
-        for i in 0..=n {
-            idx.push(Pair { row: i, col: i });
-            idx.push(Pair { row: n, col: i });
-            idx.push(Pair { row: i, col: n });
-        }
-        let (pattern, _) = SymbolicSparseColMat::try_new_from_indices(n + 1, n + 1, &idx)
+        idx.extend((0..n).map(|i| Pair { row: i, col: i }));
+        let (pattern, _) = SymbolicSparseColMat::try_new_from_indices(n, n, &idx)
             .expect("pattern indices are in range");
         let nnz = pattern.row_idx().len();
         // The symbolic LU depends on the pattern only: computed here, shared by every clone.
         let symbolic_lu = faer::sparse::linalg::solvers::SymbolicLu::try_new(pattern.as_ref()).ok();
-        let mut jac = Self {
+        Self {
             n,
             storage: Storage::Sparse,
             values: vec![0.0; nnz],
             pattern: Some(pattern),
-            border_row_slots: Vec::new(),
-            border_col_slots: Vec::new(),
             symbolic_lu,
             factorisations: 0,
-        };
-        jac.border_row_slots = (0..=n)
-            .map(|j| jac.find_slot(n, j).expect("border row is in the pattern"))
-            .collect();
-        jac.border_col_slots = (0..n)
-            .map(|i| {
-                jac.find_slot(i, n)
-                    .expect("border column is in the pattern")
-            })
-            .collect();
-        jac
+        }
     }
 
     /// Dimension n of J (without the border).
@@ -120,7 +104,7 @@ impl AssembledJacobian {
         self.storage
     }
 
-    /// Stored entries of J and its border (dense: n²).
+    /// Stored entries of J (dense: n²).
     pub fn stored_entries(&self) -> usize {
         self.values.len()
     }
@@ -194,14 +178,9 @@ impl AssembledJacobian {
                 solve_dense(&a, b)
             }
             Storage::Sparse => {
-                let mut row = vec![0.0; self.n + 1];
-                row[self.n] = 1.0;
-                let col = vec![0.0; self.n];
-                let mut rhs = b.to_vec();
-                rhs.push(0.0);
-                let mut y = self.solve_sparse_bordered(1.0, &col, &row, &rhs)?;
-                y.pop();
-                Ok(y)
+                let lu = self.sparse_lu(1.0)?;
+                let x = self.checked_solve(&lu, 1.0, b)?;
+                Ok(x)
             }
         }
     }
@@ -236,6 +215,83 @@ impl AssembledJacobian {
         }
     }
 
+    /// Numeric LU of s·J with the shared symbolic factorisation.
+    fn sparse_lu(
+        &mut self,
+        col_scale: f64,
+    ) -> Result<faer::sparse::linalg::solvers::Lu<usize, f64>, LinearSolveError> {
+        if self.values.iter().any(|v| !v.is_finite()) {
+            return Err(LinearSolveError::NonFinite);
+        }
+        let pattern = self.pattern.clone().expect("sparse storage has a pattern");
+        if self.symbolic_lu.is_none() {
+            let symbolic = faer::sparse::linalg::solvers::SymbolicLu::try_new(pattern.as_ref())
+                .map_err(|_| LinearSolveError::Singular { ratio: 0.0 })?;
+            self.symbolic_lu = Some(symbolic);
+        }
+        let symbolic = self.symbolic_lu.clone().expect("set above");
+        let vals: Vec<f64> = self.values.iter().map(|v| v * col_scale).collect();
+        let matrix = SparseColMat::new(pattern, vals);
+        let lu =
+            faer::sparse::linalg::solvers::Lu::try_new_with_symbolic(symbolic, matrix.as_ref())
+                .map_err(|_| LinearSolveError::Singular { ratio: 0.0 })?;
+        self.factorisations += 1;
+        Ok(lu)
+    }
+
+    /// y += s·J x.
+    fn mul_add(&self, col_scale: f64, x: &[f64], y: &mut [f64]) {
+        let p = self.pattern.as_ref().expect("sparse storage has a pattern");
+        let (col_ptr, rows) = (p.col_ptr(), p.row_idx());
+        for j in 0..self.n {
+            let xj = col_scale * x[j];
+            for k in col_ptr[j]..col_ptr[j + 1] {
+                y[rows[k]] += self.values[k] * xj;
+            }
+        }
+    }
+
+    /// Solves s·J x = b with a factorisation of s·J, with one refinement step, and refuses a
+    /// solution whose residual exceeds 1e-6 of ‖b‖ (a numerically singular J can give finite
+    /// garbage).
+    fn checked_solve(
+        &self,
+        lu: &faer::sparse::linalg::solvers::Lu<usize, f64>,
+        col_scale: f64,
+        b: &[f64],
+    ) -> Result<Vec<f64>, LinearSolveError> {
+        if b.iter().any(|v| !v.is_finite()) {
+            return Err(LinearSolveError::NonFinite);
+        }
+        let n = self.n;
+        let solve = |rhs: &[f64]| -> Result<Vec<f64>, LinearSolveError> {
+            let m = Mat::from_fn(n, 1, |i, _| rhs[i]);
+            let x = lu.solve(&m);
+            let out: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
+            if out.iter().any(|v| !v.is_finite()) {
+                return Err(LinearSolveError::Singular { ratio: 0.0 });
+            }
+            Ok(out)
+        };
+        let mut x = solve(b)?;
+        let residual = |x: &[f64]| {
+            let mut r: Vec<f64> = b.iter().map(|v| -v).collect();
+            self.mul_add(col_scale, x, &mut r);
+            r
+        };
+        let r = residual(&x);
+        let dx = solve(&r)?;
+        x.iter_mut().zip(&dx).for_each(|(a, d)| *a -= d);
+        let rn = norm(&residual(&x));
+        let bn = norm(b);
+        if rn > 1e-6 * bn.max(f64::MIN_POSITIVE) {
+            return Err(LinearSolveError::Singular { ratio: rn / bn });
+        }
+        Ok(x)
+    }
+
+    /// The bordered solve by block elimination with one LU of s·J (see the module docs),
+    /// refined on the full bordered residual.
     fn solve_sparse_bordered(
         &mut self,
         col_scale: f64,
@@ -244,54 +300,58 @@ impl AssembledJacobian {
         rhs: &[f64],
     ) -> Result<Vec<f64>, LinearSolveError> {
         let n = self.n;
-        if rhs.iter().chain(col).chain(row).any(|v| !v.is_finite())
-            || self.values.iter().any(|v| !v.is_finite())
-        {
+        if rhs.iter().chain(col).chain(row).any(|v| !v.is_finite()) {
             return Err(LinearSolveError::NonFinite);
         }
-        let pattern = self.pattern.clone().expect("sparse storage has a pattern");
-        // Scaled J, then the border (the border slots of J's own entries are overwritten).
-        let mut vals: Vec<f64> = self.values.iter().map(|v| v * col_scale).collect();
-        for (j, &s) in self.border_row_slots.iter().enumerate() {
-            vals[s] = row[j];
-        }
-        for (i, &s) in self.border_col_slots.iter().enumerate() {
-            vals[s] = col[i];
-        }
-        let matrix = SparseColMat::new(pattern, vals);
-        if self.symbolic_lu.is_none() {
-            let symbolic = faer::sparse::linalg::solvers::SymbolicLu::try_new(matrix.symbolic())
-                .map_err(|_| LinearSolveError::Singular { ratio: 0.0 })?;
-            self.symbolic_lu = Some(symbolic);
-        }
-        let symbolic = self.symbolic_lu.clone().expect("set above");
-        let lu =
-            faer::sparse::linalg::solvers::Lu::try_new_with_symbolic(symbolic, matrix.as_ref())
-                .map_err(|_| LinearSolveError::Singular { ratio: 0.0 })?;
-        self.factorisations += 1;
-        let b = Mat::from_fn(n + 1, 1, |i, _| rhs[i]);
-        let x = lu.solve(&b);
-        let out: Vec<f64> = (0..=n).map(|i| x[(i, 0)]).collect();
-        if out.iter().any(|v| !v.is_finite()) {
+        let lu = self.sparse_lu(col_scale)?;
+        let two = Mat::from_fn(n, 2, |i, j| if j == 0 { rhs[i] } else { col[i] });
+        let ab = lu.solve(&two);
+        let dot_row = |v: &dyn Fn(usize) -> f64| (0..n).map(|i| row[i] * v(i)).sum::<f64>();
+        // Bordered residual of (y, z): [f − sJ y − c z; g − r·y − d z].
+        let bordered_residual = |y: &[f64], z: f64| -> Vec<f64> {
+            let mut r: Vec<f64> = (0..n).map(|i| -(rhs[i] - col[i] * z)).collect();
+            self.mul_add(col_scale, y, &mut r);
+            let mut out: Vec<f64> = r.iter().map(|v| -v).collect();
+            out.push(rhs[n] - dot_row(&|i| y[i]) - row[n] * z);
+            out
+        };
+        let b_col: Vec<f64> = (0..n).map(|i| ab[(i, 1)]).collect();
+        let denominator = row[n] - dot_row(&|i| b_col[i]);
+        if denominator == 0.0 || !denominator.is_finite() {
             return Err(LinearSolveError::Singular { ratio: 0.0 });
         }
-        // A numerically singular matrix can give finite garbage: check the residual.
-        let mut r: Vec<f64> = rhs.to_vec();
-        let col_ptr = matrix.symbolic().col_ptr();
-        let rows = matrix.symbolic().row_idx();
-        let v = matrix.val();
-        for j in 0..=n {
-            for k in col_ptr[j]..col_ptr[j + 1] {
-                r[rows[k]] -= v[k] * out[j];
+        // Solves the bordered system for a right-hand side (f, g) by block elimination.
+        let eliminate = |f: &[f64], g: f64| -> Vec<f64> {
+            let m = Mat::from_fn(n, 1, |i, _| f[i]);
+            let a = lu.solve(&m);
+            let z = (g - dot_row(&|i| a[(i, 0)])) / denominator;
+            let mut y: Vec<f64> = (0..n).map(|i| a[(i, 0)] - b_col[i] * z).collect();
+            y.push(z);
+            y
+        };
+        let mut y = eliminate(&rhs[..n], rhs[n]);
+        let scale = norm(rhs).max(f64::MIN_POSITIVE);
+        for _ in 0..3 {
+            let r = bordered_residual(&y[..n], y[n]);
+            if y.iter().any(|v| !v.is_finite()) {
+                return Err(LinearSolveError::Singular { ratio: 0.0 });
             }
+            if norm(&r) <= 1e-12 * scale {
+                break;
+            }
+            let d = eliminate(&r[..n], r[n]);
+            y.iter_mut().zip(&d).for_each(|(a, b)| *a += b);
         }
-        let rn = r.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let bn = rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
-        if rn > 1e-6 * bn.max(f64::MIN_POSITIVE) {
-            return Err(LinearSolveError::Singular { ratio: rn / bn });
+        let rn = norm(&bordered_residual(&y[..n], y[n]));
+        if !rn.is_finite() || rn > 1e-6 * scale {
+            return Err(LinearSolveError::Singular { ratio: rn / scale });
         }
-        Ok(out)
+        Ok(y)
     }
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 #[cfg(test)]

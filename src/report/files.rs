@@ -112,7 +112,36 @@ struct SolutionFile<'a> {
     turning_points_hz: &'a [f64],
     step_cuts: &'a [StepCut],
     leaps_hz: &'a [(f64, f64)],
-    points: &'a [FrfPoint],
+    /// Where the coefficients are when they are not inline (large models).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    coefficients_file: Option<CoefficientsFile>,
+    points: Vec<PointRecord<'a>>,
+}
+
+/// Most coefficients per point kept inline in `solution.json`; larger models append them to
+/// `coefficients.bin` instead (rewriting a JSON file of every point's full coefficients would
+/// cost time quadratic in the number of points).
+pub const INLINE_COEFFICIENTS: usize = 4096;
+
+/// Description of `coefficients.bin`.
+#[derive(Debug, Clone, Serialize)]
+struct CoefficientsFile {
+    file: &'static str,
+    values_per_point: usize,
+    layout: &'static str,
+}
+
+/// One point as written in `solution.json`.
+#[derive(Serialize)]
+struct PointRecord<'a> {
+    freq_hz: f64,
+    amplitudes: &'a [f64],
+    peaks: &'a [f64],
+    states: &'a [crate::contact::ContactState],
+    newton_iterations: usize,
+    residual: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    coefficients: Option<&'a [f64]>,
 }
 
 /// A cut continuation step, kept for the record.
@@ -138,6 +167,8 @@ pub struct FrfWriter {
     leaps: Vec<(f64, f64)>,
     started: Instant,
     last_json: Option<Instant>,
+    /// Time the last `solution.json` write took (s); writes are spaced by at least ten times it.
+    last_json_s: f64,
     /// First write error met (writing stops being attempted after it).
     pub error: Option<WriteError>,
 }
@@ -157,6 +188,7 @@ impl FrfWriter {
             leaps: Vec::new(),
             started: Instant::now(),
             last_json: None,
+            last_json_s: 0.0,
             error: None,
         }
     }
@@ -173,7 +205,12 @@ impl FrfWriter {
 
     /// Writes `solution.json` with a status line ("running", "complete", or a failure).
     pub fn write_solution(&mut self, status: &str) -> Result<(), WriteError> {
+        let write_started = Instant::now();
         let elapsed = self.started.elapsed().as_secs_f64();
+        let inline = self
+            .points
+            .first()
+            .is_none_or(|p| p.coefficients.len() <= INLINE_COEFFICIENTS);
         let file = SolutionFile {
             info: &self.info,
             status,
@@ -186,10 +223,52 @@ impl FrfWriter {
             turning_points_hz: &self.turning_points,
             step_cuts: &self.step_cuts,
             leaps_hz: &self.leaps,
-            points: &self.points,
+            coefficients_file: (!inline).then(|| CoefficientsFile {
+                file: "coefficients.bin",
+                values_per_point: self.points[0].coefficients.len(),
+                layout: "f64 little-endian, one row per point in point order, each row the \
+                         point's Fourier coefficients harmonic-major (blocks of info.blocks, each \
+                         holding every DOF of info.dofs)",
+            }),
+            points: self
+                .points
+                .iter()
+                .map(|p| PointRecord {
+                    freq_hz: p.freq_hz,
+                    amplitudes: &p.amplitudes,
+                    peaks: &p.peaks,
+                    states: &p.states,
+                    newton_iterations: p.newton_iterations,
+                    residual: p.residual,
+                    coefficients: inline.then_some(p.coefficients.as_slice()),
+                })
+                .collect(),
         };
         let json = serde_json::to_vec_pretty(&file).expect("result types serialise");
-        write_atomic(&self.dir.join("solution.json"), &json)
+        let result = write_atomic(&self.dir.join("solution.json"), &json);
+        self.last_json_s = write_started.elapsed().as_secs_f64();
+        result
+    }
+
+    /// Appends a point's coefficients to `coefficients.bin` (large models).
+    fn append_coefficients(&self, point: &FrfPoint) -> Result<(), WriteError> {
+        use std::io::Write as _;
+        let path = self.dir.join("coefficients.bin");
+        let err = |source| WriteError {
+            path: path.display().to_string(),
+            source,
+        };
+        let mut f = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(&path)
+            .map_err(err)?;
+        let bytes: Vec<u8> = point
+            .coefficients
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        f.write_all(&bytes).map_err(err)
     }
 
     fn record(&mut self, r: Result<(), WriteError>) {
@@ -210,9 +289,17 @@ impl FrfObserver for FrfWriter {
         self.csv.push_str(&frf_row(point));
         let r = write_atomic(&self.dir.join("frf.csv"), self.csv.as_bytes());
         self.record(r);
+        if point.coefficients.len() > INLINE_COEFFICIENTS {
+            if self.points.len() == 1 {
+                let _ = std::fs::remove_file(self.dir.join("coefficients.bin"));
+            }
+            let r = self.append_coefficients(point);
+            self.record(r);
+        }
+        let spacing = (10.0 * self.last_json_s).max(0.5);
         let due = self
             .last_json
-            .is_none_or(|t| t.elapsed().as_secs_f64() >= 0.5);
+            .is_none_or(|t| t.elapsed().as_secs_f64() >= spacing);
         if due && self.error.is_none() {
             let r = self.write_solution("running");
             self.record(r);
