@@ -15,17 +15,17 @@ use crate::model::{Formulation, JacobianStrategy, Problem};
 /// Full or condensed harmonic balance.
 pub enum HbmOperator<'p> {
     /// Unknowns on all DOFs.
-    Full(HbmSystem<'p>),
+    Full(Box<HbmSystem<'p>>),
     /// Unknowns on the contact DOFs.
-    Condensed(CondensedHbm<'p>),
+    Condensed(Box<CondensedHbm<'p>>),
 }
 
 impl<'p> HbmOperator<'p> {
     /// The operator of the problem's formulation.
     pub fn new(problem: &'p Problem) -> Result<Self, HbmError> {
         Ok(match problem.formulation() {
-            Formulation::Condensed => HbmOperator::Condensed(CondensedHbm::new(problem)?),
-            _ => HbmOperator::Full(HbmSystem::new(problem)?),
+            Formulation::Condensed => HbmOperator::Condensed(Box::new(CondensedHbm::new(problem)?)),
+            _ => HbmOperator::Full(Box::new(HbmSystem::new(problem)?)),
         })
     }
 

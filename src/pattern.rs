@@ -25,6 +25,38 @@ pub struct ContactSlots {
     pub slots: Vec<usize>,
 }
 
+/// A contact's DOFs (sorted, unique) and its rows on them.
+struct LocalRows {
+    dofs: Vec<usize>,
+    tangential: Vec<(usize, f64)>,
+    normal: Vec<(usize, f64)>,
+}
+
+impl LocalRows {
+    fn of(c: &crate::contact::ContactPoint) -> Self {
+        let mut dofs: Vec<usize> = c
+            .tangential
+            .iter()
+            .chain(&c.normal)
+            .map(|&(d, _)| d)
+            .collect();
+        dofs.sort_unstable();
+        dofs.dedup();
+        let to_local = |row: &[(usize, f64)]| -> Vec<(usize, f64)> {
+            row.iter()
+                .map(|&(d, a)| (dofs.binary_search(&d).expect("listed above"), a))
+                .collect()
+        };
+        let tangential = to_local(&c.tangential);
+        let normal = to_local(&c.normal);
+        Self {
+            dofs,
+            tangential,
+            normal,
+        }
+    }
+}
+
 /// Slot tables of the harmonic-balance Jacobian of one problem.
 #[derive(Debug, Clone)]
 pub struct JacobianLayout {
@@ -74,28 +106,7 @@ impl JacobianLayout {
             Block::Sin(h) => set.cos_block(h),
             Block::Constant => None,
         };
-        let local: Vec<(Vec<usize>, Vec<(usize, f64)>, Vec<(usize, f64)>)> = problem
-            .contacts
-            .iter()
-            .map(|c| {
-                let mut dofs: Vec<usize> = c
-                    .tangential
-                    .iter()
-                    .chain(&c.normal)
-                    .map(|&(d, _)| d)
-                    .collect();
-                dofs.sort_unstable();
-                dofs.dedup();
-                let to_local = |row: &[(usize, f64)]| -> Vec<(usize, f64)> {
-                    row.iter()
-                        .map(|&(d, a)| (dofs.binary_search(&d).expect("listed above"), a))
-                        .collect()
-                };
-                let t = to_local(&c.tangential);
-                let nr = to_local(&c.normal);
-                (dofs, t, nr)
-            })
-            .collect();
+        let local: Vec<LocalRows> = problem.contacts.iter().map(LocalRows::of).collect();
 
         let template = match storage {
             Storage::Dense => AssembledJacobian::dense(dim),
@@ -107,7 +118,7 @@ impl JacobianLayout {
                         entries.extend(damping.iter().map(|e| (j * n + e.0, pj * n + e.1)));
                     }
                 }
-                for (dofs, _, _) in &local {
+                for LocalRows { dofs, .. } in &local {
                     for j in 0..nb {
                         for i in 0..nb {
                             for &p in dofs {
@@ -143,25 +154,31 @@ impl JacobianLayout {
             .collect();
         let contacts = local
             .into_iter()
-            .map(|(dofs, tangential, normal)| {
-                let d = dofs.len();
-                let mut slots = Vec::with_capacity(nb * nb * d * d);
-                for j in 0..nb {
-                    for i in 0..nb {
-                        for &p in &dofs {
-                            for &q in &dofs {
-                                slots.push(template.slot(j * n + p, i * n + q));
+            .map(
+                |LocalRows {
+                     dofs,
+                     tangential,
+                     normal,
+                 }| {
+                    let d = dofs.len();
+                    let mut slots = Vec::with_capacity(nb * nb * d * d);
+                    for j in 0..nb {
+                        for i in 0..nb {
+                            for &p in &dofs {
+                                for &q in &dofs {
+                                    slots.push(template.slot(j * n + p, i * n + q));
+                                }
                             }
                         }
                     }
-                }
-                ContactSlots {
-                    dofs: d,
-                    tangential,
-                    normal,
-                    slots,
-                }
-            })
+                    ContactSlots {
+                        dofs: d,
+                        tangential,
+                        normal,
+                        slots,
+                    }
+                },
+            )
             .collect();
         Self {
             storage,
@@ -193,19 +210,11 @@ impl JacobianLayout {
             .contacts
             .iter()
             .map(|c| {
-                let mut dofs: Vec<usize> = c
-                    .tangential
-                    .iter()
-                    .chain(&c.normal)
-                    .map(|&(d, _)| d)
-                    .collect();
-                dofs.sort_unstable();
-                dofs.dedup();
-                let to_local = |row: &[(usize, f64)]| -> Vec<(usize, f64)> {
-                    row.iter()
-                        .map(|&(d, a)| (dofs.binary_search(&d).expect("listed above"), a))
-                        .collect()
-                };
+                let LocalRows {
+                    dofs,
+                    tangential,
+                    normal,
+                } = LocalRows::of(c);
                 let d = dofs.len();
                 let mut slots = Vec::with_capacity(nb * nb * d * d);
                 for j in 0..nb {
@@ -222,8 +231,8 @@ impl JacobianLayout {
                 }
                 ContactSlots {
                     dofs: d,
-                    tangential: to_local(&c.tangential),
-                    normal: to_local(&c.normal),
+                    tangential,
+                    normal,
                     slots,
                 }
             })

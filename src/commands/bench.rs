@@ -61,13 +61,11 @@ pub fn run(command: &BenchCommand) -> Result<String, BenchError> {
             three_d,
             modes,
         } => {
-            let dir = tempdir()?;
             let size = ModelSize {
                 three_d: *three_d,
                 refine: *refine,
             };
-            let (m, _) = scaling::measure_reduction(size, *modes, &dir)?;
-            let _ = std::fs::remove_dir_all(&dir);
+            let m = scaling::measure_reduction(size, *modes)?;
             serde_json::to_string(&m).map_err(|e| BenchError::Io(e.to_string()))
         }
         BenchCommand::Scaling { out, quick } => {
@@ -84,6 +82,11 @@ fn tempdir() -> Result<PathBuf, BenchError> {
     std::fs::create_dir_all(&dir).map_err(|e| BenchError::Io(format!("{}: {e}", dir.display())))?;
     Ok(dir)
 }
+
+/// Largest unknown count for which a whole FRF is run with the dense formulation.
+const DENSE_FRF_LIMIT: usize = 3000;
+/// Largest unknown count for which a whole FRF is run with finite differences.
+const FD_FRF_LIMIT: usize = 400;
 
 /// Everything measured so far.
 #[derive(Default, serde::Serialize)]
@@ -145,7 +148,7 @@ fn scaling_study(dir: &Path, quick: bool) -> Result<String, BenchError> {
             three_d: false,
             refine,
         };
-        let (_, reduced) = scaling::measure_reduction(size, 20, &work)?;
+        let reduced = scaling::reduced_problem(size, 20, &work)?;
         let case = format!("2D r{refine}, reduced");
         for &h in harmonics {
             for f in [
@@ -154,18 +157,15 @@ fn scaling_study(dir: &Path, quick: bool) -> Result<String, BenchError> {
                 Formulation::Condensed,
             ] {
                 eprintln!("solve: {case}, H = {h}, {}", scaling::formulation_name(f));
-                let m = scaling::measure_solve(
-                    &case,
-                    &reduced,
-                    h,
-                    f,
-                    JacobianStrategy::Analytic,
-                    true,
-                )?;
+                // A whole FRF where it is affordable (dense LU grows as n³), else one iteration.
+                let unknowns = reduced.model.n_dofs() * (2 * h + 1);
+                let frf = f != Formulation::Dense || unknowns <= DENSE_FRF_LIMIT;
+                let m =
+                    scaling::measure_solve(&case, &reduced, h, f, JacobianStrategy::Analytic, frf)?;
                 study.solves.push(m);
                 // Finite differences: a whole FRF where it is affordable, else one iteration.
                 let unknowns = study.solves.last().map(|m| m.unknowns).unwrap_or(0);
-                let fd_frf = unknowns <= 400;
+                let fd_frf = unknowns <= FD_FRF_LIMIT;
                 let m = scaling::measure_solve(
                     &case,
                     &reduced,
@@ -260,7 +260,7 @@ fn markdown(study: &Study) -> String {
     }
     let _ = writeln!(
         s,
-        "\n## Solver cost (800-900 Hz window, single FRF, m = 0)\n\n\
+        "\n## Solver cost (700-1000 Hz window around the first bending pair, at most 1000 points, single FRF, m = 0)\n\n\
          Time per Newton iteration is the FRF time over its Newton iterations (tangent solves \
          included) for full runs, or the time of one iteration (residual, Jacobian, linear \
          solve) where an FRF with finite differences would take too long (`frf = no`).\n\n\
