@@ -157,6 +157,40 @@ pub struct Problem {
     pub outputs: Vec<usize>,
     /// Limit analysis settings, when the scene asks for one.
     pub limits: Option<crate::limits::LimitSettings>,
+    /// The FE mesh the problem comes from, for results on the mesh (None for lumped models
+    /// and Matrix Market input).
+    pub fe: Option<std::sync::Arc<FeOrigin>>,
+}
+
+/// The FE mesh of a problem and the map from the problem's coordinates to its nodes.
+#[derive(Debug)]
+pub struct FeOrigin {
+    /// The mesh.
+    pub mesh: crate::fe::Mesh,
+    /// DOF (node, direction) of each row of the full FE model.
+    pub dofs: crate::fe::DofMap,
+    /// For a reduced problem, row d holds the full-model displacement of DOF d per reduced
+    /// coordinate (the Craig-Bampton basis T); None when the problem is the full model, or when
+    /// the basis would be too large to keep (then results on the mesh are not written).
+    pub recovery: Option<Vec<Vec<f64>>>,
+    /// Whether the problem is reduced.
+    pub reduced: bool,
+}
+
+impl FeOrigin {
+    /// Full-model values of DOF rows from problem coordinates `q` (one block of coefficients);
+    /// None when a reduced problem has no recovery basis.
+    pub fn full_values(&self, q: &[f64]) -> Option<Vec<f64>> {
+        match (&self.recovery, self.reduced) {
+            (_, false) => Some(q.to_vec()),
+            (Some(rows), true) => Some(
+                rows.iter()
+                    .map(|r| r.iter().zip(q).map(|(a, b)| a * b).sum())
+                    .collect(),
+            ),
+            (None, true) => None,
+        }
+    }
 }
 
 impl Problem {

@@ -23,6 +23,9 @@ use fricbound_reduction::{craig_bampton, CbOptions, Ordering, ReducedModel, Redu
 use crate::matrix::StructuralMatrix;
 use crate::model::{HarmonicLoad, LinearModel, Problem};
 
+/// Most entries of the Craig-Bampton basis kept for results on the mesh (8 bytes each).
+pub const MAX_BASIS_ENTRIES: usize = 20_000_000;
+
 /// Settings of a reduction.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ReductionSettings {
@@ -94,6 +97,14 @@ pub fn reduce(
     let loaded = loaded_dofs(problem);
     let mut recover = loaded.clone();
     recover.extend_from_slice(&settings.recover);
+    // Results on the mesh need the whole basis: kept while it stays small.
+    let n = problem.model.n_dofs();
+    let recover_all =
+        problem.fe.is_some() && n * (boundary.len() + settings.modes) <= MAX_BASIS_ENTRIES;
+    let first_all = recover.len();
+    if recover_all {
+        recover.extend(0..n);
+    }
     let mut options = CbOptions::with_modes(settings.modes);
     options.ordering = settings.ordering;
     let mut reduced = craig_bampton(k.as_ref(), m.as_ref(), &boundary, &recover, &options)?;
@@ -104,6 +115,13 @@ pub fn reduce(
         .map(|r| r.row)
         .collect();
     let row_of = |d: usize| &load_rows[loaded.binary_search(&d).expect("listed as loaded")];
+    let basis: Option<Vec<Vec<f64>>> = recover_all.then(|| {
+        reduced
+            .recovery
+            .drain(first_all - loaded.len()..)
+            .map(|r| r.row)
+            .collect()
+    });
     let nb = boundary.len();
     let nr = reduced.size();
     let mut position = vec![usize::MAX; problem.model.n_dofs()];
@@ -166,6 +184,14 @@ pub fn reduce(
         })
         .collect();
     out.outputs = problem.outputs.iter().map(|&d| position[d]).collect();
+    out.fe = problem.fe.as_ref().map(|fe| {
+        std::sync::Arc::new(crate::model::FeOrigin {
+            mesh: fe.mesh.clone(),
+            dofs: fe.dofs.clone(),
+            recovery: basis,
+            reduced: true,
+        })
+    });
     debug_assert!(nb <= nr);
     Ok(Reduction {
         problem: out,

@@ -1382,6 +1382,16 @@ impl Scene {
             },
             outputs,
             limits: self.validate_limits(&ck)?,
+            fe: fe.as_ref().and_then(|f| {
+                f.mesh.as_ref().map(|mesh| {
+                    std::sync::Arc::new(crate::model::FeOrigin {
+                        mesh: mesh.clone(),
+                        dofs: f.dofs.clone(),
+                        recovery: None,
+                        reduced: false,
+                    })
+                })
+            }),
         };
         self.validate_sweep(&ck)?;
         let problem = match &self.reduction {

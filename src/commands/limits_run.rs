@@ -80,6 +80,16 @@ pub(super) fn write_analysis(
     write_tables(ctx, analysis)?;
     write_hysteresis(ctx, analysis)?;
     write_json(ctx, analysis, elapsed)?;
+    // Each limit curve's peak on the mesh (FE scenes).
+    for c in &analysis.limits {
+        crate::report::mesh_results::write_point(
+            &ctx.dir,
+            &format!("peak_{}", c.case.name),
+            &ctx.problem,
+            &c.peak.coefficients,
+            &c.peak.states,
+        )?;
+    }
     plot(ctx, analysis)
 }
 

@@ -30,6 +30,9 @@ pub enum CommandError {
     /// The scene is unreadable or invalid.
     #[error(transparent)]
     Scene(#[from] SceneError),
+    /// Results on the mesh could not be written.
+    #[error(transparent)]
+    Vtu(#[from] crate::fe::VtuError),
     /// A result file could not be written.
     #[error(transparent)]
     Write(#[from] WriteError),
@@ -416,6 +419,20 @@ fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
             &fig,
             &dir.join(format!("frf_{name}.png")),
             &dir.join(format!("frf_{name}.svg")),
+        )?;
+    }
+    // The response on the mesh at the largest amplitude of the first output (FE scenes).
+    if let Some(peak) = run
+        .points
+        .iter()
+        .max_by(|a, b| a.amplitudes[0].total_cmp(&b.amplitudes[0]))
+    {
+        crate::report::mesh_results::write_point(
+            dir,
+            "response_peak",
+            problem,
+            &peak.coefficients,
+            &peak.states,
         )?;
     }
     let turning = if run.turning_points.is_empty() {

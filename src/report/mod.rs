@@ -3,5 +3,6 @@
 pub mod files;
 pub mod limit_files;
 pub mod limit_plots;
+pub mod mesh_results;
 pub mod paper_summary;
 pub mod plot;
