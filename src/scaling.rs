@@ -4,16 +4,17 @@
 //! refinement (2D quadrangles or 3D hexahedra): assembled, clamped, its contact patches paired,
 //! reduced by Craig-Bampton, and solved by continuation over a frequency window around the
 //! first bending pair. Nothing is synthetic: the contact count per side grows with the
-//! refinement of the contact faces (3·refine + 1 pairs per side in 2D).
+//! refinement of the contact faces (3·refine·contact_refine + 1 pairs per side in 2D).
 //!
 //! Two measurements:
 //! - [`measure_reduction`]: mesh generation, assembly and clamping, then Craig-Bampton, with
 //!   the reduction's own report (phase times, factor size, peak resident memory). Peak memory
 //!   is a per-process figure, so the command runs each size in its own process.
-//! - [`measure_solve`]: one FRF of a reduced (or unreduced) problem with a given formulation and
-//!   Jacobian strategy: wall time per continuation point and per Newton iteration (FRF time
-//!   divided by the Newton iterations of the run, tangent solves included), or, for the
-//!   finite-difference strategies on large problems, the time of one Newton iteration only.
+//! - [`measure_solve`]: one Newton iteration (residual, Jacobian, linear solve) of a reduced
+//!   (or unreduced) problem with a given formulation and Jacobian strategy, and where that is
+//!   affordable an FRF over the window limited to a number of continuation points: wall time
+//!   per point and per Newton iteration (FRF time over its Newton iterations, tangent solves
+//!   included).
 
 use std::path::Path;
 use std::time::Instant;
@@ -46,6 +47,38 @@ pub struct ModelSize {
     pub three_d: bool,
     /// Generator refinement.
     pub refine: usize,
+    /// Extra refinement of the contact faces and the damper.
+    pub contact_refine: usize,
+}
+
+impl ModelSize {
+    /// A model of the generator's uniform refinement `refine`.
+    pub fn uniform(three_d: bool, refine: usize) -> Self {
+        Self {
+            three_d,
+            refine,
+            contact_refine: 1,
+        }
+    }
+
+    /// Short label: `2D r2`, `2D r2 c8`, `3D r1`.
+    pub fn label(&self) -> String {
+        let dim = if self.three_d { "3D" } else { "2D" };
+        if self.contact_refine > 1 {
+            format!("{dim} r{} c{}", self.refine, self.contact_refine)
+        } else {
+            format!("{dim} r{}", self.refine)
+        }
+    }
+
+    fn params(&self) -> BladePairParams {
+        BladePairParams {
+            refine: self.refine,
+            contact_refine: self.contact_refine,
+            three_d: self.three_d,
+            ..Default::default()
+        }
+    }
 }
 
 /// The blade-pair scene text for a mesh file (the physics of `meshes/blade-pair/`).
@@ -94,16 +127,11 @@ pub fn full_problem(
     harmonics: usize,
     dir: &Path,
 ) -> Result<Problem, ScalingError> {
-    let params = BladePairParams {
-        refine: size.refine,
-        three_d: size.three_d,
-        ..Default::default()
-    };
+    let params = size.params();
     let mesh = blade_pair::generate(&params).map_err(setup)?;
     let file = dir.join(format!(
-        "blade-pair-{}-r{}.msh",
-        if size.three_d { "3d" } else { "2d" },
-        size.refine
+        "blade-pair-{}.msh",
+        size.label().replace(' ', "-").to_lowercase()
     ));
     write_msh(&file, &mesh, MshFormat::Binary).map_err(setup)?;
     let text = blade_pair_scene(&file, size.three_d, harmonics);
@@ -153,11 +181,7 @@ pub struct ReductionMeasure {
 pub fn measure_reduction(size: ModelSize, modes: usize) -> Result<ReductionMeasure, ScalingError> {
     use crate::fe::{self, Direction, GroupMaterial, Material, PlaneAssumption};
     let started = Instant::now();
-    let params = BladePairParams {
-        refine: size.refine,
-        three_d: size.three_d,
-        ..Default::default()
-    };
+    let params = size.params();
     let mesh = blade_pair::generate(&params).map_err(setup)?;
     let materials: Vec<GroupMaterial> = ["blade1", "blade2", "damper"]
         .iter()
@@ -240,23 +264,46 @@ pub struct SolveMeasure {
     pub formulation: String,
     /// Jacobian strategy.
     pub jacobian: String,
+    /// Initial tangential state m of every contact point (0, or ±1 for a limit curve).
+    pub m: f64,
     /// Unknowns of the operator solved.
     pub unknowns: usize,
-    /// Whether a whole FRF was run (else one Newton iteration was timed).
+    /// Wall time of one Newton iteration at the stuck linear guess at the window's centre
+    /// (residual, Jacobian, linear solve; ms).
+    pub iteration_ms: f64,
+    /// Whether an FRF was run (else only the iteration was timed).
     pub frf: bool,
+    /// Most continuation points the FRF was allowed.
+    pub max_points: usize,
     /// Continuation points (FRF runs).
     pub points: usize,
     /// Newton iterations (FRF runs).
     pub iterations: usize,
-    /// Whether the FRF reached the end of its window.
+    /// Whether the FRF reached the end of its window within `max_points`.
     pub complete: bool,
     /// Wall time of the FRF (s; FRF runs).
     pub frf_s: f64,
     /// Wall time per continuation point (ms; FRF runs).
     pub per_point_ms: f64,
-    /// Wall time per Newton iteration (ms): FRF time over its iterations, or one timed
-    /// iteration (residual, Jacobian, linear solve).
-    pub per_iteration_ms: f64,
+    /// Wall time per Newton iteration within the FRF (ms): FRF time over its Newton
+    /// iterations, tangent solves included (FRF runs).
+    pub frf_iteration_ms: f64,
+}
+
+/// Unknowns of `base` with harmonics 1..H (and the 0th) in formulation `formulation`.
+pub fn unknowns(
+    base: &Problem,
+    harmonics: usize,
+    formulation: Formulation,
+) -> Result<usize, ScalingError> {
+    let mut p = base.clone();
+    p.harmonics = (1..=harmonics).collect();
+    p.analysis.formulation = formulation;
+    let blocks = p.unknown_harmonics().n_blocks();
+    Ok(match p.formulation() {
+        Formulation::Condensed => p.contact_dofs().len() * blocks,
+        _ => p.model.n_dofs() * blocks,
+    })
 }
 
 /// Label of a formulation.
@@ -278,18 +325,20 @@ pub fn jacobian_name(j: JacobianStrategy) -> &'static str {
     }
 }
 
-/// Measures one configuration of `base` (harmonics 1..H, formulation, Jacobian strategy).
-/// With `frf` a whole FRF over the window is run; otherwise one Newton iteration at the
-/// linear (stuck) guess at the window's centre is timed.
+/// Measures one configuration of `base` (harmonics 1..H, formulation, Jacobian strategy,
+/// every contact point starting at T = m·μN): the time of one Newton iteration at the linear
+/// (stuck) guess at the window's centre, and with `max_points` Some(p) an FRF over the window
+/// limited to p continuation points.
 pub fn measure_solve(
     case: &str,
     base: &Problem,
     harmonics: usize,
     formulation: Formulation,
     jacobian: JacobianStrategy,
-    frf: bool,
+    m_initial: f64,
+    max_points: Option<usize>,
 ) -> Result<SolveMeasure, ScalingError> {
-    let mut p = base.clone();
+    let mut p = crate::limits::LimitCase::uniform(base, m_initial).apply(base);
     p.harmonics = (1..=harmonics).collect();
     p.samples = p.samples.max(32 * harmonics).max(128);
     p.analysis.formulation = formulation;
@@ -302,40 +351,45 @@ pub fn measure_solve(
         harmonics,
         formulation: formulation_name(p.formulation()).to_string(),
         jacobian: jacobian_name(jacobian).to_string(),
+        m: m_initial,
         unknowns,
-        frf,
+        iteration_ms: 0.0,
+        frf: max_points.is_some(),
+        max_points: max_points.unwrap_or(0),
         points: 0,
         iterations: 0,
         complete: false,
         frf_s: 0.0,
         per_point_ms: 0.0,
-        per_iteration_ms: 0.0,
+        frf_iteration_ms: 0.0,
     };
-    if frf {
+    let f = 0.5 * (p.analysis.freq_start_hz + p.analysis.freq_end_hz);
+    let omega = 2.0 * std::f64::consts::PI * f;
+    let guess = crate::linear::stuck_guess(&p, operator.unknowns(), omega).map_err(setup)?;
+    let x = operator.restrict(&guess);
+    let mut r = vec![0.0; unknowns];
+    let mut dr = vec![0.0; unknowns];
+    let mut jac = operator.new_jacobian();
+    let started = Instant::now();
+    operator
+        .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
+        .map_err(setup)?;
+    let neg: Vec<f64> = r.iter().map(|v| -v).collect();
+    jac.solve(&neg).map_err(setup)?;
+    m.iteration_ms = 1e3 * started.elapsed().as_secs_f64();
+    drop(jac);
+    drop(operator);
+    if let Some(max_points) = max_points {
+        p.analysis.max_points = max_points;
         let started = Instant::now();
         let mut points = Vec::new();
         let outcome = frf::solve(&p, &mut Collect(&mut points));
         m.frf_s = started.elapsed().as_secs_f64();
-        m.complete = outcome.is_ok();
         m.points = points.len();
+        m.complete = outcome.is_ok_and(|run| run.end == crate::continuation::PathEnd::EndFrequency);
         m.iterations = points.iter().map(|q| q.newton_iterations).sum();
         m.per_point_ms = 1e3 * m.frf_s / m.points.max(1) as f64;
-        m.per_iteration_ms = 1e3 * m.frf_s / m.iterations.max(1) as f64;
-    } else {
-        let f = 0.5 * (p.analysis.freq_start_hz + p.analysis.freq_end_hz);
-        let omega = 2.0 * std::f64::consts::PI * f;
-        let guess = crate::linear::stuck_guess(&p, operator.unknowns(), omega).map_err(setup)?;
-        let x = operator.restrict(&guess);
-        let mut r = vec![0.0; unknowns];
-        let mut dr = vec![0.0; unknowns];
-        let mut jac = operator.new_jacobian();
-        let started = Instant::now();
-        operator
-            .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
-            .map_err(setup)?;
-        let neg: Vec<f64> = r.iter().map(|v| -v).collect();
-        jac.solve(&neg).map_err(setup)?;
-        m.per_iteration_ms = 1e3 * started.elapsed().as_secs_f64();
+        m.frf_iteration_ms = 1e3 * m.frf_s / m.iterations.max(1) as f64;
     }
     Ok(m)
 }

@@ -367,6 +367,36 @@ fn damper_is_a_free_body() {
     }
 }
 
+/// `contact_refine` multiplies the contact divisions alone: 3·refine·N + 1 pairs per side, the
+/// blades keep their divisions, every pair is coincident and the contact area is unchanged.
+#[test]
+fn contact_refinement_multiplies_the_pairs_only() {
+    let base = BladePairParams {
+        refine: 2,
+        ..BladePairParams::default()
+    };
+    let fine = BladePairParams {
+        contact_refine: 5,
+        ..base.clone()
+    };
+    let (d0, d1) = (base.divisions().unwrap(), fine.divisions().unwrap());
+    assert_eq!(d1.contact, 5 * d0.contact);
+    assert_eq!(d1.damper, 5 * d0.damper);
+    assert_eq!(
+        (d1.blade_x, d1.blade_y, d1.platform_free),
+        (d0.blade_x, d0.blade_y, d0.platform_free)
+    );
+    let (mesh, model) = assembled(&fine);
+    for spec in fine.patch_specs().unwrap() {
+        let patch = pair_patch(&mesh, &model.dofs, &spec).unwrap();
+        assert_eq!(patch.pairs.len(), 3 * 2 * 5 + 1);
+        assert!(patch.pairs.iter().all(|p| p.node_distance < 1e-15));
+        let (m0, b0) = assembled(&base);
+        let coarse = pair_patch(&m0, &b0.dofs, &spec).unwrap();
+        assert!((patch.area() - coarse.area()).abs() < 1e-12 * coarse.area());
+    }
+}
+
 #[test]
 fn bad_parameters_are_rejected() {
     let bad = |p: BladePairParams| generate(&p).unwrap_err().to_string();
@@ -391,6 +421,14 @@ fn bad_parameters_are_rejected() {
         ..BladePairParams::default()
     });
     assert!(msg.contains("refine = 0"), "{msg}");
+    let msg = bad(BladePairParams {
+        contact_refine: 0,
+        ..BladePairParams::default()
+    });
+    assert!(
+        msg.contains("contact_refine = 0 must lie in 1..=1000"),
+        "{msg}"
+    );
     let msg = bad(BladePairParams {
         thickness: f64::NAN,
         ..BladePairParams::default()
@@ -491,6 +529,7 @@ fn mesh_command_writes_a_readable_file() {
     let vtu = dir.path().join("pair.vtu");
     let args = BladePairArgs {
         refine: 1,
+        contact_refine: 2,
         beta: 90.0,
         platform_width: None,
         thickness: Some(0.02),

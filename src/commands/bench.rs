@@ -33,6 +33,9 @@ pub enum BenchCommand {
         /// Generator refinement.
         #[arg(long)]
         refine: usize,
+        /// Extra refinement of the contact faces and the damper.
+        #[arg(long, default_value_t = 1)]
+        contact_refine: usize,
         /// 3D hexahedra.
         #[arg(long = "3d")]
         three_d: bool,
@@ -58,12 +61,14 @@ pub fn run(command: &BenchCommand) -> Result<String, BenchError> {
     match command {
         BenchCommand::Reduction {
             refine,
+            contact_refine,
             three_d,
             modes,
         } => {
             let size = ModelSize {
                 three_d: *three_d,
                 refine: *refine,
+                contact_refine: *contact_refine,
             };
             let m = scaling::measure_reduction(size, *modes)?;
             serde_json::to_string(&m).map_err(|e| BenchError::Io(e.to_string()))
@@ -83,10 +88,16 @@ fn tempdir() -> Result<PathBuf, BenchError> {
     Ok(dir)
 }
 
-/// Largest unknown count for which a whole FRF is run with the dense formulation.
-const DENSE_FRF_LIMIT: usize = 3000;
-/// Largest unknown count for which a whole FRF is run with finite differences.
-const FD_FRF_LIMIT: usize = 400;
+/// Largest unknown count for which one iteration with the analytic Jacobian is timed (dense
+/// LU grows as n³: about 10 s at 8000 unknowns here).
+const ANALYTIC_LIMIT: usize = 8000;
+/// Largest unknown count for which one iteration with finite differences is timed (n residual
+/// evaluations of O(n²) each on reduced models).
+const FD_LIMIT: usize = 3000;
+/// Largest one-iteration time (ms) for which an FRF is run as well.
+const FRF_ITERATION_LIMIT_MS: f64 = 40.0;
+/// Continuation points of the FRFs of the study (the targets speak of FRFs of about 150).
+const FRF_POINTS: usize = 150;
 
 /// Everything measured so far.
 #[derive(Default, serde::Serialize)]
@@ -94,6 +105,7 @@ struct Study {
     machine: String,
     reductions: Vec<ReductionMeasure>,
     solves: Vec<SolveMeasure>,
+    limit_curves: Vec<SolveMeasure>,
 }
 
 fn scaling_study(dir: &Path, quick: bool) -> Result<String, BenchError> {
@@ -139,51 +151,97 @@ fn scaling_study(dir: &Path, quick: bool) -> Result<String, BenchError> {
         write_study(dir, &study)?;
     }
 
-    // Solver costs on reduced models with growing contact counts.
+    // Solver costs on reduced models with growing contact counts: the coarse 2D blade pair
+    // (refine 2) with its contact faces and damper refined (7 to 199 pairs per side).
     let work = tempdir()?;
-    let refines: &[usize] = if quick { &[1, 2] } else { &[1, 2, 4, 8, 16] };
+    let contact_refines: &[usize] = if quick {
+        &[1, 2]
+    } else {
+        &[1, 2, 4, 8, 16, 33]
+    };
     let harmonics: &[usize] = if quick { &[1, 3] } else { &[1, 3, 5, 7] };
-    for &refine in refines {
+    for &contact_refine in contact_refines {
         let size = ModelSize {
             three_d: false,
-            refine,
+            refine: 2,
+            contact_refine,
         };
         let reduced = scaling::reduced_problem(size, 20, &work)?;
-        let case = format!("2D r{refine}, reduced");
+        let case = format!("{}, reduced", size.label());
         for &h in harmonics {
             for f in [
                 Formulation::Dense,
                 Formulation::Sparse,
                 Formulation::Condensed,
             ] {
-                eprintln!("solve: {case}, H = {h}, {}", scaling::formulation_name(f));
-                // A whole FRF where it is affordable (dense LU grows as n³), else one iteration.
-                let unknowns = reduced.model.n_dofs() * (2 * h + 1);
-                let frf = f != Formulation::Dense || unknowns <= DENSE_FRF_LIMIT;
-                let m =
-                    scaling::measure_solve(&case, &reduced, h, f, JacobianStrategy::Analytic, frf)?;
-                study.solves.push(m);
-                // Finite differences: a whole FRF where it is affordable, else one iteration.
-                let unknowns = study.solves.last().map(|m| m.unknowns).unwrap_or(0);
-                let fd_frf = unknowns <= FD_FRF_LIMIT;
-                let m = scaling::measure_solve(
-                    &case,
-                    &reduced,
-                    h,
-                    f,
+                for j in [
+                    JacobianStrategy::Analytic,
                     JacobianStrategy::ForwardDifference,
-                    fd_frf,
-                )?;
-                study.solves.push(m);
+                ] {
+                    let unknowns = scaling::unknowns(&reduced, h, f)?;
+                    let limit = if j == JacobianStrategy::Analytic {
+                        ANALYTIC_LIMIT
+                    } else {
+                        FD_LIMIT
+                    };
+                    if unknowns > limit {
+                        eprintln!(
+                            "skip: {case}, H = {h}, {}, {}: {unknowns} unknowns",
+                            scaling::formulation_name(f),
+                            scaling::jacobian_name(j)
+                        );
+                        continue;
+                    }
+                    eprintln!(
+                        "solve: {case}, H = {h}, {}, {}",
+                        scaling::formulation_name(f),
+                        scaling::jacobian_name(j)
+                    );
+                    let mut m = scaling::measure_solve(&case, &reduced, h, f, j, 0.0, None)?;
+                    if m.iteration_ms <= FRF_ITERATION_LIMIT_MS {
+                        m = scaling::measure_solve(
+                            &case,
+                            &reduced,
+                            h,
+                            f,
+                            j,
+                            0.0,
+                            Some(FRF_POINTS),
+                        )?;
+                    }
+                    study.solves.push(m);
+                    write_study(dir, &study)?;
+                }
+            }
+        }
+        // The target case: a limit curve (m = +1 on every point) with about 50 points per
+        // side at H = 3, analytic against finite differences, with the automatic formulation.
+        if contact_refine == 8 || (quick && contact_refine == 2) {
+            for j in [
+                JacobianStrategy::Analytic,
+                JacobianStrategy::ForwardDifference,
+            ] {
+                eprintln!("limit FRF: {case}, H = 3, {}", scaling::jacobian_name(j));
+                let mut m =
+                    scaling::measure_solve(&case, &reduced, 3, Formulation::Auto, j, 1.0, None)?;
+                if j == JacobianStrategy::Analytic || m.iteration_ms <= 1000.0 {
+                    m = scaling::measure_solve(
+                        &case,
+                        &reduced,
+                        3,
+                        Formulation::Auto,
+                        j,
+                        1.0,
+                        Some(FRF_POINTS),
+                    )?;
+                }
+                study.limit_curves.push(m);
                 write_study(dir, &study)?;
             }
         }
     }
     // The unreduced model solved by the sparse formulation, beside its reduced version.
-    let size = ModelSize {
-        three_d: false,
-        refine: 2,
-    };
+    let size = ModelSize::uniform(false, 2);
     let full = scaling::full_problem(size, 1, &work)?;
     for &h in &harmonics[..harmonics.len().min(2)] {
         eprintln!("solve: 2D r2 unreduced, H = {h}, sparse");
@@ -193,7 +251,8 @@ fn scaling_study(dir: &Path, quick: bool) -> Result<String, BenchError> {
             h,
             Formulation::Sparse,
             JacobianStrategy::Analytic,
-            true,
+            0.0,
+            Some(FRF_POINTS),
         )?;
         study.solves.push(m);
         write_study(dir, &study)?;
@@ -260,48 +319,69 @@ fn markdown(study: &Study) -> String {
     }
     let _ = writeln!(
         s,
-        "\n## Solver cost (700-1000 Hz window around the first bending pair, at most 1000 points, single FRF, m = 0)\n\n\
-         Time per Newton iteration is the FRF time over its Newton iterations (tangent solves \
-         included) for full runs, or the time of one iteration (residual, Jacobian, linear \
-         solve) where an FRF with finite differences would take too long (`frf = no`).\n\n\
-         | case | pairs/side | H | formulation | Jacobian | unknowns | frf | points | complete | FRF (s) | per point (ms) | per iteration (ms) |\n\
-         | --- | ---: | ---: | --- | --- | ---: | --- | ---: | --- | ---: | ---: | ---: |"
+        "\n## Solver cost (700-1000 Hz window around the first bending pair, 20 fixed-interface modes, m = 0)\n\n\
+         `iteration` is one Newton iteration (residual, Jacobian, linear solve) at the stuck \
+         linear guess at 850 Hz. Where it takes at most {FRF_ITERATION_LIMIT_MS} ms an FRF over \
+         the window is run as well, limited to {FRF_POINTS} continuation points (`complete`: it \
+         reached 1000 Hz within them); its time per Newton iteration includes the tangent \
+         solves. Cases above {ANALYTIC_LIMIT} unknowns (analytic) or {FD_LIMIT} (finite \
+         differences) are not run.\n"
     );
-    for m in &study.solves {
+    solve_table(&mut s, &study.solves);
+    if !study.limit_curves.is_empty() {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.3} |",
+            "\n## Limit curve with about 50 contact points per side, H = 3\n\n\
+             One limit curve (m = +1 at every point), automatic formulation, at most \
+             {FRF_POINTS} continuation points; the finite-difference FRF is run only where one \
+             of its iterations takes at most 1 s.\n"
+        );
+        solve_table(&mut s, &study.limit_curves);
+    }
+    s
+}
+
+fn solve_table(s: &mut String, rows: &[SolveMeasure]) {
+    let _ = writeln!(
+        s,
+        "| case | pairs/side | H | formulation | Jacobian | unknowns | iteration (ms) | FRF points | complete | FRF (s) | per point (ms) | per FRF iteration (ms) |\n\
+         | --- | ---: | ---: | --- | --- | ---: | ---: | ---: | --- | ---: | ---: | ---: |"
+    );
+    let dash = || "–".to_string();
+    for m in rows {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {:.2} | {} | {} | {} | {} | {} |",
             m.case,
             m.pairs_per_side,
             m.harmonics,
             m.formulation,
             m.jacobian,
             m.unknowns,
-            if m.frf { "yes" } else { "no" },
+            m.iteration_ms,
+            if m.frf { m.points.to_string() } else { dash() },
             if m.frf {
-                m.points.to_string()
+                if m.complete { "yes" } else { "no" }.to_string()
             } else {
-                "–".into()
-            },
-            if m.frf {
-                if m.complete { "yes" } else { "stalled" }.to_string()
-            } else {
-                "–".into()
+                dash()
             },
             if m.frf {
                 format!("{:.2}", m.frf_s)
             } else {
-                "–".into()
+                dash()
             },
             if m.frf {
                 format!("{:.2}", m.per_point_ms)
             } else {
-                "–".into()
+                dash()
             },
-            m.per_iteration_ms
+            if m.frf {
+                format!("{:.2}", m.frf_iteration_ms)
+            } else {
+                dash()
+            },
         );
     }
-    s
 }
 
 /// Time per Newton iteration against contact pairs per side, one line per formulation and
@@ -324,13 +404,9 @@ fn plot_study(dir: &Path, study: &Study) -> Result<(), BenchError> {
         match lines.iter_mut().find(|l| l.0 == label) {
             Some(l) => {
                 l.1.push(m.pairs_per_side as f64);
-                l.2.push(m.per_iteration_ms);
+                l.2.push(m.iteration_ms);
             }
-            None => lines.push((
-                label,
-                vec![m.pairs_per_side as f64],
-                vec![m.per_iteration_ms],
-            )),
+            None => lines.push((label, vec![m.pairs_per_side as f64], vec![m.iteration_ms])),
         }
     }
     let series: Vec<Series> = lines

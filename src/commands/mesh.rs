@@ -30,6 +30,10 @@ pub struct BladePairArgs {
     /// Refinement: element size = blade width / (5 N).
     #[arg(long, default_value_t = 1, value_name = "N")]
     pub refine: usize,
+    /// Extra refinement of the contact faces and the damper (more contact pairs per side on
+    /// the same blades).
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    pub contact_refine: usize,
     /// Apical angle of the wedge damper (degrees, 30..170).
     #[arg(long, default_value_t = 120.0, value_name = "DEG")]
     pub beta: f64,
@@ -98,6 +102,7 @@ pub fn params(args: &BladePairArgs) -> BladePairParams {
     let defaults = BladePairParams::default();
     BladePairParams {
         refine: args.refine,
+        contact_refine: args.contact_refine,
         beta_deg: args.beta,
         platform_width: args.platform_width.unwrap_or(defaults.platform_width),
         thickness: args.thickness.unwrap_or(defaults.thickness),

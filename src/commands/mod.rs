@@ -499,7 +499,7 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
         problem.contacts.len(),
         problem.sides.len()
     );
-    for c in &problem.contacts {
+    for c in problem.contacts.iter().take(CHECK_LISTED) {
         let _ = writeln!(
             s,
             "  {:<12} side {:<8} kt {:.3e} N/m  kn {:.3e} N/m  mu {}  gap {:.3e} m  m {}",
@@ -512,6 +512,7 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
             c.law.initial_state
         );
     }
+    more_line(&mut s, problem.contacts.len());
     let statics: Vec<String> = problem
         .static_load
         .iter()
@@ -524,17 +525,24 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
         "static loads {}",
         if statics.is_empty() {
             "none".into()
+        } else if statics.len() > CHECK_LISTED {
+            format!(
+                "{}, ... ({} DOFs loaded)",
+                statics[..CHECK_LISTED].join(", "),
+                statics.len()
+            )
         } else {
             statics.join(", ")
         }
     );
-    for l in &problem.harmonic_loads {
+    for l in problem.harmonic_loads.iter().take(CHECK_LISTED) {
         let _ = writeln!(
             s,
             "harmonic load {} h{}: cos {} N, sin {} N",
             problem.model.dof_names[l.dof], l.harmonic, l.cos, l.sin
         );
     }
+    more_line(&mut s, problem.harmonic_loads.len());
     let _ = writeln!(
         s,
         "analysis     {} .. {} Hz, steps {:.3e} (min {:.3e}, max {:.3e}), jacobian {:?}",
@@ -585,6 +593,17 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
         let _ = writeln!(s, "{line}");
     }
     Ok(s)
+}
+
+/// Most contacts and loads `check` lists one by one (FE scenes have hundreds).
+const CHECK_LISTED: usize = 12;
+
+/// The line after a list cut at [`CHECK_LISTED`] items.
+fn more_line(s: &mut String, total: usize) {
+    use std::fmt::Write as _;
+    if total > CHECK_LISTED {
+        let _ = writeln!(s, "  ... and {} more", total - CHECK_LISTED);
+    }
 }
 
 /// One-paragraph summary of a finished run.

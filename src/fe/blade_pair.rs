@@ -39,6 +39,9 @@
 //! | 3D | 2 | 83 259 (≈ 100 k) |
 //! | 3D | 5 | 1 212 327 (≈ 1 M) |
 //!
+//! In 2D each contact face carries 3·refine·contact_refine + 1 node pairs: `contact_refine`
+//! refines the contact faces and the damper alone, for many contact points on coarse blades.
+//!
 //! `fricbound mesh blade-pair --refine N [--3d]` prints the counts of any mesh; a test checks
 //! the small ones.
 
@@ -53,6 +56,10 @@ pub const CONTACT_FRACTION: f64 = 0.75;
 pub struct BladePairParams {
     /// Refinement: element size = blade_width / (5 · refine). ≥ 1.
     pub refine: usize,
+    /// Extra refinement of the contact faces and the damper (≥ 1): their divisions are
+    /// multiplied by it, so a coarse blade can carry many contact pairs per side (the platform
+    /// elements under the contact become slender along the face).
+    pub contact_refine: usize,
     /// Apical angle β of the damper (degrees), in [30, 170].
     pub beta_deg: f64,
     /// Blade length L, root to tip (m).
@@ -77,6 +84,7 @@ impl Default for BladePairParams {
     fn default() -> Self {
         BladePairParams {
             refine: 1,
+            contact_refine: 1,
             beta_deg: 120.0,
             blade_length: 0.1,
             blade_width: 0.01,
@@ -150,6 +158,12 @@ impl BladePairParams {
         if self.refine == 0 || self.refine > 1000 {
             return bad(format!("refine = {} must lie in 1..=1000", self.refine));
         }
+        if self.contact_refine == 0 || self.contact_refine > 1000 {
+            return bad(format!(
+                "contact_refine = {} must lie in 1..=1000",
+                self.contact_refine
+            ));
+        }
         if !(self.beta_deg.is_finite() && (30.0..=170.0).contains(&self.beta_deg)) {
             return bad(format!(
                 "beta = {} degrees must lie in [30, 170] (the damper degenerates towards 180)",
@@ -213,7 +227,8 @@ impl BladePairParams {
         let count = |len: f64, min: usize| ((len / h).round() as usize).max(min);
         let face = dist(g.base_left, g.apex);
         // Contact divisions 3k with the whole face 4k, so nodes fall on the contact end.
-        let k = ((CONTACT_FRACTION * face / (3.0 * h)).round() as usize).max(1);
+        let k =
+            ((CONTACT_FRACTION * face / (3.0 * h)).round() as usize).max(1) * self.contact_refine;
         let blade_x = count(g.b, 2).next_multiple_of(2);
         Ok(Divisions {
             blade_x,
