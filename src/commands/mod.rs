@@ -33,6 +33,9 @@ pub enum CommandError {
     /// Results on the mesh could not be written.
     #[error(transparent)]
     Vtu(#[from] crate::fe::VtuError),
+    /// The stuck-contact modes on the mesh could not be computed or written.
+    #[error(transparent)]
+    Modes(#[from] crate::report::mesh_modes::MeshModesError),
     /// A result file could not be written.
     #[error(transparent)]
     Write(#[from] WriteError),
@@ -319,6 +322,7 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
         .unwrap_or_else(|| PathBuf::from("out").join(stem));
     create_dir(&dir)?;
     let (open, stuck) = linear_references(&label, &problem, &dir)?;
+    crate::report::mesh_modes::write_stuck_modes(&dir, &problem, MESH_MODES)?;
     let ctx = RunContext {
         scene_text,
         label,
@@ -337,6 +341,9 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
     }
     run_frf(&ctx)
 }
+
+/// Stuck-contact modes written on the mesh for FE scenes (`modes_stuck.vtu`).
+const MESH_MODES: usize = 10;
 
 fn create_dir(dir: &Path) -> Result<(), CommandError> {
     std::fs::create_dir_all(dir).map_err(|source| CommandError::OutputDir {
