@@ -13,6 +13,15 @@
 //! step is cut and the reason reported to the observer; below the minimum step the run ends
 //! with [`ContinuationError::Stalled`]. Turning points (sign changes of dω/ds) are reported and
 //! traversed. The last point is solved at exactly the end frequency.
+//!
+//! On large problems (at least [`Analysis::chord_min_unknowns`] unknowns) the corrector takes
+//! chord iterations: the bordered Newton matrix factorised at one iterate is reused for the
+//! next steps as long as each cuts the relative residual by at least a factor of 4; otherwise the
+//! Jacobian is evaluated and factorised afresh at the current iterate. A chord step costs one
+//! residual and two triangular solves against an O(n³) factorisation of a Newton matrix that
+//! is dense in the contact DOFs of a reduced model. The convergence tests are the same, on the
+//! true residual, so the points are those of full Newton; the iteration count reported (and
+//! used for step adaptation) counts three chord steps as one iteration.
 
 use std::f64::consts::PI;
 
@@ -206,6 +215,12 @@ pub struct Continuation {
 const OMEGA_SCALE: f64 = 2.0 * PI;
 /// Leaps tried past a spot the corrector cannot pass, as fractions of the largest step.
 const LEAPS: &[f64] = &[0.02, 0.1, 0.5];
+/// Chord iterations of the corrector counted as one Newton iteration (for step adaptation and
+/// reports), and the factor of the iteration limit allowed with chord iterations.
+const CHORD_STEPS_PER_ITERATION: usize = 3;
+/// A chord iteration must cut the relative residual at least by this factor, else the
+/// Jacobian is recomputed and factorised at the current iterate.
+const CHORD_CONTRACTION: f64 = 0.25;
 /// Largest turn of the tangent in one step before the step is cut (unless it is a corner).
 const MAX_TURN_DEGREES: f64 = 45.0;
 
@@ -345,22 +360,42 @@ impl Continuation {
         let mut trial = vec![0.0; n];
         let mut first = f64::NAN;
         let mut rel = f64::INFINITY;
-        for it in 1..=self.analysis.max_iterations {
+        // Chord iterations on large problems: the factorised bordered matrix is reused while
+        // the residual keeps falling fast enough (see the module docs).
+        let chord = n >= self.analysis.chord_min_unknowns;
+        let mut factor: Option<crate::jacobian::BorderedFactor> = None;
+        let (mut factorisations, mut chord_steps) = (0usize, 0usize);
+        let effort = |f: usize, c: usize| (f + c / CHORD_STEPS_PER_ITERATION).max(1);
+        let limit = if chord {
+            CHORD_STEPS_PER_ITERATION * self.analysis.max_iterations
+        } else {
+            self.analysis.max_iterations
+        };
+        for it in 1..=limit {
             for i in 0..n {
                 x[i] = y[i] * self.x_scale;
             }
             let omega = y[n] * OMEGA_SCALE;
-            system
-                .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
-                .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
-            rel = norm(&r) / scale;
+            let previous = rel;
+            if factor.is_some() {
+                system
+                    .residual(&x, omega, &mut r)
+                    .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
+                rel = norm(&r) / scale;
+                if rel > CHORD_CONTRACTION * previous && rel > self.analysis.residual_tolerance {
+                    factor = None;
+                }
+            }
+            if factor.is_none() {
+                system
+                    .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
+                    .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
+                rel = norm(&r) / scale;
+            }
             if first.is_nan() {
                 first = rel;
             } else if rel > 1e4 * first.max(self.analysis.residual_tolerance) {
                 return Err(NewtonFailure::Diverged { residual: rel });
-            }
-            for i in 0..n {
-                col[i] = dr[i] * OMEGA_SCALE;
             }
             let mut rhs: Vec<f64> = r.iter().map(|v| -v).collect();
             rhs.push(
@@ -368,7 +403,31 @@ impl Continuation {
                     .map(|j| tangent[j] * (y[j] - predicted[j]))
                     .sum::<f64>(),
             );
-            let mut dy = jac.solve_bordered(self.x_scale, &col, tangent, &rhs)?;
+            let mut dy = match (&factor, chord) {
+                (Some(f), _) => {
+                    chord_steps += 1;
+                    f.solve(&rhs)?
+                }
+                (None, _) => {
+                    for i in 0..n {
+                        col[i] = dr[i] * OMEGA_SCALE;
+                    }
+                    factorisations += 1;
+                    if chord {
+                        let f = jac.factor_bordered(self.x_scale, &col, tangent)?;
+                        let d = f.solve(&rhs)?;
+                        factor = Some(f);
+                        d
+                    } else {
+                        jac.solve_bordered(self.x_scale, &col, tangent, &rhs)?
+                    }
+                }
+            };
+            let it = if chord {
+                effort(factorisations, chord_steps)
+            } else {
+                it
+            };
             if rel <= self.analysis.residual_tolerance {
                 // At tolerance, a Newton step that does not lower the residual only moves
                 // through round-off (amplified by the Jacobian's condition number near a
@@ -424,7 +483,7 @@ impl Continuation {
             }
         }
         Err(NewtonFailure::MaxIterations {
-            iterations: self.analysis.max_iterations,
+            iterations: limit,
             residual: rel,
         })
     }

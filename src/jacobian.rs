@@ -31,7 +31,59 @@ use faer::prelude::Solve;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::Mat;
 
-use crate::linalg::{solve_dense, LinearSolveError};
+use crate::linalg::{checked_lu, solve_dense, LinearSolveError};
+
+/// A factorised bordered matrix [[s·J, col], [row]], kept for several solves (the chord
+/// iterations of the corrector on large problems, see [`crate::continuation`]).
+pub struct BorderedFactor {
+    kind: FactorKind,
+}
+
+enum FactorKind {
+    /// LU of the whole (n + 1) × (n + 1) matrix.
+    Dense(faer::linalg::solvers::PartialPivLu<f64>),
+    /// LU of s·J with the border eliminated by blocks: a = (sJ)⁻¹ f, z = (g − r·a)/d,
+    /// y = a − b z with b = (sJ)⁻¹ col and d = row[n] − r·b.
+    Sparse {
+        lu: Box<faer::sparse::linalg::solvers::Lu<usize, f64>>,
+        b_col: Vec<f64>,
+        row: Vec<f64>,
+        denominator: f64,
+    },
+}
+
+impl BorderedFactor {
+    /// Solves the factorised bordered system for `rhs` (length n + 1).
+    pub fn solve(&self, rhs: &[f64]) -> Result<Vec<f64>, LinearSolveError> {
+        if rhs.iter().any(|v| !v.is_finite()) {
+            return Err(LinearSolveError::NonFinite);
+        }
+        let n1 = rhs.len();
+        let y: Vec<f64> = match &self.kind {
+            FactorKind::Dense(lu) => {
+                let x = lu.solve(Mat::from_fn(n1, 1, |i, _| rhs[i]));
+                (0..n1).map(|i| x[(i, 0)]).collect()
+            }
+            FactorKind::Sparse {
+                lu,
+                b_col,
+                row,
+                denominator,
+            } => {
+                let n = n1 - 1;
+                let a = lu.solve(Mat::from_fn(n, 1, |i, _| rhs[i]));
+                let z = (rhs[n] - (0..n).map(|i| row[i] * a[(i, 0)]).sum::<f64>()) / denominator;
+                let mut y: Vec<f64> = (0..n).map(|i| a[(i, 0)] - b_col[i] * z).collect();
+                y.push(z);
+                y
+            }
+        };
+        if y.iter().any(|v| !v.is_finite()) {
+            return Err(LinearSolveError::Singular { ratio: 0.0 });
+        }
+        Ok(y)
+    }
+}
 
 /// Dense or sparse storage of a Jacobian, chosen per problem.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -213,6 +265,48 @@ impl AssembledJacobian {
             }
             Storage::Sparse => self.solve_sparse_bordered(col_scale, col, row, rhs),
         }
+    }
+
+    /// Factorises the bordered matrix [[s·J, col], [row]] for several solves
+    /// ([`BorderedFactor::solve`], without the refinement steps of [`Self::solve_bordered`]).
+    pub fn factor_bordered(
+        &mut self,
+        col_scale: f64,
+        col: &[f64],
+        row: &[f64],
+    ) -> Result<BorderedFactor, LinearSolveError> {
+        let n = self.n;
+        if col.iter().chain(row).any(|v| !v.is_finite()) {
+            return Err(LinearSolveError::NonFinite);
+        }
+        let kind = match self.storage {
+            Storage::Dense => {
+                let a = Mat::from_fn(n + 1, n + 1, |i, j| match (i < n, j < n) {
+                    (true, true) => self.values[i + j * n] * col_scale,
+                    (true, false) => col[i],
+                    (false, _) => row[j],
+                });
+                let lu = checked_lu(&a)?;
+                self.factorisations += 1;
+                FactorKind::Dense(lu)
+            }
+            Storage::Sparse => {
+                let lu = self.sparse_lu(col_scale)?;
+                let b = lu.solve(Mat::from_fn(n, 1, |i, _| col[i]));
+                let b_col: Vec<f64> = (0..n).map(|i| b[(i, 0)]).collect();
+                let denominator = row[n] - (0..n).map(|i| row[i] * b_col[i]).sum::<f64>();
+                if denominator == 0.0 || !denominator.is_finite() {
+                    return Err(LinearSolveError::Singular { ratio: 0.0 });
+                }
+                FactorKind::Sparse {
+                    lu: Box::new(lu),
+                    b_col,
+                    row: row.to_vec(),
+                    denominator,
+                }
+            }
+        };
+        Ok(BorderedFactor { kind })
     }
 
     /// Numeric LU of s·J with the shared symbolic factorisation.

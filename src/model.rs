@@ -128,7 +128,14 @@ pub struct Analysis {
     pub formulation: Formulation,
     /// Points of the uniform frequency grid of the linear references.
     pub linear_points: usize,
+    /// Unknowns from which the continuation corrector reuses a factorised Jacobian over
+    /// several iterations (chord iterations) while the residual falls fast enough: on large
+    /// dense Newton matrices the factorisation dominates and a chord step costs a residual.
+    pub chord_min_unknowns: usize,
 }
+
+/// Default of [`Analysis::chord_min_unknowns`].
+pub const CHORD_MIN_UNKNOWNS: usize = 1500;
 
 /// A checked problem, ready to solve.
 #[derive(Debug, Clone)]

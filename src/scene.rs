@@ -1379,6 +1379,7 @@ impl Scene {
                 jacobian: a.jacobian,
                 formulation: a.formulation,
                 linear_points: a.linear_points,
+                chord_min_unknowns: crate::model::CHORD_MIN_UNKNOWNS,
             },
             outputs,
             limits: self.validate_limits(&ck)?,

@@ -1,0 +1,52 @@
+//! Times one limit curve (m = +1 on every contact point) of the reduced blade pair with many
+//! contact pairs per side: `cargo run --release --example limit_curve_timing -- [contact_refine]
+//! [H] [max_points] [chord_min_unknowns] [fd]` (defaults 8, 3, 150, the library default; `fd`
+//! = 1 for forward differences). The scaling study (`fricbound bench scaling`) measures the
+//! same case among others.
+
+use fricbound::model::{Formulation, JacobianStrategy};
+use fricbound::scaling::{self, ModelSize};
+
+fn main() {
+    let args: Vec<usize> = std::env::args()
+        .skip(1)
+        .map(|a| a.parse().expect("integer arguments"))
+        .collect();
+    let arg = |i: usize, default: usize| args.get(i).copied().unwrap_or(default);
+    let size = ModelSize {
+        three_d: false,
+        refine: 2,
+        contact_refine: arg(0, 8),
+    };
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let mut reduced = scaling::reduced_problem(size, 20, dir.path()).expect("reduced model");
+    reduced.analysis.chord_min_unknowns = arg(3, fricbound::model::CHORD_MIN_UNKNOWNS);
+    let m = scaling::measure_solve(
+        &size.label(),
+        &reduced,
+        arg(1, 3),
+        Formulation::Auto,
+        if arg(4, 0) == 1 {
+            JacobianStrategy::ForwardDifference
+        } else {
+            JacobianStrategy::Analytic
+        },
+        1.0,
+        Some(arg(2, 150)),
+    )
+    .expect("measured");
+    println!(
+        "{}: {} pairs/side, H = {}, {} unknowns ({}, {}): one iteration {:.1} ms; {} points in {:.2} s, {:.1} ms per point, {} iterations",
+        m.case,
+        m.pairs_per_side,
+        m.harmonics,
+        m.unknowns,
+        m.formulation,
+        m.jacobian,
+        m.iteration_ms,
+        m.points,
+        m.frf_s,
+        m.per_point_ms,
+        m.iterations
+    );
+}
