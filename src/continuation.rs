@@ -210,6 +210,9 @@ pub struct Continuation {
     pub analysis: Analysis,
     /// Scale of x in the arc length (m).
     pub x_scale: f64,
+    /// Chord corrector only: the factorisation of its last iterate with the tangent row it
+    /// was built with, reused for the tangent at the corrected point.
+    last_factor: std::cell::RefCell<Option<(Vec<f64>, crate::jacobian::BorderedFactor)>>,
 }
 
 const OMEGA_SCALE: f64 = 2.0 * PI;
@@ -225,6 +228,20 @@ const CHORD_CONTRACTION: f64 = 0.25;
 const MAX_TURN_DEGREES: f64 = 45.0;
 
 impl Continuation {
+    /// A driver with these settings and arc-length scale of x (m).
+    pub fn new(analysis: Analysis, x_scale: f64) -> Self {
+        Self {
+            analysis,
+            x_scale,
+            last_factor: std::cell::RefCell::new(None),
+        }
+    }
+
+    /// Keeps the chord corrector's last factorisation for the tangent at its point.
+    fn keep_factor(&self, factor: Option<crate::jacobian::BorderedFactor>, tangent: &[f64]) {
+        *self.last_factor.borrow_mut() = factor.map(|f| (tangent.to_vec(), f));
+    }
+
     /// Convergence test of a Newton iterate: the relative residual at tolerance and the scaled
     /// step below its tolerance.
     fn converged(&self, relative_residual: f64, step: f64) -> bool {
@@ -310,6 +327,23 @@ impl Continuation {
         previous: Option<&[f64]>,
     ) -> Result<Vec<f64>, NewtonFailure> {
         let n = system.dim();
+        let mut rhs = vec![0.0; n + 1];
+        rhs[n] = 1.0;
+        // Chord corrector: the factorisation of its last iterate, built with the same tangent
+        // row, gives the tangent without a new Jacobian (its iterate is within the corrector's
+        // tolerance of the point, and the tangent only orients the next prediction).
+        let kept = self.last_factor.borrow_mut().take();
+        if let (Some((row, factor)), Some(p)) = (kept, previous) {
+            if row == p {
+                let mut t = factor.solve(&rhs)?;
+                let nt = norm(&t);
+                t.iter_mut().for_each(|v| *v /= nt);
+                if dot(&t, p) < 0.0 {
+                    t.iter_mut().for_each(|v| *v = -*v);
+                }
+                return Ok(t);
+            }
+        }
         let mut r = vec![0.0; n];
         let mut dr = vec![0.0; n];
         let mut jac = system.new_jacobian();
@@ -317,8 +351,6 @@ impl Continuation {
             .residual_and_jacobian(&point.x, point.omega, &mut r, &mut jac, &mut dr)
             .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
         let col: Vec<f64> = dr.iter().map(|v| v * OMEGA_SCALE).collect();
-        let mut rhs = vec![0.0; n + 1];
-        rhs[n] = 1.0;
         let row = match previous {
             Some(p) => p.to_vec(),
             None => {
@@ -363,6 +395,7 @@ impl Continuation {
         // Chord iterations on large problems: the factorised bordered matrix is reused while
         // the residual keeps falling fast enough (see the module docs).
         let chord = n >= self.analysis.chord_min_unknowns;
+        *self.last_factor.borrow_mut() = None;
         let mut factor: Option<crate::jacobian::BorderedFactor> = None;
         let (mut factorisations, mut chord_steps) = (0usize, 0usize);
         let effort = |f: usize, c: usize| (f + c / CHORD_STEPS_PER_ITERATION).max(1);
@@ -439,6 +472,7 @@ impl Continuation {
                     .residual(&trial, (y[n] + dy[n]) * OMEGA_SCALE, &mut r)
                     .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
                 if norm(&r) / scale >= rel {
+                    self.keep_factor(factor.take(), tangent);
                     return Ok((y, it, rel));
                 }
             } else {
@@ -466,6 +500,7 @@ impl Continuation {
             }
             let step = norm(&dy);
             if self.converged(rel, step) {
+                self.keep_factor(factor.take(), tangent);
                 return Ok((y, it, rel));
             }
             if step <= self.analysis.step_tolerance {
@@ -478,6 +513,7 @@ impl Continuation {
                     .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
                 let rel_new = norm(&r) / scale;
                 if rel_new <= self.analysis.residual_tolerance {
+                    self.keep_factor(factor.take(), tangent);
                     return Ok((y, it, rel_new));
                 }
             }

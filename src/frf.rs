@@ -188,10 +188,7 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
     let set = system.unknowns().clone();
     let omega0 = 2.0 * PI * problem.analysis.freq_start_hz;
     let guess = system.restrict(&linear::stuck_guess(problem, &set, omega0)?);
-    let continuation = Continuation {
-        analysis: problem.analysis,
-        x_scale: arc_length_x_scale(problem, &set)?,
-    };
+    let continuation = Continuation::new(problem.analysis, arc_length_x_scale(problem, &set)?);
     let mut adapter = Adapter {
         observer,
         points: Vec::new(),
@@ -223,10 +220,7 @@ impl<'p> PointSolver<'p> {
     pub fn new(problem: &'p Problem) -> Result<Self, FrfError> {
         let system = HbmOperator::new(problem)?;
         let set = system.unknowns().clone();
-        let continuation = Continuation {
-            analysis: problem.analysis,
-            x_scale: arc_length_x_scale(problem, &set)?,
-        };
+        let continuation = Continuation::new(problem.analysis, arc_length_x_scale(problem, &set)?);
         Ok(Self {
             system,
             continuation,
