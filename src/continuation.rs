@@ -21,7 +21,9 @@
 //! residual and two triangular solves against an O(n³) factorisation of a Newton matrix that
 //! is dense in the contact DOFs of a reduced model. The convergence tests are the same, on the
 //! true residual, so the points are those of full Newton; the iteration count reported (and
-//! used for step adaptation) counts three chord steps as one iteration.
+//! used for step adaptation) counts three chord steps as one iteration. The tangent at the
+//! corrected point is then solved with the corrector's last factorisation (the same bordered
+//! system, its iterate within tolerance of the point) instead of a new Jacobian.
 
 use std::f64::consts::PI;
 
