@@ -247,22 +247,7 @@ impl AssembledJacobian {
         rhs: &[f64],
     ) -> Result<Vec<f64>, LinearSolveError> {
         match self.storage {
-            Storage::Dense => {
-                let n = self.n;
-                let mut a = Mat::<f64>::zeros(n + 1, n + 1);
-                for j in 0..n {
-                    for i in 0..n {
-                        a[(i, j)] = self.values[i + j * n] * col_scale;
-                    }
-                }
-                for i in 0..n {
-                    a[(i, n)] = col[i];
-                }
-                for j in 0..=n {
-                    a[(n, j)] = row[j];
-                }
-                solve_dense(&a, rhs)
-            }
+            Storage::Dense => self.factor_bordered(col_scale, col, row)?.solve(rhs),
             Storage::Sparse => self.solve_sparse_bordered(col_scale, col, row, rhs),
         }
     }
@@ -394,36 +379,18 @@ impl AssembledJacobian {
         rhs: &[f64],
     ) -> Result<Vec<f64>, LinearSolveError> {
         let n = self.n;
-        if rhs.iter().chain(col).chain(row).any(|v| !v.is_finite()) {
-            return Err(LinearSolveError::NonFinite);
-        }
-        let lu = self.sparse_lu(col_scale)?;
-        let two = Mat::from_fn(n, 2, |i, j| if j == 0 { rhs[i] } else { col[i] });
-        let ab = lu.solve(&two);
-        let dot_row = |v: &dyn Fn(usize) -> f64| (0..n).map(|i| row[i] * v(i)).sum::<f64>();
+        // One LU of s·J (non-finite input is refused by the factorisation and its solves); each solve eliminates the border by blocks.
+        let factor = self.factor_bordered(col_scale, col, row)?;
+        let dot_row = |y: &[f64]| (0..n).map(|i| row[i] * y[i]).sum::<f64>();
         // Bordered residual of (y, z): [f − sJ y − c z; g − r·y − d z].
         let bordered_residual = |y: &[f64], z: f64| -> Vec<f64> {
             let mut r: Vec<f64> = (0..n).map(|i| -(rhs[i] - col[i] * z)).collect();
             self.mul_add(col_scale, y, &mut r);
             let mut out: Vec<f64> = r.iter().map(|v| -v).collect();
-            out.push(rhs[n] - dot_row(&|i| y[i]) - row[n] * z);
+            out.push(rhs[n] - dot_row(y) - row[n] * z);
             out
         };
-        let b_col: Vec<f64> = (0..n).map(|i| ab[(i, 1)]).collect();
-        let denominator = row[n] - dot_row(&|i| b_col[i]);
-        if denominator == 0.0 || !denominator.is_finite() {
-            return Err(LinearSolveError::Singular { ratio: 0.0 });
-        }
-        // Solves the bordered system for a right-hand side (f, g) by block elimination.
-        let eliminate = |f: &[f64], g: f64| -> Vec<f64> {
-            let m = Mat::from_fn(n, 1, |i, _| f[i]);
-            let a = lu.solve(&m);
-            let z = (g - dot_row(&|i| a[(i, 0)])) / denominator;
-            let mut y: Vec<f64> = (0..n).map(|i| a[(i, 0)] - b_col[i] * z).collect();
-            y.push(z);
-            y
-        };
-        let mut y = eliminate(&rhs[..n], rhs[n]);
+        let mut y = factor.solve(rhs)?;
         let scale = norm(rhs).max(f64::MIN_POSITIVE);
         for _ in 0..3 {
             let r = bordered_residual(&y[..n], y[n]);
@@ -433,7 +400,7 @@ impl AssembledJacobian {
             if norm(&r) <= 1e-12 * scale {
                 break;
             }
-            let d = eliminate(&r[..n], r[n]);
+            let d = factor.solve(&r)?;
             y.iter_mut().zip(&d).for_each(|(a, b)| *a += b);
         }
         let rn = norm(&bordered_residual(&y[..n], y[n]));
