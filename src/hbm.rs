@@ -24,6 +24,8 @@ use crate::jacobian::{AssembledJacobian, Storage};
 use crate::linalg::LinearSolveError;
 use crate::model::{Coupling, Formulation, JacobianStrategy, Problem};
 use crate::pattern::{ContactSlots, JacobianLayout};
+use crate::schur::{RelativeCoordinates, RelativeCoordinatesError};
+use std::sync::Arc;
 
 /// Errors while evaluating or solving the harmonic balance.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -39,6 +41,9 @@ pub enum HbmError {
     /// A linear solve failed.
     #[error("linear solve: {0}")]
     Linear(#[from] LinearSolveError),
+    /// The problem does not admit the formulation asked for.
+    #[error("formulation: {0}")]
+    Formulation(#[from] RelativeCoordinatesError),
     /// The static pre-solve of the uncoupled mode did not converge.
     #[error("static pre-solve did not converge in {iterations} iterations (relative residual {residual:.3e})")]
     StaticNotConverged {
@@ -69,6 +74,8 @@ pub struct HbmSystem<'p> {
     storage: Storage,
     /// Pattern and slot tables, built on the first Jacobian request.
     layout: Option<JacobianLayout>,
+    /// Relative contact coordinates of the schur formulation.
+    relative: Option<Arc<RelativeCoordinates>>,
 }
 
 impl<'p> HbmSystem<'p> {
@@ -107,6 +114,15 @@ impl<'p> HbmSystem<'p> {
             Coupling::Coupled => vec![0.0; n],
             Coupling::Uncoupled => static_solve(problem)?,
         };
+        let storage = match problem.formulation() {
+            Formulation::Sparse => Storage::Sparse,
+            Formulation::Schur => Storage::Schur,
+            _ => Storage::Dense,
+        };
+        let relative = match storage {
+            Storage::Schur => Some(Arc::new(RelativeCoordinates::new(problem, &unknowns)?)),
+            _ => None,
+        };
         Ok(Self {
             problem,
             block_map,
@@ -117,11 +133,9 @@ impl<'p> HbmSystem<'p> {
             v_coef: vec![0.0; nbf],
             states: vec![ContactState::Open; problem.contacts.len()],
             strategy: problem.analysis.jacobian,
-            storage: match problem.formulation() {
-                Formulation::Sparse => Storage::Sparse,
-                _ => Storage::Dense,
-            },
+            storage,
             layout: None,
+            relative,
             unknowns,
         })
     }
@@ -131,21 +145,30 @@ impl<'p> HbmSystem<'p> {
         self.storage
     }
 
-    /// Uses `storage` for the Jacobian from now on (for comparisons and benchmarks).
-    pub fn set_storage(&mut self, storage: Storage) {
+    /// Uses `storage` for the Jacobian from now on (for comparisons and benchmarks); the
+    /// schur storage fails when the problem has no independent relative contact coordinates.
+    pub fn set_storage(&mut self, storage: Storage) -> Result<(), HbmError> {
+        if storage == Storage::Schur && self.relative.is_none() {
+            self.relative = Some(Arc::new(RelativeCoordinates::new(
+                self.problem,
+                &self.unknowns,
+            )?));
+        }
         if storage != self.storage {
             self.storage = storage;
             self.layout = None;
         }
+        Ok(())
     }
 
     fn layout(&mut self) -> &JacobianLayout {
         if self.layout.is_none() {
-            self.layout = Some(JacobianLayout::new(
-                self.problem,
-                &self.unknowns,
-                self.storage,
-            ));
+            self.layout = Some(match (&self.relative, self.storage) {
+                (Some(r), Storage::Schur) => {
+                    JacobianLayout::relative(self.problem, &self.unknowns, Arc::clone(r))
+                }
+                _ => JacobianLayout::new(self.problem, &self.unknowns, self.storage),
+            });
         }
         self.layout.as_ref().expect("built above")
     }
@@ -233,33 +256,43 @@ impl<'p> HbmSystem<'p> {
         Ok(report.state)
     }
 
-    /// Linear part D(ω)x − F̂_ex into r, and ∂(D x)/∂ω into `dr_domega` if given.
+    /// Linear part D(ω)x − F̂_ex into r, and ∂(D x)/∂ω into `dr_domega` if given. K, M and C
+    /// are applied to all coefficient blocks at once ([`StructuralMatrix::mul_blocks`]).
+    ///
+    /// [`StructuralMatrix::mul_blocks`]: crate::matrix::StructuralMatrix::mul_blocks
     fn linear_residual(&self, x: &[f64], omega: f64, r: &mut [f64], dr_domega: Option<&mut [f64]>) {
         let n = self.problem.model.n_dofs();
         let m = &self.problem.model;
         let blocks = self.unknowns.blocks();
+        let nb = blocks.len();
+        let kx = m.stiffness.mul_blocks(x, nb);
+        let mx = m.mass.mul_blocks(x, nb);
+        let cx = m.damping.mul_blocks(x, nb);
         for (j, b) in blocks.iter().enumerate() {
             let hw = b.harmonic() as f64 * omega;
-            let xj = &x[j * n..(j + 1) * n];
+            let partner = self.partner(*b);
             let rj = &mut r[j * n..(j + 1) * n];
             for (p, v) in rj.iter_mut().enumerate() {
-                *v = -self.excitation[j * n + p];
+                *v = kx[(p, j)] - hw * hw * mx[(p, j)] - self.excitation[j * n + p];
             }
-            m.stiffness.mul_add(1.0, xj, rj);
-            m.mass.mul_add(-hw * hw, xj, rj);
-            if let Some((pj, c_sign)) = self.partner(*b) {
-                m.damping.mul_add(c_sign * hw, &x[pj * n..(pj + 1) * n], rj);
+            if let Some((pj, c_sign)) = partner {
+                for (p, v) in rj.iter_mut().enumerate() {
+                    *v += c_sign * hw * cx[(p, pj)];
+                }
             }
         }
         if let Some(dr) = dr_domega {
-            dr.iter_mut().for_each(|v| *v = 0.0);
             for (j, b) in blocks.iter().enumerate() {
                 let h = b.harmonic() as f64;
-                let xj = &x[j * n..(j + 1) * n];
+                let partner = self.partner(*b);
                 let drj = &mut dr[j * n..(j + 1) * n];
-                m.mass.mul_add(-2.0 * h * h * omega, xj, drj);
-                if let Some((pj, c_sign)) = self.partner(*b) {
-                    m.damping.mul_add(c_sign * h, &x[pj * n..(pj + 1) * n], drj);
+                for (p, v) in drj.iter_mut().enumerate() {
+                    *v = -2.0 * h * h * omega * mx[(p, j)];
+                }
+                if let Some((pj, c_sign)) = partner {
+                    for (p, v) in drj.iter_mut().enumerate() {
+                        *v += c_sign * h * cx[(p, pj)];
+                    }
                 }
             }
         }
@@ -284,6 +317,7 @@ impl<'p> HbmSystem<'p> {
     /// Linear part of ∂R/∂x into `jac` (overwrites).
     fn linear_jacobian(&mut self, omega: f64, jac: &mut AssembledJacobian) {
         jac.clear();
+        jac.set_frequency(omega);
         let blocks = self.unknowns.blocks().to_vec();
         let partners: Vec<Option<(usize, f64)>> = blocks.iter().map(|b| self.partner(*b)).collect();
         let layout = self.layout();
@@ -399,6 +433,18 @@ impl<'p> HbmSystem<'p> {
                 self.linear_jacobian(omega, jac);
                 self.add_contacts(x, r, Some(jac))
             }
+            JacobianStrategy::ForwardDifference | JacobianStrategy::CentralDifference
+                if self.storage == Storage::Schur =>
+            {
+                self.linear_residual(x, omega, r, Some(dr_domega));
+                self.linear_jacobian(omega, jac);
+                self.add_contacts(x, r, None)?;
+                let states = self.states.clone();
+                let central = self.strategy == JacobianStrategy::CentralDifference;
+                self.contact_difference_blocks(x, central, jac)?;
+                self.states = states;
+                Ok(())
+            }
             JacobianStrategy::ForwardDifference | JacobianStrategy::CentralDifference => {
                 self.layout();
                 self.linear_residual(x, omega, r, Some(dr_domega));
@@ -409,6 +455,85 @@ impl<'p> HbmSystem<'p> {
                 Ok(())
             }
         }
+    }
+
+    /// The contact blocks of the schur storage by forward or central differences of each
+    /// contact's AFT with respect to its own relative-coordinate coefficients (û, v̂ on every
+    /// unknown block): 2·blocks (forward) or 4·blocks (central) contact evaluations per
+    /// contact, the linear part being exact. Steps as in [`finite_difference_jacobian`],
+    /// relative to |coefficient| or, when smaller, the RMS of x.
+    fn contact_difference_blocks(
+        &mut self,
+        x: &[f64],
+        central: bool,
+        jac: &mut AssembledJacobian,
+    ) -> Result<(), HbmError> {
+        let nb = self.block_map.len();
+        let dim = x.len().max(1);
+        let typical = (x.iter().map(|v| v * v).sum::<f64>() / dim as f64).sqrt();
+        let eps = if central { 6e-6 } else { 1.5e-8 };
+        let problem = self.problem;
+        let slots = self
+            .layout()
+            .contacts
+            .iter()
+            .map(|c| c.slots.clone())
+            .collect::<Vec<_>>();
+        for c in 0..problem.contacts.len() {
+            self.contact_coefficients(c, x);
+            let (u0, v0) = (self.u_coef.clone(), self.v_coef.clone());
+            let base = self.contact_force_coefficients(c, &u0, &v0)?;
+            for (i, &if_) in self.block_map.clone().iter().enumerate() {
+                for b in 0..2 {
+                    let value = if b == 0 { u0[if_] } else { v0[if_] };
+                    let step = eps * value.abs().max(typical).max(1e-12);
+                    let perturbed = |sign: f64| {
+                        let (mut u, mut v) = (u0.clone(), v0.clone());
+                        if b == 0 {
+                            u[if_] += sign * step;
+                        } else {
+                            v[if_] += sign * step;
+                        }
+                        (u, v)
+                    };
+                    let (up, vp) = perturbed(1.0);
+                    let plus = self.contact_force_coefficients(c, &up, &vp)?;
+                    let minus = if central {
+                        let (um, vm) = perturbed(-1.0);
+                        Some(self.contact_force_coefficients(c, &um, &vm)?)
+                    } else {
+                        None
+                    };
+                    for (j, &jf) in self.block_map.iter().enumerate() {
+                        for a in 0..2 {
+                            let d = match &minus {
+                                Some(m) => (plus[a][jf] - m[a][jf]) / (2.0 * step),
+                                None => (plus[a][jf] - base[a][jf]) / step,
+                            };
+                            jac.add_at(slots[c][((j * nb + i) * 2 + a) * 2 + b], d);
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// T̂ and N̂ (AFT blocks) of contact `c` at given û, v̂ (v̂ including the gap).
+    fn contact_force_coefficients(
+        &mut self,
+        c: usize,
+        u: &[f64],
+        v: &[f64],
+    ) -> Result<[Vec<f64>; 2], HbmError> {
+        let contact = &self.problem.contacts[c];
+        self.aft
+            .evaluate(&contact.law, self.problem.effects.contact, u, v, false)
+            .map_err(|source| HbmError::Aft {
+                contact: contact.name.clone(),
+                source,
+            })?;
+        Ok([self.aft.t_hat.clone(), self.aft.n_hat.clone()])
     }
 
     /// ∂R/∂x by forward or central differences (the strategy decides), given R at x.
@@ -475,6 +600,8 @@ pub fn static_solve(problem: &Problem) -> Result<Vec<f64>, HbmError> {
         .sum::<f64>()
         .sqrt()
         .max(f64::MIN_POSITIVE);
+    // The static system has one block: dense unless the model is held sparse (the schur
+    // formulation's elimination would not pay off on one block).
     let storage = if problem.formulation() == Formulation::Sparse {
         Storage::Sparse
     } else {

@@ -29,4 +29,5 @@ pub mod reference;
 pub mod report;
 pub mod scaling;
 pub mod scene;
+pub mod schur;
 pub mod sweep;

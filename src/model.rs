@@ -96,6 +96,10 @@ pub enum Formulation {
     /// Contact DOFs only: the linear DOFs are eliminated per harmonic (dynamic Schur
     /// complement), dense Jacobian on the contact DOFs.
     Condensed,
+    /// All DOFs in the residual; each linear solve eliminates everything but the relative
+    /// contact coordinates (two per contact point) per harmonic, and factorises a dense
+    /// matrix on those only ([`crate::schur`]). For dense (lumped or reduced) models.
+    Schur,
 }
 
 /// Continuation and Newton settings. Frequencies in Hz; arc-length steps are measured in the
@@ -230,9 +234,10 @@ impl Problem {
     }
 
     /// The formulation actually used: the scene's choice, or for `auto` the sparse one on
-    /// sparse models and on dense models with more than [`DENSE_LIMIT`] unknowns, the
-    /// condensed one on dense models of that size whose contact DOFs are at most half of the
-    /// DOFs, and the dense one otherwise.
+    /// sparse models, the dense one on dense models with at most [`DENSE_LIMIT`] unknowns, and
+    /// on larger dense models the schur one when the contact points have independent relative
+    /// coordinates (see [`crate::schur::check_relative_coordinates`]); otherwise the condensed
+    /// one when the contact DOFs are at most half of the DOFs, and the sparse one.
     pub fn formulation(&self) -> Formulation {
         match self.analysis.formulation {
             Formulation::Auto => {
@@ -241,6 +246,8 @@ impl Problem {
                     Formulation::Sparse
                 } else if unknowns <= DENSE_LIMIT {
                     Formulation::Dense
+                } else if crate::schur::check_relative_coordinates(self).is_ok() {
+                    Formulation::Schur
                 } else if 2 * self.contact_dofs().len() <= self.model.n_dofs() {
                     Formulation::Condensed
                 } else {

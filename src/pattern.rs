@@ -76,7 +76,14 @@ pub struct JacobianLayout {
 
 impl JacobianLayout {
     /// Builds the pattern and slots for `problem` with unknowns `set`, in `storage`.
+    ///
+    /// `Storage::Schur` needs the relative coordinates ([`Self::relative`]); asked here it
+    /// gives the dense layout.
     pub fn new(problem: &Problem, set: &HarmonicSet, storage: Storage) -> Self {
+        let storage = match storage {
+            Storage::Schur => Storage::Dense,
+            s => s,
+        };
         let model = &problem.model;
         let n = model.n_dofs();
         let nb = set.n_blocks();
@@ -109,7 +116,7 @@ impl JacobianLayout {
         let local: Vec<LocalRows> = problem.contacts.iter().map(LocalRows::of).collect();
 
         let template = match storage {
-            Storage::Dense => AssembledJacobian::dense(dim),
+            Storage::Dense | Storage::Schur => AssembledJacobian::dense(dim),
             Storage::Sparse => {
                 let mut entries: Vec<(usize, usize)> = Vec::new();
                 for (j, b) in set.blocks().iter().enumerate() {
@@ -239,6 +246,36 @@ impl JacobianLayout {
             .collect();
         Self {
             storage: Storage::Dense,
+            dim,
+            stiffness: vec![Vec::new(); nb],
+            damping: vec![Vec::new(); nb],
+            contacts,
+            template,
+        }
+    }
+
+    /// The layout of the schur formulation ([`crate::schur`]): no linear slots (the linear
+    /// part is formed from ω when the Jacobian is factorised) and, per contact, its block on
+    /// the contact's own relative coordinates (u, v), slot ((j·blocks + i)·2 + a)·2 + b.
+    pub fn relative(
+        problem: &Problem,
+        set: &HarmonicSet,
+        coords: std::sync::Arc<crate::schur::RelativeCoordinates>,
+    ) -> Self {
+        let nb = set.n_blocks();
+        let dim = problem.model.n_dofs() * nb;
+        let template = AssembledJacobian::schur(coords);
+        let per_contact = 4 * nb * nb;
+        let contacts = (0..problem.contacts.len())
+            .map(|p| ContactSlots {
+                dofs: 2,
+                tangential: vec![(0, 1.0)],
+                normal: vec![(1, 1.0)],
+                slots: (p * per_contact..(p + 1) * per_contact).collect(),
+            })
+            .collect();
+        Self {
+            storage: Storage::Schur,
             dim,
             stiffness: vec![Vec::new(); nb],
             damping: vec![Vec::new(); nb],

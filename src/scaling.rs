@@ -313,6 +313,7 @@ pub fn formulation_name(f: Formulation) -> &'static str {
         Formulation::Dense => "dense",
         Formulation::Sparse => "sparse",
         Formulation::Condensed => "condensed",
+        Formulation::Schur => "schur",
     }
 }
 

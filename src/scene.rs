@@ -461,7 +461,7 @@ pub struct AnalysisSpec {
     /// `analytic` (default), `forward-difference` or `central-difference`.
     #[serde(default)]
     pub jacobian: JacobianStrategy,
-    /// `auto` (default), `dense`, `sparse` or `condensed`.
+    /// `auto` (default), `dense`, `sparse`, `condensed` or `schur`.
     #[serde(default)]
     pub formulation: Formulation,
     /// Points of the uniform grid for the linear references.
@@ -1422,6 +1422,10 @@ impl Scene {
             }
         };
         check_stuck_structure(&ck, &problem)?;
+        if problem.analysis.formulation == Formulation::Schur {
+            crate::schur::check_relative_coordinates(&problem)
+                .map_err(|e| ck.err("analysis.formulation", e.to_string()))?;
+        }
         Ok(problem)
     }
 

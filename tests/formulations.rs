@@ -1,4 +1,4 @@
-//! Dense, sparse and condensed formulations of the harmonic balance solve the same problem:
+//! Dense, sparse, condensed and schur formulations of the harmonic balance solve the same problem:
 //! same solutions to solver tolerance, Jacobians that match central differences, and sparse
 //! or dense storage of the structural matrices giving the same answers.
 
@@ -132,6 +132,7 @@ fn all_formulations_agree_on_the_paper_case_around_the_3rd_resonance() {
             "sparse storage, auto",
             with_formulation(sparse_storage(base.clone()), Formulation::Auto),
         ),
+        ("schur", with_formulation(base.clone(), Formulation::Schur)),
     ];
     assert_eq!(variants[2].1.formulation(), Formulation::Sparse);
     assert_variants_agree(&base, &variants);
@@ -168,6 +169,21 @@ fn all_formulations_agree_with_eliminated_linear_dofs_and_three_harmonics() {
             p.analysis.jacobian = JacobianStrategy::ForwardDifference;
             p
         }),
+        ("schur", with_formulation(base.clone(), Formulation::Schur)),
+        (
+            "schur, sparse storage",
+            with_formulation(sparse_storage(base.clone()), Formulation::Schur),
+        ),
+        ("schur, forward differences", {
+            let mut p = with_formulation(base.clone(), Formulation::Schur);
+            p.analysis.jacobian = JacobianStrategy::ForwardDifference;
+            p
+        }),
+        ("schur, central differences", {
+            let mut p = with_formulation(base.clone(), Formulation::Schur);
+            p.analysis.jacobian = JacobianStrategy::CentralDifference;
+            p
+        }),
     ];
     assert_variants_agree(&base, &variants);
 }
@@ -186,6 +202,7 @@ fn uncoupled_statics_agree_between_formulations() {
             "condensed",
             with_formulation(base.clone(), Formulation::Condensed),
         ),
+        ("schur", with_formulation(base.clone(), Formulation::Schur)),
     ];
     assert_variants_agree(&base, &variants);
 }
@@ -200,6 +217,7 @@ fn sparse_and_condensed_jacobians_match_central_differences() {
     let run = frf::solve(&base, &mut Silent).unwrap();
     let sparse = with_formulation(sparse_storage(base.clone()), Formulation::Sparse);
     let condensed = with_formulation(base.clone(), Formulation::Condensed);
+    let schur = with_formulation(base.clone(), Formulation::Schur);
     let mut checked_slipping = 0;
     for p in run.points.iter().step_by(7) {
         let omega = 2.0 * std::f64::consts::PI * p.freq_hz;
@@ -221,6 +239,16 @@ fn sparse_and_condensed_jacobians_match_central_differences() {
             p.freq_hz,
             check.relative()
         );
+        let mut s = HbmSystem::new(&schur).unwrap();
+        assert_eq!(s.storage(), Storage::Schur);
+        let check = check_jacobian(&mut s, &p.coefficients, omega, 1e-7).unwrap();
+        assert!(
+            check.relative() < 1e-6,
+            "schur at {:.3} Hz: {:.3e}",
+            p.freq_hz,
+            check.relative()
+        );
+        schur_solves_match_dense(&base, &schur, &p.coefficients, omega);
         if p.states.iter().any(|s| s.is_unique()) {
             checked_slipping += 1;
         }
@@ -248,11 +276,89 @@ fn full_continuation_runs_agree_between_formulations() {
             .amplitude
     };
     let dense = peak(&base);
-    for f in [Formulation::Sparse, Formulation::Condensed] {
+    for f in [
+        Formulation::Sparse,
+        Formulation::Condensed,
+        Formulation::Schur,
+    ] {
         let other = peak(&with_formulation(base.clone(), f));
         assert!(
             (other - dense).abs() <= 1e-6 * dense,
             "{f:?}: refined peak {other:.8e} vs dense {dense:.8e}"
         );
     }
+}
+
+/// The schur Jacobian at (x, ω) has the dense Jacobian's entries, and its solves (plain and
+/// bordered) give the dense solutions.
+fn schur_solves_match_dense(dense: &Problem, schur: &Problem, x: &[f64], omega: f64) {
+    let mut d = HbmSystem::new(dense).unwrap();
+    let mut s = HbmSystem::new(schur).unwrap();
+    let n = d.dim();
+    let (mut r, mut dw) = (vec![0.0; n], vec![0.0; n]);
+    let mut jd = d.new_jacobian();
+    let mut js = s.new_jacobian();
+    d.residual_and_jacobian(x, omega, &mut r, &mut jd, &mut dw)
+        .unwrap();
+    s.residual_and_jacobian(x, omega, &mut r, &mut js, &mut dw)
+        .unwrap();
+    let (a, b) = (jd.to_dense(), js.to_dense());
+    let scale = (0..n)
+        .flat_map(|i| (0..n).map(move |j| (i, j)))
+        .fold(0.0_f64, |m, (i, j)| m.max(a[(i, j)].abs()));
+    for i in 0..n {
+        for j in 0..n {
+            assert!(
+                (a[(i, j)] - b[(i, j)]).abs() <= 1e-12 * scale,
+                "entry ({i}, {j}): dense {} vs schur {}",
+                a[(i, j)],
+                b[(i, j)]
+            );
+        }
+    }
+    let rhs: Vec<f64> = (0..n).map(|i| ((i * 37 % 11) as f64 - 5.0) * 0.1).collect();
+    let xd = jd.solve(&rhs).unwrap();
+    let xs = js.solve(&rhs).unwrap();
+    let xn = xd.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    for i in 0..n {
+        assert!(
+            (xd[i] - xs[i]).abs() <= 1e-9 * xn,
+            "solve {i}: {} vs {}",
+            xd[i],
+            xs[i]
+        );
+    }
+    let row: Vec<f64> = (0..=n).map(|i| ((i * 13 % 7) as f64 - 3.0) * 0.2).collect();
+    let mut brhs = rhs.clone();
+    brhs.push(0.7);
+    let yd = jd.solve_bordered(3.0, &dw, &row, &brhs).unwrap();
+    let ys = js.solve_bordered(3.0, &dw, &row, &brhs).unwrap();
+    let yn = yd.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    for i in 0..=n {
+        assert!(
+            (yd[i] - ys[i]).abs() <= 1e-9 * yn,
+            "bordered {i}: {} vs {}",
+            yd[i],
+            ys[i]
+        );
+    }
+}
+
+#[test]
+fn schur_formulation_refuses_dependent_contact_rows() {
+    let mut p = with_blade_tips(paper(&[]));
+    let twin = p.contacts[0].clone();
+    p.contacts.push(fricbound::contact::ContactPoint {
+        name: "twin".into(),
+        ..twin
+    });
+    p.analysis.formulation = Formulation::Schur;
+    let err = HbmSystem::new(&p)
+        .err()
+        .expect("dependent rows are refused");
+    assert!(err.to_string().contains("linearly dependent"), "{err}");
+    // `auto` does not pick the schur formulation for such a problem.
+    p.analysis.formulation = Formulation::Auto;
+    p.harmonics = (1..=40).collect();
+    assert_ne!(p.formulation(), Formulation::Schur);
 }
