@@ -206,6 +206,68 @@ pub enum PathEnd {
     MaxPoints,
 }
 
+/// Broyden's ("good") updates of a factorised bordered Newton matrix B₀ over the chord steps
+/// of one corrector, in inverse product form: H_k = (I + a_{k−1} s_{k−1}ᵀ) ⋯ (I + a₀ s₀ᵀ) B₀⁻¹
+/// with s_j the steps taken. Each step needs one solve with B₀ (the same as a plain chord
+/// step) and O(n·k) vector work; the secant updates follow the change of the contact
+/// Jacobian along the iterates, so the residual falls faster than with B₀ alone.
+/// With p = −H_k G(y_{k+1}) and d_k the previous direction, H_k (G_{k+1} − G_k) = d_k − p,
+/// so a_k = (s_k − d_k + p) / (s_kᵀ(d_k − p)) and the next direction is p + a_k (s_kᵀ p).
+#[derive(Default)]
+struct BroydenUpdates {
+    /// (a_j, s_j), oldest first.
+    pairs: Vec<(Vec<f64>, Vec<f64>)>,
+    /// The last direction d_k and the step s_k = α d_k taken along it (None before the step).
+    last: Option<(Vec<f64>, Option<Vec<f64>>)>,
+}
+
+impl BroydenUpdates {
+    /// Forgets the updates (a new base factorisation or border).
+    fn clear(&mut self) {
+        self.pairs.clear();
+        self.last = None;
+    }
+
+    /// A new base factorisation whose first direction is `d`.
+    fn restart(&mut self, d: &[f64]) {
+        self.pairs.clear();
+        self.last = Some((d.to_vec(), None));
+    }
+
+    /// The step along the last direction was taken with length α (α = 0: not taken).
+    fn stepped(&mut self, alpha: f64) {
+        if alpha == 0.0 {
+            self.clear();
+        } else if let Some((d, step)) = &mut self.last {
+            *step = Some(d.iter().map(|v| alpha * v).collect());
+        }
+    }
+
+    /// The next direction from p = −B₀⁻¹ G(y) at the new iterate.
+    fn direction(&mut self, mut p: Vec<f64>) -> Vec<f64> {
+        for (a, s) in &self.pairs {
+            let c = dot(s, &p);
+            p.iter_mut().zip(a).for_each(|(v, ai)| *v += ai * c);
+        }
+        if let Some((d, Some(s))) = self.last.take() {
+            let hy: Vec<f64> = d.iter().zip(&p).map(|(di, pi)| di - pi).collect();
+            let denominator = dot(s.as_slice(), &hy);
+            if denominator.abs() > 1e-12 * norm(&s) * norm(&hy) && denominator.is_finite() {
+                let a: Vec<f64> = s
+                    .iter()
+                    .zip(&hy)
+                    .map(|(si, hi)| (si - hi) / denominator)
+                    .collect();
+                let c = dot(&s, &p);
+                p.iter_mut().zip(&a).for_each(|(v, ai)| *v += ai * c);
+                self.pairs.push((a, s));
+            }
+        }
+        self.last = Some((p.clone(), None));
+        p
+    }
+}
+
 /// Newton/continuation driver.
 pub struct Continuation {
     /// Settings (frequencies in Hz).
@@ -215,6 +277,9 @@ pub struct Continuation {
     /// Chord corrector only: the factorisation of its last iterate with the tangent row it
     /// was built with, reused for the tangent at the corrected point.
     last_factor: std::cell::RefCell<Option<(Vec<f64>, crate::jacobian::BorderedFactor)>>,
+    /// Chord corrector only: the last factorisation made, and the points since it was made,
+    /// for the next corrector to start from (storages whose border is eliminated by blocks).
+    carried: std::cell::RefCell<Option<(crate::jacobian::BorderedFactor, usize)>>,
 }
 
 const OMEGA_SCALE: f64 = 2.0 * PI;
@@ -225,7 +290,9 @@ const LEAPS: &[f64] = &[0.02, 0.1, 0.5];
 const CHORD_STEPS_PER_ITERATION: usize = 3;
 /// A chord iteration must cut the relative residual at least by this factor, else the
 /// Jacobian is recomputed and factorised at the current iterate.
-const CHORD_CONTRACTION: f64 = 0.25;
+const CHORD_CONTRACTION: f64 = 0.5;
+/// Continuation points a factorisation may be carried over to (see [`Continuation::correct`]).
+const CARRY_POINTS: usize = 8;
 /// Largest turn of the tangent in one step before the step is cut (unless it is a corner).
 const MAX_TURN_DEGREES: f64 = 45.0;
 
@@ -236,6 +303,7 @@ impl Continuation {
             analysis,
             x_scale,
             last_factor: std::cell::RefCell::new(None),
+            carried: std::cell::RefCell::new(None),
         }
     }
 
@@ -267,16 +335,60 @@ impl Continuation {
         let mut trial = vec![0.0; n];
         let mut rt = vec![0.0; n];
         let eval_err = |e: S::Error| NewtonFailure::Evaluation(e.to_string());
-        let max_iter = self.analysis.max_iterations.max(1) * 3;
+        // Chord steps on large problems, as in the corrector: the factorisation is kept while
+        // each step cuts the residual by CHORD_CONTRACTION.
+        let chord = n >= self.analysis.chord_min_unknowns;
+        let max_iter = self.analysis.max_iterations.max(1)
+            * 3
+            * if chord { CHORD_STEPS_PER_ITERATION } else { 1 };
+        let mut factor: Option<crate::jacobian::BorderedFactor> = None;
+        let (mut factorisations, mut chord_steps) = (0usize, 0usize);
+        // Whether r holds the residual at x (the accepted trial of the previous step).
+        let mut r_current = false;
         let mut rel = f64::INFINITY;
         for it in 1..=max_iter {
-            system
-                .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
-                .map_err(eval_err)?;
-            rel = norm(&r) / scale;
+            let previous = rel;
+            if factor.is_some() {
+                if !r_current {
+                    system.residual(&x, omega, &mut r).map_err(eval_err)?;
+                }
+                rel = norm(&r) / scale;
+                if rel > CHORD_CONTRACTION * previous && rel > self.analysis.residual_tolerance {
+                    factor = None;
+                }
+            }
+            if factor.is_none() {
+                system
+                    .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
+                    .map_err(eval_err)?;
+                rel = norm(&r) / scale;
+            }
             let at_tolerance = rel <= self.analysis.residual_tolerance;
             let neg: Vec<f64> = r.iter().map(|v| -v).collect();
-            let dx = jac.solve(&neg)?;
+            let dx = match &factor {
+                Some(f) => {
+                    chord_steps += 1;
+                    let mut rhs = neg;
+                    rhs.push(0.0);
+                    let mut d = f.solve_chord(&rhs)?;
+                    d.truncate(n);
+                    d
+                }
+                None if chord => {
+                    // J bordered by a unit row: its factorisation solves J alone.
+                    factorisations += 1;
+                    let mut row = vec![0.0; n + 1];
+                    row[n] = 1.0;
+                    let f = jac.factor_bordered(1.0, &vec![0.0; n], &row)?;
+                    let mut rhs = neg;
+                    rhs.push(0.0);
+                    let mut d = f.solve(&rhs)?;
+                    d.truncate(n);
+                    factor = Some(f);
+                    d
+                }
+                None => jac.solve(&neg)?,
+            };
             let step_norm = norm(&dx) / self.x_scale;
             let mut alpha = 1.0;
             let improved = loop {
@@ -299,7 +411,14 @@ impl Continuation {
             let stalled_at_tolerance = at_tolerance && !improved;
             if !stalled_at_tolerance {
                 x.copy_from_slice(&trial);
+                r.copy_from_slice(&rt);
             }
+            r_current = true;
+            let it = if chord {
+                (factorisations + chord_steps / CHORD_STEPS_PER_ITERATION).max(1)
+            } else {
+                it
+            };
             if stalled_at_tolerance || self.converged(rel, alpha * step_norm) {
                 // Leave the operator evaluated at the returned point.
                 system
@@ -399,6 +518,27 @@ impl Continuation {
         let chord = n >= self.analysis.chord_min_unknowns;
         *self.last_factor.borrow_mut() = None;
         let mut factor: Option<crate::jacobian::BorderedFactor> = None;
+        // A factorisation made at an earlier point of the path (at most CARRY_POINTS back),
+        // bordered with this tangent, serves for the first chord steps: when the contact
+        // states have not moved much, the point converges without a new factorisation.
+        let mut from_carried = false;
+        // Whether r holds the residual at the current iterate y (the accepted trial of the
+        // previous step), so that a chord step need not evaluate it again.
+        let mut r_current = false;
+        let mut broyden = BroydenUpdates::default();
+        if chord {
+            let mut carried = self.carried.borrow_mut();
+            if let Some((f, age)) = carried.as_mut() {
+                if *age < CARRY_POINTS {
+                    *age += 1;
+                    factor = f.rebordered(tangent);
+                    from_carried = factor.is_some();
+                    broyden.clear();
+                } else {
+                    *carried = None;
+                }
+            }
+        }
         let (mut factorisations, mut chord_steps) = (0usize, 0usize);
         let effort = |f: usize, c: usize| (f + c / CHORD_STEPS_PER_ITERATION).max(1);
         let limit = if chord {
@@ -413,9 +553,11 @@ impl Continuation {
             let omega = y[n] * OMEGA_SCALE;
             let previous = rel;
             if factor.is_some() {
-                system
-                    .residual(&x, omega, &mut r)
-                    .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
+                if !r_current {
+                    system
+                        .residual(&x, omega, &mut r)
+                        .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
+                }
                 rel = norm(&r) / scale;
                 if rel > CHORD_CONTRACTION * previous && rel > self.analysis.residual_tolerance {
                     factor = None;
@@ -441,7 +583,8 @@ impl Continuation {
             let mut dy = match (&factor, chord) {
                 (Some(f), _) => {
                     chord_steps += 1;
-                    f.solve(&rhs)?
+                    let p = f.solve_chord(&rhs)?;
+                    broyden.direction(p)
                 }
                 (None, _) => {
                     for i in 0..n {
@@ -451,6 +594,9 @@ impl Continuation {
                     if chord {
                         let f = jac.factor_bordered(self.x_scale, &col, tangent)?;
                         let d = f.solve(&rhs)?;
+                        broyden.restart(&d);
+                        *self.carried.borrow_mut() = f.rebordered(tangent).map(|c| (c, 0));
+                        from_carried = false;
                         factor = Some(f);
                         d
                     } else {
@@ -477,6 +623,7 @@ impl Continuation {
                     self.keep_factor(factor.take(), tangent);
                     return Ok((y, it, rel));
                 }
+                r_current = true;
             } else {
                 // Backtracking: halve the step while it does not reduce the residual (the
                 // contact law is only piecewise smooth, and full steps can cycle between
@@ -493,9 +640,22 @@ impl Continuation {
                     if norm(&r) / scale < rel || alpha < 1e-3 {
                         break;
                     }
+                    if from_carried {
+                        // A factorisation carried from an earlier point that does not lower
+                        // the residual with a full step is not worth backtracking on: stay,
+                        // and factorise afresh at this iterate.
+                        alpha = 0.0;
+                        factor = None;
+                        from_carried = false;
+                        break;
+                    }
                     alpha *= 0.5;
                 }
+                // r now holds the residual at the accepted iterate (not after a rejected
+                // carried step, which leaves the iterate where it was).
+                r_current = alpha > 0.0;
                 dy.iter_mut().for_each(|v| *v *= alpha);
+                broyden.stepped(alpha);
             }
             for j in 0..=n {
                 y[j] += dy[j];
@@ -514,6 +674,7 @@ impl Continuation {
                     .residual(&x, y[n] * OMEGA_SCALE, &mut r)
                     .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
                 let rel_new = norm(&r) / scale;
+                r_current = true;
                 if rel_new <= self.analysis.residual_tolerance {
                     self.keep_factor(factor.take(), tangent);
                     return Ok((y, it, rel_new));
@@ -781,4 +942,55 @@ pub fn norm(v: &[f64]) -> f64 {
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::prelude::Solve;
+    use faer::Mat;
+
+    /// On a linear system G(y) = A y − b with a wrong base matrix B₀, Broyden's updates reach
+    /// the solution in at most 2n steps (Gay's theorem), where the plain chord iteration with
+    /// B₀ is still far off.
+    #[test]
+    fn broyden_updates_solve_a_linear_system_with_a_wrong_base_matrix() {
+        let n = 4;
+        let a = Mat::from_fn(n, n, |i, j| {
+            [
+                [4.0, 1.0, 0.5, 0.0],
+                [0.3, 3.0, -1.0, 0.2],
+                [0.0, 1.2, 5.0, 1.0],
+                [0.7, 0.0, -0.4, 2.0],
+            ][i][j]
+        });
+        let b0 = Mat::from_fn(n, n, |i, j| if i == j { 1.6 * a[(i, i)] } else { 0.0 });
+        let lu = b0.partial_piv_lu();
+        let rhs = [1.0, -2.0, 0.5, 3.0];
+        let residual = |y: &[f64]| -> Vec<f64> {
+            (0..n)
+                .map(|i| (0..n).map(|j| a[(i, j)] * y[j]).sum::<f64>() - rhs[i])
+                .collect()
+        };
+        let base_step = |g: &[f64]| -> Vec<f64> {
+            let x = lu.solve(Mat::from_fn(n, 1, |i, _| -g[i]));
+            (0..n).map(|i| x[(i, 0)]).collect()
+        };
+        let run = |broyden: bool| -> f64 {
+            let mut y = vec![0.0; n];
+            let mut updates = BroydenUpdates::default();
+            let mut d = base_step(&residual(&y));
+            updates.restart(&d);
+            for _ in 0..2 * n {
+                y.iter_mut().zip(&d).for_each(|(v, s)| *v += s);
+                updates.stepped(1.0);
+                let p = base_step(&residual(&y));
+                d = if broyden { updates.direction(p) } else { p };
+            }
+            norm(&residual(&y))
+        };
+        let (with, without) = (run(true), run(false));
+        assert!(with < 1e-10, "Broyden residual {with:e}");
+        assert!(without > 1e-3, "chord residual {without:e}");
+    }
 }

@@ -120,12 +120,31 @@ pub fn point_outputs(
 /// divided so that climbing to it costs a quarter of the range in arc length.
 fn arc_length_x_scale(problem: &Problem, set: &HarmonicSet) -> Result<f64, LinearSolveError> {
     let a = &problem.analysis;
-    let mut x_ref = 0.0_f64;
+    // The 0th harmonic of the guess does not depend on ω: solved once, the dynamic harmonics
+    // on the grid.
+    let dynamic = HarmonicSet::new(
+        set.harmonics()
+            .iter()
+            .copied()
+            .filter(|&h| h != 0)
+            .collect(),
+    );
+    let static_norm = if set.has_constant() {
+        crate::continuation::norm(&linear::stuck_guess(
+            problem,
+            &HarmonicSet::new(vec![0]),
+            0.0,
+        )?)
+    } else {
+        0.0
+    };
+    let mut dynamic_norm = 0.0_f64;
     for i in 0..=40 {
         let f = a.freq_start_hz + (a.freq_end_hz - a.freq_start_hz) * i as f64 / 40.0;
-        let x = linear::stuck_guess(problem, set, 2.0 * PI * f)?;
-        x_ref = x_ref.max(crate::continuation::norm(&x));
+        let x = linear::stuck_guess(problem, &dynamic, 2.0 * PI * f)?;
+        dynamic_norm = dynamic_norm.max(crate::continuation::norm(&x));
     }
+    let x_ref = static_norm.hypot(dynamic_norm);
     let range = a.freq_end_hz - a.freq_start_hz;
     Ok((x_ref / (0.25 * range)).max(f64::MIN_POSITIVE))
 }

@@ -96,6 +96,9 @@ fn harmonic_response(
     for (i, &p) in dofs.iter().enumerate() {
         position[p] = i;
     }
+    if !problem.model.stiffness.is_sparse() && na > 0 {
+        return dense_harmonic_response(problem, k, dofs, &position, harmonic, hw);
+    }
     // Real 2n form [[D, hωC], [−hωC, D]] with D = K − (hω)²M.
     let mut a: Vec<(usize, usize, f64)> = Vec::new();
     let mut push_d = |p: usize, q: usize, d: f64| {
@@ -141,6 +144,62 @@ fn harmonic_response(
     Ok((qc, qs))
 }
 
+/// [`harmonic_response`] of a dense model: the complex dynamic stiffness
+/// D + i hωC (D = K − (hω)²M; complex-symmetric, so LU rather than Cholesky) acting on
+/// q_c − i q_s with load f_c − i f_s, by dense complex LU: half the work of the real 2n form.
+fn dense_harmonic_response(
+    problem: &Problem,
+    k: &[(usize, usize, f64)],
+    dofs: &[usize],
+    position: &[usize],
+    harmonic: usize,
+    hw: f64,
+) -> Result<(Vec<f64>, Vec<f64>), LinearSolveError> {
+    use faer::c64;
+    let n = problem.model.n_dofs();
+    let na = dofs.len();
+    let mut a = faer::Mat::<c64>::zeros(na, na);
+    let mut add = |p: usize, q: usize, v: c64| {
+        let (i, j) = (position[p], position[q]);
+        if i != usize::MAX && j != usize::MAX {
+            a[(i, j)] += v;
+        }
+    };
+    for &(p, q, v) in k {
+        add(p, q, c64::new(v, 0.0));
+    }
+    let m = &problem.model;
+    m.mass
+        .for_each_nonzero(|p, q, v| add(p, q, c64::new(-hw * hw * v, 0.0)));
+    m.damping
+        .for_each_nonzero(|p, q, v| add(p, q, c64::new(0.0, hw * v)));
+    let mut rhs = faer::Mat::<c64>::zeros(na, 1);
+    for l in problem
+        .harmonic_loads
+        .iter()
+        .filter(|l| l.harmonic == harmonic)
+    {
+        if position[l.dof] != usize::MAX {
+            rhs[(position[l.dof], 0)] += c64::new(l.cos, -l.sin);
+        }
+    }
+    if (0..na).any(|i| !(rhs[(i, 0)].re.is_finite() && rhs[(i, 0)].im.is_finite())) {
+        return Err(LinearSolveError::NonFinite);
+    }
+    let lu = crate::linalg::packed_complex_lu(a)?;
+    lu.solve_in_place(&mut rhs);
+    let mut qc = vec![0.0; n];
+    let mut qs = vec![0.0; n];
+    for (i, &p) in dofs.iter().enumerate() {
+        qc[p] = rhs[(i, 0)].re;
+        qs[p] = -rhs[(i, 0)].im;
+        if !(qc[p].is_finite() && qs[p].is_finite()) {
+            return Err(LinearSolveError::NonFinite);
+        }
+    }
+    Ok((qc, qs))
+}
+
 /// First-harmonic amplitude √(c² + s²) of every DOF (m) at each frequency (Hz).
 pub fn frf(
     problem: &Problem,
@@ -180,7 +239,8 @@ pub fn stuck_guess(
             let q0 = solve_triplets(n, &k, &rhs, problem.model.stiffness.is_sparse())?;
             let j = set.constant_block().expect("h = 0 is in the set");
             x[j * n..(j + 1) * n].copy_from_slice(&q0);
-        } else {
+        } else if problem.harmonic_loads.iter().any(|l| l.harmonic == h) {
+            // Harmonics without a load have a zero linear response (x stays zero).
             let (qc, qs) = harmonic_response(problem, &k, &all, h, omega)?;
             for (j, b) in set.blocks().iter().enumerate() {
                 match *b {
@@ -226,4 +286,43 @@ pub fn reference_curve(
         freqs_hz,
         amplitudes,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The complex dense path and the real 2n sparse path give the same response.
+    #[test]
+    fn dense_complex_and_sparse_real_form_responses_agree() {
+        let dense = crate::scene::parse(crate::reference::paper_wedge_scene(), "paper", &[])
+            .unwrap()
+            .validate("paper")
+            .unwrap();
+        let mut sparse = dense.clone();
+        for m in [
+            &mut sparse.model.stiffness,
+            &mut sparse.model.mass,
+            &mut sparse.model.damping,
+        ] {
+            *m = crate::matrix::StructuralMatrix::sparse_from_triplets(m.n(), &m.triplets());
+        }
+        for case in [LinearCase::Stuck, LinearCase::Open] {
+            let k = case_stiffness(&dense, case);
+            let all = connected_to_loads(&dense, &k, 1);
+            for f in [50.0, 180.0, 221.0, 400.0] {
+                let w = 2.0 * std::f64::consts::PI * f;
+                let (dc, ds) = harmonic_response(&dense, &k, &all, 1, w).unwrap();
+                let (sc, ss) = harmonic_response(&sparse, &k, &all, 1, w).unwrap();
+                let scale = dc.iter().chain(&ds).fold(0.0_f64, |m, v| m.max(v.abs()));
+                assert!(scale > 0.0);
+                for (a, b) in dc.iter().chain(&ds).zip(sc.iter().chain(&ss)) {
+                    assert!(
+                        (a - b).abs() <= 1e-10 * scale,
+                        "{case:?} at {f} Hz: {a:e} vs {b:e}"
+                    );
+                }
+            }
+        }
+    }
 }

@@ -93,6 +93,38 @@ impl StructuralMatrix {
         out
     }
 
+    /// M X for X holding `blocks` vectors of length n one after the other (harmonic-major
+    /// coefficients); the result is n × blocks. Dense matrices use one matrix product, so M is
+    /// read once for all blocks (the harmonic-balance residual applies K, M and C to every
+    /// coefficient block).
+    pub fn mul_blocks(&self, x: &[f64], blocks: usize) -> Mat<f64> {
+        let n = self.n();
+        debug_assert_eq!(x.len(), n * blocks);
+        let xm = faer::MatRef::from_column_major_slice(x, n, blocks);
+        match self {
+            StructuralMatrix::Dense(m) => {
+                let mut out = Mat::zeros(n, blocks);
+                faer::linalg::matmul::matmul(
+                    out.as_mut(),
+                    faer::Accum::Replace,
+                    m.as_ref(),
+                    xm,
+                    1.0,
+                    faer::Par::Seq,
+                );
+                out
+            }
+            StructuralMatrix::Sparse(_) => {
+                let mut out = Mat::zeros(n, blocks);
+                for j in 0..blocks {
+                    let col = out.col_mut(j).try_as_col_major_mut().expect("owned column");
+                    self.mul_add(1.0, &x[j * n..(j + 1) * n], col.as_slice_mut());
+                }
+                out
+            }
+        }
+    }
+
     /// y += α A x.
     pub fn mul_add(&self, alpha: f64, x: &[f64], y: &mut [f64]) {
         if alpha == 0.0 {
@@ -100,15 +132,17 @@ impl StructuralMatrix {
         }
         match self {
             StructuralMatrix::Dense(m) => {
-                for j in 0..m.ncols() {
-                    let xj = alpha * x[j];
-                    if xj == 0.0 {
-                        continue;
-                    }
-                    for i in 0..m.nrows() {
-                        y[i] += m[(i, j)] * xj;
-                    }
-                }
+                // y += α M x as one faer matrix-vector product (vectorised, M read once).
+                let xs = faer::ColRef::from_slice(x);
+                let ys = faer::ColMut::from_slice_mut(y);
+                faer::linalg::matmul::matmul(
+                    ys.as_mat_mut(),
+                    faer::Accum::Add,
+                    m.as_ref(),
+                    xs.as_mat(),
+                    alpha,
+                    faer::Par::Seq,
+                );
             }
             StructuralMatrix::Sparse(s) => {
                 let col_ptr = s.symbolic().col_ptr();

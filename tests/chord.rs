@@ -1,9 +1,11 @@
-//! Chord iterations in the continuation corrector (a factorised Jacobian reused while the
-//! residual falls fast enough; on by default only for large problems) trace the same solutions
-//! as full Newton: forced on for the paper case around the 3rd resonance, the refined limit
-//! peaks (amplitude and frequency, independent of the path's sampling) agree with full Newton
-//! to 1e-6 relative, with dense and with sparse storage of the Jacobian, for less effort
-//! (a chord step counts a third of a Newton iteration).
+//! Chord iterations in the continuation corrector and in fixed-frequency Newton (a factorised
+//! Jacobian reused, with Broyden updates, while the residual falls fast enough; on by default
+//! only for large problems) trace the same solutions as full Newton: forced on for the paper
+//! case around the 3rd resonance, the refined limit peaks (amplitude and frequency, independent
+//! of the path's sampling) agree with full Newton to 1e-6 relative, with dense and sparse
+//! storage of the Jacobian and with the schur formulation (whose factorisations are also
+//! carried from one continuation point to the next and whose chord solves run in single
+//! precision), for less effort (a chord step counts a third of a Newton iteration).
 
 use fricbound::limits;
 use fricbound::model::Problem;
@@ -30,7 +32,7 @@ fn paper(formulation: &str, chord: bool) -> Problem {
 
 #[test]
 fn chord_iterations_give_the_newton_limit_peaks() {
-    for formulation in ["dense", "sparse"] {
+    for formulation in ["dense", "sparse", "schur"] {
         let (newton, chord) = (paper(formulation, false), paper(formulation, true));
         for case in limits::two_point_cases(&newton) {
             let a = limits::solve_case(&newton, &case, None).unwrap();
