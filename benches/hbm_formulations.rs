@@ -1,7 +1,7 @@
 //! One Newton iteration (residual, Jacobian, linear solve) of the reduced blade pair with 13
 //! contact pairs per side (generator refine 2, contact_refine 2, 20 fixed-interface modes), at
-//! H = 1 and H = 3, for each formulation (dense, sparse, condensed) with the analytic Jacobian
-//! and with forward differences (the baseline). `fricbound bench scaling` measures the same
+//! H = 1 and H = 3, for each formulation (dense, sparse, condensed, schur) with the analytic
+//! Jacobian and with forward differences (the baseline; per contact point for schur). `fricbound bench scaling` measures the same
 //! over more contact counts and harmonics, with whole FRFs; this is its criterion counterpart.
 //! Run single-threaded for figures comparable with the README: `RAYON_NUM_THREADS=1`.
 
@@ -26,6 +26,7 @@ fn formulations(c: &mut Criterion) {
             Formulation::Dense,
             Formulation::Sparse,
             Formulation::Condensed,
+            Formulation::Schur,
         ] {
             for j in [
                 JacobianStrategy::Analytic,

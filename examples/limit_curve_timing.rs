@@ -1,15 +1,26 @@
 //! Times one limit curve (m = +1 on every contact point) of the reduced blade pair with many
 //! contact pairs per side: `cargo run --release --example limit_curve_timing -- [contact_refine]
-//! [H] [max_points] [chord_min_unknowns] [fd]` (defaults 8, 3, 150, the library default; `fd`
-//! = 1 for forward differences). The scaling study (`fricbound bench scaling`) measures the
-//! same case among others.
+//! [H] [max_points] [chord_min_unknowns] [fd] [formulation]` (defaults 8, 3, 150, the library
+//! default, 0, auto; `fd` = 1 for forward differences; formulation `auto`, `dense`, `sparse`,
+//! `condensed` or `schur`). The scaling study (`fricbound bench scaling`) measures the same
+//! case among others.
 
 use fricbound::model::{Formulation, JacobianStrategy};
 use fricbound::scaling::{self, ModelSize};
 
 fn main() {
-    let args: Vec<usize> = std::env::args()
-        .skip(1)
+    let raw: Vec<String> = std::env::args().skip(1).collect();
+    let formulation = match raw.get(5).map(String::as_str) {
+        None | Some("auto") => Formulation::Auto,
+        Some("dense") => Formulation::Dense,
+        Some("sparse") => Formulation::Sparse,
+        Some("condensed") => Formulation::Condensed,
+        Some("schur") => Formulation::Schur,
+        Some(other) => panic!("unknown formulation `{other}`"),
+    };
+    let args: Vec<usize> = raw
+        .iter()
+        .take(5)
         .map(|a| a.parse().expect("integer arguments"))
         .collect();
     let arg = |i: usize, default: usize| args.get(i).copied().unwrap_or(default);
@@ -25,7 +36,7 @@ fn main() {
         &size.label(),
         &reduced,
         arg(1, 3),
-        Formulation::Auto,
+        formulation,
         if arg(4, 0) == 1 {
             JacobianStrategy::ForwardDifference
         } else {

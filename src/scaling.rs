@@ -306,6 +306,22 @@ pub fn unknowns(
     })
 }
 
+/// Rows of the matrix factorised per Newton iteration: the unknowns, except for the schur
+/// formulation (2 relative coordinates per contact point and coefficient block).
+pub fn factored_size(
+    base: &Problem,
+    harmonics: usize,
+    formulation: Formulation,
+) -> Result<usize, ScalingError> {
+    let mut p = base.clone();
+    p.harmonics = (1..=harmonics).collect();
+    p.analysis.formulation = formulation;
+    Ok(match p.formulation() {
+        Formulation::Schur => 2 * p.contacts.len() * p.unknown_harmonics().n_blocks(),
+        _ => unknowns(base, harmonics, formulation)?,
+    })
+}
+
 /// Label of a formulation.
 pub fn formulation_name(f: Formulation) -> &'static str {
     match f {
