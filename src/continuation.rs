@@ -16,14 +16,19 @@
 //!
 //! On large problems (at least [`Analysis::chord_min_unknowns`] unknowns) the corrector takes
 //! chord iterations: the bordered Newton matrix factorised at one iterate is reused for the
-//! next steps as long as each cuts the relative residual by at least a factor of 4; otherwise the
-//! Jacobian is evaluated and factorised afresh at the current iterate. A chord step costs one
-//! residual and two triangular solves against an O(n³) factorisation of a Newton matrix that
-//! is dense in the contact DOFs of a reduced model. The convergence tests are the same, on the
-//! true residual, so the points are those of full Newton; the iteration count reported (and
-//! used for step adaptation) counts three chord steps as one iteration. The tangent at the
-//! corrected point is then solved with the corrector's last factorisation (the same bordered
-//! system, its iterate within tolerance of the point) instead of a new Jacobian.
+//! next steps, with Broyden's secant updates (`BroydenUpdates`), as long as each cuts the
+//! relative residual by at least a factor of 2; otherwise the Jacobian is evaluated and
+//! factorised afresh at the current iterate. A chord step costs one residual and one solve
+//! against an O(n³) factorisation of a Newton matrix that is dense in the contact DOFs of a
+//! reduced model (single-precision factors where the storage keeps them, see
+//! [`crate::schur`]). Where the border is eliminated by blocks (sparse and schur storage) the
+//! last factorisation is carried over to the next continuation points (up to `CARRY_POINTS`)
+//! with the new tangent as border; a carried factorisation whose full step does not lower the
+//! residual is dropped at once. Fixed-frequency Newton takes chord steps the same way. The
+//! convergence tests are the same, on the true residual, so the points are those of full
+//! Newton; the iteration count reported (and used for step adaptation) counts three chord steps
+//! as one iteration. The tangent at the corrected point is then solved with the corrector's
+//! last factorisation (the same bordered system) instead of a new Jacobian.
 
 use std::f64::consts::PI;
 
