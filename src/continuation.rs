@@ -324,6 +324,37 @@ impl Continuation {
             && step <= self.analysis.step_tolerance.max(1e-14)
     }
 
+    /// The residual at an iterate of a chord iteration, returned relative to the load: with a
+    /// kept factorisation only the residual (unless `r_current` says r holds it already), and
+    /// the factorisation dropped when the residual fell by less than CHORD_CONTRACTION from
+    /// `previous`; without one (or once dropped) the residual with the Jacobian and ∂R/∂ω.
+    fn chord_evaluate<S: ParametricResidual>(
+        &self,
+        system: &mut S,
+        (x, omega): (&[f64], f64),
+        (r, jac, dr): (&mut [f64], &mut AssembledJacobian, &mut [f64]),
+        factor: &mut Option<crate::jacobian::BorderedFactor>,
+        r_current: bool,
+        previous: f64,
+    ) -> Result<f64, NewtonFailure> {
+        let eval_err = |e: S::Error| NewtonFailure::Evaluation(e.to_string());
+        let scale = system.residual_scale();
+        if factor.is_some() {
+            if !r_current {
+                system.residual(x, omega, r).map_err(eval_err)?;
+            }
+            let rel = norm(r) / scale;
+            if rel <= CHORD_CONTRACTION * previous || rel <= self.analysis.residual_tolerance {
+                return Ok(rel);
+            }
+            *factor = None;
+        }
+        system
+            .residual_and_jacobian(x, omega, r, jac, dr)
+            .map_err(eval_err)?;
+        Ok(norm(r) / scale)
+    }
+
     /// Newton at fixed ω from `x0`, with backtracking on the residual norm.
     pub fn solve_fixed<S: ParametricResidual>(
         &self,
@@ -353,21 +384,14 @@ impl Continuation {
         let mut rel = f64::INFINITY;
         for it in 1..=max_iter {
             let previous = rel;
-            if factor.is_some() {
-                if !r_current {
-                    system.residual(&x, omega, &mut r).map_err(eval_err)?;
-                }
-                rel = norm(&r) / scale;
-                if rel > CHORD_CONTRACTION * previous && rel > self.analysis.residual_tolerance {
-                    factor = None;
-                }
-            }
-            if factor.is_none() {
-                system
-                    .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
-                    .map_err(eval_err)?;
-                rel = norm(&r) / scale;
-            }
+            rel = self.chord_evaluate(
+                system,
+                (&x, omega),
+                (&mut r, &mut jac, &mut dr),
+                &mut factor,
+                r_current,
+                previous,
+            )?;
             let at_tolerance = rel <= self.analysis.residual_tolerance;
             let neg: Vec<f64> = r.iter().map(|v| -v).collect();
             let dx = match &factor {
@@ -557,23 +581,14 @@ impl Continuation {
             }
             let omega = y[n] * OMEGA_SCALE;
             let previous = rel;
-            if factor.is_some() {
-                if !r_current {
-                    system
-                        .residual(&x, omega, &mut r)
-                        .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
-                }
-                rel = norm(&r) / scale;
-                if rel > CHORD_CONTRACTION * previous && rel > self.analysis.residual_tolerance {
-                    factor = None;
-                }
-            }
-            if factor.is_none() {
-                system
-                    .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
-                    .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
-                rel = norm(&r) / scale;
-            }
+            rel = self.chord_evaluate(
+                system,
+                (&x, omega),
+                (&mut r, &mut jac, &mut dr),
+                &mut factor,
+                r_current,
+                previous,
+            )?;
             if first.is_nan() {
                 first = rel;
             } else if rel > 1e4 * first.max(self.analysis.residual_tolerance) {

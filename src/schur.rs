@@ -219,26 +219,22 @@ pub fn check_relative_coordinates(problem: &Problem) -> Result<(), RelativeCoord
         .flat_map(|c| [c.tangential.as_slice(), c.normal.as_slice()])
         .collect();
     let n_q = rows.len();
-    // Dense rows over the DOFs for the Gram products (n_q × n is small where this applies).
-    let mut dense = vec![vec![0.0; n]; n_q];
+    // Per DOF, the rows touching it with their coefficient (duplicates summed): the Gram
+    // products come from these sparse columns.
+    let mut touching: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
     for (r, row) in rows.iter().enumerate() {
         for &(d, a) in row.iter() {
-            dense[r][d] += a;
-        }
-    }
-    let mut touching: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for (r, row) in rows.iter().enumerate() {
-        for &(d, _) in row.iter() {
-            if touching[d].last() != Some(&r) {
-                touching[d].push(r);
+            match touching[d].last_mut() {
+                Some(last) if last.0 == r => last.1 += a,
+                _ => touching[d].push((r, a)),
             }
         }
     }
     let mut gram = Mat::<f64>::zeros(n_q, n_q);
-    for (d, rs) in touching.iter().enumerate() {
-        for &i in rs {
-            for &j in rs {
-                gram[(i, j)] += dense[i][d] * dense[j][d];
+    for column in &touching {
+        for &(i, ai) in column {
+            for &(j, aj) in column {
+                gram[(i, j)] += ai * aj;
             }
         }
     }
@@ -368,11 +364,6 @@ impl RelativeCoordinates {
     /// Number of relative coordinates n_q (2 per contact point).
     pub fn n_relative(&self) -> usize {
         self.n_q
-    }
-
-    /// Size of the reduced Newton matrix: n_q × unknown blocks.
-    pub fn reduced_dim(&self) -> usize {
-        self.n_q * self.blocks.len()
     }
 
     /// Number of unknown blocks.
