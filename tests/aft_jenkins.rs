@@ -121,6 +121,9 @@ fn stuck_limit_states_touch_the_coulomb_limits() {
     }
 }
 
+/// Time samples per period in [`jacobian_error`].
+const GRAZING_SAMPLES: usize = 128;
+
 /// Largest |analytic − central difference| relative to the largest Jacobian entry.
 fn jacobian_error(
     l: JenkinsLaw,
@@ -130,7 +133,7 @@ fn jacobian_error(
 ) -> (f64, ContactState) {
     let set = HarmonicSet::up_to(3);
     let nb = set.n_blocks();
-    let mut aft = AftWorkspace::new(&set, 128);
+    let mut aft = AftWorkspace::new(&set, GRAZING_SAMPLES);
     let state = aft.evaluate(&l, effects, u, v, true).unwrap().state;
     let (tu, tv, nv) = (aft.dt_du.clone(), aft.dt_dv.clone(), aft.dn_dv.clone());
     let scale_u = u.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
@@ -255,6 +258,13 @@ proptest! {
     fn jacobian_grazing((s, m, mu) in regime_strategy(), touch in 0.97..1.03f64) {
         // Mean normal gap about equal to the normal amplitude: the contact just touches or
         // just separates once per period.
+        // The normal force has a kink where the gap closes. Central differences of step
+        // 1e-7 straddle it when a time sample lies that close to the closing instant, and
+        // then they measure neither one-sided derivative: such inputs are not a check.
+        let closest = (0..GRAZING_SAMPLES)
+            .map(|k| (touch + (std::f64::consts::TAU * k as f64 / GRAZING_SAMPLES as f64).cos()).abs())
+            .fold(f64::INFINITY, f64::min);
+        prop_assume!(closest > 1e-5);
         let mut u = vec![0.0; 7];
         let mut v = vec![0.0; 7];
         v[1] = 3e-5;
