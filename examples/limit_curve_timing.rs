@@ -6,7 +6,7 @@
 //! case among others.
 
 use fricbound::model::{Formulation, JacobianStrategy};
-use fricbound::scaling::{self, ModelSize};
+use fricbound::scaling::{self, ModelSize, SolverConfig};
 
 fn main() {
     let raw: Vec<String> = std::env::args().skip(1).collect();
@@ -28,24 +28,24 @@ fn main() {
         three_d: false,
         refine: 2,
         contact_refine: arg(0, 8),
+        contact_pairs: None,
     };
     let dir = tempfile::tempdir().expect("temporary folder");
-    let mut reduced = scaling::reduced_problem(size, 20, dir.path()).expect("reduced model");
-    reduced.analysis.chord_min_unknowns = arg(3, fricbound::model::CHORD_MIN_UNKNOWNS);
-    let m = scaling::measure_solve(
-        &size.label(),
-        &reduced,
-        arg(1, 3),
+    let reduced = scaling::reduced_problem(size, 20, dir.path()).expect("reduced model");
+    let config = SolverConfig {
+        harmonics: arg(1, 3),
         formulation,
-        if arg(4, 0) == 1 {
+        jacobian: if arg(4, 0) == 1 {
             JacobianStrategy::ForwardDifference
         } else {
             JacobianStrategy::Analytic
         },
-        1.0,
-        Some(arg(2, 150)),
-    )
-    .expect("measured");
+        m: 1.0,
+    };
+    let mut p = config.apply(&reduced);
+    p.analysis.chord_min_unknowns = arg(3, fricbound::model::CHORD_MIN_UNKNOWNS);
+    p.analysis.max_points = arg(2, 150);
+    let m = scaling::measure_solve(&size.label(), &p, &config, true).expect("measured");
     println!(
         "{}: {} pairs/side, H = {}, {} unknowns ({}, {}): one iteration {:.1} ms; {} points in {:.2} s, {:.1} ms per point, {} iterations",
         m.case,

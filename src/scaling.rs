@@ -4,7 +4,12 @@
 //! refinement (2D quadrangles or 3D hexahedra): assembled, clamped, its contact patches paired,
 //! reduced by Craig-Bampton, and solved by continuation over a frequency window around the
 //! first bending pair. Nothing is synthetic: the contact count per side grows with the
-//! refinement of the contact faces (3·refine·contact_refine + 1 pairs per side in 2D).
+//! refinement of the contact faces (3·refine·contact_refine + 1 pairs per side in 2D), or is
+//! set directly (`contact_pairs`, for the 2-pair end of the ladder).
+//!
+//! The solver configurations ([`SolverConfig`]: harmonics, formulation, Jacobian strategy,
+//! limit case) and the timed iteration ([`NewtonIteration`]) are shared by the study and the
+//! criterion bench `hbm_formulations`.
 //!
 //! Two measurements:
 //! - [`measure_reduction`]: mesh generation, assembly and clamping, then Craig-Bampton, with
@@ -49,6 +54,8 @@ pub struct ModelSize {
     pub refine: usize,
     /// Extra refinement of the contact faces and the damper.
     pub contact_refine: usize,
+    /// Contact pairs per side set directly (see [`BladePairParams::contact_pairs`]).
+    pub contact_pairs: Option<usize>,
 }
 
 impl ModelSize {
@@ -58,13 +65,17 @@ impl ModelSize {
             three_d,
             refine,
             contact_refine: 1,
+            contact_pairs: None,
         }
     }
 
-    /// Short label: `2D r2`, `2D r2 c8`, `3D r1`.
+    /// Short label: `2D r2`, `2D r2 c8` (contact refinement), `2D r2 p2` (contact pairs),
+    /// `3D r1`.
     pub fn label(&self) -> String {
         let dim = if self.three_d { "3D" } else { "2D" };
-        if self.contact_refine > 1 {
+        if let Some(pairs) = self.contact_pairs {
+            format!("{dim} r{} p{pairs}", self.refine)
+        } else if self.contact_refine > 1 {
             format!("{dim} r{} c{}", self.refine, self.contact_refine)
         } else {
             format!("{dim} r{}", self.refine)
@@ -75,6 +86,7 @@ impl ModelSize {
         BladePairParams {
             refine: self.refine,
             contact_refine: self.contact_refine,
+            contact_pairs: self.contact_pairs,
             three_d: self.three_d,
             ..Default::default()
         }
@@ -290,36 +302,93 @@ pub struct SolveMeasure {
     pub frf_iteration_ms: f64,
 }
 
-/// Unknowns of `base` with harmonics 1..H (and the 0th) in formulation `formulation`.
-pub fn unknowns(
-    base: &Problem,
-    harmonics: usize,
-    formulation: Formulation,
-) -> Result<usize, ScalingError> {
-    let mut p = base.clone();
-    p.harmonics = (1..=harmonics).collect();
-    p.analysis.formulation = formulation;
-    let blocks = p.unknown_harmonics().n_blocks();
-    Ok(match p.formulation() {
-        Formulation::Condensed => p.contact_dofs().len() * blocks,
-        _ => p.model.n_dofs() * blocks,
-    })
+/// Formulations the study and the criterion bench compare.
+pub const FORMULATIONS: [Formulation; 4] = [
+    Formulation::Dense,
+    Formulation::Sparse,
+    Formulation::Condensed,
+    Formulation::Schur,
+];
+
+/// Jacobian strategies the study and the criterion bench compare: the analytic AFT Jacobian
+/// and its finite-difference baseline.
+pub const JACOBIANS: [JacobianStrategy; 2] = [
+    JacobianStrategy::Analytic,
+    JacobianStrategy::ForwardDifference,
+];
+
+/// One solver configuration: harmonics 1..H (with the 0th), formulation, Jacobian strategy
+/// and the initial tangential state m of every contact point (0, or ±1 for a limit curve).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverConfig {
+    /// Highest harmonic H.
+    pub harmonics: usize,
+    /// Formulation.
+    pub formulation: Formulation,
+    /// Jacobian strategy.
+    pub jacobian: JacobianStrategy,
+    /// Initial tangential state of every contact point, T(0) = m·μN.
+    pub m: f64,
 }
 
-/// Rows of the matrix factorised per Newton iteration: the unknowns, except for the schur
-/// formulation (2 relative coordinates per contact point and coefficient block).
-pub fn factored_size(
-    base: &Problem,
-    harmonics: usize,
-    formulation: Formulation,
-) -> Result<usize, ScalingError> {
-    let mut p = base.clone();
-    p.harmonics = (1..=harmonics).collect();
-    p.analysis.formulation = formulation;
-    Ok(match p.formulation() {
+impl SolverConfig {
+    /// Every formulation × Jacobian strategy of [`FORMULATIONS`] and [`JACOBIANS`] for each H
+    /// in `harmonics`, with m = 0, in the order the study runs them.
+    pub fn grid(harmonics: &[usize]) -> Vec<SolverConfig> {
+        harmonics
+            .iter()
+            .flat_map(|&h| {
+                FORMULATIONS.into_iter().flat_map(move |formulation| {
+                    JACOBIANS.into_iter().map(move |jacobian| SolverConfig {
+                        harmonics: h,
+                        formulation,
+                        jacobian,
+                        m: 0.0,
+                    })
+                })
+            })
+            .collect()
+    }
+
+    /// `base` set up for this configuration (harmonics, AFT samples 32·H but at least 128,
+    /// formulation, Jacobian, limit case); the one copy of the problem a configuration makes.
+    pub fn apply(&self, base: &Problem) -> Problem {
+        let mut p = crate::limits::LimitCase::uniform(base, self.m).apply(base);
+        p.harmonics = (1..=self.harmonics).collect();
+        p.samples = p.samples.max(32 * self.harmonics).max(128);
+        p.analysis.formulation = self.formulation;
+        p.analysis.jacobian = self.jacobian;
+        p
+    }
+
+    /// Label `H = 3, schur, analytic` (the formulation as given, `auto` unresolved).
+    pub fn label(&self) -> String {
+        format!(
+            "H = {}, {}, {}",
+            self.harmonics,
+            formulation_name(self.formulation),
+            jacobian_name(self.jacobian)
+        )
+    }
+}
+
+/// Unknowns of Newton's iteration on `p`: all DOFs per coefficient block, or the contact DOFs
+/// per block for the condensed formulation.
+pub fn unknowns(p: &Problem) -> usize {
+    let blocks = p.unknown_harmonics().n_blocks();
+    match p.formulation() {
+        Formulation::Condensed => p.contact_dofs().len() * blocks,
+        _ => p.model.n_dofs() * blocks,
+    }
+}
+
+/// Rows of the matrix factorised per Newton iteration on `p`: the unknowns, except for the
+/// schur formulation (2 relative coordinates per contact point and coefficient block).
+pub fn factored_size(p: &Problem) -> usize {
+    match p.formulation() {
         Formulation::Schur => 2 * p.contacts.len() * p.unknown_harmonics().n_blocks(),
-        _ => unknowns(base, harmonics, formulation)?,
-    })
+        _ => unknowns(p),
+    }
 }
 
 /// Label of a formulation.
@@ -342,37 +411,79 @@ pub fn jacobian_name(j: JacobianStrategy) -> &'static str {
     }
 }
 
-/// Measures one configuration of `base` (harmonics 1..H, formulation, Jacobian strategy,
-/// every contact point starting at T = m·μN): the time of one Newton iteration at the linear
-/// (stuck) guess at the window's centre, and with `max_points` Some(p) an FRF over the window
-/// limited to p continuation points.
+/// One Newton iteration of a problem, ready to repeat: residual, Jacobian and linear solve at
+/// the stuck linear guess at one frequency. The study times it once, the criterion bench many
+/// times.
+pub struct NewtonIteration<'a> {
+    operator: HbmOperator<'a>,
+    jacobian: crate::jacobian::AssembledJacobian,
+    x: Vec<f64>,
+    omega: f64,
+    residual: Vec<f64>,
+    d_residual: Vec<f64>,
+}
+
+impl<'a> NewtonIteration<'a> {
+    /// Prepares the iteration of `p` at `freq_hz` (operator, Jacobian storage, linear guess).
+    pub fn new(p: &'a Problem, freq_hz: f64) -> Result<Self, ScalingError> {
+        let mut operator = HbmOperator::new(p).map_err(setup)?;
+        let omega = 2.0 * std::f64::consts::PI * freq_hz;
+        let guess = crate::linear::stuck_guess(p, operator.unknowns(), omega).map_err(setup)?;
+        let x = operator.restrict(&guess);
+        let n = operator.dim();
+        Ok(Self {
+            jacobian: operator.new_jacobian(),
+            operator,
+            x,
+            omega,
+            residual: vec![0.0; n],
+            d_residual: vec![0.0; n],
+        })
+    }
+
+    /// Unknowns of the iteration.
+    pub fn unknowns(&self) -> usize {
+        self.operator.dim()
+    }
+
+    /// Runs the iteration once: residual and Jacobian, then the Newton step (returned).
+    pub fn run(&mut self) -> Result<Vec<f64>, ScalingError> {
+        self.operator
+            .residual_and_jacobian(
+                &self.x,
+                self.omega,
+                &mut self.residual,
+                &mut self.jacobian,
+                &mut self.d_residual,
+            )
+            .map_err(setup)?;
+        let neg: Vec<f64> = self.residual.iter().map(|v| -v).collect();
+        self.jacobian.solve(&neg).map_err(setup)
+    }
+}
+
+/// Measures `p`, set up by `config` (see [`SolverConfig::apply`]): the time of one Newton
+/// iteration at the stuck linear guess at the window's centre, and with `frf` an FRF over the
+/// window limited to `p.analysis.max_points` continuation points.
 pub fn measure_solve(
     case: &str,
-    base: &Problem,
-    harmonics: usize,
-    formulation: Formulation,
-    jacobian: JacobianStrategy,
-    m_initial: f64,
-    max_points: Option<usize>,
+    p: &Problem,
+    config: &SolverConfig,
+    frf: bool,
 ) -> Result<SolveMeasure, ScalingError> {
-    let mut p = crate::limits::LimitCase::uniform(base, m_initial).apply(base);
-    p.harmonics = (1..=harmonics).collect();
-    p.samples = p.samples.max(32 * harmonics).max(128);
-    p.analysis.formulation = formulation;
-    p.analysis.jacobian = jacobian;
-    let mut operator = HbmOperator::new(&p).map_err(setup)?;
-    let unknowns = operator.dim();
+    let centre = 0.5 * (p.analysis.freq_start_hz + p.analysis.freq_end_hz);
+    let mut iteration = NewtonIteration::new(p, centre)?;
     let mut m = SolveMeasure {
         case: case.to_string(),
         pairs_per_side: p.contacts.len() / p.sides.len().max(1),
-        harmonics,
+        harmonics: config.harmonics,
         formulation: formulation_name(p.formulation()).to_string(),
-        jacobian: jacobian_name(jacobian).to_string(),
-        m: m_initial,
-        unknowns,
+        jacobian: jacobian_name(config.jacobian).to_string(),
+        m: config.m,
+        unknowns: iteration.unknowns(),
         iteration_ms: 0.0,
-        frf: max_points.is_some(),
-        max_points: max_points.unwrap_or(0),
+        frf,
+        max_points: if frf { p.analysis.max_points } else { 0 },
         points: 0,
         iterations: 0,
         complete: false,
@@ -380,27 +491,14 @@ pub fn measure_solve(
         per_point_ms: 0.0,
         frf_iteration_ms: 0.0,
     };
-    let f = 0.5 * (p.analysis.freq_start_hz + p.analysis.freq_end_hz);
-    let omega = 2.0 * std::f64::consts::PI * f;
-    let guess = crate::linear::stuck_guess(&p, operator.unknowns(), omega).map_err(setup)?;
-    let x = operator.restrict(&guess);
-    let mut r = vec![0.0; unknowns];
-    let mut dr = vec![0.0; unknowns];
-    let mut jac = operator.new_jacobian();
     let started = Instant::now();
-    operator
-        .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
-        .map_err(setup)?;
-    let neg: Vec<f64> = r.iter().map(|v| -v).collect();
-    jac.solve(&neg).map_err(setup)?;
+    iteration.run()?;
     m.iteration_ms = 1e3 * started.elapsed().as_secs_f64();
-    drop(jac);
-    drop(operator);
-    if let Some(max_points) = max_points {
-        p.analysis.max_points = max_points;
+    drop(iteration);
+    if frf {
         let started = Instant::now();
         let mut points = Vec::new();
-        let outcome = frf::solve(&p, &mut Collect(&mut points));
+        let outcome = frf::solve(p, &mut Collect(&mut points));
         m.frf_s = started.elapsed().as_secs_f64();
         m.points = points.len();
         m.complete = outcome.is_ok_and(|run| run.end == crate::continuation::PathEnd::EndFrequency);

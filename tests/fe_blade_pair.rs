@@ -33,9 +33,18 @@ fn count(mesh: &Mesh, kind: ElementKind) -> usize {
 
 #[test]
 fn node_and_element_counts_follow_the_divisions() {
-    for refine in [1, 2, 3] {
+    let cases = [
+        (1, None),
+        (2, None),
+        (3, None),
+        (1, Some(2)),
+        (2, Some(3)),
+        (2, Some(11)),
+    ];
+    for (refine, contact_pairs) in cases {
         let params = BladePairParams {
             refine,
+            contact_pairs,
             ..BladePairParams::default()
         };
         let d = params.divisions().unwrap();
@@ -46,9 +55,10 @@ fn node_and_element_counts_follow_the_divisions() {
         // Per blade: blade grid plus the platform grid minus its shared root column.
         let blade_nodes = (d.blade_x + 1) * (ny + 1) + platform_x * (nt + 1);
         let blade_quads = d.blade_x * ny + platform_x * nt;
-        // Damper: three n×n patches sharing three edges and the centroid.
-        let n = d.damper;
-        let damper_nodes = 3 * (n + 1) * (n + 1) - 3 * (n + 1) + 1;
+        // Damper: two x×y patches and one y×y patch, sharing three edges (x, y, y
+        // divisions) and the centroid.
+        let [x, y] = d.damper;
+        let damper_nodes = 2 * (x + 1) * (y + 1) + (y + 1) * (y + 1) - (x + 1) - 2 * (y + 1) + 1;
         assert_eq!(
             mesh.nodes.len(),
             2 * blade_nodes + damper_nodes,
@@ -56,8 +66,12 @@ fn node_and_element_counts_follow_the_divisions() {
         );
         assert_eq!(
             count(&mesh, ElementKind::Quad4),
-            2 * blade_quads + 3 * n * n
+            2 * blade_quads + 2 * x * y + y * y
         );
+        if let Some(pairs) = contact_pairs {
+            assert_eq!(d.contact, pairs - 1);
+            assert_eq!(x, pairs - 1, "the face splits at the contact end");
+        }
         assert_eq!(
             count(&mesh, ElementKind::Line2),
             2 * d.blade_x + 4 * d.contact,
@@ -381,7 +395,7 @@ fn contact_refinement_multiplies_the_pairs_only() {
     };
     let (d0, d1) = (base.divisions().unwrap(), fine.divisions().unwrap());
     assert_eq!(d1.contact, 5 * d0.contact);
-    assert_eq!(d1.damper, 5 * d0.damper);
+    assert_eq!(d1.damper, [5 * d0.damper[0], 5 * d0.damper[1]]);
     assert_eq!(
         (d1.blade_x, d1.blade_y, d1.platform_free),
         (d0.blade_x, d0.blade_y, d0.platform_free)
@@ -394,6 +408,52 @@ fn contact_refinement_multiplies_the_pairs_only() {
         let (m0, b0) = assembled(&base);
         let coarse = pair_patch(&m0, &b0.dofs, &spec).unwrap();
         assert!((patch.area() - coarse.area()).abs() < 1e-12 * coarse.area());
+    }
+}
+
+/// `contact_pairs` gives exactly that many coincident pairs per side over the same contact
+/// area, from 2 up, in 2D and 3D; the blades keep their divisions and the damper stays one
+/// free body of well-shaped elements (positive definite mass, three rigid-body modes).
+#[test]
+fn contact_pairs_set_the_count_directly() {
+    let base = BladePairParams {
+        refine: 2,
+        ..BladePairParams::default()
+    };
+    let (m0, b0) = assembled(&base);
+    for (pairs, three_d) in [(2, false), (3, false), (5, false), (200, false), (2, true)] {
+        let params = BladePairParams {
+            contact_pairs: Some(pairs),
+            three_d,
+            ..base.clone()
+        };
+        let d = params.divisions().unwrap();
+        let d0 = base.divisions().unwrap();
+        assert_eq!(
+            (d.blade_x, d.blade_y, d.platform_free),
+            (d0.blade_x, d0.blade_y, d0.platform_free)
+        );
+        let (mesh, model) = assembled(&params);
+        for spec in params.patch_specs().unwrap() {
+            let patch = pair_patch(&mesh, &model.dofs, &spec).unwrap();
+            let per_layer = if three_d { d.layers + 1 } else { 1 };
+            assert_eq!(
+                patch.pairs.len(),
+                pairs * per_layer,
+                "{pairs} pairs, 3d {three_d}"
+            );
+            assert!(patch.pairs.iter().all(|p| p.node_distance < 1e-15));
+            if !three_d {
+                let coarse = pair_patch(&m0, &b0.dofs, &spec).unwrap();
+                assert!((patch.area() - coarse.area()).abs() < 1e-12 * coarse.area());
+            }
+        }
+        if !three_d && pairs <= 5 {
+            let eig = damper_spectrum(&mesh, &model);
+            let scale = eig.last().unwrap().abs();
+            let zero = eig.iter().filter(|&&l| l.abs() < 1e-10 * scale).count();
+            assert_eq!(zero, 3, "{pairs} pairs: spectrum starts {:?}", &eig[..5]);
+        }
     }
 }
 
@@ -427,6 +487,25 @@ fn bad_parameters_are_rejected() {
     });
     assert!(
         msg.contains("contact_refine = 0 must lie in 1..=1000"),
+        "{msg}"
+    );
+    let msg = bad(BladePairParams {
+        contact_pairs: Some(1),
+        ..BladePairParams::default()
+    });
+    assert!(
+        msg.contains("contact_pairs = 1 must lie in 2..=3001"),
+        "{msg}"
+    );
+    let msg = bad(BladePairParams {
+        contact_pairs: Some(4),
+        contact_refine: 2,
+        ..BladePairParams::default()
+    });
+    assert!(
+        msg.contains(
+            "contact_pairs = 4 sets the contact divisions itself: contact_refine must be 1, not 2"
+        ),
         "{msg}"
     );
     let msg = bad(BladePairParams {
@@ -530,6 +609,7 @@ fn mesh_command_writes_a_readable_file() {
     let args = BladePairArgs {
         refine: 1,
         contact_refine: 2,
+        contact_pairs: None,
         beta: 90.0,
         platform_width: None,
         thickness: Some(0.02),
@@ -538,6 +618,15 @@ fn mesh_command_writes_a_readable_file() {
         binary: true,
         vtu: Some(vtu.clone()),
     };
+    let two_pairs = BladePairArgs {
+        contact_refine: 1,
+        contact_pairs: Some(2),
+        vtu: None,
+        ..args.clone()
+    };
+    let text = run(&MeshCommand::BladePair(two_pairs)).unwrap();
+    assert!(text.contains("contact side left  2 pairs"), "{text}");
+    assert!(text.contains("contact side right 2 pairs"), "{text}");
     let text = run(&MeshCommand::BladePair(args)).unwrap();
     assert!(text.contains("contact side left"), "{text}");
     assert!(text.contains("DOFs"), "{text}");

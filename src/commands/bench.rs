@@ -12,7 +12,7 @@ use crate::model::{Formulation, JacobianStrategy};
 use crate::report::files::write_atomic;
 use crate::report::limit_plots::palette;
 use crate::report::plot::{plot_lines, Series};
-use crate::scaling::{self, ModelSize, ReductionMeasure, SolveMeasure};
+use crate::scaling::{self, ModelSize, ReductionMeasure, SolveMeasure, SolverConfig};
 
 /// Bench subcommands.
 #[derive(Debug, clap::Subcommand)]
@@ -36,6 +36,9 @@ pub enum BenchCommand {
         /// Extra refinement of the contact faces and the damper.
         #[arg(long, default_value_t = 1)]
         contact_refine: usize,
+        /// Contact pairs per side set directly (with --contact-refine 1).
+        #[arg(long)]
+        contact_pairs: Option<usize>,
         /// 3D hexahedra.
         #[arg(long = "3d")]
         three_d: bool,
@@ -62,6 +65,7 @@ pub fn run(command: &BenchCommand) -> Result<String, BenchError> {
         BenchCommand::Reduction {
             refine,
             contact_refine,
+            contact_pairs,
             three_d,
             modes,
         } => {
@@ -69,6 +73,7 @@ pub fn run(command: &BenchCommand) -> Result<String, BenchError> {
                 three_d: *three_d,
                 refine: *refine,
                 contact_refine: *contact_refine,
+                contact_pairs: *contact_pairs,
             };
             let m = scaling::measure_reduction(size, *modes)?;
             serde_json::to_string(&m).map_err(|e| BenchError::Io(e.to_string()))
@@ -152,92 +157,76 @@ fn scaling_study(dir: &Path, quick: bool) -> Result<String, BenchError> {
     }
 
     // Solver costs on reduced models with growing contact counts: the coarse 2D blade pair
-    // (refine 2) with its contact faces and damper refined (7 to 199 pairs per side).
+    // (refine 2) with 2 contact pairs per side, then with its contact faces and damper
+    // refined (7 to 199 pairs per side).
     let work = tempdir()?;
-    let contact_refines: &[usize] = if quick {
-        &[1, 2]
+    let contact_ladder: &[(usize, Option<usize>)] = if quick {
+        &[(1, Some(2)), (1, None), (2, None)]
     } else {
-        &[1, 2, 4, 8, 16, 33]
+        &[
+            (1, Some(2)),
+            (1, None),
+            (2, None),
+            (4, None),
+            (8, None),
+            (16, None),
+            (33, None),
+        ]
     };
     let harmonics: &[usize] = if quick { &[1, 3] } else { &[1, 3, 5, 7] };
-    for &contact_refine in contact_refines {
+    for &(contact_refine, contact_pairs) in contact_ladder {
         let size = ModelSize {
             three_d: false,
             refine: 2,
             contact_refine,
+            contact_pairs,
         };
         let reduced = scaling::reduced_problem(size, 20, &work)?;
         let case = format!("{}, reduced", size.label());
-        for &h in harmonics {
-            for f in [
-                Formulation::Dense,
-                Formulation::Sparse,
-                Formulation::Condensed,
-                Formulation::Schur,
-            ] {
-                for j in [
-                    JacobianStrategy::Analytic,
-                    JacobianStrategy::ForwardDifference,
-                ] {
-                    let unknowns = scaling::unknowns(&reduced, h, f)?;
-                    // The cost grows with the factorised size; the schur formulation's
-                    // finite differences are per contact point, not per unknown.
-                    let factored = scaling::factored_size(&reduced, h, f)?;
-                    let limit = if j == JacobianStrategy::Analytic || f == Formulation::Schur {
-                        ANALYTIC_LIMIT
-                    } else {
-                        FD_LIMIT
-                    };
-                    if factored > limit {
-                        eprintln!(
-                            "skip: {case}, H = {h}, {}, {}: {unknowns} unknowns",
-                            scaling::formulation_name(f),
-                            scaling::jacobian_name(j)
-                        );
-                        continue;
-                    }
-                    eprintln!(
-                        "solve: {case}, H = {h}, {}, {}",
-                        scaling::formulation_name(f),
-                        scaling::jacobian_name(j)
-                    );
-                    let mut m = scaling::measure_solve(&case, &reduced, h, f, j, 0.0, None)?;
-                    if m.iteration_ms <= FRF_ITERATION_LIMIT_MS {
-                        m = scaling::measure_solve(
-                            &case,
-                            &reduced,
-                            h,
-                            f,
-                            j,
-                            0.0,
-                            Some(FRF_POINTS),
-                        )?;
-                    }
-                    study.solves.push(m);
-                    write_study(dir, &study)?;
-                }
+        for config in SolverConfig::grid(harmonics) {
+            let mut p = config.apply(&reduced);
+            p.analysis.max_points = FRF_POINTS;
+            // The cost grows with the factorised size; the schur formulation's finite
+            // differences are per contact point, not per unknown.
+            let limit = if config.jacobian == JacobianStrategy::Analytic
+                || p.formulation() == Formulation::Schur
+            {
+                ANALYTIC_LIMIT
+            } else {
+                FD_LIMIT
+            };
+            if scaling::factored_size(&p) > limit {
+                eprintln!(
+                    "skip: {case}, {}: {} unknowns",
+                    config.label(),
+                    scaling::unknowns(&p)
+                );
+                continue;
             }
+            eprintln!("solve: {case}, {}", config.label());
+            let mut m = scaling::measure_solve(&case, &p, &config, false)?;
+            if m.iteration_ms <= FRF_ITERATION_LIMIT_MS {
+                m = scaling::measure_solve(&case, &p, &config, true)?;
+            }
+            study.solves.push(m);
+            write_study(dir, &study)?;
         }
         // The target case: a limit curve (m = +1 on every point) with about 50 points per
         // side at H = 3, analytic against finite differences, with the automatic formulation.
         if contact_refine == 8 || (quick && contact_refine == 2) {
-            for j in [
-                JacobianStrategy::Analytic,
-                JacobianStrategy::ForwardDifference,
-            ] {
-                eprintln!("limit FRF: {case}, H = 3, {}", scaling::jacobian_name(j));
-                let mut m =
-                    scaling::measure_solve(&case, &reduced, 3, Formulation::Auto, j, 1.0, None)?;
-                if j == JacobianStrategy::Analytic || m.iteration_ms <= 1000.0 {
-                    m = scaling::measure_solve(
-                        &case,
-                        &reduced,
-                        3,
-                        Formulation::Auto,
-                        j,
-                        1.0,
-                        Some(FRF_POINTS),
-                    )?;
+            for jacobian in scaling::JACOBIANS {
+                let config = SolverConfig {
+                    harmonics: 3,
+                    formulation: Formulation::Auto,
+                    jacobian,
+                    m: 1.0,
+                };
+                let mut p = config.apply(&reduced);
+                p.analysis.max_points = FRF_POINTS;
+                eprintln!("limit FRF: {case}, {}", config.label());
+                let mut m = scaling::measure_solve(&case, &p, &config, false)?;
+                if jacobian == JacobianStrategy::Analytic || m.iteration_ms <= 1000.0 {
+                    m = scaling::measure_solve(&case, &p, &config, true)?;
                 }
                 study.limit_curves.push(m);
                 write_study(dir, &study)?;
@@ -248,16 +237,16 @@ fn scaling_study(dir: &Path, quick: bool) -> Result<String, BenchError> {
     let size = ModelSize::uniform(false, 2);
     let full = scaling::full_problem(size, 1, &work)?;
     for &h in &harmonics[..harmonics.len().min(2)] {
-        eprintln!("solve: 2D r2 unreduced, H = {h}, sparse");
-        let m = scaling::measure_solve(
-            "2D r2, unreduced",
-            &full,
-            h,
-            Formulation::Sparse,
-            JacobianStrategy::Analytic,
-            0.0,
-            Some(FRF_POINTS),
-        )?;
+        let config = SolverConfig {
+            harmonics: h,
+            formulation: Formulation::Sparse,
+            jacobian: JacobianStrategy::Analytic,
+            m: 0.0,
+        };
+        let mut p = config.apply(&full);
+        p.analysis.max_points = FRF_POINTS;
+        eprintln!("solve: 2D r2 unreduced, {}", config.label());
+        let m = scaling::measure_solve("2D r2, unreduced", &p, &config, true)?;
         study.solves.push(m);
         write_study(dir, &study)?;
     }

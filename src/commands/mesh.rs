@@ -34,6 +34,10 @@ pub struct BladePairArgs {
     /// the same blades).
     #[arg(long, default_value_t = 1, value_name = "N")]
     pub contact_refine: usize,
+    /// Node pairs per contact face (2 or more), instead of the count the refinement gives
+    /// (with --contact-refine 1).
+    #[arg(long, value_name = "N")]
+    pub contact_pairs: Option<usize>,
     /// Apical angle of the wedge damper (degrees, 30..170).
     #[arg(long, default_value_t = 120.0, value_name = "DEG")]
     pub beta: f64,
@@ -103,6 +107,7 @@ pub fn params(args: &BladePairArgs) -> BladePairParams {
     BladePairParams {
         refine: args.refine,
         contact_refine: args.contact_refine,
+        contact_pairs: args.contact_pairs,
         beta_deg: args.beta,
         platform_width: args.platform_width.unwrap_or(defaults.platform_width),
         thickness: args.thickness.unwrap_or(defaults.thickness),

@@ -41,6 +41,9 @@
 //!
 //! In 2D each contact face carries 3·refine·contact_refine + 1 node pairs: `contact_refine`
 //! refines the contact faces and the damper alone, for many contact points on coarse blades.
+//! `contact_pairs` sets the count directly instead (any count from 2, e.g. for the few-point
+//! end of a contact ladder): each damper face is then split at the contact end rather than
+//! at its midpoint, with `contact_pairs − 1` divisions below and about a third of that above.
 //!
 //! `fricbound mesh blade-pair --refine N [--3d]` prints the counts of any mesh; a test checks
 //! the small ones.
@@ -60,6 +63,10 @@ pub struct BladePairParams {
     /// multiplied by it, so a coarse blade can carry many contact pairs per side (the platform
     /// elements under the contact become slender along the face).
     pub contact_refine: usize,
+    /// Node pairs per contact face (≥ 2), instead of the count the refinement gives; needs
+    /// `contact_refine` = 1. The damper faces are then split at the contact end (see the
+    /// module doc).
+    pub contact_pairs: Option<usize>,
     /// Apical angle β of the damper (degrees), in [30, 170].
     pub beta_deg: f64,
     /// Blade length L, root to tip (m).
@@ -85,6 +92,7 @@ impl Default for BladePairParams {
         BladePairParams {
             refine: 1,
             contact_refine: 1,
+            contact_pairs: None,
             beta_deg: 120.0,
             blade_length: 0.1,
             blade_width: 0.01,
@@ -109,8 +117,14 @@ pub struct Divisions {
     pub platform_free: usize,
     /// Along each contact face (pairs per side = contact + 1).
     pub contact: usize,
-    /// Along each edge of the damper's three sub-quadrangles.
-    pub damper: usize,
+    /// Along each damper face: from the base corner to the face's split node, and from there
+    /// to the apex. The damper is three quadrangular sub-patches around its centroid, whose
+    /// edges carry these counts (the base halves and the spokes to the split nodes the
+    /// second, the spoke to the base midpoint the first).
+    pub damper: [usize; 2],
+    /// The split node of each damper face is the contact end (`contact_pairs` given), else
+    /// the face midpoint.
+    pub split_at_contact_end: bool,
     /// Through the thickness (3D only; even).
     pub layers: usize,
 }
@@ -163,6 +177,18 @@ impl BladePairParams {
                 "contact_refine = {} must lie in 1..=1000",
                 self.contact_refine
             ));
+        }
+        if let Some(pairs) = self.contact_pairs {
+            if !(2..=3001).contains(&pairs) {
+                return bad(format!("contact_pairs = {pairs} must lie in 2..=3001"));
+            }
+            if self.contact_refine != 1 {
+                return bad(format!(
+                    "contact_pairs = {pairs} sets the contact divisions itself: contact_refine \
+                     must be 1, not {}",
+                    self.contact_refine
+                ));
+            }
         }
         if !(self.beta_deg.is_finite() && (30.0..=170.0).contains(&self.beta_deg)) {
             return bad(format!(
@@ -226,9 +252,17 @@ impl BladePairParams {
         let h = self.element_size();
         let count = |len: f64, min: usize| ((len / h).round() as usize).max(min);
         let face = dist(g.base_left, g.apex);
-        // Contact divisions 3k with the whole face 4k, so nodes fall on the contact end.
+        // Contact divisions 3k with the whole face 4k, so nodes fall on the contact end; or
+        // the contact divisions asked for, and about a third of them above the contact end.
         let k =
             ((CONTACT_FRACTION * face / (3.0 * h)).round() as usize).max(1) * self.contact_refine;
+        let (contact, damper, split_at_contact_end) = match self.contact_pairs {
+            Some(pairs) => {
+                let c = pairs - 1;
+                (c, [c, ((c as f64 / 3.0).round() as usize).max(1)], true)
+            }
+            None => (3 * k, [2 * k, 2 * k], false),
+        };
         let blade_x = count(g.b, 2).next_multiple_of(2);
         Ok(Divisions {
             blade_x,
@@ -238,8 +272,9 @@ impl BladePairParams {
                 count(g.l - g.y_top, 1),
             ],
             platform_free: count(g.base_left[0] - g.b, 1),
-            contact: 3 * k,
-            damper: 2 * k,
+            contact,
+            damper,
+            split_at_contact_end,
             layers: count(self.thickness, 2).next_multiple_of(2),
         })
     }
@@ -452,26 +487,35 @@ fn blade(g: &Geometry, d: &Divisions) -> Part {
 /// The wedge damper: three quadrangular sub-patches around the centroid.
 fn damper(g: &Geometry, d: &Divisions) -> Part {
     let mut p = Part::default();
-    let n = d.damper;
-    let mid = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
+    // Opposite edges of each sub-quadrangle need equal counts: with x below the face split
+    // nodes and y above them, the base halves and the spokes to the face split nodes carry
+    // y and the spoke to the base midpoint x.
+    let [x, y] = d.damper;
+    let split = if d.split_at_contact_end {
+        CONTACT_FRACTION
+    } else {
+        0.5
+    };
+    let along =
+        |a: [f64; 2], b: [f64; 2], t: f64| [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
     let (bl, br, ap) = (g.base_left, g.base_right, g.apex);
     let b = p.node(bl);
     let c = p.node(br);
     let a = p.node(ap);
-    let m_bc = p.node(mid(bl, br));
-    let m_ca = p.node(mid(br, ap));
-    let m_ab = p.node(mid(ap, bl));
+    let m_bc = p.node(along(bl, br, 0.5));
+    let m_ca = p.node(along(br, ap, split));
+    let m_ab = p.node(along(bl, ap, split));
     let centre = p.node([(bl[0] + br[0] + ap[0]) / 3.0, (bl[1] + br[1] + ap[1]) / 3.0]);
     let rev = |v: Vec<usize>| v.into_iter().rev().collect::<Vec<_>>();
-    let b_mab = p.edge(b, m_ab, n);
-    let mab_a = p.edge(m_ab, a, n);
-    let a_mca = p.edge(a, m_ca, n);
-    let mca_c = p.edge(m_ca, c, n);
-    let c_mbc = p.edge(c, m_bc, n);
-    let mbc_b = p.edge(m_bc, b, n);
-    let g_mab = p.edge(centre, m_ab, n);
-    let g_mbc = p.edge(centre, m_bc, n);
-    let g_mca = p.edge(centre, m_ca, n);
+    let b_mab = p.edge(b, m_ab, x);
+    let mab_a = p.edge(m_ab, a, y);
+    let a_mca = p.edge(a, m_ca, y);
+    let mca_c = p.edge(m_ca, c, x);
+    let c_mbc = p.edge(c, m_bc, y);
+    let mbc_b = p.edge(m_bc, b, y);
+    let g_mab = p.edge(centre, m_ab, y);
+    let g_mbc = p.edge(centre, m_bc, x);
+    let g_mca = p.edge(centre, m_ca, y);
     p.patch(
         "damper",
         &rev(mbc_b.clone()),
@@ -588,10 +632,17 @@ pub fn generate(params: &BladePairParams) -> Result<Mesh, BladePairError> {
     } else {
         "blade-pair-2d"
     };
-    let mut builder = MeshBuilder::new(&format!(
-        "{name} (refine {}, beta {} deg)",
-        params.refine, params.beta_deg
-    ));
+    let title = match params.contact_pairs {
+        Some(pairs) => format!(
+            "{name} (refine {}, {pairs} contact pairs, beta {} deg)",
+            params.refine, params.beta_deg
+        ),
+        None => format!(
+            "{name} (refine {}, beta {} deg)",
+            params.refine, params.beta_deg
+        ),
+    };
+    let mut builder = MeshBuilder::new(&title);
     let layers = params.three_d.then_some((d.layers, params.thickness));
     add_part(&mut builder, &blade1, layers);
     add_part(&mut builder, &blade2, layers);
