@@ -135,8 +135,14 @@ pub enum ContinuationError {
         /// Cause.
         reason: NewtonFailure,
     },
-    /// The step fell below the minimum.
-    #[error("continuation stalled at {freq_hz:.4} Hz (step {step:.3e} below minimum): {reason}")]
+    /// The step fell below the minimum. When Newton stagnates just above the tolerance, a
+    /// contact transition (stick-slip or lift-off) usually sits between two AFT time samples,
+    /// where the residual has a kink; the message says so and names the remedy.
+    #[error(
+        "continuation stalled at {freq_hz:.4} Hz (step {step:.3e} below minimum): {reason}; \
+         if the residual stagnates just above tolerance, a contact transition falls between AFT \
+         time samples: more samples ([harmonics] samples) usually get past it"
+    )]
     Stalled {
         /// Frequency of the last converged point (Hz).
         freq_hz: f64,

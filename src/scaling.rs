@@ -182,6 +182,9 @@ pub struct ReductionMeasure {
     pub factor_entries: usize,
     /// Peak resident memory of the process (bytes), where known.
     pub peak_memory_bytes: Option<u64>,
+    /// The reduction's full report (phase and sub-phase times, CPU seconds, solver counts).
+    #[serde(default)]
+    pub report: String,
 }
 
 /// Builds and reduces one model size, with `modes` fixed-interface modes: mesh generation,
@@ -246,6 +249,7 @@ pub fn measure_reduction(size: ModelSize, modes: usize) -> Result<ReductionMeasu
         constraint_s: report.t_constraint,
         factor_entries: report.factor_nnz,
         peak_memory_bytes: fricbound_reduction::peak_memory_bytes(),
+        report: report.to_string(),
     })
 }
 
