@@ -73,23 +73,21 @@ impl<'p> CondensedHbm<'p> {
     /// Builds the operator for `problem` (its contact DOFs become the unknowns).
     pub fn new(problem: &'p Problem) -> Result<Self, HbmError> {
         let full = HbmSystem::new(problem)?;
-        let n = problem.model.n_dofs();
-        let contact_dofs = problem.contact_dofs();
-        let mut local = vec![usize::MAX; n];
-        for (i, &d) in contact_dofs.iter().enumerate() {
-            local[d] = i;
-        }
-        let linear_dofs: Vec<usize> = (0..n).filter(|&d| local[d] == usize::MAX).collect();
-        let layout =
-            JacobianLayout::contacts_only(problem, full.unknowns(), &local, contact_dofs.len());
+        let split = problem.dof_split();
+        let layout = JacobianLayout::contacts_only(
+            problem,
+            full.unknowns(),
+            &split.local,
+            split.contact.len(),
+        );
         let dim_full = full.dim();
         Ok(Self {
             dense_k: problem.model.stiffness.to_dense(),
             dense_m: problem.model.mass.to_dense(),
             dense_c: problem.model.damping.to_dense(),
             full,
-            contact_dofs,
-            linear_dofs,
+            contact_dofs: split.contact,
+            linear_dofs: split.linear,
             layout,
             cache: None,
             x_full: vec![0.0; dim_full],

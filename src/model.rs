@@ -233,6 +233,24 @@ impl Problem {
         dofs
     }
 
+    /// The DOFs split into the contact DOFs and the others (the linear DOFs), with each DOF's
+    /// index among the contact DOFs: the partition that the condensed and schur formulations
+    /// eliminate along.
+    pub fn dof_split(&self) -> DofSplit {
+        let n = self.model.n_dofs();
+        let contact = self.contact_dofs();
+        let mut local = vec![None; n];
+        for (i, &d) in contact.iter().enumerate() {
+            local[d] = Some(i);
+        }
+        let linear = (0..n).filter(|&d| local[d].is_none()).collect();
+        DofSplit {
+            contact,
+            linear,
+            local,
+        }
+    }
+
     /// The formulation actually used: the scene's choice, or for `auto` the sparse one on
     /// sparse models, the dense one on dense models with at most [`DENSE_LIMIT`] unknowns, and
     /// on larger dense models the schur one when the contact points have independent relative
@@ -257,6 +275,17 @@ impl Problem {
             f => f,
         }
     }
+}
+
+/// The DOFs of a problem split by [`Problem::dof_split`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DofSplit {
+    /// DOFs touched by some contact (sorted, unique).
+    pub contact: Vec<usize>,
+    /// All other DOFs (sorted).
+    pub linear: Vec<usize>,
+    /// Per DOF, its index in `contact` (None for a linear DOF).
+    pub local: Vec<Option<usize>>,
 }
 
 /// Most unknowns for which `auto` keeps a dense full Jacobian.

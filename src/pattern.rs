@@ -198,8 +198,8 @@ impl JacobianLayout {
     }
 
     /// A dense layout over a subset of the DOFs holding only the contact couplings: DOF p of
-    /// the problem is row/column `local[p]` of each block of size `n_local` (`usize::MAX` for
-    /// DOFs outside the subset, which no contact may touch). Used by the condensed
+    /// the problem is row/column `local[p]` of each block of size `n_local` (None for DOFs
+    /// outside the subset, which no contact may touch). Used by the condensed
     /// formulation, whose unknowns are the contact DOFs.
     ///
     /// # Panics
@@ -207,7 +207,7 @@ impl JacobianLayout {
     pub fn contacts_only(
         problem: &Problem,
         set: &HarmonicSet,
-        local: &[usize],
+        local: &[Option<usize>],
         n_local: usize,
     ) -> Self {
         let nb = set.n_blocks();
@@ -228,10 +228,10 @@ impl JacobianLayout {
                     for i in 0..nb {
                         for &p in &dofs {
                             for &q in &dofs {
-                                assert!(local[p] != usize::MAX && local[q] != usize::MAX);
-                                slots.push(
-                                    template.slot(j * n_local + local[p], i * n_local + local[q]),
-                                );
+                                let (Some(lp), Some(lq)) = (local[p], local[q]) else {
+                                    panic!("contact DOF {p} or {q} outside the subset");
+                                };
+                                slots.push(template.slot(j * n_local + lp, i * n_local + lq));
                             }
                         }
                     }

@@ -39,7 +39,7 @@ use faer::{c64, Mat};
 
 use crate::harmonic::{Block, HarmonicSet};
 use crate::linalg::{checked_lu, packed_complex_lu, packed_lu, LinearSolveError, PackedLu};
-use crate::model::Problem;
+use crate::model::{DofSplit, Problem};
 
 /// Largest model (DOFs) the schur formulation accepts: it holds the structural matrices dense.
 pub const MAX_DOFS: usize = 10_000;
@@ -122,8 +122,7 @@ struct ContactComponent {
 fn contact_components(
     problem: &Problem,
     rows: &[ContactRows],
-    contact_dofs: &[usize],
-    local: &[usize],
+    split: &DofSplit,
 ) -> Result<Vec<ContactComponent>, RelativeCoordinatesError> {
     let n_contacts = rows.len();
     let n_q = 2 * n_contacts;
@@ -135,15 +134,19 @@ fn contact_components(
         }
         i
     }
-    let mut owner = vec![usize::MAX; contact_dofs.len()];
+    // The contact that first touched each contact DOF.
+    let mut owner: Vec<Option<usize>> = vec![None; split.contact.len()];
     for (p, (t, nr)) in rows.iter().enumerate() {
         for &(d, _) in t.iter().chain(nr) {
-            let l = local[d];
-            if owner[l] == usize::MAX {
-                owner[l] = p;
-            } else {
-                let (a, b) = (find(&mut parent, owner[l]), find(&mut parent, p));
-                parent[a.max(b)] = a.min(b);
+            let Some(l) = split.local[d] else {
+                continue; // every DOF of a contact row is a contact DOF
+            };
+            match owner[l] {
+                None => owner[l] = Some(p),
+                Some(first) => {
+                    let (a, b) = (find(&mut parent, first), find(&mut parent, p));
+                    parent[a.max(b)] = a.min(b);
+                }
             }
         }
     }
@@ -271,19 +274,14 @@ impl RelativeCoordinates {
     pub fn new(problem: &Problem, set: &HarmonicSet) -> Result<Self, RelativeCoordinatesError> {
         check_relative_coordinates(problem)?;
         let n = problem.model.n_dofs();
-        let contact_dofs = problem.contact_dofs();
-        let mut local = vec![usize::MAX; n];
-        for (i, &d) in contact_dofs.iter().enumerate() {
-            local[d] = i;
-        }
-        let other_dofs: Vec<usize> = (0..n).filter(|&d| local[d] == usize::MAX).collect();
+        let split = problem.dof_split();
         let rows: Vec<ContactRows> = problem
             .contacts
             .iter()
             .map(|c| (c.tangential.clone(), c.normal.clone()))
             .collect();
         let n_q = 2 * rows.len();
-        let components = contact_components(problem, &rows, &contact_dofs, &local)?;
+        let components = contact_components(problem, &rows, &split)?;
         let dense = |m: &crate::matrix::StructuralMatrix| m.to_dense();
         let (k, m, c) = (
             dense(&problem.model.stiffness),
@@ -337,7 +335,7 @@ impl RelativeCoordinates {
         let mut coords = Self {
             n,
             n_q,
-            other_dofs,
+            other_dofs: split.linear,
             components,
             k_y: Mat::zeros(0, 0),
             m_y: Mat::zeros(0, 0),
@@ -373,50 +371,42 @@ impl RelativeCoordinates {
 
     /// Tᵀ X for X with n rows (columns transformed independently).
     fn to_relative_coordinates(&self, x: &Mat<f64>) -> Mat<f64> {
-        let k = x.ncols();
-        let n_c = self.n - self.other_dofs.len();
-        let mut y = Mat::zeros(self.n, k);
-        for c in &self.components {
-            for (jl, &row) in c.y_rows.iter().enumerate() {
-                for col in 0..k {
-                    let mut v = 0.0;
-                    for (il, &d) in c.dofs.iter().enumerate() {
-                        v += c.block[(il, jl)] * x[(d, col)];
-                    }
-                    y[(row, col)] = v;
-                }
-            }
-        }
-        for (i, &d) in self.other_dofs.iter().enumerate() {
-            for col in 0..k {
-                y[(n_c + i, col)] = x[(d, col)];
-            }
-        }
-        y
+        self.change_coordinates(x, true)
     }
 
     /// T Y for Y with n rows.
     fn to_problem_coordinates(&self, y: &Mat<f64>) -> Mat<f64> {
-        let k = y.ncols();
+        self.change_coordinates(y, false)
+    }
+
+    /// Tᵀ X (`to_relative`) or T X: each component's block maps its DOFs to its y rows (or
+    /// back), the other DOFs are copied to the last rows (or back).
+    fn change_coordinates(&self, x: &Mat<f64>, to_relative: bool) -> Mat<f64> {
+        let k = x.ncols();
         let n_c = self.n - self.other_dofs.len();
-        let mut x = Mat::zeros(self.n, k);
+        let mut out = Mat::zeros(self.n, k);
         for c in &self.components {
             for (il, &d) in c.dofs.iter().enumerate() {
-                for col in 0..k {
-                    let mut v = 0.0;
-                    for (jl, &row) in c.y_rows.iter().enumerate() {
-                        v += c.block[(il, jl)] * y[(row, col)];
+                for (jl, &row) in c.y_rows.iter().enumerate() {
+                    let (from, to) = if to_relative { (d, row) } else { (row, d) };
+                    let w = c.block[(il, jl)];
+                    for col in 0..k {
+                        out[(to, col)] += w * x[(from, col)];
                     }
-                    x[(d, col)] = v;
                 }
             }
         }
         for (i, &d) in self.other_dofs.iter().enumerate() {
+            let (from, to) = if to_relative {
+                (d, n_c + i)
+            } else {
+                (n_c + i, d)
+            };
             for col in 0..k {
-                x[(d, col)] = y[(n_c + i, col)];
+                out[(to, col)] = x[(from, col)];
             }
         }
-        x
+        out
     }
 
     /// Tᵀ A T.
