@@ -8,7 +8,7 @@
 //! `RAYON_NUM_THREADS=1`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use fricbound::scaling::{self, ModelSize, NewtonIteration, SolverConfig};
+use fricbound::study::scaling::{self, ModelSize, NewtonIteration, SolverConfig};
 
 fn formulations(c: &mut Criterion) {
     let dir = tempfile::tempdir().expect("temporary folder");

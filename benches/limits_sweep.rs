@@ -9,9 +9,9 @@
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode};
-use fricbound::limits::{self, LimitCase};
+use fricbound::analysis::limits::{self, LimitCase};
 use fricbound::scene;
-use fricbound::sweep;
+use fricbound::study::sweep;
 
 const SCENE: &str = include_str!("../meshes/paper-wedge/fig16a-d.toml");
 

@@ -2,9 +2,9 @@
 //! H = 5, analytic Jacobian; and H = 1 with forward differences as the baseline.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use fricbound::frf::{self, Silent};
-use fricbound::reference::paper_wedge_scene;
+use fricbound::analysis::frf::{self, Silent};
 use fricbound::scene;
+use fricbound::scene::paper_wedge_scene;
 
 fn problem(overrides: &[&str]) -> fricbound::model::Problem {
     let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();

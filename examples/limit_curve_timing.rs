@@ -6,7 +6,7 @@
 //! case among others.
 
 use fricbound::model::{Formulation, JacobianStrategy};
-use fricbound::scaling::{self, ModelSize, SolverConfig};
+use fricbound::study::scaling::{self, ModelSize, SolverConfig};
 
 fn main() {
     let raw: Vec<String> = std::env::args().skip(1).collect();

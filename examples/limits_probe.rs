@@ -11,22 +11,19 @@ fn main() {
         "analysis.max_step=0.1".into(),
     ];
     overrides.extend(args);
-    let problem = fricbound::scene::parse(
-        fricbound::reference::paper_wedge_scene(),
-        "paper",
-        &overrides,
-    )
-    .and_then(|s| s.validate("paper"))
-    .unwrap_or_else(|e| panic!("{e}"));
-    let settings = fricbound::limits::LimitSettings {
+    let problem =
+        fricbound::scene::parse(fricbound::scene::paper_wedge_scene(), "paper", &overrides)
+            .and_then(|s| s.validate("paper"))
+            .unwrap_or_else(|e| panic!("{e}"));
+    let settings = fricbound::analysis::limits::LimitSettings {
         intermediate: vec![-0.5, 0.0, 0.5],
         grid_points: 71,
         bound_scan: vec![-0.5, 0.0, 0.5],
         ..Default::default()
     };
     let t = std::time::Instant::now();
-    let a =
-        fricbound::limits::analyse(&problem, &settings, |_| {}).unwrap_or_else(|e| panic!("{e}"));
+    let a = fricbound::analysis::limits::analyse(&problem, &settings, |_| {})
+        .unwrap_or_else(|e| panic!("{e}"));
     println!("time {:.3}s", t.elapsed().as_secs_f64());
     for c in a.limits.iter().chain(&a.intermediate) {
         println!(

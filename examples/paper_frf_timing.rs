@@ -7,18 +7,16 @@ fn main() {
     let mut args = std::env::args().skip(1);
     let repeats: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(20);
     let overrides: Vec<String> = args.collect();
-    let problem = fricbound::scene::parse(
-        fricbound::reference::paper_wedge_scene(),
-        "paper",
-        &overrides,
-    )
-    .and_then(|s| s.validate("paper"))
-    .unwrap_or_else(|e| panic!("{e}"));
+    let problem =
+        fricbound::scene::parse(fricbound::scene::paper_wedge_scene(), "paper", &overrides)
+            .and_then(|s| s.validate("paper"))
+            .unwrap_or_else(|e| panic!("{e}"));
     let mut best = f64::INFINITY;
     let mut points = 0;
     for _ in 0..repeats {
         let t = Instant::now();
-        let run = fricbound::frf::solve(&problem, &mut fricbound::frf::Silent).expect("solves");
+        let run = fricbound::analysis::frf::solve(&problem, &mut fricbound::analysis::frf::Silent)
+            .expect("solves");
         best = best.min(t.elapsed().as_secs_f64());
         points = run.points.len();
     }

@@ -6,28 +6,13 @@
 // rewrites would hide the maths.
 #![allow(clippy::needless_range_loop)]
 
-pub mod aft;
-pub mod commands;
-pub mod condensed;
+pub mod analysis;
+pub mod cli;
 pub mod contact;
-pub mod continuation;
 pub mod fe;
-pub mod fe_scene;
-pub mod frf;
-pub mod harmonic;
 pub mod hbm;
-pub mod jacobian;
-pub mod limits;
-pub mod linalg;
-pub mod linear;
-pub mod matrix;
 pub mod model;
-pub mod operator;
-pub mod pattern;
-pub mod reduce;
-pub mod reference;
+pub mod numerics;
 pub mod report;
-pub mod scaling;
 pub mod scene;
-pub mod schur;
-pub mod sweep;
+pub mod study;

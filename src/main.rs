@@ -1,4 +1,4 @@
-//! `fricbound` command line: parses arguments and dispatches to [`fricbound::commands`].
+//! `fricbound` command line: parses arguments and dispatches to [`fricbound::cli`].
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -52,12 +52,12 @@ enum Command {
     /// Generate or inspect FE meshes.
     Mesh {
         #[command(subcommand)]
-        command: fricbound::commands::mesh::MeshCommand,
+        command: fricbound::cli::mesh::MeshCommand,
     },
     /// Scaling study of FE size, contact points, harmonics and solver strategies.
     Bench {
         #[command(subcommand)]
-        command: fricbound::commands::bench::BenchCommand,
+        command: fricbound::cli::bench::BenchCommand,
     },
 }
 
@@ -70,31 +70,31 @@ fn main() -> ExitCode {
             overrides,
             quiet,
         } => {
-            let options = fricbound::commands::RunOptions {
+            let options = fricbound::cli::RunOptions {
                 scene,
                 out,
                 overrides,
                 quiet,
                 ..Default::default()
             };
-            fricbound::commands::run(&options).map(|r| {
+            fricbound::cli::run(&options).map(|r| {
                 if !quiet {
-                    println!("{}", fricbound::commands::run_summary(&r));
+                    println!("{}", fricbound::cli::run_summary(&r));
                 }
             })
         }
         Command::Paper { out, quick, quiet } => {
-            let options = fricbound::commands::paper::PaperOptions { out, quick, quiet };
-            fricbound::commands::paper::paper(&options).map(|r| {
+            let options = fricbound::cli::paper::PaperOptions { out, quick, quiet };
+            fricbound::cli::paper::paper(&options).map(|r| {
                 if !quiet {
-                    println!("{}", fricbound::commands::paper::paper_summary_line(&r));
+                    println!("{}", fricbound::cli::paper::paper_summary_line(&r));
                 }
             })
         }
         Command::Check { scene, overrides } => {
-            fricbound::commands::check(scene.as_deref(), &overrides).map(|s| print!("{s}"))
+            fricbound::cli::check(scene.as_deref(), &overrides).map(|s| print!("{s}"))
         }
-        Command::Bench { command } => match fricbound::commands::bench::run(&command) {
+        Command::Bench { command } => match fricbound::cli::bench::run(&command) {
             Ok(text) => {
                 print!("{text}");
                 Ok(())
@@ -104,7 +104,7 @@ fn main() -> ExitCode {
                 return ExitCode::FAILURE;
             }
         },
-        Command::Mesh { command } => match fricbound::commands::mesh::run(&command) {
+        Command::Mesh { command } => match fricbound::cli::mesh::run(&command) {
             Ok(text) => {
                 print!("{text}");
                 Ok(())

@@ -1,10 +1,10 @@
 //! AFT of a single Jenkins element: describing function (paper Appendix) and the analytic
 //! Jacobian against central differences in every contact regime.
 
-use fricbound::aft::AftWorkspace;
+use fricbound::contact::aft::AftWorkspace;
+use fricbound::contact::harmonic::HarmonicSet;
+use fricbound::contact::jenkins_describing_function;
 use fricbound::contact::{ContactEffects, ContactState, JenkinsLaw, NormalLoad};
-use fricbound::harmonic::HarmonicSet;
-use fricbound::reference::jenkins_describing_function;
 use proptest::prelude::*;
 
 fn law(kt: f64, kn: f64, mu: f64, m: f64) -> JenkinsLaw {

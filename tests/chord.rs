@@ -7,10 +7,10 @@
 //! carried from one continuation point to the next and whose chord solves run in single
 //! precision), for less effort (a chord step counts a third of a Newton iteration).
 
-use fricbound::limits;
+use fricbound::analysis::limits;
 use fricbound::model::Problem;
-use fricbound::reference::paper_wedge_scene;
 use fricbound::scene;
+use fricbound::scene::paper_wedge_scene;
 
 fn paper(formulation: &str, chord: bool) -> Problem {
     let overrides = vec![

@@ -1,11 +1,11 @@
 //! Switched effects (constant normal load, no lift-off, uncoupled statics) and Jacobian
 //! strategies on the paper case.
 
-use fricbound::frf::{self, Silent};
+use fricbound::analysis::frf::{self, Silent};
 use fricbound::hbm::{check_jacobian, HbmSystem};
 use fricbound::model::Problem;
-use fricbound::reference::paper_wedge_scene;
 use fricbound::scene;
+use fricbound::scene::paper_wedge_scene;
 
 fn paper(overrides: &[&str]) -> Problem {
     let mut o: Vec<String> = vec![
@@ -77,7 +77,7 @@ fn jacobian_strategies_give_the_same_curve() {
         ]);
         let run = frf::solve(&problem, &mut Silent).unwrap();
         // Compare the peaks and the end point (the paths may place points differently).
-        let peak = |pts: &[fricbound::frf::FrfPoint]| {
+        let peak = |pts: &[fricbound::analysis::frf::FrfPoint]| {
             pts.iter().map(|p| p.amplitudes[0]).fold(0.0, f64::max)
         };
         let (a, b) = (peak(&reference.points), peak(&run.points));

@@ -3,7 +3,7 @@
 //! `mesh` command.
 
 use faer::{Mat, Side};
-use fricbound::commands::mesh::{run, BladePairArgs, MeshCommand};
+use fricbound::cli::mesh::{run, BladePairArgs, MeshCommand};
 use fricbound::fe::assembly::{assemble, dof_map, FeModel, GroupMaterial};
 use fricbound::fe::blade_pair::{generate, BladePairParams, CONTACT_FRACTION};
 use fricbound::fe::contact_patch::pair_patch;

@@ -3,8 +3,8 @@
 //! resonance, for both limit cases (m = ±1 on every contact point), the response amplitudes
 //! agree within 0.5 %, and so do their largest values (the sampled peaks).
 
-use fricbound::frf::PointSolver;
-use fricbound::limits::LimitCase;
+use fricbound::analysis::frf::PointSolver;
+use fricbound::analysis::limits::LimitCase;
 use fricbound::model::{Formulation, Problem};
 use fricbound::scene;
 
@@ -25,7 +25,7 @@ fn amplitudes(p: &Problem, freqs: &[f64]) -> Vec<Option<f64>> {
     freqs
         .iter()
         .map(|&f| {
-            let guess = fricbound::linear::stuck_guess(
+            let guess = fricbound::analysis::linear::stuck_guess(
                 p,
                 &p.unknown_harmonics(),
                 2.0 * std::f64::consts::PI * f,
@@ -97,7 +97,7 @@ fn reduced_solution_recovers_the_full_displacement_field() {
     assert!(!fe_f.reduced);
     let freq = 860.0;
     let solve = |p: &Problem| {
-        let guess = fricbound::linear::stuck_guess(
+        let guess = fricbound::analysis::linear::stuck_guess(
             p,
             &p.unknown_harmonics(),
             2.0 * std::f64::consts::PI * freq,
@@ -186,11 +186,11 @@ fn stuck_modes_on_the_mesh_match_the_unreduced_model() {
 
     let n = full.model.n_dofs();
     let mut triplets = full.model.stiffness.triplets();
-    triplets.extend(fricbound::linear::contact_stiffness(&full));
-    let k = fricbound::matrix::StructuralMatrix::sparse_from_triplets(n, &triplets);
+    triplets.extend(fricbound::analysis::linear::contact_stiffness(&full));
+    let k = fricbound::model::matrix::StructuralMatrix::sparse_from_triplets(n, &triplets);
     let (
-        fricbound::matrix::StructuralMatrix::Sparse(k),
-        fricbound::matrix::StructuralMatrix::Sparse(m),
+        fricbound::model::matrix::StructuralMatrix::Sparse(k),
+        fricbound::model::matrix::StructuralMatrix::Sparse(m),
     ) = (&k, &full.model.mass)
     else {
         panic!("the unreduced FE model is sparse");
@@ -213,7 +213,7 @@ fn stuck_modes_on_the_mesh_match_the_unreduced_model() {
 /// (700 Hz) its response in the two models agrees within 1 %.
 #[test]
 fn unreduced_linear_references_solve_and_match_the_reduced_ones() {
-    use fricbound::linear::{reference_curve, LinearCase};
+    use fricbound::analysis::linear::{reference_curve, LinearCase};
     let reduced = problem(&[]);
     let full = problem(&["reduction="]);
     for case in [LinearCase::Open, LinearCase::Stuck] {

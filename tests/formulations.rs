@@ -3,14 +3,14 @@
 //! or dense storage of the structural matrices giving the same answers.
 
 use faer::Mat;
-use fricbound::frf::{self, PointSolver, Silent};
+use fricbound::analysis::frf::{self, PointSolver, Silent};
+use fricbound::hbm::operator::HbmOperator;
 use fricbound::hbm::{check_jacobian, check_operator_jacobian, HbmSystem};
-use fricbound::jacobian::Storage;
-use fricbound::matrix::StructuralMatrix;
+use fricbound::model::matrix::StructuralMatrix;
 use fricbound::model::{Formulation, HarmonicLoad, JacobianStrategy, Problem};
-use fricbound::operator::HbmOperator;
-use fricbound::reference::paper_wedge_scene;
+use fricbound::numerics::jacobian::Storage;
 use fricbound::scene;
+use fricbound::scene::paper_wedge_scene;
 
 fn paper(overrides: &[&str]) -> Problem {
     let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
@@ -270,7 +270,7 @@ fn full_continuation_runs_agree_between_formulations() {
     // unknowns), so compare the refined peaks, which do not depend on the sampling.
     let peak = |p: &Problem| {
         let run = frf::solve(p, &mut Silent).unwrap();
-        fricbound::limits::refine_peak(p, &run.points, 0, None)
+        fricbound::analysis::limits::refine_peak(p, &run.points, 0, None)
             .unwrap()
             .expect("a peak inside the range")
             .amplitude

@@ -1,11 +1,11 @@
 //! Two-point limit method on the paper case (§4.2-4.3), labels, bounds and sweeps.
 
+use fricbound::analysis::limits::{self, LimitCase, LimitLabel, LimitSettings, Regime};
 use fricbound::contact::ContactState;
-use fricbound::limits::{self, LimitCase, LimitLabel, LimitSettings, Regime};
 use fricbound::model::Problem;
-use fricbound::reference::paper_wedge_scene;
+use fricbound::scene::paper_wedge_scene;
 use fricbound::scene::{self, SweepOutput, SweepSpec, SweepTarget};
-use fricbound::sweep;
+use fricbound::study::sweep;
 
 fn overrides(lo: f64, hi: f64, extra: &[String]) -> Vec<String> {
     let mut o = vec![
@@ -135,8 +135,9 @@ fn labels_agree_with_the_static_balance_of_the_damper() {
         let mut n0 = Vec::new();
         for (c, curve) in analysis.limits.iter().enumerate() {
             let p = curve.case.apply(&problem);
-            let x = fricbound::frf::interpolate_on_path(&curve.run.points, g.freq_hz).unwrap();
-            let mut solver = fricbound::frf::PointSolver::new(&p).unwrap();
+            let x = fricbound::analysis::frf::interpolate_on_path(&curve.run.points, g.freq_hz)
+                .unwrap();
+            let mut solver = fricbound::analysis::frf::PointSolver::new(&p).unwrap();
             let point = solver.solve(&x, g.freq_hz).unwrap();
             let q0 = &point.coefficients[0..6];
             let (xd, yd) = (q0[4], q0[5]);
@@ -324,9 +325,10 @@ fn hysteresis_loops_at_peaks_and_at_requested_frequencies() {
             assert_eq!(set.amplitude, curve.peak.amplitude);
             None
         } else {
-            let x = fricbound::frf::interpolate_on_path(&curve.run.points, set.freq_hz).unwrap();
+            let x = fricbound::analysis::frf::interpolate_on_path(&curve.run.points, set.freq_hz)
+                .unwrap();
             let p = curve.case.apply(&problem);
-            let mut solver = fricbound::frf::PointSolver::new(&p).unwrap();
+            let mut solver = fricbound::analysis::frf::PointSolver::new(&p).unwrap();
             Some(solver.solve(&x, set.freq_hz).unwrap())
         };
         if let Some(point) = point {
@@ -336,9 +338,10 @@ fn hysteresis_loops_at_peaks_and_at_requested_frequencies() {
         let states = if set.at == "peak" {
             curve.peak.states.clone()
         } else {
-            let x = fricbound::frf::interpolate_on_path(&curve.run.points, set.freq_hz).unwrap();
+            let x = fricbound::analysis::frf::interpolate_on_path(&curve.run.points, set.freq_hz)
+                .unwrap();
             let p = curve.case.apply(&problem);
-            let mut solver = fricbound::frf::PointSolver::new(&p).unwrap();
+            let mut solver = fricbound::analysis::frf::PointSolver::new(&p).unwrap();
             solver.solve(&x, set.freq_hz).unwrap().states
         };
         for (l, state) in set.loops.iter().zip(&states) {
@@ -371,7 +374,8 @@ fn refined_peak_follows_the_fold() {
     extra.push("contacts.0.initial_state=1".into());
     extra.push("contacts.1.initial_state=1".into());
     let problem = paper(185.0, 205.0, &extra);
-    let run = fricbound::frf::solve(&problem, &mut fricbound::frf::Silent).unwrap();
+    let run =
+        fricbound::analysis::frf::solve(&problem, &mut fricbound::analysis::frf::Silent).unwrap();
     assert!(
         run.turning_points.len() >= 2,
         "no fold: {:?}",
@@ -398,7 +402,7 @@ fn refined_peak_follows_the_fold() {
     assert!(peak.amplitude >= sampled);
     // The refined point is a solution, and a local maximum on its own branch: Newton from it at
     // nearby fixed frequencies stays on the branch and finds smaller amplitudes.
-    let mut solver = fricbound::frf::PointSolver::new(&problem).unwrap();
+    let mut solver = fricbound::analysis::frf::PointSolver::new(&problem).unwrap();
     let again = solver.solve(&peak.coefficients, peak.freq_hz).unwrap();
     assert!((again.amplitudes[0] - peak.amplitude).abs() < 1e-9 * peak.amplitude);
     for df in [-2e-3, 2e-3] {

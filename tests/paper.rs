@@ -5,9 +5,9 @@
 use std::path::Path;
 use std::process::Command;
 
-use fricbound::commands::paper::FIGURES;
+use fricbound::cli::paper::FIGURES;
 use fricbound::scene;
-use fricbound::sweep;
+use fricbound::study::sweep;
 
 /// Every figure scene, as shipped in `meshes/paper-wedge/` and as built into the binary, is
 /// valid with and without the `--quick` overrides, at every one of its sweep points.

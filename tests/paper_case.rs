@@ -1,13 +1,13 @@
 //! The paper's wedge-damper case (section 4): linear limits, static balance of the damper and
 //! the qualitative contact facts of section 4.2.
 
+use fricbound::analysis::frf::{self, FrfPoint, Silent};
+use fricbound::analysis::linear::{self, LinearCase};
 use fricbound::contact::ContactState;
-use fricbound::frf::{self, FrfPoint, Silent};
 use fricbound::hbm::{check_jacobian, HbmSystem};
-use fricbound::linear::{self, LinearCase};
 use fricbound::model::Problem;
-use fricbound::reference::paper_wedge_scene;
 use fricbound::scene;
+use fricbound::scene::paper_wedge_scene;
 
 fn paper(overrides: &[&str]) -> Problem {
     let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();

@@ -3,7 +3,7 @@
 //! Newton iteration and a measured FRF.
 
 use fricbound::model::{Formulation, JacobianStrategy};
-use fricbound::scaling::{self, ModelSize, NewtonIteration, SolverConfig};
+use fricbound::study::scaling::{self, ModelSize, NewtonIteration, SolverConfig};
 
 fn two_pairs() -> fricbound::model::Problem {
     let dir = tempfile::tempdir().unwrap();

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use fricbound::reference::paper_wedge_scene;
+use fricbound::scene::paper_wedge_scene;
 use fricbound::scene::{self, SceneError};
 use tempfile::TempDir;
 

@@ -11,10 +11,10 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::continuation::NewtonFailure;
-use crate::frf::{FrfObserver, FrfPoint};
-use crate::linear::LinearCurve;
+use crate::analysis::frf::{FrfObserver, FrfPoint};
+use crate::analysis::linear::LinearCurve;
 use crate::model::Problem;
+use crate::numerics::continuation::NewtonFailure;
 
 /// Writing a result file failed.
 #[derive(Debug, thiserror::Error)]

@@ -18,9 +18,9 @@
 
 use std::fmt::Write as _;
 
-use crate::limits::{GridPoint, HysteresisLoop, LimitCase, Peak, Regime};
+use crate::analysis::limits::{GridPoint, HysteresisLoop, LimitCase, Peak, Regime};
 use crate::model::Problem;
-use crate::sweep::SweepPoint;
+use crate::study::sweep::SweepPoint;
 
 fn side_list(problem: &Problem, sides: &[usize]) -> String {
     sides

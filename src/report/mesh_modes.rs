@@ -50,7 +50,7 @@ pub fn write_stuck_modes(
         return Ok(None);
     }
     let mut k = problem.model.stiffness.to_dense();
-    for (i, j, v) in crate::linear::contact_stiffness(problem) {
+    for (i, j, v) in crate::analysis::linear::contact_stiffness(problem) {
         k[(i, j)] += v;
     }
     let m = problem.model.mass.to_dense();

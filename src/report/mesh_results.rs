@@ -7,9 +7,9 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::contact::harmonic::HarmonicSet;
 use crate::contact::ContactState;
 use crate::fe::{write_vtu, PointField, VtuError};
-use crate::harmonic::HarmonicSet;
 use crate::model::Problem;
 
 /// Numeric code of a contact state in the `contact_state` field (−1 at nodes without contact).

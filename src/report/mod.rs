@@ -5,5 +5,4 @@ pub mod limit_files;
 pub mod limit_plots;
 pub mod mesh_modes;
 pub mod mesh_results;
-pub mod paper_summary;
 pub mod plot;

@@ -19,9 +19,9 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
+use crate::analysis::frf::FrfPoint;
+use crate::analysis::linear::LinearCurve;
 use crate::contact::ContactState;
-use crate::frf::FrfPoint;
-use crate::linear::LinearCurve;
 
 /// Error of a figure.
 #[derive(Debug, thiserror::Error)]

@@ -1,0 +1,292 @@
+//! The checked problem: linear structure, contacts, loads, effects and analysis settings.
+//!
+//! A [`Problem`] is what a validated scene becomes (see [`crate::scene`]); the solver never
+//! sees unchecked input. Units are SI throughout: masses in kg, stiffness in N/m, damping in
+//! N·s/m, forces in N, displacements in m; frequencies are in Hz in [`Analysis`] and converted
+//! to ω (rad/s) by the solver.
+
+use crate::contact::aft::MarchSettings;
+use crate::contact::harmonic::HarmonicSet;
+use crate::contact::{ContactEffects, ContactPoint, DamperSide};
+use crate::model::matrix::StructuralMatrix;
+
+/// Linear structure: dense for lumped or reduced models, sparse for unreduced FE models.
+#[derive(Debug, Clone)]
+pub struct LinearModel {
+    /// DOF names, in matrix order.
+    pub dof_names: Vec<String>,
+    /// Mass matrix M (kg), symmetric positive semi-definite.
+    pub mass: StructuralMatrix,
+    /// Viscous damping matrix C (N·s/m).
+    pub damping: StructuralMatrix,
+    /// Stiffness matrix K (N/m), symmetric positive semi-definite (free bodies allowed).
+    pub stiffness: StructuralMatrix,
+}
+
+impl LinearModel {
+    /// Number of DOFs.
+    pub fn n_dofs(&self) -> usize {
+        self.dof_names.len()
+    }
+
+    /// Index of a DOF by name.
+    pub fn dof_index(&self, name: &str) -> Option<usize> {
+        self.dof_names.iter().position(|d| d == name)
+    }
+}
+
+/// A harmonic force on one DOF: F(τ) = cos·cos(hτ) + sin·sin(hτ) (N).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HarmonicLoad {
+    /// DOF index.
+    pub dof: usize,
+    /// Harmonic number h ≥ 1.
+    pub harmonic: usize,
+    /// Cosine amplitude (N).
+    pub cos: f64,
+    /// Sine amplitude (N).
+    pub sin: f64,
+}
+
+/// Whether statics and dynamics are solved together.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Coupling {
+    /// The 0th harmonic is an unknown of the harmonic balance (paper Eq. 3, coupled approach).
+    #[default]
+    Coupled,
+    /// A static pre-solve fixes the 0th harmonic; only h ≥ 1 are solved dynamically.
+    Uncoupled,
+}
+
+/// Effects switched on by the scene. An effect that is off adds no unknowns and no work.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Effects {
+    /// Contact-law effects (normal-load model, lift-off).
+    pub contact: ContactEffects,
+    /// Static/dynamic coupling through the 0th harmonic.
+    pub coupling: Coupling,
+}
+
+/// How the Jacobian of the harmonic-balance residual is formed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum JacobianStrategy {
+    /// Chain rule through the contact march (default).
+    #[default]
+    Analytic,
+    /// Forward finite differences (one residual per unknown).
+    ForwardDifference,
+    /// Central finite differences (two residuals per unknown).
+    CentralDifference,
+}
+
+/// How the harmonic-balance equations are stored and solved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Formulation {
+    /// Dense for small models, sparse for large or sparse ones, condensed for dense models
+    /// whose contact DOFs are few compared with the rest (see [`Problem::formulation`]).
+    #[default]
+    Auto,
+    /// All DOFs, dense Jacobian (dense LU).
+    Dense,
+    /// All DOFs, sparse Jacobian (sparse LU, symbolic factorisation once per scene).
+    Sparse,
+    /// Contact DOFs only: the linear DOFs are eliminated per harmonic (dynamic Schur
+    /// complement), dense Jacobian on the contact DOFs.
+    Condensed,
+    /// All DOFs in the residual; each linear solve eliminates everything but the relative
+    /// contact coordinates (two per contact point) per harmonic, and factorises a dense
+    /// matrix on those only ([`crate::hbm::schur`]). For dense (lumped or reduced) models.
+    Schur,
+}
+
+/// Continuation and Newton settings. Frequencies in Hz; arc-length steps are measured in the
+/// scaled space where a unit of frequency is 1 Hz (see [`crate::numerics::continuation`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Analysis {
+    /// Start frequency (Hz), > 0.
+    pub freq_start_hz: f64,
+    /// End frequency (Hz), > start.
+    pub freq_end_hz: f64,
+    /// First arc-length step (Hz-equivalent).
+    pub initial_step: f64,
+    /// Smallest step before continuation gives up.
+    pub min_step: f64,
+    /// Largest step.
+    pub max_step: f64,
+    /// Most continuation points.
+    pub max_points: usize,
+    /// Newton iterations aimed at per point; steps grow below and shrink above it.
+    pub target_iterations: usize,
+    /// Newton iterations before a point fails.
+    pub max_iterations: usize,
+    /// Convergence: ‖R‖ ≤ residual_tolerance · ‖F_ex‖ (static and harmonic loads).
+    pub residual_tolerance: f64,
+    /// Convergence: scaled Newton step norm ≤ step_tolerance.
+    pub step_tolerance: f64,
+    /// Jacobian strategy.
+    pub jacobian: JacobianStrategy,
+    /// Storage and elimination of the harmonic-balance equations.
+    pub formulation: Formulation,
+    /// Points of the uniform frequency grid of the linear references.
+    pub linear_points: usize,
+    /// Unknowns from which the continuation corrector reuses a factorised Jacobian over
+    /// several iterations (chord iterations) while the residual falls fast enough: on large
+    /// dense Newton matrices the factorisation dominates and a chord step costs a residual.
+    pub chord_min_unknowns: usize,
+}
+
+/// Default of [`Analysis::chord_min_unknowns`].
+pub const CHORD_MIN_UNKNOWNS: usize = 1500;
+
+/// A checked problem, ready to solve.
+#[derive(Debug, Clone)]
+pub struct Problem {
+    /// Linear structure.
+    pub model: LinearModel,
+    /// Contact points.
+    pub contacts: Vec<ContactPoint>,
+    /// Damper sides grouping the contact points.
+    pub sides: Vec<DamperSide>,
+    /// Static loads per DOF (N), length n_dofs.
+    pub static_load: Vec<f64>,
+    /// Harmonic loads.
+    pub harmonic_loads: Vec<HarmonicLoad>,
+    /// Dynamic harmonics h ≥ 1 balanced (the 0th is added by the coupling effect).
+    pub harmonics: Vec<usize>,
+    /// AFT time samples per period.
+    pub samples: usize,
+    /// Switched effects.
+    pub effects: Effects,
+    /// March limits of the AFT.
+    pub march: MarchSettings,
+    /// Analysis settings.
+    pub analysis: Analysis,
+    /// DOF indices reported in outputs.
+    pub outputs: Vec<usize>,
+    /// Limit analysis settings, when the scene asks for one.
+    pub limits: Option<crate::analysis::limits::LimitSettings>,
+    /// The FE mesh the problem comes from, for results on the mesh (None for lumped models
+    /// and Matrix Market input).
+    pub fe: Option<std::sync::Arc<FeOrigin>>,
+}
+
+/// The FE mesh of a problem and the map from the problem's coordinates to its nodes.
+#[derive(Debug)]
+pub struct FeOrigin {
+    /// The mesh.
+    pub mesh: crate::fe::Mesh,
+    /// DOF (node, direction) of each row of the full FE model.
+    pub dofs: crate::fe::DofMap,
+    /// For a reduced problem, row d holds the full-model displacement of DOF d per reduced
+    /// coordinate (the Craig-Bampton basis T); None when the problem is the full model, or when
+    /// the basis would be too large to keep (then results on the mesh are not written).
+    pub recovery: Option<Vec<Vec<f64>>>,
+    /// Whether the problem is reduced.
+    pub reduced: bool,
+}
+
+impl FeOrigin {
+    /// Full-model values of DOF rows from problem coordinates `q` (one block of coefficients);
+    /// None when a reduced problem has no recovery basis.
+    pub fn full_values(&self, q: &[f64]) -> Option<Vec<f64>> {
+        match (&self.recovery, self.reduced) {
+            (_, false) => Some(q.to_vec()),
+            (Some(rows), true) => Some(
+                rows.iter()
+                    .map(|r| r.iter().zip(q).map(|(a, b)| a * b).sum())
+                    .collect(),
+            ),
+            (None, true) => None,
+        }
+    }
+}
+
+impl Problem {
+    /// The harmonic set of the unknowns: the dynamic harmonics, plus 0 when coupled.
+    pub fn unknown_harmonics(&self) -> HarmonicSet {
+        let mut h = self.harmonics.clone();
+        if self.effects.coupling == Coupling::Coupled {
+            h.push(0);
+        }
+        HarmonicSet::new(h)
+    }
+
+    /// The harmonic set used by the AFT (always includes the 0th harmonic).
+    pub fn force_harmonics(&self) -> HarmonicSet {
+        let mut h = self.harmonics.clone();
+        h.push(0);
+        HarmonicSet::new(h)
+    }
+
+    /// DOFs touched by some contact (sorted, unique): the nonlinear DOFs.
+    pub fn contact_dofs(&self) -> Vec<usize> {
+        let mut dofs: Vec<usize> = self
+            .contacts
+            .iter()
+            .flat_map(|c| c.tangential.iter().chain(&c.normal).map(|&(d, _)| d))
+            .collect();
+        dofs.sort_unstable();
+        dofs.dedup();
+        dofs
+    }
+
+    /// The DOFs split into the contact DOFs and the others (the linear DOFs), with each DOF's
+    /// index among the contact DOFs: the partition that the condensed and schur formulations
+    /// eliminate along.
+    pub fn dof_split(&self) -> DofSplit {
+        let n = self.model.n_dofs();
+        let contact = self.contact_dofs();
+        let mut local = vec![None; n];
+        for (i, &d) in contact.iter().enumerate() {
+            local[d] = Some(i);
+        }
+        let linear = (0..n).filter(|&d| local[d].is_none()).collect();
+        DofSplit {
+            contact,
+            linear,
+            local,
+        }
+    }
+
+    /// The formulation actually used: the scene's choice, or for `auto` the sparse one on
+    /// sparse models, the dense one on dense models with at most [`DENSE_LIMIT`] unknowns, and
+    /// on larger dense models the schur one when the contact points have independent relative
+    /// coordinates (see [`crate::hbm::schur::check_relative_coordinates`]); otherwise the condensed
+    /// one when the contact DOFs are at most half of the DOFs, and the sparse one.
+    pub fn formulation(&self) -> Formulation {
+        match self.analysis.formulation {
+            Formulation::Auto => {
+                let unknowns = self.model.n_dofs() * self.unknown_harmonics().n_blocks();
+                if self.model.stiffness.is_sparse() {
+                    Formulation::Sparse
+                } else if unknowns <= DENSE_LIMIT {
+                    Formulation::Dense
+                } else if crate::hbm::schur::check_relative_coordinates(self).is_ok() {
+                    Formulation::Schur
+                } else if 2 * self.contact_dofs().len() <= self.model.n_dofs() {
+                    Formulation::Condensed
+                } else {
+                    Formulation::Sparse
+                }
+            }
+            f => f,
+        }
+    }
+}
+
+/// The DOFs of a problem split by [`Problem::dof_split`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DofSplit {
+    /// DOFs touched by some contact (sorted, unique).
+    pub contact: Vec<usize>,
+    /// All other DOFs (sorted).
+    pub linear: Vec<usize>,
+    /// Per DOF, its index in `contact` (None for a linear DOF).
+    pub local: Vec<Option<usize>>,
+}
+
+/// Most unknowns for which `auto` keeps a dense full Jacobian.
+pub const DENSE_LIMIT: usize = 600;

@@ -1,0 +1,439 @@
+//! Scene input for finite-element models: a Gmsh mesh assembled with materials per physical
+//! group, or K and M exported as Matrix Market files with a DOF map; contact patches paired
+//! node to node between facing groups; loads and outputs on physical groups; Craig-Bampton
+//! reduction settings.
+//!
+//! This module turns those scene tables into the pieces [`crate::scene`] assembles into a
+//! [`crate::model::Problem`]: a sparse [`LinearModel`] whose DOFs are named `<node>.<dir>`
+//! (e.g. `123.y`), the contact points of every patch, and DOF/weight lists for group loads.
+//! File paths are relative to the scene file's folder.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::contact::{ContactPoint, JenkinsLaw};
+use crate::fe::{
+    self, Direction, DofMap, GroupMaterial, Material, Mesh, PatchSpec, PlaneAssumption,
+};
+use crate::model::matrix::StructuralMatrix;
+use crate::model::LinearModel;
+use crate::scene::SceneError;
+
+/// Plane assumption of 2D meshes, as written in scenes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum PlaneSpec {
+    /// Plane stress (thin bodies loaded in their plane).
+    #[default]
+    Stress,
+    /// Plane strain.
+    Strain,
+}
+
+/// `[[model.materials]]`: the material of one physical group of the mesh.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Physical group (of the mesh's dimension).
+    pub group: String,
+    /// Young's modulus E (Pa).
+    pub young: f64,
+    /// Poisson's ratio ν (–).
+    pub poisson: f64,
+    /// Density ρ (kg/m³).
+    pub density: f64,
+    /// Out-of-plane thickness (m) of 2D meshes.
+    #[serde(default)]
+    pub thickness: Option<f64>,
+}
+
+/// `[model.matrix_market]`: K and M exported by another FE code.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MatrixMarketSpec {
+    /// Stiffness matrix file (N/m).
+    pub stiffness: PathBuf,
+    /// Mass matrix file (kg).
+    pub mass: PathBuf,
+    /// DOF map (CSV `node,direction,row`).
+    pub dof_map: PathBuf,
+    /// Relative tolerance of the symmetry check of `general` files.
+    #[serde(default = "default_symmetry_tolerance")]
+    pub symmetry_tolerance: f64,
+}
+
+fn default_symmetry_tolerance() -> f64 {
+    1e-8
+}
+
+/// `[reduction]`: Craig-Bampton reduction of an FE model.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReductionSpec {
+    /// Fixed-interface modes kept.
+    pub modes: usize,
+    /// Modal damping ratio of the fixed-interface modes (–).
+    #[serde(default)]
+    pub modal_damping: f64,
+    /// Ordering of the interior Cholesky factorisation: `metis` (default) or `amd`.
+    #[serde(default)]
+    pub ordering: OrderingSpec,
+}
+
+/// Fill-reducing ordering, as written in scenes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum OrderingSpec {
+    /// METIS nested dissection.
+    #[default]
+    Metis,
+    /// Approximate minimum degree.
+    Amd,
+}
+
+impl OrderingSpec {
+    /// The reduction crate's ordering.
+    pub fn ordering(self) -> fricbound_reduction::Ordering {
+        match self {
+            OrderingSpec::Metis => fricbound_reduction::Ordering::Metis,
+            OrderingSpec::Amd => fricbound_reduction::Ordering::Amd,
+        }
+    }
+}
+
+/// `[[contact_patches]]`: one damper side paired node to node with the body it touches.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactPatchSpec {
+    /// Damper side; the points are named `<side>-1`, `<side>-2`, ... along the patch.
+    pub side: String,
+    /// Physical group of the damper's contact face.
+    pub damper: String,
+    /// Physical group of the body's contact face.
+    pub body: String,
+    /// Tangential contact stiffness of the whole patch (N/m), shared among the pairs in
+    /// proportion to their tributary areas.
+    pub kt: f64,
+    /// Normal contact stiffness of the whole patch (N/m), shared likewise.
+    pub kn: f64,
+    /// Friction coefficient (–).
+    pub mu: f64,
+    /// Initial normal gap added to the meshed one (m); negative for an interference.
+    #[serde(default)]
+    pub gap: f64,
+    /// Initial tangential state m ∈ [−1, 1] of every point.
+    #[serde(default)]
+    pub initial_state: f64,
+    /// Largest distance (m) between paired nodes.
+    #[serde(default = "default_pair_tolerance")]
+    pub tolerance: f64,
+    /// 3D meshes: tangential direction of the patch (projected on each pair's tangent plane).
+    #[serde(default)]
+    pub tangent: Option<[f64; 3]>,
+}
+
+fn default_pair_tolerance() -> f64 {
+    1e-9
+}
+
+/// A linear FE structure ready for a scene.
+#[derive(Debug, Clone)]
+pub struct FeStructure {
+    /// Sparse K, M and C = αM + βK; DOFs named `<node>.<dir>`.
+    pub model: LinearModel,
+    /// DOF of each row.
+    pub dofs: DofMap,
+    /// The mesh, when the model came from one.
+    pub mesh: Option<Mesh>,
+    /// Out-of-plane thickness of 2D meshes (m), for contact areas.
+    pub thickness: f64,
+    /// Row of each DOF name.
+    pub index: HashMap<String, usize>,
+}
+
+/// Resolves a path relative to the scene file's folder.
+pub fn resolve(scene_file: &str, path: &Path) -> PathBuf {
+    if path.is_absolute() {
+        return path.to_path_buf();
+    }
+    Path::new(scene_file)
+        .parent()
+        .map(|d| d.join(path))
+        .unwrap_or_else(|| path.to_path_buf())
+}
+
+fn invalid(file: &str, field: impl Into<String>, reason: impl Into<String>) -> SceneError {
+    SceneError::Invalid {
+        file: file.to_string(),
+        field: field.into(),
+        reason: reason.into(),
+    }
+}
+
+/// Builds the FE structure of `[model]` from a mesh (`mesh`, `materials`, `plane`, `clamp`)
+/// or from Matrix Market files (`matrix_market`), with Rayleigh damping (α 1/s, β s).
+#[allow(clippy::too_many_arguments)]
+pub fn build_structure(
+    file: &str,
+    mesh_path: Option<&Path>,
+    materials: &[MaterialSpec],
+    plane: PlaneSpec,
+    clamp: &[String],
+    matrix_market: Option<&MatrixMarketSpec>,
+    rayleigh: (f64, f64),
+) -> Result<FeStructure, SceneError> {
+    let (stiffness, mass, dofs, mesh, thickness) = match (mesh_path, matrix_market) {
+        (Some(path), None) => {
+            let full = resolve(file, path);
+            let mesh =
+                fe::read_msh(&full).map_err(|e| invalid(file, "model.mesh", e.to_string()))?;
+            if materials.is_empty() {
+                return Err(invalid(
+                    file,
+                    "model.materials",
+                    "a mesh needs at least one [[model.materials]] entry (group, young, poisson, density)",
+                ));
+            }
+            let needs_thickness = mesh.dimension() == 2;
+            let mut groups = Vec::new();
+            let mut thickness = 1.0;
+            for (i, m) in materials.iter().enumerate() {
+                let t = match (needs_thickness, m.thickness) {
+                    (true, Some(t)) => t,
+                    (true, None) => {
+                        return Err(invalid(
+                            file,
+                            format!("model.materials[{i}].thickness"),
+                            "2D meshes need the out-of-plane thickness (m)",
+                        ))
+                    }
+                    (false, t) => t.unwrap_or(1.0),
+                };
+                let material = Material {
+                    young_modulus: m.young,
+                    poisson_ratio: m.poisson,
+                    density: m.density,
+                    thickness: t,
+                };
+                material
+                    .check(needs_thickness)
+                    .map_err(|r| invalid(file, format!("model.materials[{i}]"), r))?;
+                if i == 0 {
+                    thickness = t;
+                }
+                groups.push(GroupMaterial::new(&m.group, material));
+            }
+            let plane = match plane {
+                PlaneSpec::Stress => PlaneAssumption::Stress,
+                PlaneSpec::Strain => PlaneAssumption::Strain,
+            };
+            let mut model = fe::assemble(&mesh, &groups, plane)
+                .map_err(|e| invalid(file, "model.materials", e.to_string()))?;
+            for (i, g) in clamp.iter().enumerate() {
+                model = model
+                    .clamp_group(&mesh, g)
+                    .map_err(|e| invalid(file, format!("model.clamp[{i}]"), e.to_string()))?;
+            }
+            (
+                model.stiffness,
+                model.mass,
+                model.dofs,
+                Some(mesh),
+                thickness,
+            )
+        }
+        (None, Some(mm)) => {
+            let m = fe::read_fe_matrices(
+                &resolve(file, &mm.stiffness),
+                &resolve(file, &mm.mass),
+                &resolve(file, &mm.dof_map),
+                mm.symmetry_tolerance,
+            )
+            .map_err(|e| invalid(file, "model.matrix_market", e.to_string()))?;
+            (m.stiffness, m.mass, m.dofs, None, 1.0)
+        }
+        (Some(_), Some(_)) => {
+            return Err(invalid(
+                file,
+                "model",
+                "give either `mesh` or `matrix_market`, not both",
+            ))
+        }
+        (None, None) => {
+            return Err(invalid(
+                file,
+                "model",
+                "needs inline matrices (`dofs`, `mass`, `stiffness`), a `mesh`, or `matrix_market`",
+            ))
+        }
+    };
+    let n = dofs.len();
+    if n == 0 {
+        return Err(invalid(file, "model", "the FE model has no free DOF"));
+    }
+    let names = dofs.names();
+    let index: HashMap<String, usize> = names
+        .iter()
+        .cloned()
+        .enumerate()
+        .map(|(i, s)| (s, i))
+        .collect();
+    let (alpha, beta) = rayleigh;
+    let stiffness = StructuralMatrix::Sparse(stiffness);
+    let mass = StructuralMatrix::Sparse(mass);
+    let mut c = Vec::new();
+    if alpha != 0.0 {
+        mass.for_each_nonzero(|i, j, v| c.push((i, j, alpha * v)));
+    }
+    if beta != 0.0 {
+        stiffness.for_each_nonzero(|i, j, v| c.push((i, j, beta * v)));
+    }
+    let damping = StructuralMatrix::sparse_from_triplets(n, &c);
+    Ok(FeStructure {
+        model: LinearModel {
+            dof_names: names,
+            mass,
+            damping,
+            stiffness,
+        },
+        dofs,
+        mesh,
+        thickness,
+        index,
+    })
+}
+
+/// The contact points of one patch: one Jenkins element per node pair, frame from the pair,
+/// stiffness shared by tributary area. `side` is the index of the patch's damper side.
+pub fn patch_contacts(
+    file: &str,
+    field: &str,
+    structure: &FeStructure,
+    spec: &ContactPatchSpec,
+    side: usize,
+) -> Result<Vec<ContactPoint>, SceneError> {
+    let Some(mesh) = &structure.mesh else {
+        return Err(invalid(
+            file,
+            field,
+            "contact patches need a mesh (`model.mesh`); with Matrix Market models list the \
+             contact points in [[contacts]]",
+        ));
+    };
+    let patch = fe::pair_patch(
+        mesh,
+        &structure.dofs,
+        &PatchSpec {
+            side: spec.side.clone(),
+            damper_group: spec.damper.clone(),
+            body_group: spec.body.clone(),
+            tolerance: spec.tolerance,
+            tangent: spec.tangent,
+            thickness: structure.thickness,
+        },
+    )
+    .map_err(|e| invalid(file, field, e.to_string()))?;
+    let area = patch.area();
+    if patch.pairs.is_empty() || area <= 0.0 {
+        return Err(invalid(file, field, "the patch has no node pair"));
+    }
+    let node_index = mesh.node_index_map();
+    let position = |id: u64| mesh.nodes[node_index[&id]].coords;
+    Ok(patch
+        .pairs
+        .iter()
+        .map(|pair| {
+            let share = pair.area_weight / area;
+            let row = |v: &[f64; 3]| -> Vec<(usize, f64)> {
+                let mut r = Vec::new();
+                for (k, (&d, &b)) in pair.damper_dofs.iter().zip(&pair.body_dofs).enumerate() {
+                    if v[k] != 0.0 {
+                        r.push((d, v[k]));
+                        r.push((b, -v[k]));
+                    }
+                }
+                r
+            };
+            ContactPoint {
+                name: pair.name.clone(),
+                side,
+                tangential: row(&pair.tangent),
+                normal: row(&pair.normal),
+                // Signed meshed gap: how far the body node lies beyond the damper node along n.
+                gap: {
+                    let (xd, xb) = (position(pair.damper_node), position(pair.body_node));
+                    (0..3)
+                        .map(|k| pair.normal[k] * (xb[k] - xd[k]))
+                        .sum::<f64>()
+                        + spec.gap
+                },
+                law: JenkinsLaw {
+                    kt: spec.kt * share,
+                    kn: spec.kn * share,
+                    mu: spec.mu,
+                    initial_state: spec.initial_state,
+                },
+            }
+        })
+        .collect())
+}
+
+/// The DOFs of a group's nodes in one direction with weights summing to 1, proportional to
+/// the row sums of M (a uniform body force, e.g. centrifugal, distributes that way); equal
+/// weights when the group carries no mass.
+pub fn group_load(
+    file: &str,
+    field: &str,
+    structure: &FeStructure,
+    group: &str,
+    direction: &str,
+) -> Result<Vec<(usize, f64)>, SceneError> {
+    let Some(mesh) = &structure.mesh else {
+        return Err(invalid(
+            file,
+            field,
+            "loads on groups need a mesh (`model.mesh`); name a DOF (`dof = \"<node>.<dir>\"`) instead",
+        ));
+    };
+    let dir = Direction::parse(direction).ok_or_else(|| {
+        invalid(
+            file,
+            format!("{field}.direction"),
+            format!("unknown direction `{direction}` (x, y or z)"),
+        )
+    })?;
+    let nodes = mesh
+        .group_nodes(group)
+        .map_err(|e| invalid(file, format!("{field}.group"), e.to_string()))?;
+    let rows: Vec<usize> = nodes
+        .iter()
+        .filter_map(|&i| structure.dofs.row(mesh.nodes[i].id, dir))
+        .collect();
+    if rows.is_empty() {
+        return Err(invalid(
+            file,
+            format!("{field}.group"),
+            format!("group `{group}` has no free DOF in direction {direction} (clamped?)"),
+        ));
+    }
+    let mut row_mass: HashMap<usize, f64> = rows.iter().map(|&r| (r, 0.0)).collect();
+    structure.model.mass.for_each_nonzero(|i, _, v| {
+        if let Some(m) = row_mass.get_mut(&i) {
+            *m += v;
+        }
+    });
+    let total: f64 = rows.iter().map(|r| row_mass[r]).sum();
+    Ok(rows
+        .iter()
+        .map(|&r| {
+            let w = if total > 0.0 {
+                row_mass[&r] / total
+            } else {
+                1.0 / rows.len() as f64
+            };
+            (r, w)
+        })
+        .collect())
+}
