@@ -41,10 +41,10 @@ fn f0_sweep(c: &mut Criterion) {
     group.bench_function("5_preloads_x_2_limit_frfs", |b| {
         b.iter(|| sweep::run(SCENE, "fig16a-d", &ci, &spec_with(&ci), |_| {}).expect("runs"))
     });
-    let problem = scene::parse(SCENE, "fig16a-d", &["sweep=".to_string()])
-        .and_then(|s| s.validate("fig16a-d"))
+    let (problem, limits) = scene::parse(SCENE, "fig16a-d", &["sweep=".to_string()])
+        .and_then(|s| s.validate_with_limits("fig16a-d"))
         .expect("valid");
-    let window = problem.limits.as_ref().and_then(|l| l.peak_window_hz);
+    let window = limits.as_ref().and_then(|l| l.peak_window_hz);
     let case = LimitCase::uniform(&problem, 1.0);
     group.bench_function("one_limit_frf_F0_120N", |b| {
         b.iter(|| limits::solve_case(&problem, &case, window).expect("solves"))

@@ -241,20 +241,21 @@ fn sweeps_are_identical_with_one_and_two_threads() {
 }
 
 /// The paper case with a `[limits]` table appended (and the frequency range of `overrides`).
-fn paper_with_limits(limits: &str, lo: f64, hi: f64, extra: &[String]) -> Problem {
+fn paper_with_limits(limits: &str, lo: f64, hi: f64, extra: &[String]) -> (Problem, LimitSettings) {
     let mut text = paper_wedge_scene().to_string();
     text.push_str(limits);
-    scene::parse(&text, "paper", &overrides(lo, hi, extra))
+    let (problem, settings) = scene::parse(&text, "paper", &overrides(lo, hi, extra))
         .unwrap()
-        .validate("paper")
-        .unwrap()
+        .validate_with_limits("paper")
+        .unwrap();
+    (problem, settings.unwrap())
 }
 
 #[test]
 fn per_side_cases_matter_only_on_the_stuck_side() {
     // Around the 3rd resonance at F0 = 80 N the blade-1 side (`left`) sticks and the blade-2
     // side slips at the peaks; the scene's m is 0 on both sides.
-    let problem = paper_with_limits(
+    let (problem, settings) = paper_with_limits(
         "\n[limits]\n[[limits.cases]]\nsides = { left = 0.5 }\n\
          [[limits.cases]]\nname = \"right-only\"\nsides = { right = 0.5 }\n\
          [[limits.cases]]\ncontacts = { left = -0.5 }\nsides = { left = 1.0 }\n",
@@ -262,7 +263,6 @@ fn per_side_cases_matter_only_on_the_stuck_side() {
         240.0,
         &[preload(80.0)],
     );
-    let settings = problem.limits.clone().unwrap();
     let cases = settings.intermediate_cases(&problem);
     let names: Vec<&str> = cases.iter().map(|c| c.name.as_str()).collect();
     assert_eq!(names, ["left+0.5", "right-only", "left+1_left-0.5"]);
@@ -301,14 +301,13 @@ fn per_side_cases_matter_only_on_the_stuck_side() {
 
 #[test]
 fn hysteresis_loops_at_peaks_and_at_requested_frequencies() {
-    let problem = paper_with_limits(
+    let (problem, settings) = paper_with_limits(
         "\n[limits]\nintermediate = [0.0]\ngrid_points = 41\n\
          [limits.hysteresis]\nat_peaks = true\nfreqs_hz = [214.0, 234.9]\n",
         200.0,
         235.0,
         &[],
     );
-    let settings = problem.limits.clone().unwrap();
     let a = limits::analyse(&problem, &settings, |_| {}).unwrap();
     // Three curves (m+1, m-1, m0), each at its peak and at the two frequencies.
     assert_eq!(a.loops.len(), 9, "{:?}", a.loops_missing);

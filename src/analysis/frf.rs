@@ -10,11 +10,11 @@ use crate::contact::ContactState;
 use crate::hbm::operator::HbmOperator;
 use crate::hbm::{HbmError, HbmSystem};
 use crate::model::Problem;
-use crate::numerics::continuation::{
+use crate::numerics::linalg::LinearSolveError;
+use crate::numerics::{
     Continuation, ContinuationError, NewtonFailure, Observer, ParametricResidual, PathEnd,
     PathPoint,
 };
-use crate::numerics::linalg::LinearSolveError;
 
 /// One converged point of a nonlinear frequency response.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -130,7 +130,7 @@ fn arc_length_x_scale(problem: &Problem, set: &HarmonicSet) -> Result<f64, Linea
             .collect(),
     );
     let static_norm = if set.has_constant() {
-        crate::numerics::continuation::norm(&linear::stuck_guess(
+        crate::numerics::linalg::norm(&linear::stuck_guess(
             problem,
             &HarmonicSet::new(vec![0]),
             0.0,
@@ -142,7 +142,7 @@ fn arc_length_x_scale(problem: &Problem, set: &HarmonicSet) -> Result<f64, Linea
     for i in 0..=40 {
         let f = a.freq_start_hz + (a.freq_end_hz - a.freq_start_hz) * i as f64 / 40.0;
         let x = linear::stuck_guess(problem, &dynamic, 2.0 * PI * f)?;
-        dynamic_norm = dynamic_norm.max(crate::numerics::continuation::norm(&x));
+        dynamic_norm = dynamic_norm.max(crate::numerics::linalg::norm(&x));
     }
     let x_ref = static_norm.hypot(dynamic_norm);
     let range = a.freq_end_hz - a.freq_start_hz;
@@ -207,7 +207,10 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
     let set = system.unknowns().clone();
     let omega0 = 2.0 * PI * problem.analysis.freq_start_hz;
     let guess = system.restrict(&linear::stuck_guess(problem, &set, omega0)?);
-    let continuation = Continuation::new(problem.analysis, arc_length_x_scale(problem, &set)?);
+    let continuation = Continuation::new(
+        problem.analysis.continuation(),
+        arc_length_x_scale(problem, &set)?,
+    );
     let mut adapter = Adapter {
         observer,
         points: Vec::new(),
@@ -239,7 +242,10 @@ impl<'p> PointSolver<'p> {
     pub fn new(problem: &'p Problem) -> Result<Self, FrfError> {
         let system = HbmOperator::new(problem)?;
         let set = system.unknowns().clone();
-        let continuation = Continuation::new(problem.analysis, arc_length_x_scale(problem, &set)?);
+        let continuation = Continuation::new(
+            problem.analysis.continuation(),
+            arc_length_x_scale(problem, &set)?,
+        );
         Ok(Self {
             system,
             continuation,
@@ -285,7 +291,7 @@ impl<'p> PointSolver<'p> {
         };
         let (ya, yb) = (scaled(a), scaled(b));
         let mut chord: Vec<f64> = ya.iter().zip(&yb).map(|(p, q)| q - p).collect();
-        let length = crate::numerics::continuation::norm(&chord);
+        let length = crate::numerics::linalg::norm(&chord);
         if length == 0.0 {
             return self.solve(&a.coefficients, a.freq_hz);
         }

@@ -26,10 +26,7 @@ pub(super) fn write_curve(ctx: &RunContext<'_>, curve: &CaseCurve) -> Result<(),
 /// Runs the limit analysis of the context's scene.
 pub fn run_limits(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
     let problem = &ctx.problem;
-    let settings = problem
-        .limits
-        .clone()
-        .expect("called for scenes with [limits]");
+    let settings = ctx.limits.clone().expect("called for scenes with [limits]");
     let n_curves = 2
         + settings.intermediate.len()
         + settings.cases.len()

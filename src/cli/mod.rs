@@ -17,10 +17,11 @@ use indicatif::{ProgressBar, ProgressStyle};
 use sha2::{Digest, Sha256};
 
 use crate::analysis::frf::{self, FrfError, FrfObserver, FrfPoint};
+use crate::analysis::limits::LimitSettings;
 use crate::analysis::linear::{self, LinearCase};
 use crate::contact::harmonic::Block;
 use crate::model::Problem;
-use crate::numerics::continuation::NewtonFailure;
+use crate::numerics::NewtonFailure;
 use crate::report::files::{self, FrfWriter, RunInfo, WriteError};
 use crate::report::plot::{self, FrfFigure, PlotError};
 use crate::scene::{self, Scene, SceneError};
@@ -148,6 +149,8 @@ pub struct RunContext<'a> {
     pub scene: Scene,
     /// The checked problem.
     pub problem: Problem,
+    /// The limit analysis the scene asks for, if any.
+    pub limits: Option<LimitSettings>,
     /// Output folder.
     pub dir: PathBuf,
     /// Linear reference with contacts open.
@@ -204,23 +207,22 @@ impl RunContext<'_> {
     }
 }
 
+/// A scene loaded and checked: its label, the scene, the problem and the limit analysis it
+/// asks for.
+pub type LoadedScene = (String, Scene, Problem, Option<LimitSettings>);
+
 /// Loads the scene named by `path` (or the built-in default) with overrides.
-pub fn load_scene(
-    path: Option<&Path>,
-    overrides: &[String],
-) -> Result<(String, Scene, Problem), SceneError> {
-    match path {
-        Some(p) => {
-            let (scene, problem) = scene::load_problem(p, overrides)?;
-            Ok((p.display().to_string(), scene, problem))
-        }
+pub fn load_scene(path: Option<&Path>, overrides: &[String]) -> Result<LoadedScene, SceneError> {
+    let (label, scene) = match path {
+        Some(p) => (p.display().to_string(), scene::load(p, overrides)?),
         None => {
             let label = scene::default_scene_label().display().to_string();
             let scene = scene::parse(scene::PAPER_DEFAULT_SCENE, &label, overrides)?;
-            let problem = scene.validate(&label)?;
-            Ok((label, scene, problem))
+            (label, scene)
         }
-    }
+    };
+    let (problem, limits) = scene.validate_with_limits(&label)?;
+    Ok((label, scene, problem, limits))
 }
 
 /// SHA-256 of the scene's canonical TOML, hex.
@@ -310,7 +312,7 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
         (None, None) => scene::PAPER_DEFAULT_SCENE.to_string(),
     };
     let scene = scene::parse(&scene_text, &label, &options.overrides)?;
-    let problem = scene.validate(&label)?;
+    let (problem, limits) = scene.validate_with_limits(&label)?;
     let stem = options
         .scene
         .as_deref()
@@ -329,6 +331,7 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
         label,
         scene,
         problem,
+        limits,
         dir,
         open,
         stuck,
@@ -337,7 +340,7 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
     if ctx.scene.sweep.is_some() {
         return sweep_run::run_sweep(&ctx);
     }
-    if ctx.problem.limits.is_some() {
+    if ctx.limits.is_some() {
         return limits_run::run_limits(&ctx);
     }
     run_frf(&ctx)
@@ -468,7 +471,7 @@ fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
 
 /// `fricbound check`: validates the scene and returns a printable summary.
 pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, CommandError> {
-    let (label, scene, problem) = load_scene(scene_path, overrides)?;
+    let (label, scene, problem, limits) = load_scene(scene_path, overrides)?;
     let set = problem.unknown_harmonics();
     let n = problem.model.n_dofs();
     let e = &problem.effects;
@@ -566,7 +569,7 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
             .collect::<Vec<_>>()
             .join(", ")
     );
-    if let Some(l) = &problem.limits {
+    if let Some(l) = &limits {
         let cases: Vec<String> = crate::analysis::limits::two_point_cases(&problem)
             .into_iter()
             .chain(l.intermediate_cases(&problem))

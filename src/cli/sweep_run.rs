@@ -14,6 +14,7 @@ use std::path::PathBuf;
 use std::sync::Mutex;
 
 use super::{limits_run, CommandError, RunContext, RunOutcome, RunReport};
+use crate::analysis::limits::LimitSettings;
 use crate::model::Problem;
 use crate::report::files;
 use crate::report::limit_files;
@@ -57,8 +58,7 @@ fn write_point_analysis(
     ctx: &RunContext<'_>,
     spec: &SweepSpec,
     point: &SweepPoint,
-    scene: &Scene,
-    problem: &Problem,
+    (scene, problem, limits): (&Scene, &Problem, &LimitSettings),
 ) -> Result<(), CommandError> {
     let Some(analysis) = &point.analysis else {
         return Ok(());
@@ -81,6 +81,7 @@ fn write_point_analysis(
         label,
         scene,
         problem: problem.clone(),
+        limits: Some(limits.clone()),
         dir,
         open,
         stuck,
@@ -110,8 +111,8 @@ pub fn run_sweep(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
         &ctx.label,
         &ctx.options.overrides,
         &spec,
-        |point, scene, problem| {
-            let written = write_point_analysis(ctx, &spec, point, scene, problem);
+        |point, scene, problem, limits| {
+            let written = write_point_analysis(ctx, &spec, point, (scene, problem, limits));
             let mut guard = finished.lock().expect("no panics while holding the lock");
             if let Err(e) = written {
                 guard.1.get_or_insert(e);
@@ -380,7 +381,7 @@ fn plot_peaks(
             .collect();
         // The linear references' resonance in the peak window, as levels the limits start
         // from and tend to (valid for every value when only static loads are swept).
-        let window = ctx.problem.limits.as_ref().and_then(|l| l.peak_window_hz);
+        let window = ctx.limits.as_ref().and_then(|l| l.peak_window_hz);
         let x_span: Vec<f64> = {
             let xs = data.iter().flat_map(|g| g.x.iter().copied());
             let lo = xs.clone().fold(f64::INFINITY, f64::min);

@@ -1,6 +1,7 @@
 //! Harmonic balance: residual, Jacobian patterns and assembly, the formulations and the operator.
 
 pub mod condensed;
+pub mod formulation;
 pub mod operator;
 pub mod pattern;
 pub mod schur;

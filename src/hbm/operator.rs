@@ -9,8 +9,8 @@ use crate::contact::ContactState;
 use crate::hbm::condensed::CondensedHbm;
 use crate::hbm::{HbmError, HbmSystem};
 use crate::model::{Formulation, JacobianStrategy, Problem};
-use crate::numerics::continuation::ParametricResidual;
 use crate::numerics::jacobian::AssembledJacobian;
+use crate::numerics::ParametricResidual;
 
 /// Full or condensed harmonic balance.
 pub enum HbmOperator<'p> {

@@ -264,7 +264,9 @@ impl JacobianLayout {
     ) -> Self {
         let nb = set.n_blocks();
         let dim = problem.model.n_dofs() * nb;
-        let template = AssembledJacobian::schur(coords);
+        let template = AssembledJacobian::implicit(std::sync::Arc::new(
+            crate::hbm::schur::SchurJacobian(coords),
+        ));
         let per_contact = 4 * nb * nb;
         let contacts = (0..problem.contacts.len())
             .map(|p| ContactSlots {

@@ -38,35 +38,12 @@ use faer::prelude::Solve;
 use faer::{c64, Mat};
 
 use crate::contact::harmonic::{Block, HarmonicSet};
+use crate::hbm::formulation::{check_relative_coordinates, RelativeCoordinatesError};
 use crate::model::{DofSplit, Problem};
+use crate::numerics::jacobian::{ImplicitFactor, ImplicitJacobian};
 use crate::numerics::linalg::{
     checked_lu, packed_complex_lu, packed_lu, LinearSolveError, PackedLu,
 };
-
-/// Largest model (DOFs) the schur formulation accepts: it holds the structural matrices dense.
-pub const MAX_DOFS: usize = 10_000;
-
-/// Why a problem has no relative contact coordinates.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum RelativeCoordinatesError {
-    /// No contact point.
-    #[error("the schur formulation needs at least one contact point")]
-    NoContacts,
-    /// The model is too large to hold dense.
-    #[error("the schur formulation holds the structural matrices dense; {n} DOFs is above its limit of {MAX_DOFS} (reduce the model, or use the sparse formulation)")]
-    TooLarge {
-        /// DOFs of the model.
-        n: usize,
-    },
-    /// The contact rows are linearly dependent.
-    #[error("the tangential and normal rows of the contact points are linearly dependent (smallest/largest pivot of B Bᵀ {ratio:.3e}, at contact `{contact}`): relative coordinates are not independent unknowns (use the dense, sparse or condensed formulation)")]
-    Dependent {
-        /// Contact at which the dependence shows.
-        contact: String,
-        /// Pivot ratio of the Gram matrix.
-        ratio: f64,
-    },
-}
 
 /// One contact's rows over the DOFs: (tangential, normal).
 type ContactRows = (Vec<(usize, f64)>, Vec<(usize, f64)>);
@@ -205,70 +182,6 @@ fn contact_components(
         });
     }
     Ok(components)
-}
-
-/// Checks that the problem has independent relative contact coordinates: the pivots of the
-/// Cholesky factor of B Bᵀ (one row per contact direction) stay above 1e-6 of the largest,
-/// i.e. cond(B) below about 10⁶. Cheap (n_q² entries at most).
-pub fn check_relative_coordinates(problem: &Problem) -> Result<(), RelativeCoordinatesError> {
-    let n = problem.model.n_dofs();
-    if problem.contacts.is_empty() {
-        return Err(RelativeCoordinatesError::NoContacts);
-    }
-    if n > MAX_DOFS {
-        return Err(RelativeCoordinatesError::TooLarge { n });
-    }
-    let rows: Vec<&[(usize, f64)]> = problem
-        .contacts
-        .iter()
-        .flat_map(|c| [c.tangential.as_slice(), c.normal.as_slice()])
-        .collect();
-    let n_q = rows.len();
-    // Per DOF, the rows touching it with their coefficient (duplicates summed): the Gram
-    // products come from these sparse columns.
-    let mut touching: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
-    for (r, row) in rows.iter().enumerate() {
-        for &(d, a) in row.iter() {
-            match touching[d].last_mut() {
-                Some(last) if last.0 == r => last.1 += a,
-                _ => touching[d].push((r, a)),
-            }
-        }
-    }
-    let mut gram = Mat::<f64>::zeros(n_q, n_q);
-    for column in &touching {
-        for &(i, ai) in column {
-            for &(j, aj) in column {
-                gram[(i, j)] += ai * aj;
-            }
-        }
-    }
-    // Unpivoted Cholesky by hand: the pivot where it fails names the contact.
-    let max_diag = (0..n_q).map(|i| gram[(i, i)]).fold(0.0_f64, f64::max);
-    for k in 0..n_q {
-        let pivot = gram[(k, k)];
-        let ratio = pivot / max_diag.max(f64::MIN_POSITIVE);
-        if ratio.is_nan() || ratio <= 1e-12 {
-            return Err(RelativeCoordinatesError::Dependent {
-                contact: problem.contacts[k / 2].name.clone(),
-                ratio,
-            });
-        }
-        let root = pivot.sqrt();
-        for i in k..n_q {
-            gram[(i, k)] /= root;
-        }
-        for j in k + 1..n_q {
-            let gjk = gram[(j, k)];
-            if gjk == 0.0 {
-                continue;
-            }
-            for i in j..n_q {
-                gram[(i, j)] -= gram[(i, k)] * gjk;
-            }
-        }
-    }
-    Ok(())
 }
 
 impl RelativeCoordinates {
@@ -705,6 +618,37 @@ enum ZPart {
     Complex(Option<Mat<c64>>),
 }
 
+/// The schur formulation's Jacobian storage for [`AssembledJacobian::implicit`]: the values
+/// are one (2·blocks)² block per contact point (see [`RelativeCoordinates::factor`]); the
+/// linear part is formed from the structural matrices at ω.
+///
+/// [`AssembledJacobian::implicit`]: crate::numerics::jacobian::AssembledJacobian::implicit
+#[derive(Debug)]
+pub struct SchurJacobian(pub Arc<RelativeCoordinates>);
+
+impl ImplicitJacobian for SchurJacobian {
+    fn dim(&self) -> usize {
+        self.0.n_dofs() * self.0.n_blocks()
+    }
+    fn values_len(&self) -> usize {
+        let nb = self.0.n_blocks();
+        self.0.n_relative() / 2 * 4 * nb * nb
+    }
+    fn entry(&self, omega: f64, values: &[f64], i: usize, j: usize) -> f64 {
+        self.0.entry(omega, values, i, j)
+    }
+    fn mul_add(&self, omega: f64, values: &[f64], col_scale: f64, x: &[f64], y: &mut [f64]) {
+        self.0.mul_add(omega, values, col_scale, x, y)
+    }
+    fn factor(
+        &self,
+        omega: f64,
+        values: &[f64],
+    ) -> Result<Box<dyn ImplicitFactor>, LinearSolveError> {
+        Ok(Box::new(self.0.factor(omega, values)?))
+    }
+}
+
 /// A factorised Jacobian of the schur formulation (see the module docs).
 pub struct SchurFactor {
     coords: Arc<RelativeCoordinates>,
@@ -715,12 +659,12 @@ pub struct SchurFactor {
     lu_q_single: PackedLu<f32>,
 }
 
-impl SchurFactor {
+impl ImplicitFactor for SchurFactor {
     /// Solves J x = b (problem coordinates, harmonic-major, length n·blocks). With `single`,
     /// the reduced system is solved with the factors rounded to single precision: twice as
     /// fast on large factors, with a relative error of about 10⁻⁷ times the condition number
     /// (for the chord steps of a corrector, whose convergence is judged on the true residual).
-    pub fn solve(&self, b: &[f64], single: bool) -> Vec<f64> {
+    fn solve(&self, b: &[f64], single: bool) -> Vec<f64> {
         let co = &self.coords;
         let (n, n_q, nb) = (co.n, co.n_q, co.blocks.len());
         let bm = Mat::from_fn(n, nb, |i, j| b[j * n + i]);

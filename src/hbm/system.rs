@@ -19,12 +19,13 @@
 use crate::contact::aft::{AftError, AftWorkspace};
 use crate::contact::harmonic::{Block, HarmonicSet};
 use crate::contact::ContactState;
+use crate::hbm::formulation::RelativeCoordinatesError;
 use crate::hbm::pattern::{ContactSlots, JacobianLayout};
-use crate::hbm::schur::{RelativeCoordinates, RelativeCoordinatesError};
+use crate::hbm::schur::RelativeCoordinates;
 use crate::model::{Coupling, Formulation, JacobianStrategy, Problem};
-use crate::numerics::continuation::ParametricResidual;
 use crate::numerics::jacobian::{AssembledJacobian, Storage};
 use crate::numerics::linalg::LinearSolveError;
+use crate::numerics::ParametricResidual;
 use std::sync::Arc;
 
 /// Errors while evaluating or solving the harmonic balance.
@@ -546,6 +547,32 @@ impl<'p> HbmSystem<'p> {
     ) -> Result<(), HbmError> {
         let central = self.strategy == JacobianStrategy::CentralDifference;
         finite_difference_jacobian(|x, r| self.residual(x, omega, r), x, r0, central, jac)
+    }
+}
+
+impl ParametricResidual for HbmSystem<'_> {
+    type Error = HbmError;
+    fn dim(&self) -> usize {
+        HbmSystem::dim(self)
+    }
+    fn residual_scale(&self) -> f64 {
+        self.load_norm()
+    }
+    fn residual(&mut self, x: &[f64], lambda: f64, r: &mut [f64]) -> Result<(), Self::Error> {
+        HbmSystem::residual(self, x, lambda, r)
+    }
+    fn new_jacobian(&mut self) -> AssembledJacobian {
+        HbmSystem::new_jacobian(self)
+    }
+    fn residual_and_jacobian(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        r: &mut [f64],
+        jac: &mut AssembledJacobian,
+        dr_dlambda: &mut [f64],
+    ) -> Result<(), Self::Error> {
+        HbmSystem::residual_and_jacobian(self, x, lambda, r, jac, dr_dlambda)
     }
 }
 

@@ -7,5 +7,5 @@ pub mod reduce;
 
 pub use problem::{
     Analysis, Coupling, DofSplit, Effects, FeOrigin, Formulation, HarmonicLoad, JacobianStrategy,
-    LinearModel, Problem, CHORD_MIN_UNKNOWNS, DENSE_LIMIT,
+    LinearModel, Problem, CHORD_MIN_UNKNOWNS,
 };

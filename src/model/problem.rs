@@ -9,6 +9,7 @@ use crate::contact::aft::MarchSettings;
 use crate::contact::harmonic::HarmonicSet;
 use crate::contact::{ContactEffects, ContactPoint, DamperSide};
 use crate::model::matrix::StructuralMatrix;
+use crate::numerics::ContinuationSettings;
 
 /// Linear structure: dense for lumped or reduced models, sparse for unreduced FE models.
 #[derive(Debug, Clone)]
@@ -103,7 +104,8 @@ pub enum Formulation {
 }
 
 /// Continuation and Newton settings. Frequencies in Hz; arc-length steps are measured in the
-/// scaled space where a unit of frequency is 1 Hz (see [`crate::numerics::continuation`]).
+/// scaled space where a unit of frequency is 1 Hz (see [`crate::numerics::continuation`]);
+/// [`Analysis::continuation`] gives the continuation's part of them.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Analysis {
     /// Start frequency (Hz), > 0.
@@ -138,6 +140,25 @@ pub struct Analysis {
     pub chord_min_unknowns: usize,
 }
 
+impl Analysis {
+    /// The settings of the continuation that follows the path over the range.
+    pub fn continuation(&self) -> ContinuationSettings {
+        ContinuationSettings {
+            freq_start_hz: self.freq_start_hz,
+            freq_end_hz: self.freq_end_hz,
+            initial_step: self.initial_step,
+            min_step: self.min_step,
+            max_step: self.max_step,
+            max_points: self.max_points,
+            target_iterations: self.target_iterations,
+            max_iterations: self.max_iterations,
+            residual_tolerance: self.residual_tolerance,
+            step_tolerance: self.step_tolerance,
+            chord_min_unknowns: self.chord_min_unknowns,
+        }
+    }
+}
+
 /// Default of [`Analysis::chord_min_unknowns`].
 pub const CHORD_MIN_UNKNOWNS: usize = 1500;
 
@@ -166,8 +187,6 @@ pub struct Problem {
     pub analysis: Analysis,
     /// DOF indices reported in outputs.
     pub outputs: Vec<usize>,
-    /// Limit analysis settings, when the scene asks for one.
-    pub limits: Option<crate::analysis::limits::LimitSettings>,
     /// The FE mesh the problem comes from, for results on the mesh (None for lumped models
     /// and Matrix Market input).
     pub fe: Option<std::sync::Arc<FeOrigin>>,
@@ -250,31 +269,6 @@ impl Problem {
             local,
         }
     }
-
-    /// The formulation actually used: the scene's choice, or for `auto` the sparse one on
-    /// sparse models, the dense one on dense models with at most [`DENSE_LIMIT`] unknowns, and
-    /// on larger dense models the schur one when the contact points have independent relative
-    /// coordinates (see [`crate::hbm::schur::check_relative_coordinates`]); otherwise the condensed
-    /// one when the contact DOFs are at most half of the DOFs, and the sparse one.
-    pub fn formulation(&self) -> Formulation {
-        match self.analysis.formulation {
-            Formulation::Auto => {
-                let unknowns = self.model.n_dofs() * self.unknown_harmonics().n_blocks();
-                if self.model.stiffness.is_sparse() {
-                    Formulation::Sparse
-                } else if unknowns <= DENSE_LIMIT {
-                    Formulation::Dense
-                } else if crate::hbm::schur::check_relative_coordinates(self).is_ok() {
-                    Formulation::Schur
-                } else if 2 * self.contact_dofs().len() <= self.model.n_dofs() {
-                    Formulation::Condensed
-                } else {
-                    Formulation::Sparse
-                }
-            }
-            f => f,
-        }
-    }
 }
 
 /// The DOFs of a problem split by [`Problem::dof_split`].
@@ -287,6 +281,3 @@ pub struct DofSplit {
     /// Per DOF, its index in `contact` (None for a linear DOF).
     pub local: Vec<Option<usize>>,
 }
-
-/// Most unknowns for which `auto` keeps a dense full Jacobian.
-pub const DENSE_LIMIT: usize = 600;

@@ -14,7 +14,7 @@
 //! with [`ContinuationError::Stalled`]. Turning points (sign changes of dω/ds) are reported and
 //! traversed. The last point is solved at exactly the end frequency.
 //!
-//! On large problems (at least [`Analysis::chord_min_unknowns`] unknowns) the corrector takes
+//! On large problems (at least [`ContinuationSettings::chord_min_unknowns`] unknowns) the corrector takes
 //! chord iterations: the bordered Newton matrix factorised at one iterate is reused for the
 //! next steps, with Broyden's secant updates (`BroydenUpdates`), as long as each cuts the
 //! relative residual by at least a factor of 2; otherwise the Jacobian is evaluated and
@@ -32,265 +32,55 @@
 
 use std::f64::consts::PI;
 
-use crate::model::Analysis;
-use crate::numerics::jacobian::AssembledJacobian;
-use crate::numerics::linalg::LinearSolveError;
+use crate::numerics::broyden::BroydenUpdates;
+use crate::numerics::jacobian::{AssembledJacobian, BorderedFactor};
+use crate::numerics::linalg::{dot, norm};
+use crate::numerics::path::{
+    ContinuationError, NewtonFailure, Observer, PathEnd, PathPoint, PathSummary,
+};
+use crate::numerics::residual::ParametricResidual;
 
-/// An operator R(x, λ) with its Jacobian, as continuation needs it.
-pub trait ParametricResidual {
-    /// Evaluation error of the operator.
-    type Error: std::error::Error + Clone;
-    /// Number of unknowns x.
-    fn dim(&self) -> usize;
-    /// Norm that makes residuals relative (e.g. the load norm).
-    fn residual_scale(&self) -> f64;
-    /// R(x, λ) into r.
-    fn residual(&mut self, x: &[f64], lambda: f64, r: &mut [f64]) -> Result<(), Self::Error>;
-    /// An empty Jacobian with the operator's storage and pattern.
-    fn new_jacobian(&mut self) -> AssembledJacobian;
-    /// R, ∂R/∂x and ∂R/∂λ.
-    fn residual_and_jacobian(
-        &mut self,
-        x: &[f64],
-        lambda: f64,
-        r: &mut [f64],
-        jac: &mut AssembledJacobian,
-        dr_dlambda: &mut [f64],
-    ) -> Result<(), Self::Error>;
-}
-
-impl ParametricResidual for crate::hbm::HbmSystem<'_> {
-    type Error = crate::hbm::HbmError;
-    fn dim(&self) -> usize {
-        crate::hbm::HbmSystem::dim(self)
-    }
-    fn residual_scale(&self) -> f64 {
-        self.load_norm()
-    }
-    fn residual(&mut self, x: &[f64], lambda: f64, r: &mut [f64]) -> Result<(), Self::Error> {
-        crate::hbm::HbmSystem::residual(self, x, lambda, r)
-    }
-    fn new_jacobian(&mut self) -> AssembledJacobian {
-        crate::hbm::HbmSystem::new_jacobian(self)
-    }
-    fn residual_and_jacobian(
-        &mut self,
-        x: &[f64],
-        lambda: f64,
-        r: &mut [f64],
-        jac: &mut AssembledJacobian,
-        dr_dlambda: &mut [f64],
-    ) -> Result<(), Self::Error> {
-        crate::hbm::HbmSystem::residual_and_jacobian(self, x, lambda, r, jac, dr_dlambda)
-    }
-}
-
-/// Why a Newton corrector failed.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum NewtonFailure {
-    /// Iteration limit reached.
-    #[error("no convergence in {iterations} iterations (relative residual {residual:.3e})")]
-    MaxIterations {
-        /// Iterations made.
-        iterations: usize,
-        /// Last relative residual.
-        residual: f64,
-    },
-    /// The residual grew far beyond its starting value.
-    #[error("diverged (relative residual {residual:.3e})")]
-    Diverged {
-        /// Relative residual when stopped.
-        residual: f64,
-    },
-    /// A linear solve failed.
-    #[error("{0}")]
-    Linear(#[from] LinearSolveError),
-    /// The operator failed to evaluate.
-    #[error("{0}")]
-    Evaluation(String),
-    /// The tangent turned too sharply between two points (possible branch jump).
-    #[error("tangent turned by {degrees:.1}° in one step")]
-    SharpTurn {
-        /// Angle between successive tangents.
-        degrees: f64,
-    },
-    /// The corrector converged far from the predicted point (possible branch jump).
-    #[error("corrector moved {distance:.3e} from the prediction, more than the step {step:.3e}")]
-    FarCorrection {
-        /// Scaled distance between predicted and corrected points.
-        distance: f64,
-        /// Step length.
-        step: f64,
-    },
-}
-
-/// Fatal continuation errors.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum ContinuationError {
-    /// The first point could not be solved.
-    #[error("no solution at the start frequency {freq_hz:.4} Hz: {reason}")]
-    Start {
-        /// Start frequency (Hz).
-        freq_hz: f64,
-        /// Cause.
-        reason: NewtonFailure,
-    },
-    /// The step fell below the minimum. When Newton stagnates just above the tolerance, a
-    /// contact transition (stick-slip or lift-off) usually sits between two AFT time samples,
-    /// where the residual has a kink; the message says so and names the remedy.
-    #[error(
-        "continuation stalled at {freq_hz:.4} Hz (step {step:.3e} below minimum): {reason}; \
-         if the residual stagnates just above tolerance, a contact transition falls between AFT \
-         time samples: more samples ([harmonics] samples) usually get past it"
-    )]
-    Stalled {
-        /// Frequency of the last converged point (Hz).
-        freq_hz: f64,
-        /// Step that failed.
-        step: f64,
-        /// Last failure.
-        reason: NewtonFailure,
-    },
-}
-
-/// A converged point of the path.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PathPoint {
-    /// Angular frequency ω (rad/s).
-    pub omega: f64,
-    /// Unknowns x.
-    pub x: Vec<f64>,
-    /// Newton iterations used.
-    pub iterations: usize,
-    /// Final residual relative to the residual scale.
-    pub residual: f64,
-    /// Arc-length step that reached this point (0 for the first).
-    pub step: f64,
-}
-
-impl PathPoint {
-    /// Frequency in Hz.
-    pub fn freq_hz(&self) -> f64 {
-        self.omega / (2.0 * PI)
-    }
-}
-
-/// Receives continuation events; writing results as they come is an observer's job.
-pub trait Observer<S: ParametricResidual> {
-    /// A point converged. The operator was last evaluated at this point.
-    fn accepted(&mut self, _system: &mut S, _point: &PathPoint) {}
-    /// A step was rejected and will be retried with `new_step`.
-    fn rejected(&mut self, _freq_hz: f64, _step: f64, _new_step: f64, _reason: &NewtonFailure) {}
-    /// dω/ds changed sign between the previous and this point.
-    fn turning_point(&mut self, _freq_hz: f64) {}
-    /// The path could not be followed from `from_hz` and was resumed at `to_hz` (Hz).
-    fn leap(&mut self, _from_hz: f64, _to_hz: f64) {}
-}
-
-/// An observer that does nothing.
-pub struct NoObserver;
-impl<S: ParametricResidual> Observer<S> for NoObserver {}
-
-/// How a run ended.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PathSummary {
-    /// Converged points, in path order.
-    pub points: Vec<PathPoint>,
-    /// Frequencies (Hz) of turning points.
-    pub turning_points: Vec<f64>,
-    /// Rejected steps.
-    pub rejected_steps: usize,
-    /// Stretches of the path leapt over: (last point before, first point after), Hz.
-    pub leaps: Vec<(f64, f64)>,
-    /// Why the run stopped.
-    pub end: PathEnd,
-}
-
-/// Reason a run stopped normally.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PathEnd {
-    /// Reached the end frequency.
-    EndFrequency,
-    /// The path turned back below the start frequency.
-    LeftRangeBelow,
-    /// The point budget was used up.
-    MaxPoints,
-}
-
-/// Broyden's ("good") updates of a factorised bordered Newton matrix B₀ over the chord steps
-/// of one corrector, in inverse product form: H_k = (I + a_{k−1} s_{k−1}ᵀ) ⋯ (I + a₀ s₀ᵀ) B₀⁻¹
-/// with s_j the steps taken. Each step needs one solve with B₀ (the same as a plain chord
-/// step) and O(n·k) vector work; the secant updates follow the change of the contact
-/// Jacobian along the iterates, so the residual falls faster than with B₀ alone.
-/// With p = −H_k G(y_{k+1}) and d_k the previous direction, H_k (G_{k+1} − G_k) = d_k − p,
-/// so a_k = (s_k − d_k + p) / (s_kᵀ(d_k − p)) and the next direction is p + a_k (s_kᵀ p).
-#[derive(Default)]
-struct BroydenUpdates {
-    /// (a_j, s_j), oldest first.
-    pairs: Vec<(Vec<f64>, Vec<f64>)>,
-    /// The last direction d_k and the step s_k = α d_k taken along it (None before the step).
-    last: Option<(Vec<f64>, Option<Vec<f64>>)>,
-}
-
-impl BroydenUpdates {
-    /// Forgets the updates (a new base factorisation or border).
-    fn clear(&mut self) {
-        self.pairs.clear();
-        self.last = None;
-    }
-
-    /// A new base factorisation whose first direction is `d`.
-    fn restart(&mut self, d: &[f64]) {
-        self.pairs.clear();
-        self.last = Some((d.to_vec(), None));
-    }
-
-    /// The step along the last direction was taken with length α (α = 0: not taken).
-    fn stepped(&mut self, alpha: f64) {
-        if alpha == 0.0 {
-            self.clear();
-        } else if let Some((d, step)) = &mut self.last {
-            *step = Some(d.iter().map(|v| alpha * v).collect());
-        }
-    }
-
-    /// The next direction from p = −B₀⁻¹ G(y) at the new iterate.
-    fn direction(&mut self, mut p: Vec<f64>) -> Vec<f64> {
-        for (a, s) in &self.pairs {
-            let c = dot(s, &p);
-            p.iter_mut().zip(a).for_each(|(v, ai)| *v += ai * c);
-        }
-        if let Some((d, Some(s))) = self.last.take() {
-            let hy: Vec<f64> = d.iter().zip(&p).map(|(di, pi)| di - pi).collect();
-            let denominator = dot(s.as_slice(), &hy);
-            if denominator.abs() > 1e-12 * norm(&s) * norm(&hy) && denominator.is_finite() {
-                let a: Vec<f64> = s
-                    .iter()
-                    .zip(&hy)
-                    .map(|(si, hi)| (si - hi) / denominator)
-                    .collect();
-                let c = dot(&s, &p);
-                p.iter_mut().zip(&a).for_each(|(v, ai)| *v += ai * c);
-                self.pairs.push((a, s));
-            }
-        }
-        self.last = Some((p.clone(), None));
-        p
-    }
+/// Continuation and Newton settings. The parameter λ is an angular frequency ω (rad/s) and
+/// is given in Hz here; arc-length steps are measured in the scaled space where a unit of
+/// frequency is 1 Hz (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContinuationSettings {
+    /// Start frequency (Hz), > 0.
+    pub freq_start_hz: f64,
+    /// End frequency (Hz), > start.
+    pub freq_end_hz: f64,
+    /// First arc-length step (Hz-equivalent).
+    pub initial_step: f64,
+    /// Smallest step before continuation gives up.
+    pub min_step: f64,
+    /// Largest step.
+    pub max_step: f64,
+    /// Most continuation points.
+    pub max_points: usize,
+    /// Newton iterations aimed at per point; steps grow below and shrink above it.
+    pub target_iterations: usize,
+    /// Newton iterations before a point fails.
+    pub max_iterations: usize,
+    /// Convergence: ‖R‖ ≤ residual_tolerance · (the operator's residual scale).
+    pub residual_tolerance: f64,
+    /// Convergence: scaled Newton step norm ≤ step_tolerance.
+    pub step_tolerance: f64,
+    /// Unknowns from which the corrector takes chord iterations (see the module docs).
+    pub chord_min_unknowns: usize,
 }
 
 /// Newton/continuation driver.
 pub struct Continuation {
     /// Settings (frequencies in Hz).
-    pub analysis: Analysis,
+    pub settings: ContinuationSettings,
     /// Scale of x in the arc length (m).
     pub x_scale: f64,
     /// Chord corrector only: the factorisation of its last iterate with the tangent row it
     /// was built with, reused for the tangent at the corrected point.
-    last_factor: std::cell::RefCell<Option<(Vec<f64>, crate::numerics::jacobian::BorderedFactor)>>,
+    last_factor: std::cell::RefCell<Option<(Vec<f64>, BorderedFactor)>>,
     /// Chord corrector only: the last factorisation made, and the points since it was made,
     /// for the next corrector to start from (storages whose border is eliminated by blocks).
-    carried: std::cell::RefCell<Option<(crate::numerics::jacobian::BorderedFactor, usize)>>,
+    carried: std::cell::RefCell<Option<(BorderedFactor, usize)>>,
 }
 
 const OMEGA_SCALE: f64 = 2.0 * PI;
@@ -309,9 +99,9 @@ const MAX_TURN_DEGREES: f64 = 45.0;
 
 impl Continuation {
     /// A driver with these settings and arc-length scale of x (m).
-    pub fn new(analysis: Analysis, x_scale: f64) -> Self {
+    pub fn new(settings: ContinuationSettings, x_scale: f64) -> Self {
         Self {
-            analysis,
+            settings,
             x_scale,
             last_factor: std::cell::RefCell::new(None),
             carried: std::cell::RefCell::new(None),
@@ -319,19 +109,15 @@ impl Continuation {
     }
 
     /// Keeps the chord corrector's last factorisation for the tangent at its point.
-    fn keep_factor(
-        &self,
-        factor: Option<crate::numerics::jacobian::BorderedFactor>,
-        tangent: &[f64],
-    ) {
+    fn keep_factor(&self, factor: Option<BorderedFactor>, tangent: &[f64]) {
         *self.last_factor.borrow_mut() = factor.map(|f| (tangent.to_vec(), f));
     }
 
     /// Convergence test of a Newton iterate: the relative residual at tolerance and the scaled
     /// step below its tolerance.
     fn converged(&self, relative_residual: f64, step: f64) -> bool {
-        relative_residual <= self.analysis.residual_tolerance
-            && step <= self.analysis.step_tolerance.max(1e-14)
+        relative_residual <= self.settings.residual_tolerance
+            && step <= self.settings.step_tolerance.max(1e-14)
     }
 
     /// The residual at an iterate of a chord iteration, returned relative to the load: with a
@@ -343,7 +129,7 @@ impl Continuation {
         system: &mut S,
         (x, omega): (&[f64], f64),
         (r, jac, dr): (&mut [f64], &mut AssembledJacobian, &mut [f64]),
-        factor: &mut Option<crate::numerics::jacobian::BorderedFactor>,
+        factor: &mut Option<BorderedFactor>,
         r_current: bool,
         previous: f64,
     ) -> Result<f64, NewtonFailure> {
@@ -354,7 +140,7 @@ impl Continuation {
                 system.residual(x, omega, r).map_err(eval_err)?;
             }
             let rel = norm(r) / scale;
-            if rel <= CHORD_CONTRACTION * previous || rel <= self.analysis.residual_tolerance {
+            if rel <= CHORD_CONTRACTION * previous || rel <= self.settings.residual_tolerance {
                 return Ok(rel);
             }
             *factor = None;
@@ -383,11 +169,11 @@ impl Continuation {
         let eval_err = |e: S::Error| NewtonFailure::Evaluation(e.to_string());
         // Chord steps on large problems, as in the corrector: the factorisation is kept while
         // each step cuts the residual by CHORD_CONTRACTION.
-        let chord = n >= self.analysis.chord_min_unknowns;
-        let max_iter = self.analysis.max_iterations.max(1)
+        let chord = n >= self.settings.chord_min_unknowns;
+        let max_iter = self.settings.max_iterations.max(1)
             * 3
             * if chord { CHORD_STEPS_PER_ITERATION } else { 1 };
-        let mut factor: Option<crate::numerics::jacobian::BorderedFactor> = None;
+        let mut factor: Option<BorderedFactor> = None;
         let (mut factorisations, mut chord_steps) = (0usize, 0usize);
         // Whether r holds the residual at x (the accepted trial of the previous step).
         let mut r_current = false;
@@ -402,7 +188,7 @@ impl Continuation {
                 r_current,
                 previous,
             )?;
-            let at_tolerance = rel <= self.analysis.residual_tolerance;
+            let at_tolerance = rel <= self.settings.residual_tolerance;
             let neg: Vec<f64> = r.iter().map(|v| -v).collect();
             let dx = match &factor {
                 Some(f) => {
@@ -554,9 +340,9 @@ impl Continuation {
         let mut rel = f64::INFINITY;
         // Chord iterations on large problems: the factorised bordered matrix is reused while
         // the residual keeps falling fast enough (see the module docs).
-        let chord = n >= self.analysis.chord_min_unknowns;
+        let chord = n >= self.settings.chord_min_unknowns;
         *self.last_factor.borrow_mut() = None;
-        let mut factor: Option<crate::numerics::jacobian::BorderedFactor> = None;
+        let mut factor: Option<BorderedFactor> = None;
         // A factorisation made at an earlier point of the path (at most CARRY_POINTS back),
         // bordered with this tangent, serves for the first chord steps: when the contact
         // states have not moved much, the point converges without a new factorisation.
@@ -581,9 +367,9 @@ impl Continuation {
         let (mut factorisations, mut chord_steps) = (0usize, 0usize);
         let effort = |f: usize, c: usize| (f + c / CHORD_STEPS_PER_ITERATION).max(1);
         let limit = if chord {
-            CHORD_STEPS_PER_ITERATION * self.analysis.max_iterations
+            CHORD_STEPS_PER_ITERATION * self.settings.max_iterations
         } else {
-            self.analysis.max_iterations
+            self.settings.max_iterations
         };
         for it in 1..=limit {
             for i in 0..n {
@@ -601,7 +387,7 @@ impl Continuation {
             )?;
             if first.is_nan() {
                 first = rel;
-            } else if rel > 1e4 * first.max(self.analysis.residual_tolerance) {
+            } else if rel > 1e4 * first.max(self.settings.residual_tolerance) {
                 return Err(NewtonFailure::Diverged { residual: rel });
             }
             let mut rhs: Vec<f64> = r.iter().map(|v| -v).collect();
@@ -639,7 +425,7 @@ impl Continuation {
             } else {
                 it
             };
-            if rel <= self.analysis.residual_tolerance {
+            if rel <= self.settings.residual_tolerance {
                 // At tolerance, a Newton step that does not lower the residual only moves
                 // through round-off (amplified by the Jacobian's condition number near a
                 // lightly damped resonance): the point is converged.
@@ -695,7 +481,7 @@ impl Continuation {
                 self.keep_factor(factor.take(), tangent);
                 return Ok((y, it, rel));
             }
-            if step <= self.analysis.step_tolerance {
+            if step <= self.settings.step_tolerance {
                 // The step is converged: check the residual at the updated point.
                 for i in 0..n {
                     x[i] = y[i] * self.x_scale;
@@ -705,7 +491,7 @@ impl Continuation {
                     .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
                 let rel_new = norm(&r) / scale;
                 r_current = true;
-                if rel_new <= self.analysis.residual_tolerance {
+                if rel_new <= self.settings.residual_tolerance {
                     self.keep_factor(factor.take(), tangent);
                     return Ok((y, it, rel_new));
                 }
@@ -729,9 +515,9 @@ impl Continuation {
         tangent: &[f64],
     ) -> Result<Option<(PathPoint, Vec<f64>)>, ContinuationError> {
         let n = y.len() - 1;
-        let omega_end = self.analysis.freq_end_hz * OMEGA_SCALE;
+        let omega_end = self.settings.freq_end_hz * OMEGA_SCALE;
         for &fraction in LEAPS {
-            let ds = fraction * self.analysis.max_step;
+            let ds = fraction * self.settings.max_step;
             let predicted: Vec<f64> = (0..=n).map(|j| y[j] + ds * tangent[j]).collect();
             if predicted[n] * OMEGA_SCALE >= omega_end {
                 continue;
@@ -797,7 +583,7 @@ impl Continuation {
         x_guess: &[f64],
         observer: &mut O,
     ) -> Result<PathSummary, ContinuationError> {
-        let a = &self.analysis;
+        let a = &self.settings;
         let omega_start = a.freq_start_hz * OMEGA_SCALE;
         let omega_end = a.freq_end_hz * OMEGA_SCALE;
         let n = system.dim();
@@ -962,65 +748,5 @@ impl Continuation {
         }
         summary.end = PathEnd::MaxPoints;
         Ok(summary)
-    }
-}
-
-/// Euclidean norm.
-pub fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use faer::prelude::Solve;
-    use faer::Mat;
-
-    /// On a linear system G(y) = A y − b with a wrong base matrix B₀, Broyden's updates reach
-    /// the solution in at most 2n steps (Gay's theorem), where the plain chord iteration with
-    /// B₀ is still far off.
-    #[test]
-    fn broyden_updates_solve_a_linear_system_with_a_wrong_base_matrix() {
-        let n = 4;
-        let a = Mat::from_fn(n, n, |i, j| {
-            [
-                [4.0, 1.0, 0.5, 0.0],
-                [0.3, 3.0, -1.0, 0.2],
-                [0.0, 1.2, 5.0, 1.0],
-                [0.7, 0.0, -0.4, 2.0],
-            ][i][j]
-        });
-        let b0 = Mat::from_fn(n, n, |i, j| if i == j { 1.6 * a[(i, i)] } else { 0.0 });
-        let lu = b0.partial_piv_lu();
-        let rhs = [1.0, -2.0, 0.5, 3.0];
-        let residual = |y: &[f64]| -> Vec<f64> {
-            (0..n)
-                .map(|i| (0..n).map(|j| a[(i, j)] * y[j]).sum::<f64>() - rhs[i])
-                .collect()
-        };
-        let base_step = |g: &[f64]| -> Vec<f64> {
-            let x = lu.solve(Mat::from_fn(n, 1, |i, _| -g[i]));
-            (0..n).map(|i| x[(i, 0)]).collect()
-        };
-        let run = |broyden: bool| -> f64 {
-            let mut y = vec![0.0; n];
-            let mut updates = BroydenUpdates::default();
-            let mut d = base_step(&residual(&y));
-            updates.restart(&d);
-            for _ in 0..2 * n {
-                y.iter_mut().zip(&d).for_each(|(v, s)| *v += s);
-                updates.stepped(1.0);
-                let p = base_step(&residual(&y));
-                d = if broyden { updates.direction(p) } else { p };
-            }
-            norm(&residual(&y))
-        };
-        let (with, without) = (run(true), run(false));
-        assert!(with < 1e-10, "Broyden residual {with:e}");
-        assert!(without > 1e-3, "chord residual {without:e}");
     }
 }

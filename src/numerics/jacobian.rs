@@ -33,8 +33,35 @@ use faer::prelude::Solve;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::Mat;
 
-use crate::hbm::schur::{RelativeCoordinates, SchurFactor};
-use crate::numerics::linalg::{checked_lu, solve_dense, LinearSolveError};
+use crate::numerics::linalg::{checked_lu, norm, solve_dense, LinearSolveError};
+
+/// A Jacobian whose linear part is implied by an operator instead of stored: its values are
+/// only the blocks the operator needs (for the harmonic balance's schur formulation, one dense
+/// block per contact point on its relative coordinates), and it forms, applies and factorises
+/// J from them and the parameter λ (the angular frequency ω of the linear part).
+pub trait ImplicitJacobian: std::fmt::Debug + Send + Sync {
+    /// Dimension n of J.
+    fn dim(&self) -> usize;
+    /// Number of stored values.
+    fn values_len(&self) -> usize;
+    /// Entry (i, j) of J at `lambda` with stored `values`.
+    fn entry(&self, lambda: f64, values: &[f64], i: usize, j: usize) -> f64;
+    /// y += s·J x.
+    fn mul_add(&self, lambda: f64, values: &[f64], col_scale: f64, x: &[f64], y: &mut [f64]);
+    /// A factorisation of J.
+    fn factor(
+        &self,
+        lambda: f64,
+        values: &[f64],
+    ) -> Result<Box<dyn ImplicitFactor>, LinearSolveError>;
+}
+
+/// A factorisation made by an [`ImplicitJacobian`].
+pub trait ImplicitFactor: Send + Sync {
+    /// J⁻¹ b; with `single`, an approximate solve with factors rounded to single precision
+    /// where the factorisation keeps them (for chord steps, judged on the true residual).
+    fn solve(&self, b: &[f64], single: bool) -> Vec<f64>;
+}
 
 /// A factorised bordered matrix [[s·J, col], [row]], kept for several solves (the chord
 /// iterations of the corrector on large problems, see [`crate::numerics::continuation`]).
@@ -55,12 +82,12 @@ enum FactorKind {
     },
 }
 
-/// A factorisation of s·J alone (sparse LU, or the schur formulation's elimination).
+/// A factorisation of s·J alone (sparse LU, or an implicit Jacobian's own).
 enum InnerFactor {
     /// Sparse LU of s·J.
     Sparse(Box<faer::sparse::linalg::solvers::Lu<usize, f64>>),
     /// Factorisation of J, and the scale s.
-    Schur(Box<SchurFactor>, f64),
+    Implicit(Box<dyn ImplicitFactor>, f64),
 }
 
 impl InnerFactor {
@@ -76,7 +103,7 @@ impl InnerFactor {
                 let x = lu.solve(Mat::from_fn(b.len(), 1, |i, _| b[i]));
                 (0..b.len()).map(|i| x[(i, 0)]).collect()
             }
-            InnerFactor::Schur(f, scale) => {
+            InnerFactor::Implicit(f, scale) => {
                 let mut x = f.solve(b, fast);
                 x.iter_mut().for_each(|v| *v /= scale);
                 x
@@ -117,7 +144,7 @@ impl BorderedFactor {
     }
 
     /// An approximate solve for chord steps: where the factorisation keeps single-precision
-    /// factors (the schur formulation), the reduced system is solved with them — half the
+    /// factors (an implicit Jacobian such as the schur formulation's), the reduced system is solved with them — half the
     /// memory traffic, relative error about 10⁻⁷ times the condition number. Otherwise the
     /// same as [`Self::solve`].
     pub fn solve_chord(&self, rhs: &[f64]) -> Result<Vec<f64>, LinearSolveError> {
@@ -162,9 +189,9 @@ pub enum Storage {
     Dense,
     /// Sparse (faer CSC) of J alone; the border is eliminated by blocks.
     Sparse,
-    /// The schur formulation ([`crate::hbm::schur`]): the frequency and one block per contact
-    /// point on its relative coordinates; the linear part is implied by the structural
-    /// matrices. The border is eliminated by blocks.
+    /// An [`ImplicitJacobian`] that solves by Schur-complement elimination (the harmonic
+    /// balance's schur formulation): the values it keeps and the parameter λ; the linear part
+    /// is implied. The border is eliminated by blocks.
     Schur,
 }
 
@@ -179,9 +206,10 @@ pub struct AssembledJacobian {
     pattern: Option<SymbolicSparseColMat<usize>>,
     /// Sparse only: symbolic LU of the pattern (shared by clones).
     symbolic_lu: Option<faer::sparse::linalg::solvers::SymbolicLu<usize>>,
-    /// Schur only: the relative contact coordinates (shared by clones).
-    relative: Option<Arc<RelativeCoordinates>>,
-    /// Frequency ω (rad/s) the linear part was formed at (used by the schur storage).
+    /// Implicit only: the operator that forms J (shared by clones).
+    implicit: Option<Arc<dyn ImplicitJacobian>>,
+    /// Parameter λ (the frequency ω, rad/s) the linear part was formed at (used by the
+    /// implicit storage).
     omega: f64,
     /// Numeric factorisations made (for reports and tests).
     pub factorisations: usize,
@@ -196,31 +224,28 @@ impl AssembledJacobian {
             values: vec![0.0; n * n],
             pattern: None,
             symbolic_lu: None,
-            relative: None,
+            implicit: None,
             omega: 0.0,
             factorisations: 0,
         }
     }
 
-    /// A Jacobian of the schur formulation on `coords`: its values are one
-    /// (2·blocks)² block per contact point (see [`RelativeCoordinates::factor`]).
-    pub fn schur(coords: Arc<RelativeCoordinates>) -> Self {
-        let nb = coords.n_blocks();
-        let values = vec![0.0; coords.n_relative() / 2 * 4 * nb * nb];
+    /// A Jacobian formed by `operator` from the values it keeps.
+    pub fn implicit(operator: Arc<dyn ImplicitJacobian>) -> Self {
         Self {
-            n: coords.n_dofs() * nb,
+            n: operator.dim(),
             storage: Storage::Schur,
-            values,
+            values: vec![0.0; operator.values_len()],
             pattern: None,
             symbolic_lu: None,
-            relative: Some(coords),
+            implicit: Some(operator),
             omega: 0.0,
             factorisations: 0,
         }
     }
 
     /// Sets the frequency ω (rad/s) of the linear part (the dense and sparse storages hold the
-    /// linear part in their values; the schur storage forms it from ω when it factorises).
+    /// linear part in their values; the implicit storage forms it from ω when it factorises).
     pub fn set_frequency(&mut self, omega: f64) {
         self.omega = omega;
     }
@@ -245,7 +270,7 @@ impl AssembledJacobian {
             values: vec![0.0; nnz],
             pattern: Some(pattern),
             symbolic_lu,
-            relative: None,
+            implicit: None,
             omega: 0.0,
             factorisations: 0,
         }
@@ -304,7 +329,7 @@ impl AssembledJacobian {
 
     /// Entry (i, j) (zero outside the pattern).
     pub fn get(&self, i: usize, j: usize) -> f64 {
-        if let Some(r) = &self.relative {
+        if let Some(r) = &self.implicit {
             return r.entry(self.omega, &self.values, i, j);
         }
         self.find_slot(i, j).map(|s| self.values[s]).unwrap_or(0.0)
@@ -313,11 +338,11 @@ impl AssembledJacobian {
     /// Sets column j of J from a dense column (entries outside the pattern are dropped; in
     /// sparse storage they are structurally zero by construction).
     ///
-    /// The schur storage has no columns (its finite-difference Jacobian is formed per
-    /// contact, see [`crate::hbm`]): a call is a programming error and changes nothing.
+    /// The implicit storage has no columns (the schur formulation's finite-difference
+    /// Jacobian is formed per contact): a call is a programming error and changes nothing.
     pub fn set_column(&mut self, j: usize, column: &[f64]) {
         if self.storage == Storage::Schur {
-            debug_assert!(false, "set_column on a schur Jacobian");
+            debug_assert!(false, "set_column on an implicit Jacobian");
             return;
         }
         match &self.pattern {
@@ -413,13 +438,13 @@ impl AssembledJacobian {
         Ok(BorderedFactor { kind })
     }
 
-    /// Factorisation of s·J: sparse LU, or the schur formulation's elimination.
+    /// Factorisation of s·J: sparse LU, or the implicit Jacobian's own.
     fn inner_factor(&mut self, col_scale: f64) -> Result<InnerFactor, LinearSolveError> {
-        match &self.relative {
+        match &self.implicit {
             Some(r) => {
                 let f = r.factor(self.omega, &self.values)?;
                 self.factorisations += 1;
-                Ok(InnerFactor::Schur(Box::new(f), col_scale))
+                Ok(InnerFactor::Implicit(f, col_scale))
             }
             None => Ok(InnerFactor::Sparse(Box::new(self.sparse_lu(col_scale)?))),
         }
@@ -451,7 +476,7 @@ impl AssembledJacobian {
 
     /// y += s·J x.
     fn mul_add(&self, col_scale: f64, x: &[f64], y: &mut [f64]) {
-        if let Some(r) = &self.relative {
+        if let Some(r) = &self.implicit {
             r.mul_add(self.omega, &self.values, col_scale, x, y);
             return;
         }
@@ -541,10 +566,6 @@ impl AssembledJacobian {
         }
         Ok(y)
     }
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 #[cfg(test)]

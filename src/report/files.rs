@@ -14,7 +14,7 @@ use serde::Serialize;
 use crate::analysis::frf::{FrfObserver, FrfPoint};
 use crate::analysis::linear::LinearCurve;
 use crate::model::Problem;
-use crate::numerics::continuation::NewtonFailure;
+use crate::numerics::NewtonFailure;
 
 /// Writing a result file failed.
 #[derive(Debug, thiserror::Error)]

@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use faer::Mat;
 use serde::{Deserialize, Serialize};
 
+use crate::analysis::limits::LimitSettings;
 use crate::contact::aft::MarchSettings;
 use crate::contact::{ContactEffects, ContactPoint, DamperSide, JenkinsLaw, NormalLoad};
 use crate::model::matrix::StructuralMatrix;
@@ -936,6 +937,15 @@ impl Scene {
 
     /// Checks every value and builds the problem. `file` names the scene in errors.
     pub fn validate(&self, file: &str) -> Result<Problem, SceneError> {
+        self.validate_with_limits(file).map(|(problem, _)| problem)
+    }
+
+    /// Checks every value and builds the problem and, when the scene has a `[limits]` table,
+    /// the settings of its limit analysis. `file` names the scene in errors.
+    pub fn validate_with_limits(
+        &self,
+        file: &str,
+    ) -> Result<(Problem, Option<LimitSettings>), SceneError> {
         let ck = Checker { file };
         let (model, fe) = self.build_model(&ck)?;
         let dofs = DofNames::new(&model.dof_names);
@@ -1348,6 +1358,7 @@ impl Scene {
             outputs.extend(targets.into_iter().map(|(d, _)| d));
         }
 
+        let limits = self.validate_limits(&ck)?;
         let problem = Problem {
             model,
             contacts,
@@ -1384,7 +1395,6 @@ impl Scene {
                 chord_min_unknowns: crate::model::CHORD_MIN_UNKNOWNS,
             },
             outputs,
-            limits: self.validate_limits(&ck)?,
             fe: fe.as_ref().and_then(|f| {
                 f.mesh.as_ref().map(|mesh| {
                     std::sync::Arc::new(crate::model::FeOrigin {
@@ -1425,16 +1435,13 @@ impl Scene {
         };
         check_stuck_structure(&ck, &problem)?;
         if problem.analysis.formulation == Formulation::Schur {
-            crate::hbm::schur::check_relative_coordinates(&problem)
+            crate::hbm::formulation::check_relative_coordinates(&problem)
                 .map_err(|e| ck.err("analysis.formulation", e.to_string()))?;
         }
-        Ok(problem)
+        Ok((problem, limits))
     }
 
-    fn validate_limits(
-        &self,
-        ck: &Checker,
-    ) -> Result<Option<crate::analysis::limits::LimitSettings>, SceneError> {
+    fn validate_limits(&self, ck: &Checker) -> Result<Option<LimitSettings>, SceneError> {
         let Some(l) = &self.limits else {
             return Ok(None);
         };

@@ -30,7 +30,7 @@ use crate::fe::msh_write::{write_msh, MshFormat};
 use crate::hbm::operator::HbmOperator;
 use crate::model::reduce::{self, ReductionSettings};
 use crate::model::{Formulation, JacobianStrategy, Problem};
-use crate::numerics::continuation::ParametricResidual;
+use crate::numerics::ParametricResidual;
 use crate::scene;
 
 /// Errors of a scaling case.
@@ -506,8 +506,7 @@ pub fn measure_solve(
         let outcome = frf::solve(p, &mut Collect(&mut points));
         m.frf_s = started.elapsed().as_secs_f64();
         m.points = points.len();
-        m.complete = outcome
-            .is_ok_and(|run| run.end == crate::numerics::continuation::PathEnd::EndFrequency);
+        m.complete = outcome.is_ok_and(|run| run.end == crate::numerics::PathEnd::EndFrequency);
         m.iterations = points.iter().map(|q| q.newton_iterations).sum();
         m.per_point_ms = 1e3 * m.frf_s / m.points.max(1) as f64;
         m.frf_iteration_ms = 1e3 * m.frf_s / m.iterations.max(1) as f64;

@@ -15,7 +15,7 @@
 
 use rayon::prelude::*;
 
-use crate::analysis::limits::{self, LimitAnalysis, Peak};
+use crate::analysis::limits::{self, LimitAnalysis, LimitSettings, Peak};
 use crate::model::Problem;
 use crate::scene::{self, Scene, SceneError, SweepOutput, SweepSpec};
 
@@ -102,13 +102,13 @@ pub fn run<F>(
 where
     F: Fn(&SweepPoint) + Sync,
 {
-    run_with_problems(scene_text, file, overrides, spec, |point, _, _| {
+    run_with_problems(scene_text, file, overrides, spec, |point, _, _, _| {
         on_point(point)
     })
 }
 
-/// As [`run`], handing `on_point` the scene and checked problem of each value too (for
-/// writing its results).
+/// As [`run`], handing `on_point` the scene, checked problem and limit settings of each value
+/// too (for writing its results).
 pub fn run_with_problems<F>(
     scene_text: &str,
     file: &str,
@@ -117,20 +117,22 @@ pub fn run_with_problems<F>(
     on_point: F,
 ) -> Result<Vec<SweepPoint>, SweepError>
 where
-    F: Fn(&SweepPoint, &Scene, &Problem) + Sync,
+    F: Fn(&SweepPoint, &Scene, &Problem, &LimitSettings) + Sync,
 {
     sweep_points(spec)
         .par_iter()
         .map(|&(series, value)| {
-            let (scene, problem) = problem_at(scene_text, file, overrides, spec, series, value)?;
-            let point = solve_value(&problem, spec.output, series, value);
-            on_point(&point, &scene, &problem);
+            let (scene, problem, limits) =
+                problem_at(scene_text, file, overrides, spec, series, value)?;
+            let point = solve_value(&problem, &limits, spec.output, series, value);
+            on_point(&point, &scene, &problem, &limits);
             Ok(point)
         })
         .collect()
 }
 
-/// The scene and checked problem at one sweep point.
+/// The scene, checked problem and limit settings (the defaults when the scene has no
+/// `[limits]` table) at one sweep point.
 pub fn problem_at(
     scene_text: &str,
     file: &str,
@@ -138,7 +140,7 @@ pub fn problem_at(
     spec: &SweepSpec,
     series: Option<f64>,
     value: f64,
-) -> Result<(Scene, Problem), SweepError> {
+) -> Result<(Scene, Problem, LimitSettings), SweepError> {
     let mut all = overrides.to_vec();
     if let (Some(s), Some(v)) = (&spec.series, series) {
         all.extend(s.overrides(v));
@@ -146,8 +148,8 @@ pub fn problem_at(
     all.extend(spec.overrides(value));
     scene::parse(scene_text, file, &all)
         .and_then(|s| {
-            let p = s.validate(file)?;
-            Ok((s, p))
+            let (p, limits) = s.validate_with_limits(file)?;
+            Ok((s, p, limits.unwrap_or_default()))
         })
         .map_err(|source| SweepError::Scene {
             parameter: match (&spec.series, series) {
@@ -159,14 +161,14 @@ pub fn problem_at(
         })
 }
 
-/// Solves one sweep point of a checked problem (which must have limit settings).
+/// Solves one sweep point of a checked problem with its limit settings.
 pub fn solve_value(
     problem: &Problem,
+    settings: &LimitSettings,
     output: SweepOutput,
     series: Option<f64>,
     value: f64,
 ) -> SweepPoint {
-    let settings = problem.limits.clone().unwrap_or_default();
     let mut cases = limits::two_point_cases(problem);
     cases.extend(settings.intermediate_cases(problem));
     let names: Vec<String> = cases.iter().map(|c| c.name.clone()).collect();
@@ -191,7 +193,7 @@ pub fn solve_value(
                 }
             }
         }
-        SweepOutput::Limits => match limits::analyse(problem, &settings, |_| {}) {
+        SweepOutput::Limits => match limits::analyse(problem, settings, |_| {}) {
             Ok(analysis) => {
                 for (k, c) in analysis
                     .limits

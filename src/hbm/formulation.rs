@@ -1,0 +1,128 @@
+//! Which formulation of the harmonic balance a problem is solved in: the scene's choice, or
+//! for `auto` a choice from the model's size and storage and from whether its contact points
+//! have independent relative coordinates (which the schur formulation needs).
+
+use faer::Mat;
+
+use crate::model::{Formulation, Problem};
+
+/// Most unknowns for which `auto` keeps a dense full Jacobian.
+pub const DENSE_LIMIT: usize = 600;
+
+/// Largest model (DOFs) the schur formulation accepts: it holds the structural matrices dense.
+pub const MAX_DOFS: usize = 10_000;
+
+/// Why a problem has no relative contact coordinates.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RelativeCoordinatesError {
+    /// No contact point.
+    #[error("the schur formulation needs at least one contact point")]
+    NoContacts,
+    /// The model is too large to hold dense.
+    #[error("the schur formulation holds the structural matrices dense; {n} DOFs is above its limit of {MAX_DOFS} (reduce the model, or use the sparse formulation)")]
+    TooLarge {
+        /// DOFs of the model.
+        n: usize,
+    },
+    /// The contact rows are linearly dependent.
+    #[error("the tangential and normal rows of the contact points are linearly dependent (smallest/largest pivot of B Bᵀ {ratio:.3e}, at contact `{contact}`): relative coordinates are not independent unknowns (use the dense, sparse or condensed formulation)")]
+    Dependent {
+        /// Contact at which the dependence shows.
+        contact: String,
+        /// Pivot ratio of the Gram matrix.
+        ratio: f64,
+    },
+}
+
+/// Checks that the problem has independent relative contact coordinates: the pivots of the
+/// Cholesky factor of B Bᵀ (one row per contact direction) stay above 1e-6 of the largest,
+/// i.e. cond(B) below about 10⁶. Cheap (n_q² entries at most).
+pub fn check_relative_coordinates(problem: &Problem) -> Result<(), RelativeCoordinatesError> {
+    let n = problem.model.n_dofs();
+    if problem.contacts.is_empty() {
+        return Err(RelativeCoordinatesError::NoContacts);
+    }
+    if n > MAX_DOFS {
+        return Err(RelativeCoordinatesError::TooLarge { n });
+    }
+    let rows: Vec<&[(usize, f64)]> = problem
+        .contacts
+        .iter()
+        .flat_map(|c| [c.tangential.as_slice(), c.normal.as_slice()])
+        .collect();
+    let n_q = rows.len();
+    // Per DOF, the rows touching it with their coefficient (duplicates summed): the Gram
+    // products come from these sparse columns.
+    let mut touching: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
+    for (r, row) in rows.iter().enumerate() {
+        for &(d, a) in row.iter() {
+            match touching[d].last_mut() {
+                Some(last) if last.0 == r => last.1 += a,
+                _ => touching[d].push((r, a)),
+            }
+        }
+    }
+    let mut gram = Mat::<f64>::zeros(n_q, n_q);
+    for column in &touching {
+        for &(i, ai) in column {
+            for &(j, aj) in column {
+                gram[(i, j)] += ai * aj;
+            }
+        }
+    }
+    // Unpivoted Cholesky by hand: the pivot where it fails names the contact.
+    let max_diag = (0..n_q).map(|i| gram[(i, i)]).fold(0.0_f64, f64::max);
+    for k in 0..n_q {
+        let pivot = gram[(k, k)];
+        let ratio = pivot / max_diag.max(f64::MIN_POSITIVE);
+        if ratio.is_nan() || ratio <= 1e-12 {
+            return Err(RelativeCoordinatesError::Dependent {
+                contact: problem.contacts[k / 2].name.clone(),
+                ratio,
+            });
+        }
+        let root = pivot.sqrt();
+        for i in k..n_q {
+            gram[(i, k)] /= root;
+        }
+        for j in k + 1..n_q {
+            let gjk = gram[(j, k)];
+            if gjk == 0.0 {
+                continue;
+            }
+            for i in j..n_q {
+                gram[(i, j)] -= gram[(i, k)] * gjk;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The formulation choice belongs to the harmonic-balance layer, which knows the formulations'
+/// limits; it is a method of [`Problem`] so that every caller asks the problem the same way.
+impl Problem {
+    /// The formulation actually used: the scene's choice, or for `auto` the sparse one on
+    /// sparse models, the dense one on dense models with at most [`DENSE_LIMIT`] unknowns, and
+    /// on larger dense models the schur one when the contact points have independent relative
+    /// coordinates (see [`check_relative_coordinates`]); otherwise the condensed
+    /// one when the contact DOFs are at most half of the DOFs, and the sparse one.
+    pub fn formulation(&self) -> Formulation {
+        match self.analysis.formulation {
+            Formulation::Auto => {
+                let unknowns = self.model.n_dofs() * self.unknown_harmonics().n_blocks();
+                if self.model.stiffness.is_sparse() {
+                    Formulation::Sparse
+                } else if unknowns <= DENSE_LIMIT {
+                    Formulation::Dense
+                } else if check_relative_coordinates(self).is_ok() {
+                    Formulation::Schur
+                } else if 2 * self.contact_dofs().len() <= self.model.n_dofs() {
+                    Formulation::Condensed
+                } else {
+                    Formulation::Sparse
+                }
+            }
+            f => f,
+        }
+    }
+}

@@ -1,0 +1,139 @@
+//! What continuation produces and reports: converged path points, the events an observer
+//! receives, how a run ended, and why a corrector or a run failed.
+
+use std::f64::consts::PI;
+
+use crate::numerics::linalg::LinearSolveError;
+use crate::numerics::residual::ParametricResidual;
+
+/// Why a Newton corrector failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NewtonFailure {
+    /// Iteration limit reached.
+    #[error("no convergence in {iterations} iterations (relative residual {residual:.3e})")]
+    MaxIterations {
+        /// Iterations made.
+        iterations: usize,
+        /// Last relative residual.
+        residual: f64,
+    },
+    /// The residual grew far beyond its starting value.
+    #[error("diverged (relative residual {residual:.3e})")]
+    Diverged {
+        /// Relative residual when stopped.
+        residual: f64,
+    },
+    /// A linear solve failed.
+    #[error("{0}")]
+    Linear(#[from] LinearSolveError),
+    /// The operator failed to evaluate.
+    #[error("{0}")]
+    Evaluation(String),
+    /// The tangent turned too sharply between two points (possible branch jump).
+    #[error("tangent turned by {degrees:.1}° in one step")]
+    SharpTurn {
+        /// Angle between successive tangents.
+        degrees: f64,
+    },
+    /// The corrector converged far from the predicted point (possible branch jump).
+    #[error("corrector moved {distance:.3e} from the prediction, more than the step {step:.3e}")]
+    FarCorrection {
+        /// Scaled distance between predicted and corrected points.
+        distance: f64,
+        /// Step length.
+        step: f64,
+    },
+}
+
+/// Fatal continuation errors.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ContinuationError {
+    /// The first point could not be solved.
+    #[error("no solution at the start frequency {freq_hz:.4} Hz: {reason}")]
+    Start {
+        /// Start frequency (Hz).
+        freq_hz: f64,
+        /// Cause.
+        reason: NewtonFailure,
+    },
+    /// The step fell below the minimum. When Newton stagnates just above the tolerance, a
+    /// contact transition (stick-slip or lift-off) usually sits between two AFT time samples,
+    /// where the residual has a kink; the message says so and names the remedy.
+    #[error(
+        "continuation stalled at {freq_hz:.4} Hz (step {step:.3e} below minimum): {reason}; \
+         if the residual stagnates just above tolerance, a contact transition falls between AFT \
+         time samples: more samples ([harmonics] samples) usually get past it"
+    )]
+    Stalled {
+        /// Frequency of the last converged point (Hz).
+        freq_hz: f64,
+        /// Step that failed.
+        step: f64,
+        /// Last failure.
+        reason: NewtonFailure,
+    },
+}
+
+/// A converged point of the path.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathPoint {
+    /// Angular frequency ω (rad/s).
+    pub omega: f64,
+    /// Unknowns x.
+    pub x: Vec<f64>,
+    /// Newton iterations used.
+    pub iterations: usize,
+    /// Final residual relative to the residual scale.
+    pub residual: f64,
+    /// Arc-length step that reached this point (0 for the first).
+    pub step: f64,
+}
+
+impl PathPoint {
+    /// Frequency in Hz.
+    pub fn freq_hz(&self) -> f64 {
+        self.omega / (2.0 * PI)
+    }
+}
+
+/// Receives continuation events; writing results as they come is an observer's job.
+pub trait Observer<S: ParametricResidual> {
+    /// A point converged. The operator was last evaluated at this point.
+    fn accepted(&mut self, _system: &mut S, _point: &PathPoint) {}
+    /// A step was rejected and will be retried with `new_step`.
+    fn rejected(&mut self, _freq_hz: f64, _step: f64, _new_step: f64, _reason: &NewtonFailure) {}
+    /// dω/ds changed sign between the previous and this point.
+    fn turning_point(&mut self, _freq_hz: f64) {}
+    /// The path could not be followed from `from_hz` and was resumed at `to_hz` (Hz).
+    fn leap(&mut self, _from_hz: f64, _to_hz: f64) {}
+}
+
+/// An observer that does nothing.
+pub struct NoObserver;
+impl<S: ParametricResidual> Observer<S> for NoObserver {}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathSummary {
+    /// Converged points, in path order.
+    pub points: Vec<PathPoint>,
+    /// Frequencies (Hz) of turning points.
+    pub turning_points: Vec<f64>,
+    /// Rejected steps.
+    pub rejected_steps: usize,
+    /// Stretches of the path leapt over: (last point before, first point after), Hz.
+    pub leaps: Vec<(f64, f64)>,
+    /// Why the run stopped.
+    pub end: PathEnd,
+}
+
+/// Reason a run stopped normally.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PathEnd {
+    /// Reached the end frequency.
+    EndFrequency,
+    /// The path turned back below the start frequency.
+    LeftRangeBelow,
+    /// The point budget was used up.
+    MaxPoints,
+}

@@ -1,0 +1,631 @@
+//! The module graph points one way: no import cycle between any two files of the workspace,
+//! and the layers of `src/` only use layers below them.
+//!
+//! The layers, lowest first, are listed in [`LAYERS`] (and in the README's layout table). An
+//! edge A → B is any path in A's code (not its comments or strings) that names an item of
+//! module B: `crate::…` paths, `super::…` paths and, in a folder's `mod.rs`, the re-exports
+//! `pub use child::…`. A path through a re-export is followed to the module that defines the
+//! item, so `crate::contact::ContactPoint` is an edge to `contact::point`. `mod` declarations
+//! are containment, not use, and are not edges. Inline `#[cfg(test)]` modules are tests: like
+//! the files of `tests/`, they may build their fixtures with any layer, and are left out.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+/// Top-level modules of `src/`, lowest layer first. A module may use the ones before it.
+const LAYERS: &[&str] = &[
+    "numerics", "contact", "fe", "model", "hbm", "analysis", "scene", "study", "report", "cli",
+];
+
+/// One crate's modules: path (e.g. `contact::point`, "" for the root) → source file.
+struct CrateModules {
+    files: BTreeMap<String, PathBuf>,
+}
+
+impl CrateModules {
+    fn read(src: &Path) -> Self {
+        let mut files = BTreeMap::new();
+        let mut stack = vec![src.to_path_buf()];
+        while let Some(dir) = stack.pop() {
+            for entry in std::fs::read_dir(&dir).expect("source folder is readable") {
+                let path = entry.expect("folder entry").path();
+                if path.is_dir() {
+                    stack.push(path);
+                    continue;
+                }
+                if path.extension().is_none_or(|e| e != "rs") {
+                    continue;
+                }
+                let rel = path.strip_prefix(src).expect("below src");
+                let mut parts: Vec<String> = rel
+                    .iter()
+                    .map(|p| p.to_string_lossy().trim_end_matches(".rs").to_string())
+                    .collect();
+                let last = parts.last().cloned().unwrap_or_default();
+                if last == "main" && parts.len() == 1 {
+                    continue; // the binary: parses and dispatches only
+                }
+                if last == "mod" || (last == "lib" && parts.len() == 1) {
+                    parts.pop();
+                }
+                files.insert(parts.join("::"), path);
+            }
+        }
+        Self { files }
+    }
+
+    fn is_module(&self, path: &str) -> bool {
+        self.files.contains_key(path)
+    }
+}
+
+/// Source text without comments, string and character literals (replaced by spaces).
+fn code_only(text: &str) -> String {
+    let b = text.as_bytes();
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    while i < b.len() {
+        let c = b[i];
+        if c == b'/' && b.get(i + 1) == Some(&b'/') {
+            while i < b.len() && b[i] != b'\n' {
+                i += 1;
+            }
+        } else if c == b'/' && b.get(i + 1) == Some(&b'*') {
+            let mut depth = 0;
+            while i < b.len() {
+                if b[i] == b'/' && b.get(i + 1) == Some(&b'*') {
+                    depth += 1;
+                    i += 2;
+                } else if b[i] == b'*' && b.get(i + 1) == Some(&b'/') {
+                    depth -= 1;
+                    i += 2;
+                    if depth == 0 {
+                        break;
+                    }
+                } else {
+                    i += 1;
+                }
+            }
+            out.push(' ');
+        } else if c == b'r' && matches!(b.get(i + 1), Some(b'"') | Some(b'#')) && {
+            let mut j = i + 1;
+            while b.get(j) == Some(&b'#') {
+                j += 1;
+            }
+            b.get(j) == Some(&b'"') && (i == 0 || !(b[i - 1].is_ascii_alphanumeric()))
+        } {
+            let mut j = i + 1;
+            let mut hashes = 0;
+            while b[j] == b'#' {
+                hashes += 1;
+                j += 1;
+            }
+            j += 1;
+            loop {
+                if j >= b.len() {
+                    break;
+                }
+                if b[j] == b'"' && (0..hashes).all(|k| b.get(j + 1 + k) == Some(&b'#')) {
+                    j += 1 + hashes;
+                    break;
+                }
+                j += 1;
+            }
+            i = j;
+            out.push_str("\"\"");
+        } else if c == b'"' {
+            i += 1;
+            while i < b.len() && b[i] != b'"' {
+                if b[i] == b'\\' {
+                    i += 1;
+                }
+                i += 1;
+            }
+            i += 1;
+            out.push_str("\"\"");
+        } else if c == b'\'' && (b.get(i + 1) == Some(&b'\\') || b.get(i + 2) == Some(&b'\'')) {
+            // A character literal ('a', '\n', '\''); a lifetime has no closing quote.
+            i += 1;
+            if b[i] == b'\\' {
+                i += 2;
+            }
+            while i < b.len() && b[i] != b'\'' {
+                i += 1;
+            }
+            i += 1;
+            out.push_str("' '");
+        } else {
+            // Copy one UTF-8 character.
+            let len = text[i..].chars().next().map_or(1, char::len_utf8);
+            out.push_str(&text[i..i + len]);
+            i += len;
+        }
+    }
+    out
+}
+
+/// Code without its inline `#[cfg(test)] mod name { … }` blocks.
+fn without_test_modules(code: &str) -> String {
+    let mut out = code.to_string();
+    while let Some(start) = out.find("#[cfg(test)]") {
+        let rest = &out[start + "#[cfg(test)]".len()..];
+        let trimmed = rest.trim_start();
+        let is_mod = trimmed.starts_with("mod ") || trimmed.starts_with("pub mod ");
+        let Some(open) = rest.find('{').filter(|_| is_mod) else {
+            // Not a module (a test-only item): blank the attribute only.
+            out.replace_range(start..start + "#[cfg(test)]".len(), " ");
+            continue;
+        };
+        let open = start + "#[cfg(test)]".len() + open;
+        let mut depth = 0usize;
+        let mut end = out.len();
+        for (k, c) in out[open..].char_indices() {
+            match c {
+                '{' => depth += 1,
+                '}' => {
+                    depth -= 1;
+                    if depth == 0 {
+                        end = open + k + 1;
+                        break;
+                    }
+                }
+                _ => {}
+            }
+        }
+        out.replace_range(start..end, " ");
+    }
+    out
+}
+
+#[derive(Debug, Clone, PartialEq)]
+enum Token {
+    Ident(String),
+    PathSep,
+    Open,
+    Close,
+    Comma,
+    Other(char),
+}
+
+fn tokens(code: &str) -> Vec<Token> {
+    let chars: Vec<char> = code.chars().collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        if c.is_alphanumeric() || c == '_' {
+            let start = i;
+            while i < chars.len() && (chars[i].is_alphanumeric() || chars[i] == '_') {
+                i += 1;
+            }
+            out.push(Token::Ident(chars[start..i].iter().collect()));
+            continue;
+        }
+        match c {
+            ':' if chars.get(i + 1) == Some(&':') => {
+                out.push(Token::PathSep);
+                i += 1;
+            }
+            '{' => out.push(Token::Open),
+            '}' => out.push(Token::Close),
+            ',' => out.push(Token::Comma),
+            c if c.is_whitespace() => {}
+            c => out.push(Token::Other(c)),
+        }
+        i += 1;
+    }
+    out
+}
+
+/// Reads a path or use tree from `toks[*i]` (after a `::`), appending every full path.
+fn read_tree(toks: &[Token], i: &mut usize, prefix: &[String], paths: &mut Vec<Vec<String>>) {
+    match toks.get(*i) {
+        Some(Token::Open) => {
+            *i += 1;
+            loop {
+                match toks.get(*i) {
+                    Some(Token::Close) => {
+                        *i += 1;
+                        break;
+                    }
+                    Some(Token::Comma) => *i += 1,
+                    None => break,
+                    _ => {
+                        let before = *i;
+                        read_tree(toks, i, prefix, paths);
+                        // Skip `as name` and anything up to the next separator.
+                        while !matches!(toks.get(*i), Some(Token::Comma | Token::Close) | None) {
+                            *i += 1;
+                        }
+                        if *i == before {
+                            *i += 1;
+                        }
+                    }
+                }
+            }
+        }
+        Some(Token::Ident(name)) => {
+            let mut path = prefix.to_vec();
+            path.push(name.clone());
+            *i += 1;
+            if toks.get(*i) == Some(&Token::PathSep) {
+                *i += 1;
+                read_tree(toks, i, &path, paths);
+            } else {
+                paths.push(path);
+            }
+        }
+        _ => paths.push(prefix.to_vec()),
+    }
+}
+
+/// The module paths a file names, as absolute segment lists (without `crate`).
+fn named_paths(module: &str, code: &str, children: &BTreeSet<String>) -> Vec<Vec<String>> {
+    let toks = tokens(code);
+    let own: Vec<String> = if module.is_empty() {
+        Vec::new()
+    } else {
+        module.split("::").map(str::to_string).collect()
+    };
+    let parent: Vec<String> = own[..own.len().saturating_sub(1)].to_vec();
+    let mut paths = Vec::new();
+    // Brace depths at which inline `mod name {` blocks opened (their `super` is this file).
+    let mut inline_mods: Vec<usize> = Vec::new();
+    let mut depth = 0usize;
+    let mut i = 0;
+    while i < toks.len() {
+        match &toks[i] {
+            Token::Open => depth += 1,
+            Token::Close => {
+                depth = depth.saturating_sub(1);
+                if inline_mods.last() == Some(&depth) {
+                    inline_mods.pop();
+                }
+            }
+            Token::Ident(w) if w == "mod" => {
+                if let (Some(Token::Ident(_)), Some(Token::Open)) =
+                    (toks.get(i + 1), toks.get(i + 2))
+                {
+                    inline_mods.push(depth);
+                }
+            }
+            Token::Ident(w)
+                if (w == "crate" || w == "super" || (w == "use" && depth == 0))
+                    && i.checked_sub(1).map(|k| &toks[k]) != Some(&Token::PathSep) =>
+            {
+                let base = match w.as_str() {
+                    "crate" => Some(Vec::new()),
+                    "super" if inline_mods.is_empty() => Some(parent.clone()),
+                    "use" => {
+                        // `pub use child::…` in a module with that child: relative to itself.
+                        match toks.get(i + 1) {
+                            Some(Token::Ident(c)) if children.contains(c) => Some(own.clone()),
+                            _ => None,
+                        }
+                    }
+                    _ => None,
+                };
+                if let Some(base) = base {
+                    let mut k = i + 1;
+                    if w != "use" {
+                        if toks.get(k) != Some(&Token::PathSep) {
+                            i += 1;
+                            continue;
+                        }
+                        k += 1;
+                    }
+                    read_tree(&toks, &mut k, &base, &mut paths);
+                    i = k;
+                    continue;
+                }
+            }
+            _ => {}
+        }
+        i += 1;
+    }
+    paths
+}
+
+/// Paths through module aliases: `alias::rest` where `alias` names an imported module.
+fn alias_paths(code: &str, aliases: &BTreeMap<String, Vec<String>>) -> Vec<Vec<String>> {
+    let toks = tokens(code);
+    let mut paths = Vec::new();
+    let mut i = 0;
+    while i < toks.len() {
+        if let Token::Ident(name) = &toks[i] {
+            let after_sep = i.checked_sub(1).map(|k| &toks[k]) == Some(&Token::PathSep);
+            if let (Some(base), false, Some(Token::PathSep)) =
+                (aliases.get(name), after_sep, toks.get(i + 1))
+            {
+                let mut k = i + 2;
+                read_tree(&toks, &mut k, base, &mut paths);
+                i = k;
+                continue;
+            }
+        }
+        i += 1;
+    }
+    paths
+}
+
+/// Re-exports of a module: item name → absolute path of its source.
+type Reexports = BTreeMap<String, BTreeMap<String, Vec<String>>>;
+
+/// The module that defines the item a path names (following re-exports).
+fn resolve(modules: &CrateModules, reexports: &Reexports, path: &[String]) -> String {
+    let mut module = String::new();
+    for seg in path {
+        let next = if module.is_empty() {
+            seg.clone()
+        } else {
+            format!("{module}::{seg}")
+        };
+        if modules.is_module(&next) {
+            module = next;
+            continue;
+        }
+        if let Some(source) = reexports.get(&module).and_then(|r| r.get(seg)) {
+            return resolve(modules, reexports, source);
+        }
+        break;
+    }
+    module
+}
+
+/// Edges between the files (modules) of one crate.
+fn module_graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
+    let modules = CrateModules::read(src);
+    let mut raw: BTreeMap<String, Vec<Vec<String>>> = BTreeMap::new();
+    let mut reexports: Reexports = BTreeMap::new();
+    for (module, file) in &modules.files {
+        let text = std::fs::read_to_string(file).expect("source is readable");
+        let code = without_test_modules(&code_only(&text));
+        let children: BTreeSet<String> = modules
+            .files
+            .keys()
+            .filter_map(|m| {
+                let rest = if module.is_empty() {
+                    Some(m.as_str())
+                } else {
+                    m.strip_prefix(module.as_str())?.strip_prefix("::")
+                };
+                rest.filter(|r| !r.is_empty() && !r.contains("::"))
+                    .map(str::to_string)
+            })
+            .collect();
+        let mut paths = named_paths(module, &code, &children);
+        // A module brought in by name (`use crate::hbm::{self, …}`, `use crate::model::reduce`)
+        // is used through `name::item` paths: follow those instead of the import itself.
+        let mut aliases: BTreeMap<String, Vec<String>> = BTreeMap::new();
+        paths.retain(|p| {
+            let p_mod: Vec<String> = match p.last().map(String::as_str) {
+                Some("self") => p[..p.len() - 1].to_vec(),
+                _ => p.clone(),
+            };
+            if !p_mod.is_empty() && modules.is_module(&p_mod.join("::")) {
+                aliases.insert(p_mod.last().cloned().unwrap_or_default(), p_mod);
+                return false;
+            }
+            true
+        });
+        paths.extend(alias_paths(&code, &aliases));
+        // `pub use` items of this module define re-exports.
+        let toks = tokens(&code);
+        let own: Vec<String> = module
+            .split("::")
+            .filter(|s| !s.is_empty())
+            .map(String::from)
+            .collect();
+        for k in 0..toks.len().saturating_sub(1) {
+            if toks[k] != Token::Ident("pub".into()) || toks[k + 1] != Token::Ident("use".into()) {
+                continue;
+            }
+            let mut j = k + 2;
+            let base = match toks.get(j) {
+                Some(Token::Ident(c)) if c == "crate" => {
+                    j += 2;
+                    Vec::new()
+                }
+                Some(Token::Ident(c)) if c == "self" => {
+                    j += 2;
+                    own.clone()
+                }
+                _ => own.clone(),
+            };
+            let mut found = Vec::new();
+            read_tree(&toks, &mut j, &base, &mut found);
+            for p in found {
+                if let Some(name) = p.last() {
+                    reexports
+                        .entry(module.clone())
+                        .or_default()
+                        .insert(name.clone(), p.clone());
+                }
+            }
+        }
+        raw.insert(module.clone(), paths);
+    }
+    let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for (module, paths) in raw {
+        let targets = graph.entry(module.clone()).or_default();
+        for p in paths {
+            let target = resolve(&modules, &reexports, &p);
+            if !target.is_empty() && target != module {
+                targets.insert(target);
+            }
+        }
+    }
+    graph
+}
+
+/// Strongly connected components with more than one module (Tarjan).
+fn cycles(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<Vec<String>> {
+    struct State<'g> {
+        graph: &'g BTreeMap<String, BTreeSet<String>>,
+        index: BTreeMap<&'g str, usize>,
+        low: BTreeMap<&'g str, usize>,
+        stack: Vec<&'g str>,
+        on_stack: BTreeSet<&'g str>,
+        next: usize,
+        out: Vec<Vec<String>>,
+    }
+    fn visit<'g>(s: &mut State<'g>, v: &'g str) {
+        s.index.insert(v, s.next);
+        s.low.insert(v, s.next);
+        s.next += 1;
+        s.stack.push(v);
+        s.on_stack.insert(v);
+        let graph = s.graph;
+        for w in graph.get(v).into_iter().flatten() {
+            let w = w.as_str();
+            if !graph.contains_key(w) {
+                continue;
+            }
+            if !s.index.contains_key(w) {
+                visit(s, w);
+                let lw = s.low[w];
+                let lv = s.low[v];
+                s.low.insert(v, lv.min(lw));
+            } else if s.on_stack.contains(w) {
+                let iw = s.index[w];
+                let lv = s.low[v];
+                s.low.insert(v, lv.min(iw));
+            }
+        }
+        if s.low[v] == s.index[v] {
+            let mut component = Vec::new();
+            while let Some(w) = s.stack.pop() {
+                s.on_stack.remove(w);
+                component.push(w.to_string());
+                if w == v {
+                    break;
+                }
+            }
+            if component.len() > 1 {
+                component.sort();
+                s.out.push(component);
+            }
+        }
+    }
+    let mut s = State {
+        graph,
+        index: BTreeMap::new(),
+        low: BTreeMap::new(),
+        stack: Vec::new(),
+        on_stack: BTreeSet::new(),
+        next: 0,
+        out: Vec::new(),
+    };
+    for v in graph.keys() {
+        if !s.index.contains_key(v.as_str()) {
+            visit(&mut s, v);
+        }
+    }
+    s.out
+}
+
+fn describe(graph: &BTreeMap<String, BTreeSet<String>>, component: &[String]) -> String {
+    let members: BTreeSet<&String> = component.iter().collect();
+    let edges: Vec<String> = component
+        .iter()
+        .flat_map(|a| {
+            graph[a]
+                .iter()
+                .filter(|b| members.contains(b))
+                .map(move |b| format!("{a} → {b}"))
+        })
+        .collect();
+    format!("{{{}}}: {}", component.join(", "), edges.join("; "))
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn no_import_cycle_between_files_of_fricbound() {
+    let graph = module_graph(&root().join("src"));
+    assert!(graph.len() > 40, "read {} modules", graph.len());
+    let found: Vec<String> = cycles(&graph).iter().map(|c| describe(&graph, c)).collect();
+    assert!(found.is_empty(), "import cycles:\n{}", found.join("\n"));
+}
+
+#[test]
+fn no_import_cycle_between_files_of_the_reduction_crate() {
+    let graph = module_graph(&root().join("reduction/src"));
+    assert!(graph.len() > 5, "read {} modules", graph.len());
+    let found: Vec<String> = cycles(&graph).iter().map(|c| describe(&graph, c)).collect();
+    assert!(found.is_empty(), "import cycles:\n{}", found.join("\n"));
+}
+
+#[test]
+fn layers_use_only_layers_below_them() {
+    let graph = module_graph(&root().join("src"));
+    let layer = |m: &str| m.split("::").next().unwrap_or("").to_string();
+    let rank = |l: &str| LAYERS.iter().position(|x| *x == l);
+    let mut upward = Vec::new();
+    for (from, targets) in &graph {
+        let Some(rf) = rank(&layer(from)) else {
+            assert!(from.is_empty(), "module `{from}` is in no layer of LAYERS");
+            continue;
+        };
+        for to in targets {
+            let rt = rank(&layer(to)).unwrap_or(usize::MAX);
+            if rt > rf {
+                upward.push(format!("{from} → {to}"));
+            }
+        }
+    }
+    assert!(
+        upward.is_empty(),
+        "imports pointing up a layer:\n{}",
+        upward.join("\n")
+    );
+}
+
+#[test]
+fn the_checker_sees_cycles_and_re_exports() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let src = dir.path();
+    std::fs::create_dir_all(src.join("low")).expect("folder");
+    let write = |p: &str, s: &str| std::fs::write(src.join(p), s).expect("write");
+    write("lib.rs", "pub mod low;\npub mod high;\n");
+    write(
+        "low/mod.rs",
+        "//! crate::high in a comment is no edge\npub mod item;\npub use item::Thing;\n",
+    );
+    write(
+        "low/item.rs",
+        "pub struct Thing;\nconst S: &str = \"crate::high::Other\";\n",
+    );
+    write(
+        "high.rs",
+        "use crate::low::Thing;\npub struct Other(Thing);\n",
+    );
+    let graph = module_graph(src);
+    assert_eq!(graph["high"], BTreeSet::from(["low::item".to_string()]));
+    assert_eq!(graph["low"], BTreeSet::from(["low::item".to_string()]));
+    assert!(graph["low::item"].is_empty());
+    assert!(cycles(&graph).is_empty());
+    // A use back up closes a cycle.
+    write(
+        "low/item.rs",
+        "pub struct Thing;\nfn f() { let _ = crate::high::Other; }\n",
+    );
+    let graph = module_graph(src);
+    assert_eq!(
+        cycles(&graph),
+        vec![vec!["high".to_string(), "low::item".to_string()]]
+    );
+    // `super::` at file level names the parent; inside an inline test module, the file itself.
+    write(
+        "low/item.rs",
+        "pub struct Thing;\nuse super::Thing as T;\n#[cfg(test)]\nmod tests { use super::*; }\n",
+    );
+    let graph = module_graph(src);
+    assert_eq!(
+        graph["low::item"],
+        BTreeSet::from([]),
+        "re-export resolves to itself"
+    );
+}
