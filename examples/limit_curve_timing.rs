@@ -43,8 +43,8 @@ fn main() {
         m: 1.0,
     };
     let mut p = config.apply(&reduced);
-    p.analysis.chord_min_unknowns = arg(3, fricbound::model::CHORD_MIN_UNKNOWNS);
-    p.analysis.max_points = arg(2, 150);
+    p.analysis.continuation.chord_min_unknowns = arg(3, fricbound::model::CHORD_MIN_UNKNOWNS);
+    p.analysis.continuation.max_points = arg(2, 150);
     let m = scaling::measure_solve(&size.label(), &p, &config, true).expect("measured");
     println!(
         "{}: {} pairs/side, H = {}, {} unknowns ({}, {}): one iteration {:.1} ms; {} points in {:.2} s, {:.1} ms per point, {} iterations",

@@ -24,7 +24,7 @@ fn paper(formulation: &str, chord: bool) -> Problem {
         .validate("paper")
         .unwrap();
     if chord {
-        p.analysis.chord_min_unknowns = 0;
+        p.analysis.continuation.chord_min_unknowns = 0;
     }
     assert!(p.model.n_dofs() * 3 < fricbound::model::CHORD_MIN_UNKNOWNS);
     p

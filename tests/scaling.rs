@@ -93,7 +93,7 @@ fn measured_frf_reaches_the_window_end() {
         m: 1.0,
     };
     let mut p = config.apply(&base);
-    p.analysis.max_points = 2000;
+    p.analysis.continuation.max_points = 2000;
     let m = scaling::measure_solve("2D r2 p2, reduced", &p, &config, true).unwrap();
     assert_eq!(m.pairs_per_side, 2);
     assert_eq!(m.formulation, "dense");

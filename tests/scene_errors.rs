@@ -570,7 +570,7 @@ fn overrides_are_applied() {
     assert_eq!(problem.contacts[0].law.initial_state, -1.0);
     assert_eq!(problem.static_load[5], -80.0);
     assert_eq!(problem.harmonics, vec![1, 2, 3, 4, 5]);
-    assert_eq!(problem.analysis.initial_step, 0.5);
+    assert_eq!(problem.analysis.continuation.initial_step, 0.5);
 }
 
 #[test]

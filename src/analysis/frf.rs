@@ -119,7 +119,7 @@ pub fn point_outputs(
 /// Scale of x in the arc length: the largest stuck-linear response norm over the range,
 /// divided so that climbing to it costs a quarter of the range in arc length.
 fn arc_length_x_scale(problem: &Problem, set: &HarmonicSet) -> Result<f64, LinearSolveError> {
-    let a = &problem.analysis;
+    let a = &problem.analysis.continuation;
     // The 0th harmonic of the guess does not depend on ω: solved once, the dynamic harmonics
     // on the grid.
     let dynamic = HarmonicSet::new(
@@ -205,10 +205,10 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
     let started = Instant::now();
     let mut system = HbmOperator::new(problem)?;
     let set = system.unknowns().clone();
-    let omega0 = 2.0 * PI * problem.analysis.freq_start_hz;
+    let omega0 = 2.0 * PI * problem.analysis.continuation.freq_start_hz;
     let guess = system.restrict(&linear::stuck_guess(problem, &set, omega0)?);
     let continuation = Continuation::new(
-        problem.analysis.continuation(),
+        problem.analysis.continuation,
         arc_length_x_scale(problem, &set)?,
     );
     let mut adapter = Adapter {
@@ -243,7 +243,7 @@ impl<'p> PointSolver<'p> {
         let system = HbmOperator::new(problem)?;
         let set = system.unknowns().clone();
         let continuation = Continuation::new(
-            problem.analysis.continuation(),
+            problem.analysis.continuation,
             arc_length_x_scale(problem, &set)?,
         );
         Ok(Self {

@@ -347,7 +347,7 @@ pub fn solve_case(
     let mut first_error = None;
     for (retries, factor) in STEP_RETRIES.iter().enumerate() {
         let mut attempt = p.clone();
-        let a = &mut attempt.analysis;
+        let a = &mut attempt.analysis.continuation;
         a.max_step = (a.max_step * factor).max(a.min_step);
         a.initial_step = (a.initial_step * factor).clamp(a.min_step, a.max_step);
         match frf::solve(&attempt, &mut Silent) {
@@ -879,7 +879,7 @@ pub fn analyse<F>(
 where
     F: Fn(&CaseCurve) + Sync,
 {
-    let a = &problem.analysis;
+    let a = &problem.analysis.continuation;
     let n = settings.grid_points.max(2);
     let grid: Vec<f64> = (0..n)
         .map(|i| a.freq_start_hz + (a.freq_end_hz - a.freq_start_hz) * i as f64 / (n - 1) as f64)

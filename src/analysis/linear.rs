@@ -270,7 +270,7 @@ pub fn reference_curve(
     case: LinearCase,
     points: usize,
 ) -> Result<LinearCurve, LinearSolveError> {
-    let a = &problem.analysis;
+    let a = &problem.analysis.continuation;
     let freqs_hz: Vec<f64> = (0..points)
         .map(|i| {
             a.freq_start_hz

@@ -185,7 +185,7 @@ fn scaling_study(dir: &Path, quick: bool) -> Result<String, BenchError> {
         let case = format!("{}, reduced", size.label());
         for config in SolverConfig::grid(harmonics) {
             let mut p = config.apply(&reduced);
-            p.analysis.max_points = FRF_POINTS;
+            p.analysis.continuation.max_points = FRF_POINTS;
             // The cost grows with the factorised size; the schur formulation's finite
             // differences are per contact point, not per unknown.
             let limit = if config.jacobian == JacobianStrategy::Analytic
@@ -222,7 +222,7 @@ fn scaling_study(dir: &Path, quick: bool) -> Result<String, BenchError> {
                     m: 1.0,
                 };
                 let mut p = config.apply(&reduced);
-                p.analysis.max_points = FRF_POINTS;
+                p.analysis.continuation.max_points = FRF_POINTS;
                 eprintln!("limit FRF: {case}, {}", config.label());
                 let mut m = scaling::measure_solve(&case, &p, &config, false)?;
                 if jacobian == JacobianStrategy::Analytic || m.iteration_ms <= 1000.0 {
@@ -244,7 +244,7 @@ fn scaling_study(dir: &Path, quick: bool) -> Result<String, BenchError> {
             m: 0.0,
         };
         let mut p = config.apply(&full);
-        p.analysis.max_points = FRF_POINTS;
+        p.analysis.continuation.max_points = FRF_POINTS;
         eprintln!("solve: 2D r2 unreduced, {}", config.label());
         let m = scaling::measure_solve("2D r2, unreduced", &p, &config, true)?;
         study.solves.push(m);

@@ -257,7 +257,7 @@ impl FrfObserver for RunObserver<'_> {
     fn point(&mut self, point: &FrfPoint) {
         self.writer.point(point);
         if let Some(bar) = &self.bar {
-            let a = &self.problem.analysis;
+            let a = &self.problem.analysis.continuation;
             let frac = ((point.freq_hz - a.freq_start_hz) / (a.freq_end_hz - a.freq_start_hz))
                 .clamp(0.0, 1.0);
             bar.set_position((frac * 1000.0) as u64);
@@ -475,7 +475,7 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
     let set = problem.unknown_harmonics();
     let n = problem.model.n_dofs();
     let e = &problem.effects;
-    let a = &problem.analysis;
+    let a = &problem.analysis.continuation;
     let mut s = String::new();
     use std::fmt::Write as _;
     let _ = writeln!(s, "scene        {label}");
@@ -557,7 +557,7 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
     let _ = writeln!(
         s,
         "analysis     {} .. {} Hz, steps {:.3e} (min {:.3e}, max {:.3e}), jacobian {:?}",
-        a.freq_start_hz, a.freq_end_hz, a.initial_step, a.min_step, a.max_step, a.jacobian
+        a.freq_start_hz, a.freq_end_hz, a.initial_step, a.min_step, a.max_step, problem.analysis.jacobian
     );
     let _ = writeln!(
         s,

@@ -103,63 +103,22 @@ pub enum Formulation {
     Schur,
 }
 
-/// Continuation and Newton settings. Frequencies in Hz; arc-length steps are measured in the
-/// scaled space where a unit of frequency is 1 Hz (see [`crate::numerics::continuation`]);
-/// [`Analysis::continuation`] gives the continuation's part of them.
+/// Settings of a frequency-response analysis: the continuation over the range (frequencies in
+/// Hz; arc-length steps in the scaled space where a unit of frequency is 1 Hz, see
+/// [`crate::numerics::continuation`]) and how the harmonic balance is formed and stored.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Analysis {
-    /// Start frequency (Hz), > 0.
-    pub freq_start_hz: f64,
-    /// End frequency (Hz), > start.
-    pub freq_end_hz: f64,
-    /// First arc-length step (Hz-equivalent).
-    pub initial_step: f64,
-    /// Smallest step before continuation gives up.
-    pub min_step: f64,
-    /// Largest step.
-    pub max_step: f64,
-    /// Most continuation points.
-    pub max_points: usize,
-    /// Newton iterations aimed at per point; steps grow below and shrink above it.
-    pub target_iterations: usize,
-    /// Newton iterations before a point fails.
-    pub max_iterations: usize,
-    /// Convergence: ‖R‖ ≤ residual_tolerance · ‖F_ex‖ (static and harmonic loads).
-    pub residual_tolerance: f64,
-    /// Convergence: scaled Newton step norm ≤ step_tolerance.
-    pub step_tolerance: f64,
+    /// Range, steps, point budget and Newton tolerances of the continuation.
+    pub continuation: ContinuationSettings,
     /// Jacobian strategy.
     pub jacobian: JacobianStrategy,
     /// Storage and elimination of the harmonic-balance equations.
     pub formulation: Formulation,
     /// Points of the uniform frequency grid of the linear references.
     pub linear_points: usize,
-    /// Unknowns from which the continuation corrector reuses a factorised Jacobian over
-    /// several iterations (chord iterations) while the residual falls fast enough: on large
-    /// dense Newton matrices the factorisation dominates and a chord step costs a residual.
-    pub chord_min_unknowns: usize,
 }
 
-impl Analysis {
-    /// The settings of the continuation that follows the path over the range.
-    pub fn continuation(&self) -> ContinuationSettings {
-        ContinuationSettings {
-            freq_start_hz: self.freq_start_hz,
-            freq_end_hz: self.freq_end_hz,
-            initial_step: self.initial_step,
-            min_step: self.min_step,
-            max_step: self.max_step,
-            max_points: self.max_points,
-            target_iterations: self.target_iterations,
-            max_iterations: self.max_iterations,
-            residual_tolerance: self.residual_tolerance,
-            step_tolerance: self.step_tolerance,
-            chord_min_unknowns: self.chord_min_unknowns,
-        }
-    }
-}
-
-/// Default of [`Analysis::chord_min_unknowns`].
+/// Default of [`ContinuationSettings::chord_min_unknowns`].
 pub const CHORD_MIN_UNKNOWNS: usize = 1500;
 
 /// A checked problem, ready to solve.

@@ -18,6 +18,7 @@ use crate::model::matrix::StructuralMatrix;
 use crate::model::{
     Analysis, Coupling, Effects, Formulation, HarmonicLoad, JacobianStrategy, LinearModel, Problem,
 };
+use crate::numerics::ContinuationSettings;
 use crate::scene::fe_input::{
     ContactPatchSpec, FeStructure, MaterialSpec, MatrixMarketSpec, PlaneSpec, ReductionSpec,
 };
@@ -1379,20 +1380,22 @@ impl Scene {
                 ..MarchSettings::default()
             },
             analysis: Analysis {
-                freq_start_hz: f0,
-                freq_end_hz: f1,
-                initial_step,
-                min_step,
-                max_step,
-                max_points: a.max_points,
-                target_iterations: a.target_iterations,
-                max_iterations: a.max_iterations,
-                residual_tolerance,
-                step_tolerance,
+                continuation: ContinuationSettings {
+                    freq_start_hz: f0,
+                    freq_end_hz: f1,
+                    initial_step,
+                    min_step,
+                    max_step,
+                    max_points: a.max_points,
+                    target_iterations: a.target_iterations,
+                    max_iterations: a.max_iterations,
+                    residual_tolerance,
+                    step_tolerance,
+                    chord_min_unknowns: crate::model::CHORD_MIN_UNKNOWNS,
+                },
                 jacobian: a.jacobian,
                 formulation: a.formulation,
                 linear_points: a.linear_points,
-                chord_min_unknowns: crate::model::CHORD_MIN_UNKNOWNS,
             },
             outputs,
             fe: fe.as_ref().and_then(|f| {

@@ -469,14 +469,15 @@ impl<'a> NewtonIteration<'a> {
 
 /// Measures `p`, set up by `config` (see [`SolverConfig::apply`]): the time of one Newton
 /// iteration at the stuck linear guess at the window's centre, and with `frf` an FRF over the
-/// window limited to `p.analysis.max_points` continuation points.
+/// window limited to `p.analysis.continuation.max_points` continuation points.
 pub fn measure_solve(
     case: &str,
     p: &Problem,
     config: &SolverConfig,
     frf: bool,
 ) -> Result<SolveMeasure, ScalingError> {
-    let centre = 0.5 * (p.analysis.freq_start_hz + p.analysis.freq_end_hz);
+    let centre =
+        0.5 * (p.analysis.continuation.freq_start_hz + p.analysis.continuation.freq_end_hz);
     let mut iteration = NewtonIteration::new(p, centre)?;
     let mut m = SolveMeasure {
         case: case.to_string(),
@@ -488,7 +489,11 @@ pub fn measure_solve(
         unknowns: iteration.unknowns(),
         iteration_ms: 0.0,
         frf,
-        max_points: if frf { p.analysis.max_points } else { 0 },
+        max_points: if frf {
+            p.analysis.continuation.max_points
+        } else {
+            0
+        },
         points: 0,
         iterations: 0,
         complete: false,
