@@ -77,43 +77,33 @@ fn main() -> ExitCode {
                 quiet,
                 ..Default::default()
             };
-            fricbound::cli::run(&options).map(|r| {
-                if !quiet {
-                    println!("{}", fricbound::cli::run_summary(&r));
-                }
-            })
+            fricbound::cli::run(&options)
+                .map(|r| {
+                    if !quiet {
+                        println!("{}", fricbound::cli::run_summary(&r));
+                    }
+                })
+                .map_err(|e| e.to_string())
         }
         Command::Paper { out, quick, quiet } => {
             let options = fricbound::cli::paper::PaperOptions { out, quick, quiet };
-            fricbound::cli::paper::paper(&options).map(|r| {
-                if !quiet {
-                    println!("{}", fricbound::cli::paper::paper_summary_line(&r));
-                }
-            })
+            fricbound::cli::paper::paper(&options)
+                .map(|r| {
+                    if !quiet {
+                        println!("{}", fricbound::cli::paper::paper_summary_line(&r));
+                    }
+                })
+                .map_err(|e| e.to_string())
         }
-        Command::Check { scene, overrides } => {
-            fricbound::cli::check(scene.as_deref(), &overrides).map(|s| print!("{s}"))
-        }
-        Command::Bench { command } => match fricbound::cli::bench::run(&command) {
-            Ok(text) => {
-                print!("{text}");
-                Ok(())
-            }
-            Err(e) => {
-                eprintln!("error: {e}");
-                return ExitCode::FAILURE;
-            }
-        },
-        Command::Mesh { command } => match fricbound::cli::mesh::run(&command) {
-            Ok(text) => {
-                print!("{text}");
-                Ok(())
-            }
-            Err(e) => {
-                eprintln!("error: {e}");
-                return ExitCode::FAILURE;
-            }
-        },
+        Command::Check { scene, overrides } => fricbound::cli::check(scene.as_deref(), &overrides)
+            .map(|s| print!("{s}"))
+            .map_err(|e| e.to_string()),
+        Command::Bench { command } => fricbound::cli::bench::run(&command)
+            .map(|text| print!("{text}"))
+            .map_err(|e| e.to_string()),
+        Command::Mesh { command } => fricbound::cli::mesh::run(&command)
+            .map(|text| print!("{text}"))
+            .map_err(|e| e.to_string()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -5,9 +5,10 @@
 use faer::Mat;
 use fricbound::analysis::frf::{self, PointSolver, Silent};
 use fricbound::hbm::operator::HbmOperator;
-use fricbound::hbm::{check_jacobian, check_operator_jacobian, HbmSystem};
+use fricbound::hbm::{check_jacobian, HbmSystem};
 use fricbound::model::matrix::StructuralMatrix;
 use fricbound::model::{Formulation, HarmonicLoad, JacobianStrategy, Problem};
+use fricbound::numerics::derivatives::check_operator_jacobian;
 use fricbound::numerics::jacobian::Storage;
 use fricbound::scene;
 use fricbound::scene::paper_wedge_scene;

@@ -4,7 +4,7 @@
 //! With rows contiguous, the scatter/gather of a supernode's pattern and the
 //! entries of a sparse matrix each touch one contiguous `k`-vector.
 
-use crate::csc::Csc;
+use crate::csc::{Csc, SymView};
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
@@ -290,6 +290,38 @@ fn supernodal_solve_rows_impl(
                 Par::Seq,
             );
         }
+    }
+}
+
+// Products of the sparse matrices with row-major blocks live here, with the blocks: the
+// sparse storage (`csc`) knows nothing of them.
+impl Csc {
+    /// `selfᵀ x` for a general CSC and a row-major `x` (`nrows × k`):
+    /// returns `ncols × k` (column-major).
+    pub fn transpose_mul_rows(&self, x: &RowBlock) -> faer::Mat<f64> {
+        let k = x.k;
+        let mut out = faer::Mat::zeros(self.ncols, k);
+        let mut acc = vec![0.0; k];
+        for j in 0..self.ncols {
+            let (rows, vals) = self.col(j);
+            acc.iter_mut().for_each(|a| *a = 0.0);
+            for (&i, &v) in rows.iter().zip(vals) {
+                for (a, xv) in acc.iter_mut().zip(x.row(i)) {
+                    *a += v * xv;
+                }
+            }
+            for (c, a) in acc.iter().enumerate() {
+                out[(j, c)] = *a;
+            }
+        }
+        out
+    }
+}
+
+impl SymView<'_> {
+    /// `y = A x` on row-major blocks.
+    pub fn mul_rows(&self, x: &RowBlock, y: &mut RowBlock) {
+        sym_mul_rows(self.lower, self.inv, x, y)
     }
 }
 

@@ -1,15 +1,14 @@
 //! The Craig-Bampton reduction itself.
 
-use crate::block::{sym_mul_rows, RowBlock};
+use crate::constraint::constraint_blocks;
 use crate::csc::{canonical_symmetric, split, Blocks, Part, SymView};
 use crate::eigen::{lambda_to_hz, lowest_modes, Eigen, LanczosOptions};
 use crate::factor::{fill_reducing_order, PivotContext, SpdFactor};
 use crate::ordering::Ordering;
+use crate::report::{peak_memory_bytes, process_cpu_seconds, CpuClock, CpuPhases, ReductionReport};
 use crate::ReductionError;
-use faer::linalg::matmul::matmul;
 use faer::sparse::SparseColMatRef;
-use faer::{Accum, Mat, Par};
-use rayon::prelude::*;
+use faer::{Mat, Par};
 use std::time::Instant;
 
 /// Options of [`craig_bampton`].
@@ -84,199 +83,6 @@ pub struct RecoveryRow {
     pub dof: usize,
     /// length `n_boundary + n_modes`
     pub row: Vec<f64>,
-}
-
-/// CPU seconds of the calling thread per phase of a reduction.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct CpuPhases {
-    /// validation, canonicalisation, partition
-    pub validate: f64,
-    /// ordering, symbolic and numeric Cholesky
-    pub factor: f64,
-    /// fixed-interface modes
-    pub eigen: f64,
-    /// constraint modes and reduced matrices
-    pub constraint: f64,
-    /// Sturm-sequence check
-    pub sturm: f64,
-}
-
-/// CPU time of the calling thread, seconds (`/proc/thread-self/schedstat`).
-fn thread_cpu_seconds() -> Option<f64> {
-    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    let ns: f64 = s.split_whitespace().next()?.parse().ok()?;
-    Some(ns * 1e-9)
-}
-
-/// Marks phase boundaries on the calling thread's CPU clock.
-struct CpuClock {
-    last: Option<f64>,
-}
-
-impl CpuClock {
-    fn new() -> Self {
-        CpuClock {
-            last: thread_cpu_seconds(),
-        }
-    }
-    /// CPU seconds since the previous mark.
-    fn lap(&mut self) -> f64 {
-        let now = thread_cpu_seconds();
-        let d = match (self.last, now) {
-            (Some(a), Some(b)) => b - a,
-            _ => 0.0,
-        };
-        self.last = now;
-        d
-    }
-}
-
-/// Sizes, times and memory of a reduction.
-#[derive(Clone, Debug, Default)]
-pub struct ReductionReport {
-    /// DOFs of the full model
-    pub n_full: usize,
-    /// boundary DOFs kept as physical coordinates
-    pub n_boundary: usize,
-    /// interior DOFs condensed
-    pub n_interior: usize,
-    /// fixed-interface modes kept
-    pub n_modes: usize,
-    /// fixed-interface modes computed (kept + extra)
-    pub n_modes_computed: usize,
-    /// highest kept fixed-interface eigenfrequency, Hz (0 if no mode)
-    pub cutoff_hz: f64,
-    /// lowest computed but not kept fixed-interface frequency, Hz
-    pub next_hz: Option<f64>,
-    /// ordering used for `K_II`
-    pub ordering: Ordering,
-    /// stored entries of the lower triangle of `K_II`
-    pub k_ii_nnz: usize,
-    /// stored entries of the Cholesky factor of `K_II` (supernodal storage)
-    pub factor_nnz: usize,
-    /// largest relative residual of the fixed-interface modes
-    pub eigen_max_residual: f64,
-    /// thick restarts of the Lanczos solver
-    pub eigen_restarts: usize,
-    /// block solves of the Lanczos solver
-    pub eigen_solves: usize,
-    /// where the eigen solve spent its time
-    pub eigen_timings: crate::eigen::EigenTimings,
-    /// seconds of the constraint-mode phase in solves with the factor
-    /// (summed over blocks; with several threads, over threads)
-    pub t_constraint_solve: f64,
-    /// seconds of the constraint-mode phase in products with M_II
-    pub t_constraint_mass: f64,
-    /// block Lanczos block size
-    pub lanczos_block: usize,
-    /// constraint-mode block size
-    pub block_size: usize,
-    /// worker threads of the constraint-mode phase
-    pub threads: usize,
-    /// seconds: validation and canonicalisation of K, M
-    pub t_validate: f64,
-    /// seconds: interior/boundary split
-    pub t_partition: f64,
-    /// seconds: METIS ordering (0 for AMD, counted in `t_symbolic`)
-    pub t_ordering: f64,
-    /// seconds: symbolic Cholesky (with AMD when chosen)
-    pub t_symbolic: f64,
-    /// seconds: numeric Cholesky
-    pub t_numeric: f64,
-    /// seconds: fixed-interface eigen solve
-    pub t_eigen: f64,
-    /// seconds: constraint modes and reduced matrices
-    pub t_constraint: f64,
-    /// Sturm count: fixed-interface eigenvalues below the check shift
-    /// (should equal `n_modes`); `None` if not done
-    pub sturm_count: Option<usize>,
-    /// seconds: Sturm-sequence check
-    pub t_sturm: f64,
-    /// seconds in all (wall clock)
-    pub t_total: f64,
-    /// CPU seconds of the process during the reduction (user + system, all
-    /// threads; from /proc/self/stat, `None` elsewhere). Compared with
-    /// `t_total` it shows how much the machine was shared.
-    pub cpu_seconds: Option<f64>,
-    /// CPU seconds of the calling thread per phase (Linux), independent of
-    /// how busy the machine is; with `threads > 1` the constraint-mode
-    /// blocks run on other threads and are not counted here
-    pub cpu_phases: Option<CpuPhases>,
-    /// peak resident memory of the process (VmHWM of /proc/self/status),
-    /// bytes; `None` where it cannot be read
-    pub peak_memory_bytes: Option<u64>,
-}
-
-impl std::fmt::Display for ReductionReport {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        writeln!(
-            f,
-            "Craig-Bampton: {} DOFs -> {} boundary + {} modes ({} interior)",
-            self.n_full, self.n_boundary, self.n_modes, self.n_interior
-        )?;
-        writeln!(
-            f,
-            "  cut-off {:.4} Hz{}",
-            self.cutoff_hz,
-            self.next_hz
-                .map(|h| format!(", next fixed-interface mode {h:.4} Hz"))
-                .unwrap_or_default()
-        )?;
-        writeln!(
-            f,
-            "  K_II lower nnz {}, Cholesky factor entries {} ({} ordering)",
-            self.k_ii_nnz, self.factor_nnz, self.ordering
-        )?;
-        writeln!(
-            f,
-            "  eigen: max residual {:.2e}, {} restarts, {} block solves (block {})",
-            self.eigen_max_residual, self.eigen_restarts, self.eigen_solves, self.lanczos_block
-        )?;
-        let e = &self.eigen_timings;
-        writeln!(
-            f,
-            "  eigen seconds: solves {:.2}, M products {:.2}, orthogonalisation {:.2}, Rayleigh-Ritz/restart {:.2}, check {:.2}",
-            e.solve, e.mass, e.orthogonalise, e.restart, e.check
-        )?;
-        writeln!(
-            f,
-            "  constraint-mode seconds: solves {:.2}, M products {:.2}",
-            self.t_constraint_solve, self.t_constraint_mass
-        )?;
-        if let Some(c) = self.sturm_count {
-            writeln!(
-                f,
-                "  Sturm check: {c} eigenvalues below the check shift ({:.2} s)",
-                self.t_sturm
-            )?;
-        }
-        writeln!(
-            f,
-            "  seconds: validate {:.2}, partition {:.2}, ordering {:.2}, symbolic {:.2}, numeric {:.2}, eigen {:.2}, constraint modes {:.2}, total {:.2} (CPU {})",
-            self.t_validate,
-            self.t_partition,
-            self.t_ordering,
-            self.t_symbolic,
-            self.t_numeric,
-            self.t_eigen,
-            self.t_constraint,
-            self.t_total,
-            self.cpu_seconds
-                .map(|c| format!("{c:.2}"))
-                .unwrap_or_else(|| "n/a".into())
-        )?;
-        if let Some(c) = &self.cpu_phases {
-            writeln!(
-                f,
-                "  CPU seconds (calling thread): validate {:.2}, factor {:.2}, eigen {:.2}, constraint modes {:.2}, Sturm {:.2}",
-                c.validate, c.factor, c.eigen, c.constraint, c.sturm
-            )?;
-        }
-        match self.peak_memory_bytes {
-            Some(b) => write!(f, "  peak memory {:.2} GiB", b as f64 / (1u64 << 30) as f64),
-            None => write!(f, "  peak memory unknown"),
-        }
-    }
 }
 
 /// A Craig-Bampton reduced model.
@@ -370,26 +176,6 @@ impl ReducedModel {
             .map(|r| r.row.iter().zip(q).map(|(a, b)| a * b).sum())
             .collect())
     }
-}
-
-/// CPU time (user + system) of this process so far, seconds; `None` off Linux.
-pub fn process_cpu_seconds() -> Option<f64> {
-    let s = std::fs::read_to_string("/proc/self/stat").ok()?;
-    // fields after the command name (which is in parentheses)
-    let rest = &s[s.rfind(')')? + 2..];
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let utime: f64 = f.get(11)?.parse().ok()?;
-    let stime: f64 = f.get(12)?.parse().ok()?;
-    // clock ticks: 100 per second on Linux
-    Some((utime + stime) / 100.0)
-}
-
-/// Peak resident memory of this process (VmHWM), bytes; `None` off Linux.
-pub fn peak_memory_bytes() -> Option<u64> {
-    let s = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
 }
 
 pub(crate) fn check_indices(
@@ -643,7 +429,16 @@ pub fn craig_bampton(
 
     // constraint modes, block by block
     let t0 = Instant::now();
-    let cons = constraint_blocks(&kb, &mb, &inv, &factor, &phi, &part, recover, options)?;
+    let cons = constraint_blocks(
+        &kb,
+        &mb,
+        &inv,
+        &factor,
+        &phi,
+        &part,
+        recover,
+        (options.block_size, options.threads),
+    )?;
     report.t_constraint = t0.elapsed().as_secs_f64();
     cpu.constraint = clock.lap();
     report.t_constraint_solve = cons.t_solve;
@@ -777,182 +572,4 @@ fn recovery_rows(
             RecoveryRow { dof: d, row }
         })
         .collect()
-}
-
-struct ConstraintResult {
-    /// K_BB + K_BI Ψ
-    k_bb: Mat<f64>,
-    /// M_BB + M_BI Ψ + Ψᵀ M_IB + Ψᵀ M_II Ψ
-    m_bb: Mat<f64>,
-    /// (M_BI + Ψᵀ M_II) Φ, nb × nm
-    coupling: Mat<f64>,
-    /// Ψ rows (length nb) of the recovered DOFs (empty for boundary ones)
-    psi_rows: Vec<Vec<f64>>,
-    t_solve: f64,
-    t_mass: f64,
-}
-
-/// Output of one column block `a` of Ψ.
-struct BlockOut {
-    start: usize,
-    /// (K_BB + K_BI Ψ)[:, a], nb × w
-    k_cols: Mat<f64>,
-    /// M_BI Ψ_a, nb × w
-    p_cols: Mat<f64>,
-    /// −K_BI K_II⁻¹ M_II Ψ_a = Ψᵀ M_II Ψ_a, nb × w (columns a of Ψᵀ M_II Ψ)
-    g_cols: Mat<f64>,
-    /// (M_II Ψ_a)ᵀ Φ, w × nm
-    coupling_rows: Mat<f64>,
-    /// Ψ_a rows of the recovered interior DOFs: (position in recover, values)
-    psi: Vec<(usize, Vec<f64>)>,
-    t_solve: f64,
-    t_mass: f64,
-}
-
-#[allow(clippy::too_many_arguments)]
-/// Ψ = −K_II⁻¹ K_IB computed `block_size` columns at a time; only the block
-/// in hand is held (3 dense `n_I × block_size` arrays). The term Ψᵀ M_II Ψ,
-/// which pairs every block with every other, is obtained without holding Ψ
-/// through `Ψ_bᵀ M_II Ψ_a = −K_BI_b (K_II⁻¹ M_II Ψ_a)`: one more solve per
-/// block.
-fn constraint_blocks(
-    kb: &Blocks,
-    mb: &Blocks,
-    inv: &[usize],
-    factor: &SpdFactor,
-    phi: &Mat<f64>,
-    part: &[Part],
-    recover: &[usize],
-    options: &CbOptions,
-) -> Result<ConstraintResult, ReductionError> {
-    let n_i = kb.ii_lower.ncols;
-    let nb = kb.ib.ncols;
-    let nm = phi.ncols();
-    let bs = options.block_size;
-    // recovered interior DOFs: (position in recover, interior index)
-    let rec_int: Vec<(usize, usize)> = recover
-        .iter()
-        .enumerate()
-        .filter_map(|(pos, &d)| match part[d] {
-            Part::Interior(i) => Some((pos, i)),
-            Part::Boundary(_) => None,
-        })
-        .collect();
-    // M_BI Φ (nb × nm)
-    let mbi_phi = mb.ib.transpose_mul_rows(&RowBlock::from_mat(phi.as_ref()));
-
-    let starts: Vec<usize> = (0..nb).step_by(bs).collect();
-    let run_block = |start: usize| -> BlockOut {
-        let w = bs.min(nb - start);
-        // Ψ_a = −K_II⁻¹ K_IB[:, a]   (row-major n_I × w)
-        let mut psi = RowBlock::take(n_i, w);
-        psi.data.fill(0.0);
-        for c in 0..w {
-            let (rows, vals) = kb.ib.col(start + c);
-            for (&i, &v) in rows.iter().zip(vals) {
-                psi.row_mut(i)[c] = -v;
-            }
-        }
-        let t = Instant::now();
-        factor.solve_rows(&mut psi);
-        let mut t_solve = t.elapsed().as_secs_f64();
-        let mut k_cols = kb.ib.transpose_mul_rows(&psi);
-        let p_cols = mb.ib.transpose_mul_rows(&psi);
-        for c in 0..w {
-            for i in 0..nb {
-                k_cols[(i, c)] += kb.bb[(i, start + c)];
-            }
-        }
-        let psi_rec: Vec<(usize, Vec<f64>)> = rec_int
-            .iter()
-            .map(|&(pos, i)| (pos, psi.row(i).to_vec()))
-            .collect();
-        // Z = M_II Ψ_a
-        let mut z = RowBlock::take(n_i, w);
-        let t = Instant::now();
-        sym_mul_rows(&mb.ii_lower, Some(inv), &psi, &mut z);
-        let t_mass = t.elapsed().as_secs_f64();
-        psi.give_back();
-        let mut coupling_rows = Mat::zeros(w, nm);
-        matmul(
-            coupling_rows.as_mut(),
-            Accum::Replace,
-            z.view().transpose(),
-            phi.as_ref(),
-            1.0,
-            Par::Seq,
-        );
-        for c in 0..w {
-            for a in 0..nm {
-                coupling_rows[(c, a)] += mbi_phi[(start + c, a)];
-            }
-        }
-        // Y = K_II⁻¹ Z; Ψᵀ M_II Ψ_a = −K_BI Y
-        let t = Instant::now();
-        factor.solve_rows(&mut z);
-        t_solve += t.elapsed().as_secs_f64();
-        let mut g_cols = kb.ib.transpose_mul_rows(&z);
-        z.give_back();
-        for c in 0..w {
-            for i in 0..nb {
-                g_cols[(i, c)] = -g_cols[(i, c)];
-            }
-        }
-        BlockOut {
-            start,
-            k_cols,
-            p_cols,
-            g_cols,
-            coupling_rows,
-            psi: psi_rec,
-            t_solve,
-            t_mass,
-        }
-    };
-    let threads = options.threads.max(1);
-    let outs: Vec<BlockOut> = if threads == 1 {
-        starts.iter().map(|&s| run_block(s)).collect()
-    } else {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .map_err(|e| ReductionError::InvalidArgument(format!("thread pool: {e}")))?;
-        pool.install(|| starts.par_iter().map(|&s| run_block(s)).collect())
-    };
-    let mut k_bb = Mat::zeros(nb, nb);
-    let mut p = Mat::zeros(nb, nb);
-    let mut g = Mat::zeros(nb, nb);
-    let mut coupling = Mat::zeros(nb, nm);
-    let mut psi_rows: Vec<Vec<f64>> = recover.iter().map(|_| Vec::new()).collect();
-    for &(pos, _) in &rec_int {
-        psi_rows[pos] = vec![0.0; nb];
-    }
-    let (mut t_solve, mut t_mass) = (0.0, 0.0);
-    for o in outs {
-        t_solve += o.t_solve;
-        t_mass += o.t_mass;
-        let w = o.k_cols.ncols();
-        k_bb.as_mut().subcols_mut(o.start, w).copy_from(&o.k_cols);
-        p.as_mut().subcols_mut(o.start, w).copy_from(&o.p_cols);
-        g.as_mut().subcols_mut(o.start, w).copy_from(&o.g_cols);
-        coupling
-            .as_mut()
-            .subrows_mut(o.start, w)
-            .copy_from(&o.coupling_rows);
-        for (pos, vals) in o.psi {
-            psi_rows[pos][o.start..o.start + w].copy_from_slice(&vals);
-        }
-    }
-    // M̂_BB = M_BB + P + Pᵀ + G
-    let m_bb = Mat::from_fn(nb, nb, |i, j| {
-        mb.bb[(i, j)] + p[(i, j)] + p[(j, i)] + 0.5 * (g[(i, j)] + g[(j, i)])
-    });
-    Ok(ConstraintResult {
-        k_bb,
-        m_bb,
-        coupling,
-        psi_rows,
-        t_solve,
-        t_mass,
-    })
 }

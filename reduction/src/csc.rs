@@ -152,27 +152,6 @@ impl Csc {
         }
     }
 
-    /// `selfᵀ x` for a general CSC and a row-major `x` (`nrows × k`):
-    /// returns `ncols × k` (column-major).
-    pub fn transpose_mul_rows(&self, x: &crate::block::RowBlock) -> faer::Mat<f64> {
-        let k = x.k;
-        let mut out = faer::Mat::zeros(self.ncols, k);
-        let mut acc = vec![0.0; k];
-        for j in 0..self.ncols {
-            let (rows, vals) = self.col(j);
-            acc.iter_mut().for_each(|a| *a = 0.0);
-            for (&i, &v) in rows.iter().zip(vals) {
-                for (a, xv) in acc.iter_mut().zip(x.row(i)) {
-                    *a += v * xv;
-                }
-            }
-            for (c, a) in acc.iter().enumerate() {
-                out[(j, c)] = *a;
-            }
-        }
-        out
-    }
-
     /// The lower triangle as a faer matrix (sorted, for the factorisation).
     pub fn to_faer(&self) -> SparseColMat<usize, f64> {
         let symbolic = SymbolicSparseColMat::new_checked(
@@ -197,11 +176,6 @@ pub(crate) struct SymView<'a> {
 impl SymView<'_> {
     pub fn n(&self) -> usize {
         self.lower.ncols
-    }
-
-    /// `y = A x` on row-major blocks.
-    pub fn mul_rows(&self, x: &crate::block::RowBlock, y: &mut crate::block::RowBlock) {
-        crate::block::sym_mul_rows(self.lower, self.inv, x, y)
     }
 
     /// Dense copy in the permuted numbering.

@@ -66,20 +66,20 @@
 
 mod block;
 mod cb;
+mod constraint;
 mod csc;
 pub mod eigen;
 mod error;
 mod factor;
 mod ordering;
+mod report;
 pub mod testmodels;
 
-pub use cb::{
-    craig_bampton, peak_memory_bytes, process_cpu_seconds, CbOptions, CpuPhases, RecoveryRow,
-    ReducedModel, ReductionReport,
-};
+pub use cb::{craig_bampton, CbOptions, RecoveryRow, ReducedModel};
 pub use eigen::{dense_generalized_eigenvalues, Eigen, LanczosOptions};
 pub use error::ReductionError;
 pub use ordering::Ordering;
+pub use report::{peak_memory_bytes, process_cpu_seconds, CpuPhases, ReductionReport};
 
 use faer::sparse::SparseColMatRef;
 use faer::Par;

@@ -1,4 +1,30 @@
-//! Analyses of one problem: FRF runs, linear references, the limit analysis.
+//! Analyses of one checked problem: what is computed from a [`crate::model::Problem`] once the
+//! scene has been read and validated.
+//!
+//! Today these are the nonlinear frequency response by continuation of the harmonic balance,
+//! the linear references (contacts open, contacts stuck), and the paper's limit analysis of the
+//! response among multiple steady states (two-point method, Ferhatoglu & Zucca 2021, §3). Next
+//! to come here: the accuracy study (harmonics and time samples), Hill stability of the
+//! periodic solutions, time integration as an independent check, and the response envelope.
+//!
+//! Layer: above `hbm`, below `scene`. It uses `hbm` (the harmonic-balance system and
+//! operator), `model` (the problem), `contact` (contact states, harmonic sets) and `numerics`
+//! (continuation, linear solves); it does not need `fe` directly, and never names a layer above
+//! it (only the inline tests build their fixtures from `scene`). Studies over many problems
+//! (`study`), file output (`report`) and the command line (`cli`) build on it.
+//!
+//! Main items:
+//! - [`frf::solve`]: the nonlinear FRF over the analysis range by pseudo-arc-length
+//!   continuation, as an [`frf::FrfRun`] of [`frf::FrfPoint`]s, reported to an
+//!   [`frf::FrfObserver`] as they come.
+//! - [`frf::PointSolver`]: single points by Newton, at a fixed frequency or on a path's chord.
+//! - [`frf::interpolate_on_path`]: a starting guess at a frequency from a solved path.
+//! - [`linear::reference_curve`]: a linear reference ([`linear::LinearCase`]) on a grid, as a
+//!   [`linear::LinearCurve`]; [`linear::stuck_guess`] seeds the nonlinear solve.
+//! - [`limits::analyse`]: the limit analysis (limit, intermediate and scanned curves, grid
+//!   classification, bound check, hysteresis loops) as a [`limits::LimitAnalysis`].
+//! - [`limits::solve_case`]: one case's curve and its refined resonance peak.
+//! - [`limits::LimitAnalysis::variability`]: the size of the variability between the limits.
 
 pub mod frf;
 pub mod limits;

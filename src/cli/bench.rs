@@ -10,8 +10,7 @@ use std::path::{Path, PathBuf};
 
 use crate::model::{Formulation, JacobianStrategy};
 use crate::report::files::write_atomic;
-use crate::report::limit_plots::palette;
-use crate::report::plot::{plot_lines, Series};
+use crate::report::plot::{figure_files, palette, plot_lines, Curve};
 use crate::study::scaling::{self, ModelSize, ReductionMeasure, SolveMeasure, SolverConfig};
 
 /// Bench subcommands.
@@ -87,6 +86,7 @@ pub fn run(command: &BenchCommand) -> Result<String, BenchError> {
     }
 }
 
+/// A scratch folder for this process (`fricbound-bench-<pid>` in the system temp folder).
 fn tempdir() -> Result<PathBuf, BenchError> {
     let dir = std::env::temp_dir().join(format!("fricbound-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| BenchError::Io(format!("{}: {e}", dir.display())))?;
@@ -113,6 +113,8 @@ struct Study {
     limit_curves: Vec<SolveMeasure>,
 }
 
+/// Runs the scaling study (reductions in child processes, then the solves) and returns its
+/// summary; `quick` keeps to the smallest sizes.
 fn scaling_study(dir: &Path, quick: bool) -> Result<String, BenchError> {
     let mut study = Study {
         machine: machine(),
@@ -255,6 +257,7 @@ fn scaling_study(dir: &Path, quick: bool) -> Result<String, BenchError> {
     Ok(markdown(&study))
 }
 
+/// The CPU model and core count, so that timings can be read against the machine.
 fn machine() -> String {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
@@ -274,6 +277,7 @@ fn machine() -> String {
     )
 }
 
+/// Writes the study as `scaling.json` and `scaling.md` in `dir`.
 fn write_study(dir: &Path, study: &Study) -> Result<(), BenchError> {
     let io = |e: crate::report::files::WriteError| BenchError::Io(e.to_string());
     let json = serde_json::to_string_pretty(study).map_err(|e| BenchError::Io(e.to_string()))?;
@@ -281,6 +285,7 @@ fn write_study(dir: &Path, study: &Study) -> Result<(), BenchError> {
     write_atomic(&dir.join("scaling.md"), markdown(study).as_bytes()).map_err(io)
 }
 
+/// `scaling.md`: the reduction and solve tables of the study.
 fn markdown(study: &Study) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# Scaling study\n\nMachine: {}.\n", study.machine);
@@ -336,14 +341,17 @@ fn markdown(study: &Study) -> String {
     s
 }
 
+/// The table of solve measurements: one row per case, the FRF columns dashed where no FRF
+/// was run.
 fn solve_table(s: &mut String, rows: &[SolveMeasure]) {
     let _ = writeln!(
         s,
         "| case | pairs/side | H | formulation | Jacobian | unknowns | iteration (ms) | FRF points | complete | FRF (s) | per point (ms) | per FRF iteration (ms) |\n\
          | --- | ---: | ---: | --- | --- | ---: | ---: | ---: | --- | ---: | ---: | ---: |"
     );
-    let dash = || "–".to_string();
     for m in rows {
+        // The FRF columns of a row that timed Newton iterations only are dashes.
+        let frf = |cell: String| if m.frf { cell } else { "–".to_string() };
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {} | {} | {:.2} | {} | {} | {} | {} | {} |",
@@ -354,27 +362,11 @@ fn solve_table(s: &mut String, rows: &[SolveMeasure]) {
             m.jacobian,
             m.unknowns,
             m.iteration_ms,
-            if m.frf { m.points.to_string() } else { dash() },
-            if m.frf {
-                if m.complete { "yes" } else { "no" }.to_string()
-            } else {
-                dash()
-            },
-            if m.frf {
-                format!("{:.2}", m.frf_s)
-            } else {
-                dash()
-            },
-            if m.frf {
-                format!("{:.2}", m.per_point_ms)
-            } else {
-                dash()
-            },
-            if m.frf {
-                format!("{:.2}", m.frf_iteration_ms)
-            } else {
-                dash()
-            },
+            frf(m.points.to_string()),
+            frf(if m.complete { "yes" } else { "no" }.to_string()),
+            frf(format!("{:.2}", m.frf_s)),
+            frf(format!("{:.2}", m.per_point_ms)),
+            frf(format!("{:.2}", m.frf_iteration_ms)),
         );
     }
 }
@@ -404,25 +396,27 @@ fn plot_study(dir: &Path, study: &Study) -> Result<(), BenchError> {
             None => lines.push((label, vec![m.pairs_per_side as f64], vec![m.iteration_ms])),
         }
     }
-    let series: Vec<Series> = lines
+    let series: Vec<Curve> = lines
         .iter()
         .enumerate()
-        .map(|(i, l)| Series {
+        .map(|(i, l)| Curve {
             label: &l.0,
             x: &l.1,
             y: &l.2,
             color: palette(i / 2),
             dashed: i % 2 == 1,
+            markers: false,
         })
         .collect();
+    let (png, svg) = figure_files(dir, "scaling");
     plot_lines(
         &format!("Time per Newton iteration, reduced blade pair, H = {h}"),
         "contact pairs per damper side",
         "time per Newton iteration (ms)",
         true,
         &series,
-        &dir.join("scaling.png"),
-        &dir.join("scaling.svg"),
+        &png,
+        &svg,
     )
     .map_err(|e| BenchError::Io(e.to_string()))
 }

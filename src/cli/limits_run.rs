@@ -8,7 +8,9 @@ use crate::analysis::frf::FrfPoint;
 use crate::analysis::limits::{self, CaseCurve, LimitAnalysis, Regime};
 use crate::report::files::{self, frf_header, frf_row};
 use crate::report::limit_files;
-use crate::report::limit_plots::{self, palette, Curve, LimitFigure, Loop};
+use crate::report::plot::{
+    figure_files, palette, plot_hysteresis, plot_limits, Curve, LimitFigure, Loop,
+};
 
 /// Writes one curve's path as `curve_<name>.csv` (same columns as `frf.csv`).
 pub(super) fn write_curve(ctx: &RunContext<'_>, curve: &CaseCurve) -> Result<(), CommandError> {
@@ -90,6 +92,8 @@ pub(super) fn write_analysis(
     plot(ctx, analysis)
 }
 
+/// Writes `limits.csv` (the limit curves on the grid) and `peaks.csv` (the peak of every
+/// limit, intermediate and scanned curve).
 fn write_tables(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandError> {
     let cases: Vec<_> = a.limits.iter().map(|c| c.case.clone()).collect();
     files::write_atomic(
@@ -139,6 +143,8 @@ struct CurveJson<'a> {
     turning_points_hz: &'a [f64],
 }
 
+/// Writes `limits.json`: run info, every curve with its peak and path, the grid, the bound
+/// check, the scanned peaks and the hysteresis loops.
 fn write_json(ctx: &RunContext<'_>, a: &LimitAnalysis, elapsed: f64) -> Result<(), CommandError> {
     let curve = |c: &'_ CaseCurve| -> serde_json::Value {
         serde_json::to_value(CurveJson {
@@ -167,6 +173,8 @@ fn write_json(ctx: &RunContext<'_>, a: &LimitAnalysis, elapsed: f64) -> Result<(
     Ok(())
 }
 
+/// Draws `limits_<dof>` per output DOF (band, curves, multiple-solution and state rows) and
+/// `hysteresis_<contact>` per contact when loops were computed.
 fn plot(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandError> {
     let problem = &ctx.problem;
     let grid_x: Vec<f64> = a.grid.iter().map(|g| g.freq_hz).collect();
@@ -255,11 +263,8 @@ fn plot(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandError> {
             strip_states: &strip_states,
             multiple: &multiple,
         };
-        limit_plots::plot_limits(
-            &fig,
-            &ctx.dir.join(format!("limits_{name}.png")),
-            &ctx.dir.join(format!("limits_{name}.svg")),
-        )?;
+        let (png, svg) = figure_files(&ctx.dir, &format!("limits_{name}"));
+        plot_limits(&fig, &png, &svg)?;
     }
     if a.loops.is_empty() {
         return Ok(());
@@ -288,11 +293,12 @@ fn plot(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandError> {
                 color: palette(i),
             })
             .collect();
-        limit_plots::plot_hysteresis(
+        let (png, svg) = figure_files(&ctx.dir, &format!("hysteresis_{}", contact.name));
+        plot_hysteresis(
             &format!("{}: hysteresis of contact `{}`", ctx.title(), contact.name),
             &series,
-            &ctx.dir.join(format!("hysteresis_{}.png", contact.name)),
-            &ctx.dir.join(format!("hysteresis_{}.svg", contact.name)),
+            &png,
+            &svg,
         )?;
     }
     Ok(())

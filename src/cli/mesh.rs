@@ -116,6 +116,8 @@ pub fn params(args: &BladePairArgs) -> BladePairParams {
     }
 }
 
+/// `fricbound mesh blade-pair`: generates the blade-pair mesh, writes it as Gmsh `.msh` (and
+/// the contact patches as VTU if asked) and returns a summary of the mesh and its contact sides.
 fn blade_pair_command(args: &BladePairArgs) -> Result<String, MeshCommandError> {
     let params = params(args);
     let mesh = blade_pair::generate(&params)?;

@@ -1,14 +1,27 @@
-//! The command-line commands (`run`, `check`, `paper`), as library functions so that `main.rs`
-//! only parses arguments and dispatches. `run` solves what the scene asks for: a parameter
-//! sweep of the limit analysis (`[sweep]`), a limit analysis (`[limits]`), or one FRF. `paper`
-//! runs the scenes of the paper's §4 study (`meshes/paper-wedge/fig*.toml`, built into the
-//! binary) and writes a summary of the key numbers next to the paper's statements.
+//! The commands of the `fricbound` binary, as library functions: `main.rs` only parses the
+//! arguments and dispatches here, so that tests run a command exactly as the binary does.
+//!
+//! The top layer: it may use every layer below it (`numerics`, `contact`, `fe`, `model`, `hbm`,
+//! `analysis`, `scene`, `study`, `report`); nothing in `src/` uses it but `main.rs`.
+//!
+//! - [`run`] (`fricbound run`): solves what the scene asks for, a parameter sweep of the limit
+//!   analysis (`[sweep]`, `sweep_run`), a limit analysis (`[limits]`, `limits_run`) or one FRF,
+//!   and writes results, linear references and figures: [`RunOptions`] in, [`RunReport`] with
+//!   its [`RunOutcome`] out, [`run_summary`] to print it;
+//! - [`RunContext`]: what each kind of run needs (scene, problem, output folder, references);
+//! - [`check`] (`fricbound check`): validates a scene and describes it ([`load_scene`],
+//!   [`scene_hash`]);
+//! - [`paper`] (`fricbound paper`): runs the scenes of the paper's §4 study
+//!   (`meshes/paper-wedge/fig*.toml`, built into the binary) and writes a summary of the key
+//!   numbers next to the paper's statements;
+//! - [`bench`](mod@bench) (`fricbound bench`): the scaling study of the reduction and the solves;
+//! - [`mesh`] (`fricbound mesh`): generates the blade-pair mesh;
+//! - [`CommandError`]: why a command failed, naming what failed.
 
 pub mod bench;
 mod limits_run;
 pub mod mesh;
 pub mod paper;
-pub mod paper_summary;
 mod sweep_run;
 
 use std::path::{Path, PathBuf};
@@ -23,7 +36,7 @@ use crate::contact::harmonic::Block;
 use crate::model::Problem;
 use crate::numerics::NewtonFailure;
 use crate::report::files::{self, FrfWriter, RunInfo, WriteError};
-use crate::report::plot::{self, FrfFigure, PlotError};
+use crate::report::plot::{self, figure_files, FrfFigure, PlotError};
 use crate::scene::{self, Scene, SceneError};
 
 /// Errors of a command, each naming what failed.
@@ -232,6 +245,7 @@ pub fn scene_hash(scene: &Scene) -> String {
     digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
+/// Names of the harmonic blocks of the unknowns (`0`, `c1`, `s1`, ...), for the JSON files.
 fn block_names(problem: &Problem) -> Vec<String> {
     problem
         .unknown_harmonics()
@@ -349,6 +363,7 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
 /// Stuck-contact modes written on the mesh for FE scenes (`modes_stuck.vtu`).
 const MESH_MODES: usize = 10;
 
+/// Creates the output folder `dir` (and its parents).
 fn create_dir(dir: &Path) -> Result<(), CommandError> {
     std::fs::create_dir_all(dir).map_err(|source| CommandError::OutputDir {
         path: dir.display().to_string(),
@@ -426,11 +441,8 @@ fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
             open: &ctx.open,
             stuck: &ctx.stuck,
         };
-        plot::plot_frf(
-            &fig,
-            &dir.join(format!("frf_{name}.png")),
-            &dir.join(format!("frf_{name}.svg")),
-        )?;
+        let (png, svg) = figure_files(dir, &format!("frf_{name}"));
+        plot::plot_frf(&fig, &png, &svg)?;
     }
     // The response on the mesh at the largest amplitude of the first output (FE scenes).
     if let Some(peak) = run
@@ -557,7 +569,12 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
     let _ = writeln!(
         s,
         "analysis     {} .. {} Hz, steps {:.3e} (min {:.3e}, max {:.3e}), jacobian {:?}",
-        a.freq_start_hz, a.freq_end_hz, a.initial_step, a.min_step, a.max_step, problem.analysis.jacobian
+        a.freq_start_hz,
+        a.freq_end_hz,
+        a.initial_step,
+        a.min_step,
+        a.max_step,
+        problem.analysis.jacobian
     );
     let _ = writeln!(
         s,

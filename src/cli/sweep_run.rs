@@ -18,7 +18,7 @@ use crate::analysis::limits::LimitSettings;
 use crate::model::Problem;
 use crate::report::files;
 use crate::report::limit_files;
-use crate::report::limit_plots::{self, palette, BandSpec, Curve, SweepFigure};
+use crate::report::plot::{figure_files, palette, plot_sweep, BandSpec, Curve, SweepFigure};
 use crate::scene::{Scene, SweepOutput, SweepSpec};
 use crate::study::sweep::{self, SweepPoint};
 
@@ -37,20 +37,22 @@ fn point_dir(ctx: &RunContext<'_>, spec: &SweepSpec, series: Option<f64>, value:
     ctx.dir.join(name)
 }
 
+/// Parameter `name` at value `v`, with its unit if it has one: "F0 = 60 N", "m = 0".
+pub(super) fn parameter_label(name: &str, unit: &str, v: f64) -> String {
+    if unit.is_empty() {
+        format!("{name} = {}", value_text(v))
+    } else {
+        format!("{name} = {} {unit}", value_text(v))
+    }
+}
+
 /// "F0 = 60 N", "beta = 90 deg, F0 = 60 N".
 fn point_label(spec: &SweepSpec, series: Option<f64>, value: f64) -> String {
-    let one = |name: &str, unit: &str, v: f64| {
-        if unit.is_empty() {
-            format!("{name} = {}", value_text(v))
-        } else {
-            format!("{name} = {} {unit}", value_text(v))
-        }
-    };
     let mut s = String::new();
     if let (Some(sp), Some(v)) = (&spec.series, series) {
-        s = one(&sp.parameter, &sp.unit, v) + ", ";
+        s = parameter_label(&sp.parameter, &sp.unit, v) + ", ";
     }
-    s + &one(&spec.parameter, &spec.unit, value)
+    s + &parameter_label(&spec.parameter, &spec.unit, value)
 }
 
 /// Writes one sweep point's limit analysis into its own folder, as `run` would.
@@ -200,6 +202,8 @@ pub fn run_sweep(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
     })
 }
 
+/// A few lines on a finished sweep: its size and time, the largest limit-peak ratio and how
+/// many points have failed cases.
 fn summary(spec: &SweepSpec, points: &[SweepPoint], elapsed: f64) -> String {
     use std::fmt::Write as _;
     let mut s = format!(
@@ -299,13 +303,7 @@ fn plot_peaks(
             .iter()
             .map(|(s, pts)| {
                 let label = match (&spec.series, s) {
-                    (Some(sp), Some(v)) => {
-                        if sp.unit.is_empty() {
-                            format!("{} = {}", sp.parameter, value_text(*v))
-                        } else {
-                            format!("{} = {} {}", sp.parameter, value_text(*v), sp.unit)
-                        }
-                    }
+                    (Some(sp), Some(v)) => parameter_label(&sp.parameter, &sp.unit, *v),
                     _ => String::new(),
                 };
                 let x = pts.iter().map(|p| p.value).collect();
@@ -325,30 +323,15 @@ fn plot_peaks(
             .collect();
         let series = spec.series.is_some();
         // With a series the limit lines carry the legend; the bands share their colours.
-        let band_labels: Vec<String> = data
-            .iter()
-            .map(|_| {
-                if series {
-                    String::new()
-                } else {
-                    "variability band".to_string()
-                }
-            })
-            .collect();
         let bands: Vec<BandSpec> = data
             .iter()
-            .zip(&band_labels)
             .enumerate()
-            .map(|(i, (g, label))| BandSpec {
-                label,
-                x: &g.x,
-                lower: &g.lower,
-                upper: &g.upper,
-                color: if series {
-                    palette(i)
+            .map(|(i, g)| {
+                if series {
+                    group_band(i, &g.x, &g.lower, &g.upper)
                 } else {
-                    BandSpec::variability(&[], &[], &[]).color
-                },
+                    BandSpec::variability(&g.x, &g.lower, &g.upper)
+                }
             })
             .collect();
         let mut labels = Vec::new();
@@ -444,11 +427,8 @@ fn plot_peaks(
             bands: &bands,
             curves: &curves,
         };
-        limit_plots::plot_sweep(
-            &fig,
-            &ctx.dir.join(format!("{file}_{output}.png")),
-            &ctx.dir.join(format!("{file}_{output}.svg")),
-        )?;
+        let (png, svg) = figure_files(&ctx.dir, &format!("{file}_{output}"));
+        plot_sweep(&fig, &png, &svg)?;
     }
     Ok(())
 }
@@ -499,18 +479,10 @@ fn plot_bands(
             continue;
         }
         // The limit lines carry the legend; each band shares its lines' colour.
-        let band_labels: Vec<String> = data.iter().map(|_| String::new()).collect();
         let bands: Vec<BandSpec> = data
             .iter()
-            .zip(&band_labels)
             .enumerate()
-            .map(|(i, (d, label))| BandSpec {
-                label,
-                x: &d.x,
-                lower: &d.lower,
-                upper: &d.upper,
-                color: palette(i),
-            })
+            .map(|(i, d)| group_band(i, &d.x, &d.lower, &d.upper))
             .collect();
         let mut curves: Vec<Curve> = Vec::new();
         for (i, d) in data.iter().enumerate() {
@@ -562,13 +534,20 @@ fn plot_bands(
             bands: &bands,
             curves: &curves,
         };
-        limit_plots::plot_sweep(
-            &fig,
-            &ctx.dir.join(format!("bands_{output}{suffix}.png")),
-            &ctx.dir.join(format!("bands_{output}{suffix}.svg")),
-        )?;
+        let (png, svg) = figure_files(&ctx.dir, &format!("bands_{output}{suffix}"));
+        plot_sweep(&fig, &png, &svg)?;
     }
     Ok(())
+}
+
+/// The band of group `i` (a series value, or a sweep value on the bands chart) in the colour
+/// of its limit lines, [`palette`]`(i)`, without a legend entry: the lines carry the legend.
+fn group_band<'a>(i: usize, x: &'a [f64], lower: &'a [f64], upper: &'a [f64]) -> BandSpec<'a> {
+    BandSpec {
+        label: "",
+        color: palette(i),
+        ..BandSpec::variability(x, lower, upper)
+    }
 }
 
 /// Whether the sweep moves static loads only: then the scene's linear references (which do not

@@ -1,5 +1,15 @@
-//! Contact: the Jenkins law, contact points and damper sides, harmonic sets and sampled
-//! Fourier bases, the AFT with its analytic Jacobian.
+//! Contact: the friction law at one contact point and its harmonic-balance forces.
+//!
+//! Uses no other layer of the crate (only std, realfft and faer). Above it,
+//! `crate::fe` pairs mesh nodes into contact points, `crate::model` groups them in a problem and
+//! `crate::hbm` assembles their forces into the residual.
+//!
+//! | module | main types | job |
+//! |---|---|---|
+//! | [`point`] | [`ContactPoint`], [`DamperSide`], [`JenkinsLaw`], [`ContactState`] | contact points (relative displacement rows, frame, gap), damper sides, the Jenkins law's parameters, contact states |
+//! | [`harmonic`] | `HarmonicSet`, `Block`, `SampleBasis` | real Fourier basis, unknown ordering (harmonic-major), time sampling |
+//! | [`aft`] | `AftWorkspace`, `MarchSettings`, `AftError` | the alternating frequency/time march of the Jenkins law (paper Eqs. 4-6) and its analytic Jacobian |
+//! | [`describing_function`] | [`jenkins_describing_function`] | the exact first harmonic under constant normal load (paper Eqs. 17-18), the AFT's reference |
 
 pub mod aft;
 pub mod describing_function;

@@ -1,6 +1,9 @@
 //! Finite-element input and output: meshes, element assembly, Matrix Market models, contact
 //! patches, VTU output and the blade-pair mesh generator.
 //!
+//! May use `crate::contact` (a contact patch becomes contact points) and no other layer; the
+//! model layer above keeps a mesh for results on it ([`crate::model::FeOrigin`]).
+//!
 //! Two ways lead to a linear FE model ([`FeModel`] / [`FeMatrices`]: sparse K and M in full
 //! symmetric storage with a [`DofMap`] naming every row by node id and direction):
 //! - a Gmsh mesh ([`read_msh`]) assembled with a material per physical group ([`assemble`]),

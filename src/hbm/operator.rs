@@ -119,7 +119,7 @@ impl ParametricResidual for HbmOperator<'_> {
                 c.residual_and_jacobian(x, lambda, r, jac, dr_dlambda)?;
                 if strategy != JacobianStrategy::Analytic {
                     let states = c.states().to_vec();
-                    crate::hbm::finite_difference_jacobian(
+                    crate::numerics::derivatives::finite_difference_jacobian(
                         |x, r| c.residual(x, lambda, r),
                         x,
                         r,

@@ -10,50 +10,26 @@
 //!
 //! and the 0th harmonic (when coupled) is K q₀ + F̂_c,0 − F_static = 0, which carries the pre-load
 //! into the contacts (paper Eq. 3: statics and dynamics coupled through the contact forces).
-//! In the uncoupled mode the 0th harmonic is fixed by a static pre-solve ([`static_solve`]) and
+//! In the uncoupled mode the 0th harmonic is fixed by a static pre-solve ([`crate::hbm::statics::static_solve`]) and
 //! only h ≥ 1 are unknowns.
 //!
 //! The Jacobian ∂R/∂x is dense here (lumped and reduced models); contact blocks come from the
 //! analytic AFT Jacobian or, as a checked alternative, from finite differences.
 
-use crate::contact::aft::{AftError, AftWorkspace};
+use crate::contact::aft::AftWorkspace;
 use crate::contact::harmonic::{Block, HarmonicSet};
 use crate::contact::ContactState;
-use crate::hbm::formulation::RelativeCoordinatesError;
+use crate::hbm::error::HbmError;
 use crate::hbm::pattern::{ContactSlots, JacobianLayout};
 use crate::hbm::schur::RelativeCoordinates;
+use crate::hbm::statics::static_solve;
 use crate::model::{Coupling, Formulation, JacobianStrategy, Problem};
+use crate::numerics::derivatives::{
+    check_operator_jacobian, finite_difference_jacobian, JacobianCheck,
+};
 use crate::numerics::jacobian::{AssembledJacobian, Storage};
-use crate::numerics::linalg::LinearSolveError;
 use crate::numerics::ParametricResidual;
 use std::sync::Arc;
-
-/// Errors while evaluating or solving the harmonic balance.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum HbmError {
-    /// The AFT of a contact failed.
-    #[error("contact `{contact}`: {source}")]
-    Aft {
-        /// Contact name.
-        contact: String,
-        /// Cause.
-        source: AftError,
-    },
-    /// A linear solve failed.
-    #[error("linear solve: {0}")]
-    Linear(#[from] LinearSolveError),
-    /// The problem does not admit the formulation asked for.
-    #[error("formulation: {0}")]
-    Formulation(#[from] RelativeCoordinatesError),
-    /// The static pre-solve of the uncoupled mode did not converge.
-    #[error("static pre-solve did not converge in {iterations} iterations (relative residual {residual:.3e})")]
-    StaticNotConverged {
-        /// Iterations made.
-        iterations: usize,
-        /// Final residual norm relative to the static load.
-        residual: f64,
-    },
-}
 
 /// The harmonic-balance operator of a problem.
 pub struct HbmSystem<'p> {
@@ -576,169 +552,6 @@ impl ParametricResidual for HbmSystem<'_> {
     }
 }
 
-/// ∂R/∂x of any residual by forward (one evaluation per unknown) or central (two) differences,
-/// given R at x. Steps are relative to |xᵢ| or, when smaller, to the RMS of x.
-pub fn finite_difference_jacobian<E>(
-    mut residual: impl FnMut(&[f64], &mut [f64]) -> Result<(), E>,
-    x: &[f64],
-    r0: &[f64],
-    central: bool,
-    jac: &mut AssembledJacobian,
-) -> Result<(), E> {
-    let dim = x.len();
-    let mut xp = x.to_vec();
-    let mut rp = vec![0.0; dim];
-    let mut rm = vec![0.0; if central { dim } else { 0 }];
-    let mut column = vec![0.0; dim];
-    let typical = (x.iter().map(|v| v * v).sum::<f64>() / dim.max(1) as f64).sqrt();
-    let eps = if central { 6e-6 } else { 1.5e-8 };
-    jac.clear();
-    for i in 0..dim {
-        let step = eps * x[i].abs().max(typical).max(1e-12);
-        xp[i] = x[i] + step;
-        residual(&xp, &mut rp)?;
-        if central {
-            xp[i] = x[i] - step;
-            residual(&xp, &mut rm)?;
-            for k in 0..dim {
-                column[k] = (rp[k] - rm[k]) / (2.0 * step);
-            }
-        } else {
-            for k in 0..dim {
-                column[k] = (rp[k] - r0[k]) / step;
-            }
-        }
-        jac.set_column(i, &column);
-        xp[i] = x[i];
-    }
-    Ok(())
-}
-
-/// Static pre-solve of the uncoupled mode: K q + F_c,static(q) = F_static, with each contact
-/// loaded from rest (slider at zero): N = kₙ max(v, 0), T = clamp(kₜ u, −μN, μN). Newton with
-/// backtracking, on the Jacobian storage of the problem's formulation.
-pub fn static_solve(problem: &Problem) -> Result<Vec<f64>, HbmError> {
-    let n = problem.model.n_dofs();
-    let k = &problem.model.stiffness;
-    let f = &problem.static_load;
-    let fnorm = f
-        .iter()
-        .map(|x| x * x)
-        .sum::<f64>()
-        .sqrt()
-        .max(f64::MIN_POSITIVE);
-    // The static system has one block: dense unless the model is held sparse (the schur
-    // formulation's elimination would not pay off on one block).
-    let storage = if problem.formulation() == Formulation::Sparse {
-        Storage::Sparse
-    } else {
-        Storage::Dense
-    };
-    let layout = JacobianLayout::new(problem, &HarmonicSet::new(vec![0]), storage);
-    let residual_of = |q: &[f64], r: &mut [f64], jac: Option<&mut AssembledJacobian>| {
-        for (p, v) in r.iter_mut().enumerate() {
-            *v = -f[p];
-        }
-        k.mul_add(1.0, q, r);
-        let mut jac = jac;
-        if let Some(j) = jac.as_deref_mut() {
-            j.clear();
-            for &(slot, kv, _) in &layout.stiffness[0] {
-                j.add_at(slot, kv);
-            }
-        }
-        for (c, lc) in problem.contacts.iter().zip(&layout.contacts) {
-            let law = &c.law;
-            let u = c.tangential_of(q);
-            let v = c.normal_of(q) - c.gap;
-            let nf = (law.kn * v).max(0.0);
-            let limit = law.mu * nf;
-            let tp = law.kt * u;
-            let t = tp.clamp(-limit, limit);
-            for &(p, a) in &c.tangential {
-                r[p] += a * t;
-            }
-            for &(p, a) in &c.normal {
-                r[p] += a * nf;
-            }
-            if let Some(j) = jac.as_deref_mut() {
-                if v >= 0.0 {
-                    let d = lc.dofs;
-                    for &(a, ap) in &lc.normal {
-                        for &(b, aq) in &lc.normal {
-                            j.add_at(lc.slots[a * d + b], ap * law.kn * aq);
-                        }
-                    }
-                    for &(a, ap) in &lc.tangential {
-                        if tp.abs() <= limit || limit == 0.0 {
-                            for &(b, aq) in &lc.tangential {
-                                j.add_at(lc.slots[a * d + b], ap * law.kt * aq);
-                            }
-                        } else {
-                            for &(b, aq) in &lc.normal {
-                                j.add_at(
-                                    lc.slots[a * d + b],
-                                    ap * tp.signum() * law.mu * law.kn * aq,
-                                );
-                            }
-                        }
-                    }
-                }
-            }
-        }
-    };
-    let mut q = vec![0.0; n];
-    let mut r = vec![0.0; n];
-    let mut jac = layout.new_jacobian();
-    let max_iterations = 100;
-    let mut rel = f64::INFINITY;
-    let mut trial = vec![0.0; n];
-    let mut rt = vec![0.0; n];
-    for _ in 0..max_iterations {
-        residual_of(&q, &mut r, Some(&mut jac));
-        rel = r.iter().map(|x| x * x).sum::<f64>().sqrt() / fnorm;
-        if rel <= 1e-12 {
-            return Ok(q);
-        }
-        let neg: Vec<f64> = r.iter().map(|x| -x).collect();
-        let dq = jac.solve(&neg)?;
-        // Backtracking on the residual norm keeps the non-smooth contact law from cycling.
-        let mut alpha = 1.0;
-        loop {
-            for p in 0..n {
-                trial[p] = q[p] + alpha * dq[p];
-            }
-            residual_of(&trial, &mut rt, None);
-            let rel_t = rt.iter().map(|x| x * x).sum::<f64>().sqrt() / fnorm;
-            if rel_t < rel || alpha < 1e-4 {
-                break;
-            }
-            alpha *= 0.5;
-        }
-        q.copy_from_slice(&trial);
-    }
-    Err(HbmError::StaticNotConverged {
-        iterations: max_iterations,
-        residual: rel,
-    })
-}
-
-/// Comparison of the analytic Jacobian with central differences at one state.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct JacobianCheck {
-    /// Largest |analytic − central difference| over ∂R/∂x and ∂R/∂ω (scaled per column).
-    pub max_error: f64,
-    /// Largest |entry| of the analytic Jacobian (same scaling).
-    pub max_entry: f64,
-}
-
-impl JacobianCheck {
-    /// max_error / max_entry.
-    pub fn relative(&self) -> f64 {
-        self.max_error / self.max_entry.max(f64::MIN_POSITIVE)
-    }
-}
-
 /// Checks the analytic Jacobian of `system` at (x, ω) against central differences with
 /// relative step `rel_step` (on each unknown, scaled by the state's RMS value). Columns are
 /// compared after multiplying by their step scale, so x- and ω-columns weigh alike.
@@ -752,58 +565,5 @@ pub fn check_jacobian(
     system.strategy = JacobianStrategy::Analytic;
     let result = check_operator_jacobian(system, x, omega, rel_step);
     system.strategy = saved;
-    result
-}
-
-/// [`check_jacobian`] for any operator: compares the Jacobian the operator forms (whatever its
-/// strategy and storage, entries outside a sparse pattern count as zero) with central
-/// differences of its residual.
-pub fn check_operator_jacobian<S: ParametricResidual>(
-    system: &mut S,
-    x: &[f64],
-    omega: f64,
-    rel_step: f64,
-) -> Result<JacobianCheck, S::Error> {
-    let dim = system.dim();
-    let mut r = vec![0.0; dim];
-    let mut jac = system.new_jacobian();
-    let mut dw = vec![0.0; dim];
-    let result = (|| {
-        system.residual_and_jacobian(x, omega, &mut r, &mut jac, &mut dw)?;
-        let typical = (x.iter().map(|v| v * v).sum::<f64>() / dim as f64)
-            .sqrt()
-            .max(1e-12);
-        let mut xp = x.to_vec();
-        let (mut rp, mut rm) = (vec![0.0; dim], vec![0.0; dim]);
-        let mut max_error = 0.0_f64;
-        let mut max_entry = 0.0_f64;
-        for i in 0..=dim {
-            let (scale, step) = if i < dim {
-                (typical, rel_step * typical)
-            } else {
-                (omega, rel_step * omega)
-            };
-            if i < dim {
-                xp[i] = x[i] + step;
-                system.residual(&xp, omega, &mut rp)?;
-                xp[i] = x[i] - step;
-                system.residual(&xp, omega, &mut rm)?;
-                xp[i] = x[i];
-            } else {
-                system.residual(x, omega + step, &mut rp)?;
-                system.residual(x, omega - step, &mut rm)?;
-            }
-            for k in 0..dim {
-                let fd = (rp[k] - rm[k]) / (2.0 * step);
-                let an = if i < dim { jac.get(k, i) } else { dw[k] };
-                max_error = max_error.max((fd - an).abs() * scale);
-                max_entry = max_entry.max(an.abs() * scale);
-            }
-        }
-        Ok(JacobianCheck {
-            max_error,
-            max_entry,
-        })
-    })();
     result
 }

@@ -1,5 +1,14 @@
-//! Model: the checked problem, structural matrices, DOF splits and Craig-Bampton reduction of a
-//! problem.
+//! Model: the checked problem a scene becomes, ready to solve.
+//!
+//! May use `crate::fe`, `crate::contact` and `crate::numerics`. It holds no analysis settings
+//! beyond the frequency-response range and the formulation choice ([`Analysis`]); the limit
+//! analysis and sweeps keep theirs in `crate::analysis` and `crate::study`.
+//!
+//! | module | main types | job |
+//! |---|---|---|
+//! | [`problem`] | [`Problem`], [`LinearModel`], [`Effects`], [`Analysis`], [`DofSplit`], [`FeOrigin`] | linear structure, contacts, loads, switched effects, DOF splits |
+//! | [`matrix`] | `StructuralMatrix` | M, C, K in dense or sparse storage |
+//! | [`reduce`] | `reduce`, `ReductionSettings` | Craig-Bampton reduction of a problem (crate `fricbound-reduction`) |
 
 pub mod matrix;
 pub mod problem;

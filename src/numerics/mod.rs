@@ -1,11 +1,22 @@
-//! Numerics: linear solves and factorisations (dense, sparse, bordered), Newton and
-//! pseudo-arc-length continuation.
+//! Numerics: linear solves and factorisations, Newton and pseudo-arc-length continuation.
 //!
-//! Lowest layer: uses no other layer of the crate. It knows operators R(x, λ) with a Jacobian
-//! ([`ParametricResidual`]), never friction or harmonics.
+//! The lowest layer: it uses no other layer of the crate. It knows operators R(x, λ) with a
+//! Jacobian ([`ParametricResidual`]), never friction or harmonics; the harmonic balance
+//! (`crate::hbm`) is one such operator.
+//!
+//! | module | main types | job |
+//! |---|---|---|
+//! | [`residual`] | [`ParametricResidual`] | the operator continuation works on |
+//! | [`linalg`] | `checked_lu`, `PackedLu`, `LinearSolveError` | dense and sparse LU with singularity reported, norms |
+//! | [`jacobian`] | [`AssembledJacobian`], [`BorderedFactor`], [`ImplicitJacobian`] | Jacobian storage (dense, sparse, implicit) and bordered solves |
+//! | [`derivatives`] | `finite_difference_jacobian`, `check_operator_jacobian` | finite-difference Jacobians and derivative checks |
+//! | [`continuation`] | [`Continuation`], [`ContinuationSettings`] | Newton at fixed λ, predictor-corrector continuation in λ |
+//! | [`broyden`] | `BroydenUpdates` | secant updates of a factorised Newton matrix (chord steps) |
+//! | [`path`] | [`PathPoint`], [`PathSummary`], [`Observer`], [`NewtonFailure`] | what continuation produces and reports |
 
 pub mod broyden;
 pub mod continuation;
+pub mod derivatives;
 pub mod jacobian;
 pub mod linalg;
 pub mod path;

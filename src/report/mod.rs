@@ -1,8 +1,21 @@
-//! Result files and figures.
+//! Result files and figures, written from the results of the analyses and studies.
+//!
+//! This layer writes what the layers below computed; the only computing here is what a file
+//! itself needs (the stuck-contact modes of `modes_stuck.vtu`, the layout of a figure). It may
+//! use every layer below it (`numerics`, `contact`, `fe`, `model`, `hbm`, `analysis`, `scene`,
+//! `study`) and is used by `cli` only.
+//!
+//! - [`files`]: CSV and JSON of one FRF ([`files::FrfWriter`], streamed as points converge),
+//!   the linear references, [`files::RunInfo`] and [`files::write_atomic`];
+//! - [`limit_files`]: the tables of a limit analysis (limit curves on the grid, peaks,
+//!   hysteresis loops);
+//! - [`plot`]: the figures as PNG and SVG ([`plot::plot_frf`], [`plot::plot_limits`],
+//!   [`plot::plot_sweep`], [`plot::plot_hysteresis`], [`plot::plot_lines`]);
+//! - [`mesh_results`]: a converged point's response on the FE mesh (VTU);
+//! - [`mesh_modes`]: the stuck-contact modes on the FE mesh (VTU).
 
 pub mod files;
 pub mod limit_files;
-pub mod limit_plots;
 pub mod mesh_modes;
 pub mod mesh_results;
 pub mod plot;

@@ -19,7 +19,7 @@ use crate::fe::{
 };
 use crate::model::matrix::StructuralMatrix;
 use crate::model::LinearModel;
-use crate::scene::SceneError;
+use crate::scene::error::SceneError;
 
 /// Plane assumption of 2D meshes, as written in scenes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -164,14 +164,6 @@ pub fn resolve(scene_file: &str, path: &Path) -> PathBuf {
         .unwrap_or_else(|| path.to_path_buf())
 }
 
-fn invalid(file: &str, field: impl Into<String>, reason: impl Into<String>) -> SceneError {
-    SceneError::Invalid {
-        file: file.to_string(),
-        field: field.into(),
-        reason: reason.into(),
-    }
-}
-
 /// Builds the FE structure of `[model]` from a mesh (`mesh`, `materials`, `plane`, `clamp`)
 /// or from Matrix Market files (`matrix_market`), with Rayleigh damping (α 1/s, β s).
 #[allow(clippy::too_many_arguments)]
@@ -187,10 +179,10 @@ pub fn build_structure(
     let (stiffness, mass, dofs, mesh, thickness) = match (mesh_path, matrix_market) {
         (Some(path), None) => {
             let full = resolve(file, path);
-            let mesh =
-                fe::read_msh(&full).map_err(|e| invalid(file, "model.mesh", e.to_string()))?;
+            let mesh = fe::read_msh(&full)
+                .map_err(|e| SceneError::invalid(file, "model.mesh", e.to_string()))?;
             if materials.is_empty() {
-                return Err(invalid(
+                return Err(SceneError::invalid(
                     file,
                     "model.materials",
                     "a mesh needs at least one [[model.materials]] entry (group, young, poisson, density)",
@@ -203,7 +195,7 @@ pub fn build_structure(
                 let t = match (needs_thickness, m.thickness) {
                     (true, Some(t)) => t,
                     (true, None) => {
-                        return Err(invalid(
+                        return Err(SceneError::invalid(
                             file,
                             format!("model.materials[{i}].thickness"),
                             "2D meshes need the out-of-plane thickness (m)",
@@ -219,7 +211,7 @@ pub fn build_structure(
                 };
                 material
                     .check(needs_thickness)
-                    .map_err(|r| invalid(file, format!("model.materials[{i}]"), r))?;
+                    .map_err(|r| SceneError::invalid(file, format!("model.materials[{i}]"), r))?;
                 if i == 0 {
                     thickness = t;
                 }
@@ -230,11 +222,11 @@ pub fn build_structure(
                 PlaneSpec::Strain => PlaneAssumption::Strain,
             };
             let mut model = fe::assemble(&mesh, &groups, plane)
-                .map_err(|e| invalid(file, "model.materials", e.to_string()))?;
+                .map_err(|e| SceneError::invalid(file, "model.materials", e.to_string()))?;
             for (i, g) in clamp.iter().enumerate() {
-                model = model
-                    .clamp_group(&mesh, g)
-                    .map_err(|e| invalid(file, format!("model.clamp[{i}]"), e.to_string()))?;
+                model = model.clamp_group(&mesh, g).map_err(|e| {
+                    SceneError::invalid(file, format!("model.clamp[{i}]"), e.to_string())
+                })?;
             }
             (
                 model.stiffness,
@@ -251,18 +243,18 @@ pub fn build_structure(
                 &resolve(file, &mm.dof_map),
                 mm.symmetry_tolerance,
             )
-            .map_err(|e| invalid(file, "model.matrix_market", e.to_string()))?;
+            .map_err(|e| SceneError::invalid(file, "model.matrix_market", e.to_string()))?;
             (m.stiffness, m.mass, m.dofs, None, 1.0)
         }
         (Some(_), Some(_)) => {
-            return Err(invalid(
+            return Err(SceneError::invalid(
                 file,
                 "model",
                 "give either `mesh` or `matrix_market`, not both",
             ))
         }
         (None, None) => {
-            return Err(invalid(
+            return Err(SceneError::invalid(
                 file,
                 "model",
                 "needs inline matrices (`dofs`, `mass`, `stiffness`), a `mesh`, or `matrix_market`",
@@ -271,7 +263,11 @@ pub fn build_structure(
     };
     let n = dofs.len();
     if n == 0 {
-        return Err(invalid(file, "model", "the FE model has no free DOF"));
+        return Err(SceneError::invalid(
+            file,
+            "model",
+            "the FE model has no free DOF",
+        ));
     }
     let names = dofs.names();
     let index: HashMap<String, usize> = names
@@ -315,7 +311,7 @@ pub fn patch_contacts(
     side: usize,
 ) -> Result<Vec<ContactPoint>, SceneError> {
     let Some(mesh) = &structure.mesh else {
-        return Err(invalid(
+        return Err(SceneError::invalid(
             file,
             field,
             "contact patches need a mesh (`model.mesh`); with Matrix Market models list the \
@@ -334,10 +330,14 @@ pub fn patch_contacts(
             thickness: structure.thickness,
         },
     )
-    .map_err(|e| invalid(file, field, e.to_string()))?;
+    .map_err(|e| SceneError::invalid(file, field, e.to_string()))?;
     let area = patch.area();
     if patch.pairs.is_empty() || area <= 0.0 {
-        return Err(invalid(file, field, "the patch has no node pair"));
+        return Err(SceneError::invalid(
+            file,
+            field,
+            "the patch has no node pair",
+        ));
     }
     let node_index = mesh.node_index_map();
     let position = |id: u64| mesh.nodes[node_index[&id]].coords;
@@ -391,14 +391,14 @@ pub fn group_load(
     direction: &str,
 ) -> Result<Vec<(usize, f64)>, SceneError> {
     let Some(mesh) = &structure.mesh else {
-        return Err(invalid(
+        return Err(SceneError::invalid(
             file,
             field,
             "loads on groups need a mesh (`model.mesh`); name a DOF (`dof = \"<node>.<dir>\"`) instead",
         ));
     };
     let dir = Direction::parse(direction).ok_or_else(|| {
-        invalid(
+        SceneError::invalid(
             file,
             format!("{field}.direction"),
             format!("unknown direction `{direction}` (x, y or z)"),
@@ -406,13 +406,13 @@ pub fn group_load(
     })?;
     let nodes = mesh
         .group_nodes(group)
-        .map_err(|e| invalid(file, format!("{field}.group"), e.to_string()))?;
+        .map_err(|e| SceneError::invalid(file, format!("{field}.group"), e.to_string()))?;
     let rows: Vec<usize> = nodes
         .iter()
         .filter_map(|&i| structure.dofs.row(mesh.nodes[i].id, dir))
         .collect();
     if rows.is_empty() {
-        return Err(invalid(
+        return Err(SceneError::invalid(
             file,
             format!("{field}.group"),
             format!("group `{group}` has no free DOF in direction {direction} (clamped?)"),

@@ -1,4 +1,14 @@
-//! Studies over many scenes: parameter sweeps of scene fields, the scaling study.
+//! Studies over many scenes: each varies scene inputs, builds a problem per variant through
+//! `crate::scene`, and runs analyses on them.
+//!
+//! May use `crate::scene`, `crate::analysis` and every layer below. (A study sits above the
+//! scene layer because it edits scene fields; an analysis works on one checked problem and
+//! never sees a scene.)
+//!
+//! | module | main types | job |
+//! |---|---|---|
+//! | [`sweep`] | `SweepPoint`, `run`, `problem_at` | sweeps of any numeric scene field: optimal curves, resonance-frequency limits, limit analyses per value (paper Figs. 15-19) |
+//! | [`scaling`] | `ModelSize`, `SolverConfig`, `NewtonIteration` | what FE size, contact count, harmonics and solver strategy cost |
 
 pub mod scaling;
 pub mod sweep;

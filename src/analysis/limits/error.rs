@@ -1,0 +1,36 @@
+//! Errors of a limit analysis: a curve that cannot be solved, contact forces that cannot be
+//! evaluated, a curve with no converged point in the peak window.
+
+use crate::analysis::frf::FrfError;
+use crate::hbm::HbmError;
+
+/// Errors of a limit analysis.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LimitError {
+    /// A curve could not be solved.
+    #[error("curve `{case}`: {source}")]
+    Curve {
+        /// Case name.
+        case: String,
+        /// Cause.
+        source: FrfError,
+    },
+    /// Evaluating contact forces failed.
+    #[error("curve `{case}`: {source}")]
+    Contacts {
+        /// Case name.
+        case: String,
+        /// Cause.
+        source: HbmError,
+    },
+    /// No converged point of a curve lies in the peak window.
+    #[error("curve `{case}`: no converged point in the peak window {lo_hz} .. {hi_hz} Hz")]
+    NoPeak {
+        /// Case name.
+        case: String,
+        /// Window start (Hz).
+        lo_hz: f64,
+        /// Window end (Hz).
+        hi_hz: f64,
+    },
+}

@@ -1,0 +1,123 @@
+//! The `paper` command itself: runs every figure's scene into its sub-folder, one after the
+//! other, and rewrites `summary.md` and `summary.json` after each, so that an interrupted run
+//! keeps everything finished so far; a failed figure is reported and the others still run.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use super::figures::{FigureResult, FIGURES};
+use super::from_runs::key_numbers;
+use super::markdown::markdown;
+use crate::cli::{create_dir, run, CommandError, RunOptions};
+use crate::report::files;
+
+/// Options of `fricbound paper`.
+#[derive(Debug, Clone, Default)]
+pub struct PaperOptions {
+    /// Output folder; default `out/paper`.
+    pub out: Option<PathBuf>,
+    /// Coarser settings (seconds instead of minutes).
+    pub quick: bool,
+    /// No progress bars or messages.
+    pub quiet: bool,
+}
+
+/// What `paper` produced.
+#[derive(Debug)]
+pub struct PaperReport {
+    /// Output folder.
+    pub dir: PathBuf,
+    /// One entry per figure, in order.
+    pub figures: Vec<FigureResult>,
+    /// Wall time of the whole study (s).
+    pub elapsed_s: f64,
+}
+
+/// `fricbound paper`: runs every figure scene into `<out>/<figure id>/` and writes
+/// `<out>/summary.md` and `<out>/summary.json`. Returns an error naming the failed figures
+/// (after writing everything the others produced) if any figure failed.
+pub fn paper(options: &PaperOptions) -> Result<PaperReport, CommandError> {
+    let dir = options
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join("paper"));
+    create_dir(&dir)?;
+    let started = Instant::now();
+    let mut figures: Vec<FigureResult> = Vec::new();
+    for job in &FIGURES {
+        if !options.quiet {
+            eprintln!("{}: {}", job.id, job.caption);
+        }
+        let t = Instant::now();
+        let run_options = RunOptions {
+            scene: Some(Path::new("meshes/paper-wedge").join(job.scene_file)),
+            scene_text: Some(job.text.to_string()),
+            out: Some(dir.join(job.id)),
+            overrides: if options.quick {
+                job.quick.iter().map(|s| s.to_string()).collect()
+            } else {
+                Vec::new()
+            },
+            quiet: options.quiet,
+        };
+        let outcome = run(&run_options).map_err(|e| e.to_string());
+        if let (Err(e), false) = (&outcome, options.quiet) {
+            eprintln!("{}: failed: {e}", job.id);
+        }
+        figures.push(FigureResult {
+            job,
+            outcome,
+            elapsed_s: t.elapsed().as_secs_f64(),
+        });
+        write_summary(
+            &dir,
+            &figures,
+            options.quick,
+            started.elapsed().as_secs_f64(),
+        )?;
+    }
+    let report = PaperReport {
+        dir,
+        elapsed_s: started.elapsed().as_secs_f64(),
+        figures,
+    };
+    let failed: Vec<&str> = report
+        .figures
+        .iter()
+        .filter(|f| f.outcome.is_err())
+        .map(|f| f.job.id)
+        .collect();
+    if failed.is_empty() {
+        Ok(report)
+    } else {
+        Err(CommandError::Paper {
+            failed: failed.join(", "),
+            dir: report.dir.display().to_string(),
+        })
+    }
+}
+
+/// Writes `summary.md` and `summary.json` (the key numbers) of the figures run so far.
+fn write_summary(
+    dir: &Path,
+    figures: &[FigureResult],
+    quick: bool,
+    elapsed_s: f64,
+) -> Result<(), CommandError> {
+    let numbers = key_numbers(figures);
+    let text = markdown(figures, &numbers, quick, elapsed_s);
+    files::write_atomic(&dir.join("summary.md"), text.as_bytes())?;
+    let json = serde_json::to_vec_pretty(&numbers).expect("summary numbers serialise");
+    files::write_atomic(&dir.join("summary.json"), &json)?;
+    Ok(())
+}
+
+/// One paragraph on a finished study.
+pub fn paper_summary_line(r: &PaperReport) -> String {
+    format!(
+        "{} figures in {:.1} s; summary in {}",
+        r.figures.len(),
+        r.elapsed_s,
+        r.dir.join("summary.md").display()
+    )
+}

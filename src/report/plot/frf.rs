@@ -1,0 +1,252 @@
+//! The FRF figure: the nonlinear frequency response of one output DOF (first-harmonic
+//! amplitude, in path order, with markers) over the linear open- and stuck-contact references
+//! (dashed) on a log amplitude axis, with one strip per contact below it showing the contact
+//! state at each point.
+
+use std::path::Path;
+
+use plotters::style::RGBColor;
+
+use super::axes::{linear_range, log_range, YAxis};
+use super::backend::{write_figure, PlotError};
+use super::chart::ChartSpec;
+use super::series::{points, valid_runs, Line};
+use super::strips::{Strip, StripChart};
+use super::style::{state_color, NONLINEAR_COLOR, OPEN_COLOR, STUCK_COLOR};
+use crate::analysis::frf::FrfPoint;
+use crate::analysis::linear::LinearCurve;
+
+/// Inputs of the FRF figure for one output DOF.
+pub struct FrfFigure<'a> {
+    /// Figure title.
+    pub title: &'a str,
+    /// Which output DOF (index into [`FrfPoint::amplitudes`] and the curves' amplitude rows).
+    pub output_index: usize,
+    /// Name of the output DOF, e.g. "y2".
+    pub output_name: &'a str,
+    /// Contact names, one state strip each (index into [`FrfPoint::states`]).
+    pub contact_names: &'a [String],
+    /// Converged nonlinear points in path order.
+    pub points: &'a [FrfPoint],
+    /// Linear reference with all contacts open.
+    pub open: &'a LinearCurve,
+    /// Linear reference with all contacts stuck.
+    pub stuck: &'a LinearCurve,
+}
+
+/// Draws the nonlinear FRF (first-harmonic amplitude, path order, as a line with markers) over the
+/// linear open and stuck references (dashed lines), on a log amplitude axis, and below the main
+/// chart one horizontal strip per contact showing its state at each point (colour legend: stuck,
+/// stick-slip, stick-slip-liftoff, open). Writes both files.
+pub fn plot_frf(fig: &FrfFigure, png: &Path, svg: &Path) -> Result<(), PlotError> {
+    let out = fig.output_index;
+    let nonlinear = Line {
+        label: "nonlinear (harmonic balance)".to_string(),
+        runs: valid_runs(
+            fig.points.iter().map(|p| {
+                (
+                    p.freq_hz,
+                    p.amplitudes.get(out).copied().unwrap_or(f64::NAN),
+                )
+            }),
+            true,
+        ),
+        color: NONLINEAR_COLOR,
+        dashed: false,
+        markers: true,
+    };
+    let reference = |curve: &LinearCurve, label: &str, color: RGBColor| Line {
+        label: label.to_string(),
+        runs: valid_runs(
+            curve
+                .freqs_hz
+                .iter()
+                .zip(&curve.amplitudes)
+                .map(|(&f, row)| (f, row.get(out).copied().unwrap_or(f64::NAN))),
+            true,
+        ),
+        color,
+        dashed: true,
+        markers: false,
+    };
+    let curves = vec![
+        reference(fig.open, "linear, contacts open", OPEN_COLOR),
+        reference(fig.stuck, "linear, contacts stuck", STUCK_COLOR),
+        nonlinear,
+    ];
+
+    let mut freqs: Vec<f64> = points(&curves).map(|p| p.0).collect();
+    freqs.extend(fig.points.iter().map(|p| p.freq_hz));
+    let x = linear_range(freqs.iter().copied(), 0.0);
+    let y = log_range(points(&curves).map(|p| p.1));
+
+    let strips: Vec<Strip> = fig
+        .contact_names
+        .iter()
+        .enumerate()
+        .map(|(c, name)| Strip {
+            name: name.clone(),
+            marks: fig
+                .points
+                .iter()
+                .filter(|p| p.freq_hz.is_finite())
+                .filter_map(|p| p.states.get(c).map(|&s| (p.freq_hz, state_color(s))))
+                .collect(),
+        })
+        .collect();
+
+    let figure = StripChart {
+        title: fig.title.to_string(),
+        chart: ChartSpec {
+            x,
+            y: YAxis::Log(y.0, y.1),
+            x_desc: "frequency (Hz)".to_string(),
+            y_desc: format!("{} first-harmonic amplitude (m)", fig.output_name),
+            bands: Vec::new(),
+            curves,
+        },
+        strips,
+        state_key: true,
+    };
+    write_figure(&figure, png, svg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing::{drawn, resonance};
+    use super::*;
+    use crate::contact::ContactState;
+
+    fn point(f: f64, a: f64, states: Vec<ContactState>) -> FrfPoint {
+        FrfPoint {
+            freq_hz: f,
+            amplitudes: vec![a, 0.5 * a],
+            peaks: vec![a, 0.5 * a],
+            states,
+            newton_iterations: 3,
+            residual: 1e-10,
+            coefficients: Vec::new(),
+        }
+    }
+
+    fn curve(f0: f64, zeta: f64) -> LinearCurve {
+        let freqs_hz: Vec<f64> = (0..=200).map(|i| 50.0 + i as f64).collect();
+        let amplitudes = freqs_hz
+            .iter()
+            .map(|&f| {
+                let a = resonance(f, f0, zeta, 1e-5);
+                vec![a, 0.5 * a]
+            })
+            .collect();
+        LinearCurve {
+            freqs_hz,
+            amplitudes,
+        }
+    }
+
+    fn synthetic_points() -> Vec<FrfPoint> {
+        (0..=400)
+            .map(|i| {
+                let f = 50.0 + 0.5 * i as f64;
+                let a = resonance(f, 150.0, 0.03, 1e-5);
+                let s = if a < 2e-5 {
+                    ContactState::Stuck
+                } else if a < 5e-5 {
+                    ContactState::StickSlip
+                } else if a < 1e-4 {
+                    ContactState::StickSlipLiftoff
+                } else {
+                    ContactState::Open
+                };
+                let other = if f < 120.0 {
+                    ContactState::Stuck
+                } else {
+                    ContactState::StickSlip
+                };
+                point(f, a, vec![s, other, ContactState::Open])
+            })
+            .collect()
+    }
+
+    /// The figure of output `k` (named `name`) of `points`, one strip per name, over the open
+    /// and stuck references.
+    fn figure<'a>(
+        title: &'a str,
+        (k, name): (usize, &'a str),
+        names: &'a [String],
+        points: &'a [FrfPoint],
+        (open, stuck): (&'a LinearCurve, &'a LinearCurve),
+    ) -> FrfFigure<'a> {
+        FrfFigure {
+            title,
+            output_index: k,
+            output_name: name,
+            contact_names: names,
+            points,
+            open,
+            stuck,
+        }
+    }
+
+    #[test]
+    fn frf_figure_writes_png_and_svg() {
+        let dir = tempfile::tempdir().unwrap();
+        let names = vec![
+            "c1".to_string(),
+            "c2 (platform)".to_string(),
+            "c3".to_string(),
+        ];
+        let points = synthetic_points();
+        let (open, stuck) = (curve(120.0, 0.01), curve(190.0, 0.01));
+        let fig = figure("synthetic FRF", (0, "y2"), &names, &points, (&open, &stuck));
+        let svg_text = drawn(dir.path(), "frf", |png, svg| plot_frf(&fig, png, svg));
+        assert!(svg_text.contains("frequency (Hz)"));
+        assert!(svg_text.contains("y2 first-harmonic amplitude (m)"));
+        assert!(svg_text.contains("stick-slip-liftoff"));
+        assert!(svg_text.contains("linear, contacts stuck"));
+    }
+
+    #[test]
+    fn frf_figure_survives_empty_and_bad_inputs() {
+        let dir = tempfile::tempdir().unwrap();
+        let empty = LinearCurve {
+            freqs_hz: Vec::new(),
+            amplitudes: Vec::new(),
+        };
+        for (k, points) in [
+            Vec::new(),
+            vec![
+                point(10.0, 0.0, vec![]),
+                point(f64::NAN, 1e-3, vec![ContactState::Open]),
+                point(11.0, -1.0, vec![ContactState::Stuck]),
+                point(12.0, f64::INFINITY, vec![ContactState::StickSlip]),
+            ],
+            vec![point(5.0, 1e-4, vec![ContactState::Stuck])],
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let names: Vec<String> = (0..k).map(|c| format!("c{c}")).collect();
+            let fig = figure("", (7, "x"), &names, &points, (&empty, &empty));
+            drawn(dir.path(), &format!("e{k}"), |png, svg| {
+                plot_frf(&fig, png, svg)
+            });
+        }
+    }
+
+    #[test]
+    fn many_contacts_fit() {
+        let dir = tempfile::tempdir().unwrap();
+        let names: Vec<String> = (0..60).map(|c| format!("contact-{c}")).collect();
+        let points: Vec<FrfPoint> = synthetic_points()
+            .into_iter()
+            .map(|mut p| {
+                p.states = vec![p.states[0]; 60];
+                p
+            })
+            .collect();
+        let (open, stuck) = (curve(120.0, 0.01), curve(190.0, 0.01));
+        let fig = figure("many contacts", (1, "y1"), &names, &points, (&open, &stuck));
+        drawn(dir.path(), "m", |png, svg| plot_frf(&fig, png, svg));
+    }
+}

@@ -1,0 +1,203 @@
+//! The figure's layout: a title, the chart, and below it optional rows of coloured markers
+//! (the state of each contact at each point, or the frequencies with multiple solutions), one
+//! row per strip, with the colour key of the contact states. With many strips the rows narrow
+//! so that the chart keeps at least 55 % of the height.
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+use super::axes::format_linear;
+use super::backend::Figure;
+use super::chart::{draw_chart, ChartSpec};
+use super::style::{
+    font, state_color, DESC_SIZE, LABEL_SIZE, LEGEND_SIZE, RIGHT_MARGIN, STATES, TITLE_SIZE,
+    X_LABELS,
+};
+
+/// One row of coloured markers below the chart, e.g. the states of one contact.
+pub(super) struct Strip {
+    /// Name written left of the row.
+    pub(super) name: String,
+    /// Abscissa and colour of each marker.
+    pub(super) marks: Vec<(f64, RGBColor)>,
+}
+
+/// A line chart with an optional block of marker strips below it.
+pub(super) struct StripChart {
+    /// Figure title (none if blank).
+    pub(super) title: String,
+    /// The chart.
+    pub(super) chart: ChartSpec,
+    /// Marker rows below the chart, the first on top.
+    pub(super) strips: Vec<Strip>,
+    /// Draw the colour key of the contact states below the strips.
+    pub(super) state_key: bool,
+}
+
+impl StripChart {
+    /// A figure of the chart alone, without strips or state key.
+    pub(super) fn plain(title: &str, chart: ChartSpec) -> Self {
+        StripChart {
+            title: title.to_string(),
+            chart,
+            strips: Vec::new(),
+            state_key: false,
+        }
+    }
+}
+
+/// Pixel layout of the strip block.
+struct StripLayout {
+    /// Height of one row.
+    row: u32,
+    /// Height of the x tick labels and description below the rows.
+    x_label_area: u32,
+    /// Height of the state key (0 without it).
+    legend_row: u32,
+}
+
+impl StripLayout {
+    /// Height of the whole block for `n` rows.
+    fn height(&self, n: usize) -> u32 {
+        self.row * n as u32 + self.x_label_area + self.legend_row
+    }
+}
+
+impl Figure for StripChart {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<(), DB> {
+        root.fill(&WHITE)?;
+        let root = root.margin(10, 10, 10, 10);
+        let body = if self.title.trim().is_empty() {
+            root
+        } else {
+            // Long titles shrink to fit the width rather than run off the figure.
+            let width = root.dim_in_pixel().0;
+            let mut size = TITLE_SIZE;
+            while size > 14.0 && root.estimate_text_size(&self.title, &font(size))?.0 + 10 > width {
+                size -= 1.0;
+            }
+            root.titled(&self.title, font(size))?
+        };
+        let (_, body_h) = body.dim_in_pixel();
+
+        let label_style = font(LABEL_SIZE);
+        let mut name_w = 0;
+        for s in &self.strips {
+            name_w = name_w.max(body.estimate_text_size(&s.name, &label_style)?.0);
+        }
+        let y_label_area = (name_w + 25).clamp(110, 300);
+
+        if self.strips.is_empty() {
+            return draw_chart(&body, &self.chart, y_label_area, true);
+        }
+
+        let n = self.strips.len();
+        let mut layout = StripLayout {
+            row: (200 / n as u32).clamp(14, 30),
+            x_label_area: 65,
+            legend_row: if self.state_key { 40 } else { 0 },
+        };
+        let max_h = body_h * 45 / 100;
+        if layout.height(n) > max_h {
+            layout.row = ((max_h - layout.x_label_area - layout.legend_row) / n as u32).max(2);
+        }
+        let (main, lower) = body.split_vertically(body_h.saturating_sub(layout.height(n)));
+        draw_chart(&main, &self.chart, y_label_area, false)?;
+        let (strip_area, legend_area) =
+            lower.split_vertically(lower.dim_in_pixel().1 - layout.legend_row);
+        draw_strips(
+            &strip_area,
+            &self.strips,
+            self.chart.x,
+            &self.chart.x_desc,
+            y_label_area,
+            &layout,
+        )?;
+        if self.state_key {
+            draw_state_legend(&legend_area, y_label_area)?;
+        }
+        Ok(())
+    }
+}
+
+/// Draws one row per strip (the first on top) with a coloured marker at each of its abscissae.
+fn draw_strips<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    strips: &[Strip],
+    x: (f64, f64),
+    x_desc: &str,
+    y_label_area: u32,
+    layout: &StripLayout,
+) -> DrawResult<(), DB> {
+    let n = strips.len();
+    let x_scale = x.0.abs().max(x.1.abs());
+    let x_format = |v: &f64| format_linear(*v, x_scale);
+    let mut chart = ChartBuilder::on(area)
+        .margin_right(RIGHT_MARGIN)
+        .x_label_area_size(layout.x_label_area)
+        .y_label_area_size(y_label_area)
+        .build_cartesian_2d(x.0..x.1, 0.0..n as f64)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_labels(X_LABELS)
+        .y_labels(0)
+        .x_label_formatter(&x_format)
+        .label_style(font(LABEL_SIZE))
+        .axis_desc_style(font(DESC_SIZE))
+        .x_desc(x_desc)
+        .draw()?;
+
+    let name_style = font(LABEL_SIZE).pos(Pos::new(HPos::Right, VPos::Center));
+    let every = (LABEL_SIZE as u32 + 2).div_ceil(layout.row.max(1)).max(1) as usize;
+    let base = area.get_base_pixel();
+    for (c, strip) in strips.iter().enumerate().step_by(every) {
+        let (px, py) = chart.backend_coord(&(x.0, row_center(n, c)));
+        area.draw_text(&strip.name, &name_style, (px - base.0 - 10, py - base.1))?;
+    }
+    let separators = if layout.row >= 8 { 1..n } else { 0..0 };
+    chart.draw_series(separators.map(|r| {
+        PathElement::new(
+            vec![(x.0, r as f64), (x.1, r as f64)],
+            RGBColor(200, 200, 200),
+        )
+    }))?;
+    let half_h = ((layout.row as f64 * 0.4).round() as i32).max(1);
+    for (c, strip) in strips.iter().enumerate() {
+        let y = row_center(n, c);
+        chart.draw_series(strip.marks.iter().map(|&(f, color)| {
+            EmptyElement::at((f, y)) + Rectangle::new([(-2, -half_h), (2, half_h)], color.filled())
+        }))?;
+    }
+    Ok(())
+}
+
+/// Centre of contact `c`'s row, the first contact on top.
+fn row_center(n: usize, c: usize) -> f64 {
+    (n - 1 - c) as f64 + 0.5
+}
+
+/// Draws the colour key of the contact states in one row.
+fn draw_state_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    x0: u32,
+) -> DrawResult<(), DB> {
+    let style = font(LEGEND_SIZE).pos(Pos::new(HPos::Left, VPos::Center));
+    let (_, h) = area.dim_in_pixel();
+    let y = h as i32 / 2;
+    let mut x = x0 as i32;
+    let title = "contact state:";
+    area.draw_text(title, &style, (x, y))?;
+    x += area.estimate_text_size(title, &style)?.0 as i32 + 20;
+    for state in STATES {
+        area.draw(&Rectangle::new(
+            [(x, y - 8), (x + 16, y + 8)],
+            state_color(state).filled(),
+        ))?;
+        x += 24;
+        area.draw_text(state.label(), &style, (x, y))?;
+        x += area.estimate_text_size(state.label(), &style)?.0 as i32 + 30;
+    }
+    Ok(())
+}

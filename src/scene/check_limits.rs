@@ -1,0 +1,195 @@
+//! Validation of the `[limits]` table into the [`LimitSettings`] of the limit analysis:
+//! intermediate m values and cases per damper side or contact (named without clashes), the
+//! bound scan, the frequency grid, the peak window and the hysteresis loops to write.
+
+use crate::analysis::limits::{signed, CaseSpec, HysteresisRequest, LimitSettings};
+use crate::scene::checker::Checker;
+use crate::scene::error::SceneError;
+use crate::scene::schema::Scene;
+
+/// The limit-analysis settings of the scene's `[limits]` table; `None` without one. The
+/// frequency range of `[analysis]` bounds the peak window and the loop frequencies.
+pub(super) fn limit_settings(
+    scene: &Scene,
+    ck: &Checker,
+) -> Result<Option<LimitSettings>, SceneError> {
+    let Some(l) = &scene.limits else {
+        return Ok(None);
+    };
+    let check_m = |field: String, m: f64| -> Result<f64, SceneError> {
+        ck.finite(&field, m)?;
+        if !(-1.0..=1.0).contains(&m) {
+            return Err(ck.err(
+                field,
+                format!("an initial state m must lie in [-1, 1], got {m}"),
+            ));
+        }
+        Ok(m)
+    };
+    for (name, list) in [
+        ("intermediate", &l.intermediate),
+        ("bound_scan", &l.bound_scan),
+    ] {
+        for (i, m) in list.iter().enumerate() {
+            check_m(format!("limits.{name}[{i}]"), *m)?;
+        }
+    }
+    if !(2..=100_000).contains(&l.grid_points) {
+        return Err(ck.err(
+            "limits.grid_points",
+            format!("must be in 2..=100000, got {}", l.grid_points),
+        ));
+    }
+    let side_names = {
+        let mut names: Vec<String> = Vec::new();
+        for c in &scene.contacts {
+            let s = c.side_name();
+            if !names.contains(&s) {
+                names.push(s);
+            }
+        }
+        names
+    };
+    let sides = side_names.len();
+    let combinations = (l.bound_scan.len() as f64).powi(sides as i32);
+    if combinations > 4096.0 {
+        return Err(ck.err(
+            "limits.bound_scan",
+            format!(
+                "{} values on {sides} sides make {combinations} curves; at most 4096",
+                l.bound_scan.len()
+            ),
+        ));
+    }
+
+    // Intermediate cases per side or point; names must not clash with the uniform ones.
+    let mut names: Vec<String> = [1.0, -1.0]
+        .iter()
+        .chain(&l.intermediate)
+        .map(|&m| format!("m{}", signed(m)))
+        .collect();
+    let mut cases = Vec::new();
+    for (i, c) in l.cases.iter().enumerate() {
+        let f = |name: &str| format!("limits.cases[{i}].{name}");
+        if c.sides.is_empty() && c.contacts.is_empty() {
+            return Err(ck.err(
+                format!("limits.cases[{i}]"),
+                "give m for at least one damper side (`sides`) or contact (`contacts`)",
+            ));
+        }
+        let mut side_states = Vec::new();
+        for (name, &m) in &c.sides {
+            let field = format!("{}.{name}", f("sides"));
+            let side = side_names.iter().position(|s| s == name).ok_or_else(|| {
+                ck.err(
+                    field.clone(),
+                    format!(
+                        "unknown damper side `{name}` (the scene has {})",
+                        side_names.join(", ")
+                    ),
+                )
+            })?;
+            side_states.push((side, check_m(field, m)?));
+        }
+        let mut contact_states = Vec::new();
+        for (name, &m) in &c.contacts {
+            let field = format!("{}.{name}", f("contacts"));
+            let contact = scene
+                .contacts
+                .iter()
+                .position(|k| &k.name == name)
+                .ok_or_else(|| {
+                    ck.err(
+                        field.clone(),
+                        format!(
+                            "unknown contact `{name}` (the scene has {})",
+                            scene
+                                .contacts
+                                .iter()
+                                .map(|k| k.name.as_str())
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        ),
+                    )
+                })?;
+            contact_states.push((contact, check_m(field, m)?));
+        }
+        let name = match &c.name {
+            Some(n) => {
+                ck.name(&f("name"), n)?;
+                n.clone()
+            }
+            None => c
+                .sides
+                .iter()
+                .chain(&c.contacts)
+                .map(|(k, m)| format!("{k}{}", signed(*m)))
+                .collect::<Vec<_>>()
+                .join("_"),
+        };
+        if names.contains(&name) {
+            return Err(ck.err(
+                f("name"),
+                format!("case name `{name}` is already used by another curve"),
+            ));
+        }
+        names.push(name.clone());
+        cases.push(CaseSpec {
+            name,
+            sides: side_states,
+            contacts: contact_states,
+        });
+    }
+
+    let (f_lo, f_hi) = (scene.analysis.freq_start_hz, scene.analysis.freq_end_hz);
+    let peak_window_hz = match l.peak_window_hz {
+        None => None,
+        Some([lo, hi]) => {
+            ck.finite("limits.peak_window_hz[0]", lo)?;
+            ck.finite("limits.peak_window_hz[1]", hi)?;
+            if lo >= hi {
+                return Err(ck.err(
+                    "limits.peak_window_hz",
+                    format!("the window is reversed or empty: {lo} .. {hi} Hz"),
+                ));
+            }
+            if hi <= f_lo || lo >= f_hi {
+                return Err(ck.err(
+                    "limits.peak_window_hz",
+                    format!(
+                        "the window {lo} .. {hi} Hz lies outside the analysis range \
+                         {f_lo} .. {f_hi} Hz"
+                    ),
+                ));
+            }
+            Some((lo, hi))
+        }
+    };
+    let hysteresis = match &l.hysteresis {
+        None => HysteresisRequest::default(),
+        Some(h) => {
+            for (i, &f) in h.freqs_hz.iter().enumerate() {
+                let field = format!("limits.hysteresis.freqs_hz[{i}]");
+                ck.finite(&field, f)?;
+                if f < f_lo || f > f_hi {
+                    return Err(ck.err(
+                        field,
+                        format!("{f} Hz lies outside the analysis range {f_lo} .. {f_hi} Hz"),
+                    ));
+                }
+            }
+            HysteresisRequest {
+                at_peaks: h.at_peaks,
+                freqs_hz: h.freqs_hz.clone(),
+            }
+        }
+    };
+    Ok(Some(LimitSettings {
+        intermediate: l.intermediate.clone(),
+        cases,
+        grid_points: l.grid_points,
+        bound_scan: l.bound_scan.clone(),
+        peak_window_hz,
+        hysteresis,
+    }))
+}

@@ -1,0 +1,155 @@
+//! Validation of the linear structure: the `[model]` table built into a [`LinearModel`]
+//! (inline dense matrices, or an FE model through [`crate::scene::fe_input`]), the optional
+//! Craig-Bampton `[reduction]`, and the check that the structure with all contacts stuck can
+//! carry static loads.
+
+use faer::Mat;
+
+use crate::analysis::linear::contact_stiffness;
+use crate::model::matrix::StructuralMatrix;
+use crate::model::reduce::{self, ReductionSettings};
+use crate::model::{LinearModel, Problem};
+use crate::scene::checker::Checker;
+use crate::scene::error::SceneError;
+use crate::scene::fe_input::{self, FeStructure, ReductionSpec};
+use crate::scene::schema::ModelSpec;
+
+/// The linear structure: inline dense matrices, or an FE model (mesh or Matrix Market).
+pub(super) fn build_model(
+    m: &ModelSpec,
+    ck: &Checker,
+) -> Result<(LinearModel, Option<FeStructure>), SceneError> {
+    if m.is_fe() {
+        if !m.dofs.is_empty()
+            || !m.mass.is_empty()
+            || !m.stiffness.is_empty()
+            || m.damping.is_some()
+        {
+            return Err(ck.err(
+                "model",
+                "give inline matrices (`dofs`, `mass`, `stiffness`, `damping`) or an FE model \
+                 (`mesh` or `matrix_market`), not both",
+            ));
+        }
+        let [alpha, beta] = m.rayleigh.unwrap_or([0.0, 0.0]);
+        for (i, v) in [alpha, beta].iter().enumerate() {
+            ck.non_negative(&format!("model.rayleigh[{i}]"), *v)?;
+        }
+        let fe = fe_input::build_structure(
+            ck.file,
+            m.mesh.as_deref(),
+            &m.materials,
+            m.plane,
+            &m.clamp,
+            m.matrix_market.as_ref(),
+            (alpha, beta),
+        )?;
+        return Ok((fe.model.clone(), Some(fe)));
+    }
+    for (field, set) in [
+        ("model.materials", !m.materials.is_empty()),
+        ("model.clamp", !m.clamp.is_empty()),
+        ("model.rayleigh", m.rayleigh.is_some()),
+    ] {
+        if set {
+            return Err(ck.err(
+                field,
+                "applies to FE models only (`mesh` or `matrix_market`)",
+            ));
+        }
+    }
+    let dofs = &m.dofs;
+    let n = dofs.len();
+    if n == 0 {
+        return Err(ck.err("model.dofs", "must name at least one DOF"));
+    }
+    for (i, d) in dofs.iter().enumerate() {
+        ck.name(&format!("model.dofs[{i}]"), d)?;
+        if dofs[..i].contains(d) {
+            return Err(ck.err(format!("model.dofs[{i}]"), format!("duplicate DOF `{d}`")));
+        }
+    }
+    let mass = ck.matrix("model.mass", &m.mass, n)?;
+    let stiffness = ck.matrix("model.stiffness", &m.stiffness, n)?;
+    let damping = match &m.damping {
+        Some(c) => ck.matrix("model.damping", c, n)?,
+        None => Mat::zeros(n, n),
+    };
+    ck.semidefinite("model.mass", &mass)?;
+    ck.semidefinite("model.stiffness", &stiffness)?;
+    ck.semidefinite("model.damping", &damping)?;
+    Ok((
+        LinearModel {
+            dof_names: dofs.clone(),
+            mass: StructuralMatrix::Dense(mass),
+            damping: StructuralMatrix::Dense(damping),
+            stiffness: StructuralMatrix::Dense(stiffness),
+        },
+        None,
+    ))
+}
+
+/// The problem reduced by Craig-Bampton when the scene has a `[reduction]` table (with the
+/// model's Rayleigh damping, α 1/s and β s); unchanged otherwise.
+pub(super) fn reduce_problem(
+    reduction: Option<&ReductionSpec>,
+    model: &ModelSpec,
+    ck: &Checker,
+    problem: Problem,
+) -> Result<Problem, SceneError> {
+    let Some(r) = reduction else {
+        return Ok(problem);
+    };
+    if r.modes == 0 {
+        return Err(ck.err("reduction.modes", "must be ≥ 1"));
+    }
+    let zeta = ck.non_negative("reduction.modal_damping", r.modal_damping)?;
+    let [alpha, beta] = model.rayleigh.unwrap_or([0.0, 0.0]);
+    let settings = ReductionSettings {
+        modes: r.modes,
+        modal_damping: zeta,
+        rayleigh: (alpha, beta),
+        ordering: r.ordering.ordering(),
+        recover: Vec::new(),
+    };
+    Ok(reduce::reduce(&problem, &settings)
+        .map_err(|e| ck.err("reduction", e.to_string()))?
+        .problem)
+}
+
+/// The structure with all contacts stuck must carry static loads: K + contact springs must be
+/// positive definite (a free body, or an indefinite K, is refused). Dense models: eigenvalues;
+/// sparse ones: a sparse Cholesky factorisation.
+pub(super) fn check_stuck_structure(ck: &Checker, problem: &Problem) -> Result<(), SceneError> {
+    let singular = || {
+        ck.err(
+            "model.stiffness",
+            "the structure is singular or indefinite even with all contacts stuck (a body is \
+             free, or K has a negative eigenvalue: ground the body or connect it through a \
+             contact, and check K)",
+        )
+    };
+    match &problem.model.stiffness {
+        StructuralMatrix::Dense(k) => {
+            let mut k = k.clone();
+            for (i, j, v) in contact_stiffness(problem) {
+                k[(i, j)] += v;
+            }
+            let (min, max) = ck.eigen_range("model.stiffness", &k)?;
+            if min <= 1e-12 * max {
+                return Err(singular());
+            }
+        }
+        StructuralMatrix::Sparse(_) => {
+            let mut t = problem.model.stiffness.triplets();
+            t.extend(contact_stiffness(problem));
+            let StructuralMatrix::Sparse(k) =
+                StructuralMatrix::sparse_from_triplets(problem.model.n_dofs(), &t)
+            else {
+                unreachable!("sparse_from_triplets builds sparse storage")
+            };
+            k.sp_cholesky(faer::Side::Lower).map_err(|_| singular())?;
+        }
+    }
+    Ok(())
+}

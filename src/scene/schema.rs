@@ -1,0 +1,337 @@
+//! The scene schema: the serde structs of a scene file's TOML tables (model, contacts, loads,
+//! harmonics, effects, analysis, output) with their defaults. Every table rejects unknown
+//! fields; the values are checked later, at validation. The `[limits]` and `[sweep]` tables are
+//! in [`crate::scene::limits_schema`], the FE tables in [`crate::scene::fe_input`].
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+use crate::contact::NormalLoad;
+use crate::model::{Coupling, Formulation, JacobianStrategy};
+use crate::scene::fe_input::{
+    ContactPatchSpec, MaterialSpec, MatrixMarketSpec, PlaneSpec, ReductionSpec,
+};
+use crate::scene::limits_schema::{LimitsSpec, SweepSpec};
+
+/// Top-level scene.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Free text shown in plots and summaries.
+    #[serde(default)]
+    pub title: String,
+    /// Linear structure.
+    pub model: ModelSpec,
+    /// Craig-Bampton reduction of an FE model; absent: the full model is solved.
+    #[serde(default)]
+    pub reduction: Option<ReductionSpec>,
+    /// Contact points.
+    #[serde(default)]
+    pub contacts: Vec<ContactSpec>,
+    /// Contact patches of FE meshes (node-to-node pairs between facing groups).
+    #[serde(default)]
+    pub contact_patches: Vec<ContactPatchSpec>,
+    /// Static loads (N).
+    #[serde(default)]
+    pub static_loads: Vec<StaticLoadSpec>,
+    /// Harmonic loads (N).
+    #[serde(default)]
+    pub harmonic_loads: Vec<HarmonicLoadSpec>,
+    /// Harmonics and time sampling.
+    pub harmonics: HarmonicsSpec,
+    /// Switched effects.
+    #[serde(default)]
+    pub effects: EffectsSpec,
+    /// Frequency range, continuation and tolerances.
+    pub analysis: AnalysisSpec,
+    /// Outputs.
+    pub output: OutputSpec,
+    /// Limit analysis among multiple solutions (two-point method); absent: one FRF.
+    #[serde(default)]
+    pub limits: Option<LimitsSpec>,
+    /// Parameter sweep of the limit analysis (optimal curves); absent: no sweep.
+    #[serde(default)]
+    pub sweep: Option<SweepSpec>,
+}
+
+/// Inline dense matrices with DOF names.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSpec {
+    /// DOF names, in matrix order (inline models).
+    #[serde(default)]
+    pub dofs: Vec<String>,
+    /// Mass matrix (kg), rows (inline models).
+    #[serde(default)]
+    pub mass: Vec<Vec<f64>>,
+    /// Stiffness matrix (N/m), rows (inline models).
+    #[serde(default)]
+    pub stiffness: Vec<Vec<f64>>,
+    /// Viscous damping matrix (N·s/m), rows; zero when absent (inline models).
+    #[serde(default)]
+    pub damping: Option<Vec<Vec<f64>>>,
+    /// Gmsh `.msh` 4.1 mesh (FE models), relative to the scene file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<PathBuf>,
+    /// Materials per physical group of the mesh.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub materials: Vec<MaterialSpec>,
+    /// Plane assumption of 2D meshes.
+    #[serde(default)]
+    pub plane: PlaneSpec,
+    /// Physical groups clamped (all their DOFs removed).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub clamp: Vec<String>,
+    /// K and M from Matrix Market files with a DOF map (FE models).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub matrix_market: Option<MatrixMarketSpec>,
+    /// Rayleigh damping C = αM + βK of an FE model: [α (1/s), β (s)].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rayleigh: Option<[f64; 2]>,
+}
+
+impl ModelSpec {
+    /// Whether the model comes from a mesh or Matrix Market files.
+    pub fn is_fe(&self) -> bool {
+        self.mesh.is_some() || self.matrix_market.is_some()
+    }
+}
+
+/// One contact point.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// Unique name.
+    pub name: String,
+    /// Damper side the point belongs to (defaults to the contact name).
+    #[serde(default)]
+    pub side: Option<String>,
+    /// DOFs of the damper point (one per direction: x or x, y).
+    pub damper: Vec<String>,
+    /// DOFs of the body point, same directions; empty for a grounded body.
+    #[serde(default)]
+    pub body: Vec<String>,
+    /// Frame by angle (degrees, 2D): t = (cos a, sin a), n = (−sin a, cos a) (paper Eq. 16).
+    #[serde(default)]
+    pub angle_deg: Option<f64>,
+    /// Frame by vectors: tangent direction (normalised here).
+    #[serde(default)]
+    pub tangent: Option<Vec<f64>>,
+    /// Frame by vectors: normal direction, pointing from the damper into the body.
+    #[serde(default)]
+    pub normal: Option<Vec<f64>>,
+    /// Tangential stiffness (N/m).
+    pub kt: f64,
+    /// Normal stiffness (N/m).
+    pub kn: f64,
+    /// Friction coefficient.
+    pub mu: f64,
+    /// Initial normal gap (m); negative for an interference.
+    #[serde(default)]
+    pub gap: f64,
+    /// Initial tangential state m ∈ [−1, 1].
+    #[serde(default)]
+    pub initial_state: f64,
+}
+
+impl ContactSpec {
+    /// The damper side the point belongs to: `side`, or the contact name when absent.
+    pub fn side_name(&self) -> String {
+        self.side.clone().unwrap_or_else(|| self.name.clone())
+    }
+}
+
+/// A static force on one DOF.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StaticLoadSpec {
+    /// DOF name; or give `group` and `direction`.
+    #[serde(default)]
+    pub dof: Option<String>,
+    /// Physical group of an FE mesh whose nodes share the force (by mass).
+    #[serde(default)]
+    pub group: Option<String>,
+    /// Direction of a group force: `x`, `y` or `z`.
+    #[serde(default)]
+    pub direction: Option<String>,
+    /// Force (N); the total over the group for group loads.
+    pub value: f64,
+}
+
+/// A harmonic force on one DOF: cos·cos(hωt) + sin·sin(hωt).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HarmonicLoadSpec {
+    /// DOF name; or give `group` and `direction`.
+    #[serde(default)]
+    pub dof: Option<String>,
+    /// Physical group of an FE mesh whose nodes share the force (by mass).
+    #[serde(default)]
+    pub group: Option<String>,
+    /// Direction of a group force: `x`, `y` or `z`.
+    #[serde(default)]
+    pub direction: Option<String>,
+    /// Harmonic h ≥ 1.
+    #[serde(default = "one")]
+    pub harmonic: usize,
+    /// Cosine amplitude (N).
+    #[serde(default)]
+    pub cos: f64,
+    /// Sine amplitude (N).
+    #[serde(default)]
+    pub sin: f64,
+}
+
+/// Default harmonic of a harmonic load: the fundamental.
+fn one() -> usize {
+    1
+}
+
+/// Harmonic set and AFT sampling.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HarmonicsSpec {
+    /// Highest harmonic H: balance 1..H (and 0 when coupled).
+    #[serde(default)]
+    pub max: Option<usize>,
+    /// Explicit dynamic harmonics, e.g. [1, 3, 5] (0 may be listed; coupling decides).
+    #[serde(default)]
+    pub list: Option<Vec<usize>>,
+    /// Time samples per period of the AFT (> 2·H).
+    #[serde(default = "default_samples")]
+    pub samples: usize,
+    /// Most periods in the contact march before it is reported as not settling.
+    #[serde(default = "default_max_periods")]
+    pub max_periods: usize,
+}
+
+/// Default AFT time samples per period.
+fn default_samples() -> usize {
+    256
+}
+/// Default most periods of the contact march.
+fn default_max_periods() -> usize {
+    64
+}
+
+/// Switched effects.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EffectsSpec {
+    /// `variable` (default) or `constant` normal load.
+    #[serde(default)]
+    pub normal_load: NormalLoad,
+    /// Whether contacts may separate (default true).
+    #[serde(default = "yes")]
+    pub liftoff: bool,
+    /// `coupled` (default) or `uncoupled` statics.
+    #[serde(default)]
+    pub coupling: Coupling,
+}
+
+impl Default for EffectsSpec {
+    fn default() -> Self {
+        Self {
+            normal_load: NormalLoad::Variable,
+            liftoff: true,
+            coupling: Coupling::Coupled,
+        }
+    }
+}
+
+/// Default of `[effects].liftoff`: contacts may separate.
+fn yes() -> bool {
+    true
+}
+
+/// Frequency range and continuation settings.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnalysisSpec {
+    /// Start frequency (Hz).
+    pub freq_start_hz: f64,
+    /// End frequency (Hz).
+    pub freq_end_hz: f64,
+    /// First arc-length step (Hz-equivalent); default range/200.
+    #[serde(default)]
+    pub initial_step: Option<f64>,
+    /// Smallest step; default range·1e-7.
+    #[serde(default)]
+    pub min_step: Option<f64>,
+    /// Largest step; default range/50.
+    #[serde(default)]
+    pub max_step: Option<f64>,
+    /// Most continuation points.
+    #[serde(default = "default_max_points")]
+    pub max_points: usize,
+    /// Newton iterations aimed at per step.
+    #[serde(default = "default_target_iterations")]
+    pub target_iterations: usize,
+    /// Newton iterations before a step is cut.
+    #[serde(default = "default_max_iterations")]
+    pub max_iterations: usize,
+    /// Relative residual tolerance (to the load norm).
+    #[serde(default = "default_residual_tolerance")]
+    pub residual_tolerance: f64,
+    /// Scaled step tolerance.
+    #[serde(default = "default_step_tolerance")]
+    pub step_tolerance: f64,
+    /// `analytic` (default), `forward-difference` or `central-difference`.
+    #[serde(default)]
+    pub jacobian: JacobianStrategy,
+    /// `auto` (default), `dense`, `sparse`, `condensed` or `schur`.
+    #[serde(default)]
+    pub formulation: Formulation,
+    /// Points of the uniform grid for the linear references.
+    #[serde(default = "default_linear_points")]
+    pub linear_points: usize,
+}
+
+/// Default most continuation points.
+fn default_max_points() -> usize {
+    5000
+}
+/// Default Newton iterations aimed at per step.
+fn default_target_iterations() -> usize {
+    4
+}
+/// Default Newton iterations before a step is cut.
+fn default_max_iterations() -> usize {
+    12
+}
+/// Default relative residual tolerance (to the load norm).
+fn default_residual_tolerance() -> f64 {
+    1e-10
+}
+/// Default scaled step tolerance.
+fn default_step_tolerance() -> f64 {
+    1e-8
+}
+/// Default points of the linear references' frequency grid.
+fn default_linear_points() -> usize {
+    501
+}
+
+/// Outputs.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Response DOFs reported in `frf.csv` and plotted.
+    #[serde(default)]
+    pub dofs: Vec<String>,
+    /// Response DOFs by physical group of an FE mesh: every node of the group in one
+    /// direction.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub groups: Vec<GroupDirectionSpec>,
+}
+
+/// A physical group and a direction.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GroupDirectionSpec {
+    /// Physical group name.
+    pub group: String,
+    /// `x`, `y` or `z`.
+    pub direction: String,
+}
