@@ -332,8 +332,9 @@ fn schur_solves_match_dense(dense: &Problem, schur: &Problem, x: &[f64], omega: 
     let row: Vec<f64> = (0..=n).map(|i| ((i * 13 % 7) as f64 - 3.0) * 0.2).collect();
     let mut brhs = rhs.clone();
     brhs.push(0.7);
-    let yd = jd.solve_bordered(3.0, &dw, &row, &brhs).unwrap();
-    let ys = js.solve_bordered(3.0, &dw, &row, &brhs).unwrap();
+    let col_scale = vec![3.0; n];
+    let yd = jd.solve_bordered(&col_scale, &dw, &row, &brhs).unwrap();
+    let ys = js.solve_bordered(&col_scale, &dw, &row, &brhs).unwrap();
     let yn = yd.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     for i in 0..=n {
         assert!(

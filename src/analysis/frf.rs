@@ -5,7 +5,7 @@ use std::f64::consts::PI;
 use std::time::Instant;
 
 use crate::analysis::linear;
-use crate::contact::harmonic::HarmonicSet;
+use crate::contact::harmonic::{Block, HarmonicSet};
 use crate::contact::ContactState;
 use crate::hbm::operator::HbmOperator;
 use crate::hbm::{HbmError, HbmSystem};
@@ -68,6 +68,36 @@ pub struct FrfRun {
     pub elapsed_s: f64,
 }
 
+impl FrfRun {
+    /// Whether the path reached the end frequency: only then does the run cover the range.
+    pub fn is_complete(&self) -> bool {
+        self.end == PathEnd::EndFrequency
+    }
+
+    /// Why the run did not cover the range (None when it did), for the run's status line
+    /// (`incomplete: <reason>`).
+    pub fn incomplete_reason(&self) -> Option<String> {
+        let last = self.points.last().map_or(f64::NAN, |p| p.freq_hz);
+        let highest = self
+            .points
+            .iter()
+            .map(|p| p.freq_hz)
+            .fold(f64::NEG_INFINITY, f64::max);
+        match self.end {
+            PathEnd::EndFrequency => None,
+            PathEnd::LeftRangeBelow => Some(format!(
+                "the path turned back and left the range below the start frequency at \
+                 {last:.4} Hz; frequencies above {highest:.4} Hz were never reached"
+            )),
+            PathEnd::MaxPoints => Some(format!(
+                "the point budget (analysis.max_points = {}) was used up at {last:.4} Hz; \
+                 frequencies above {highest:.4} Hz were never reached",
+                self.points.len()
+            )),
+        }
+    }
+}
+
 /// Errors of an FRF run.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FrfError {
@@ -82,6 +112,46 @@ pub enum FrfError {
     Continuation(#[from] ContinuationError),
 }
 
+/// The largest |offset + q(τ)| over a period of the trigonometric polynomial q with
+/// coefficients `coef` on `set` (m): the time-domain peak of a DOF. The maximum is located on a
+/// fine grid (16 points per period of the highest harmonic, at least 64), then refined by a
+/// golden-section search between the neighbours of the best grid point, down to 10⁻¹² rad:
+/// the value is exact to round-off, so at one harmonic it equals the first-harmonic
+/// amplitude, and it does not depend on the AFT sampling.
+pub fn time_peak(set: &HarmonicSet, coef: &[f64], offset: f64) -> f64 {
+    let h_max = set.harmonics().iter().copied().max().unwrap_or(0);
+    let grid = (16 * h_max).max(64);
+    let value = |tau: f64| (offset + set.evaluate(coef, tau)).abs();
+    let dt = 2.0 * PI / grid as f64;
+    let (best, _) = (0..grid)
+        .map(|k| (k, value(k as f64 * dt)))
+        .fold((0, f64::NEG_INFINITY), |acc, (k, v)| if v > acc.1 { (k, v) } else { acc });
+    let ratio = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut lo, mut hi) = ((best as f64 - 1.0) * dt, (best as f64 + 1.0) * dt);
+    let mut c = hi - ratio * (hi - lo);
+    let mut d = lo + ratio * (hi - lo);
+    let (mut vc, mut vd) = (value(c), value(d));
+    let mut peak = value(best as f64 * dt).max(vc).max(vd);
+    while hi - lo > 1e-12 {
+        if vc >= vd {
+            hi = d;
+            d = c;
+            vd = vc;
+            c = hi - ratio * (hi - lo);
+            vc = value(c);
+            peak = peak.max(vc);
+        } else {
+            lo = c;
+            c = d;
+            vc = vd;
+            d = lo + ratio * (hi - lo);
+            vd = value(d);
+            peak = peak.max(vd);
+        }
+    }
+    peak
+}
+
 /// Output quantities of a converged point.
 pub fn point_outputs(
     problem: &Problem,
@@ -92,7 +162,6 @@ pub fn point_outputs(
     let n = problem.model.n_dofs();
     let c1 = set.cos_block(1);
     let s1 = set.sin_block(1);
-    let samples = problem.samples.max(64);
     let mut amplitudes = Vec::with_capacity(problem.outputs.len());
     let mut peaks = Vec::with_capacity(problem.outputs.len());
     let mut coef = vec![0.0; set.n_blocks()];
@@ -108,17 +177,25 @@ pub fn point_outputs(
         } else {
             static_offset[d]
         };
-        let peak = (0..samples)
-            .map(|k| (offset + set.evaluate(&coef, 2.0 * PI * k as f64 / samples as f64)).abs())
-            .fold(0.0, f64::max);
-        peaks.push(peak);
+        peaks.push(time_peak(set, &coef, offset));
     }
     (amplitudes, peaks)
 }
 
-/// Scale of x in the arc length: the largest stuck-linear response norm over the range,
-/// divided so that climbing to it costs a quarter of the range in arc length.
-fn arc_length_x_scale(problem: &Problem, set: &HarmonicSet) -> Result<f64, LinearSolveError> {
+/// Scale of each unknown in the arc length (m), in the operator's layout: per coefficient
+/// block, the largest stuck-linear response norm of that kind of block over the range (the
+/// static block's norm for the 0th harmonic, the dynamic blocks' for the others), divided so
+/// that climbing to it costs a quarter of the range in arc length.
+///
+/// One scale for all unknowns would let a large static part (a high pre-load) dominate the
+/// arc length: the dynamic response would then hardly count, steps would grow to the largest
+/// one and cross resonance peaks. Each kind of block gets its own scale, with a floor of 10⁻³
+/// of the other so that a block without load (no static load) does not get a zero scale.
+fn arc_length_x_scale(
+    problem: &Problem,
+    set: &HarmonicSet,
+    system: &HbmOperator<'_>,
+) -> Result<Vec<f64>, LinearSolveError> {
     let a = &problem.analysis.continuation;
     // The 0th harmonic of the guess does not depend on ω: solved once, the dynamic harmonics
     // on the grid.
@@ -146,7 +223,23 @@ fn arc_length_x_scale(problem: &Problem, set: &HarmonicSet) -> Result<f64, Linea
     }
     let x_ref = static_norm.hypot(dynamic_norm);
     let range = a.freq_end_hz - a.freq_start_hz;
-    Ok((x_ref / (0.25 * range)).max(f64::MIN_POSITIVE))
+    let to_scale = |block_norm: f64| {
+        (block_norm.max(1e-3 * x_ref) / (0.25 * range)).max(f64::MIN_POSITIVE)
+    };
+    let (static_scale, dynamic_scale) = (to_scale(static_norm), to_scale(dynamic_norm));
+    let n = problem.model.n_dofs();
+    let full: Vec<f64> = set
+        .blocks()
+        .iter()
+        .flat_map(|b| {
+            let s = match b {
+                Block::Constant => static_scale,
+                _ => dynamic_scale,
+            };
+            std::iter::repeat_n(s, n)
+        })
+        .collect();
+    Ok(system.restrict(&full))
 }
 
 struct Adapter<'o, O: FrfObserver> {
@@ -166,8 +259,15 @@ fn full_point(system: &mut HbmOperator<'_>, p: &PathPoint) -> Result<FrfPoint, H
         full.static_offset(),
         &coefficients,
     );
+    // A point solved at the start or end frequency (ω = 2π f) is reported at exactly f, not at
+    // ω / 2π rounded an ulp away (the last row of a range must be its end).
+    let range = &full.problem().analysis.continuation;
+    let freq_hz = [range.freq_start_hz, range.freq_end_hz]
+        .into_iter()
+        .find(|f| (p.freq_hz() - f).abs() <= 8.0 * f64::EPSILON * f)
+        .unwrap_or_else(|| p.freq_hz());
     Ok(FrfPoint {
-        freq_hz: p.freq_hz(),
+        freq_hz,
         amplitudes,
         peaks,
         states: system.states().to_vec(),
@@ -209,7 +309,7 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
     let guess = system.restrict(&linear::stuck_guess(problem, &set, omega0)?);
     let continuation = Continuation::new(
         problem.analysis.continuation,
-        arc_length_x_scale(problem, &set)?,
+        arc_length_x_scale(problem, &set, &system)?,
     );
     let mut adapter = Adapter {
         observer,
@@ -244,7 +344,7 @@ impl<'p> PointSolver<'p> {
         let set = system.unknowns().clone();
         let continuation = Continuation::new(
             problem.analysis.continuation,
-            arc_length_x_scale(problem, &set)?,
+            arc_length_x_scale(problem, &set, &system)?,
         );
         Ok(Self {
             system,
@@ -279,13 +379,14 @@ impl<'p> PointSolver<'p> {
         b: &FrfPoint,
         t: f64,
     ) -> Result<FrfPoint, NewtonFailure> {
-        let scale = self.continuation.x_scale;
+        let scale = self.continuation.x_scale.clone();
         let system = &self.system;
         let scaled = |p: &FrfPoint| -> Vec<f64> {
             system
                 .restrict(&p.coefficients)
                 .iter()
-                .map(|v| v / scale)
+                .zip(&scale)
+                .map(|(v, s)| v / s)
                 .chain(std::iter::once(p.freq_hz))
                 .collect()
         };
@@ -301,7 +402,7 @@ impl<'p> PointSolver<'p> {
             self.continuation
                 .correct(&mut self.system, &predicted, &chord)?;
         let n = y.len() - 1;
-        let x: Vec<f64> = y[..n].iter().map(|v| v * scale).collect();
+        let x: Vec<f64> = y[..n].iter().zip(&scale).map(|(v, s)| v * s).collect();
         let omega = 2.0 * PI * y[n];
         // Leave the operator (and its contact states) evaluated at the returned point.
         let mut r = vec![0.0; n];

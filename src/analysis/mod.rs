@@ -21,6 +21,8 @@
 //! - [`frf::interpolate_on_path`]: a starting guess at a frequency from a solved path.
 //! - [`linear::reference_curve`]: a linear reference ([`linear::LinearCase`]) on a grid, as a
 //!   [`linear::LinearCurve`]; [`linear::stuck_guess`] seeds the nonlinear solve.
+//! - [`peaks::path_peaks`]: every resonance peak of every output along a path, told from the
+//!   sampled law's wiggles by its prominence and refined along the path ([`peaks::Peak`]).
 //! - [`limits::analyse`]: the limit analysis (limit, intermediate and scanned curves, grid
 //!   classification, bound check, hysteresis loops) as a [`limits::LimitAnalysis`].
 //! - [`limits::solve_case`]: one case's curve and its refined resonance peak.
@@ -29,3 +31,4 @@
 pub mod frf;
 pub mod limits;
 pub mod linear;
+pub mod peaks;

@@ -1,7 +1,9 @@
 //! Newton's method with pseudo-arc-length continuation in the frequency (paper Eqs. 8-9).
 //!
 //! The path y(s) = (x(s), ω(s)) is followed in a scaled space where one unit of ω is 1 Hz
-//! (ω/2π) and one unit of x is `x_scale` (m), so step sizes read as "Hz-equivalent" arc length.
+//! (ω/2π) and one unit of xᵢ is `x_scale[i]` (m), so step sizes read as "Hz-equivalent" arc
+//! length. The scale is per unknown so that no block of unknowns (e.g. a large static part)
+//! dominates the arc length and hides the change of the others.
 //! Each step predicts along the unit tangent t, y_p = y + Δs·t, and corrects with Newton on
 //!
 //! R(x, ω) = 0,   tᵀ (y − y_p) = 0.
@@ -74,7 +76,7 @@ pub struct Continuation {
     /// Settings (frequencies in Hz).
     pub settings: ContinuationSettings,
     /// Scale of x in the arc length (m).
-    pub x_scale: f64,
+    pub x_scale: Vec<f64>,
     /// Chord corrector only: the factorisation of its last iterate with the tangent row it
     /// was built with, reused for the tangent at the corrected point.
     last_factor: std::cell::RefCell<Option<(Vec<f64>, BorderedFactor)>>,
@@ -96,10 +98,14 @@ const CHORD_CONTRACTION: f64 = 0.5;
 const CARRY_POINTS: usize = 8;
 /// Largest turn of the tangent in one step before the step is cut (unless it is a corner).
 const MAX_TURN_DEGREES: f64 = 45.0;
+/// Turn of the tangent per step the step length aims at: a step that turned the tangent by
+/// more is followed by a shorter one (at most halved), one that turned it by less may grow (at
+/// most doubled), as Newton's iteration count allows.
+const TARGET_TURN_DEGREES: f64 = 10.0;
 
 impl Continuation {
     /// A driver with these settings and arc-length scale of x (m).
-    pub fn new(settings: ContinuationSettings, x_scale: f64) -> Self {
+    pub fn new(settings: ContinuationSettings, x_scale: Vec<f64>) -> Self {
         Self {
             settings,
             x_scale,
@@ -204,7 +210,7 @@ impl Continuation {
                     factorisations += 1;
                     let mut row = vec![0.0; n + 1];
                     row[n] = 1.0;
-                    let f = jac.factor_bordered(1.0, &vec![0.0; n], &row)?;
+                    let f = jac.factor_bordered(&vec![1.0; n], &vec![0.0; n], &row)?;
                     let mut rhs = neg;
                     rhs.push(0.0);
                     let mut d = f.solve(&rhs)?;
@@ -214,7 +220,7 @@ impl Continuation {
                 }
                 None => jac.solve(&neg)?,
             };
-            let step_norm = norm(&dx) / self.x_scale;
+            let step_norm = scaled_norm(&dx, &self.x_scale);
             let mut alpha = 1.0;
             let improved = loop {
                 for i in 0..n {
@@ -305,7 +311,7 @@ impl Continuation {
                 e
             }
         };
-        let mut t = jac.solve_bordered(self.x_scale, &col, &row, &rhs)?;
+        let mut t = jac.solve_bordered(&self.x_scale, &col, &row, &rhs)?;
         let nt = norm(&t);
         t.iter_mut().for_each(|v| *v /= nt);
         let orientation = match previous {
@@ -373,7 +379,7 @@ impl Continuation {
         };
         for it in 1..=limit {
             for i in 0..n {
-                x[i] = y[i] * self.x_scale;
+                x[i] = y[i] * self.x_scale[i];
             }
             let omega = y[n] * OMEGA_SCALE;
             let previous = rel;
@@ -408,7 +414,7 @@ impl Continuation {
                     }
                     factorisations += 1;
                     if chord {
-                        let f = jac.factor_bordered(self.x_scale, &col, tangent)?;
+                        let f = jac.factor_bordered(&self.x_scale, &col, tangent)?;
                         let d = f.solve(&rhs)?;
                         broyden.restart(&d);
                         *self.carried.borrow_mut() = f.rebordered(tangent).map(|c| (c, 0));
@@ -416,7 +422,7 @@ impl Continuation {
                         factor = Some(f);
                         d
                     } else {
-                        jac.solve_bordered(self.x_scale, &col, tangent, &rhs)?
+                        jac.solve_bordered(&self.x_scale, &col, tangent, &rhs)?
                     }
                 }
             };
@@ -430,7 +436,7 @@ impl Continuation {
                 // through round-off (amplified by the Jacobian's condition number near a
                 // lightly damped resonance): the point is converged.
                 for j in 0..n {
-                    trial[j] = (y[j] + dy[j]) * self.x_scale;
+                    trial[j] = (y[j] + dy[j]) * self.x_scale[j];
                 }
                 system
                     .residual(&trial, (y[n] + dy[n]) * OMEGA_SCALE, &mut r)
@@ -448,7 +454,7 @@ impl Continuation {
                 let mut alpha = 1.0;
                 loop {
                     for j in 0..n {
-                        trial[j] = (y[j] + alpha * dy[j]) * self.x_scale;
+                        trial[j] = (y[j] + alpha * dy[j]) * self.x_scale[j];
                     }
                     system
                         .residual(&trial, (y[n] + alpha * dy[n]) * OMEGA_SCALE, &mut r)
@@ -484,7 +490,7 @@ impl Continuation {
             if step <= self.settings.step_tolerance {
                 // The step is converged: check the residual at the updated point.
                 for i in 0..n {
-                    x[i] = y[i] * self.x_scale;
+                    x[i] = y[i] * self.x_scale[i];
                 }
                 system
                     .residual(&x, y[n] * OMEGA_SCALE, &mut r)
@@ -525,7 +531,7 @@ impl Continuation {
             let Ok((yc, it, rel)) = self.correct(system, &predicted, tangent) else {
                 continue;
             };
-            let Ok((point, t_new, _)) =
+            let Ok((point, t_new, _, _)) =
                 self.corrected_point(system, &yc, it, rel, ds, &predicted, tangent)
             else {
                 continue;
@@ -543,8 +549,8 @@ impl Continuation {
         Ok(None)
     }
 
-    /// The path point of a corrected y, its tangent, and the step quality (> 1: the corrector
-    /// went farther than the step or the tangent turned by more than [`MAX_TURN_DEGREES`]).
+    /// The path point of a corrected y, its tangent, the distance of the correction relative
+    /// to the step, and the angle (degrees) the tangent turned by over the step.
     #[allow(clippy::too_many_arguments)]
     fn corrected_point<S: ParametricResidual>(
         &self,
@@ -555,7 +561,7 @@ impl Continuation {
         ds: f64,
         predicted: &[f64],
         tangent: &[f64],
-    ) -> Result<(PathPoint, Vec<f64>, f64), NewtonFailure> {
+    ) -> Result<(PathPoint, Vec<f64>, f64, f64), NewtonFailure> {
         let n = yc.len() - 1;
         let distance = norm(
             &yc.iter()
@@ -565,15 +571,26 @@ impl Continuation {
         );
         let point = PathPoint {
             omega: yc[n] * OMEGA_SCALE,
-            x: yc[..n].iter().map(|v| v * self.x_scale).collect(),
+            x: yc[..n].iter().zip(&self.x_scale).map(|(v, s)| v * s).collect(),
             iterations,
             residual,
             step: ds,
         };
         let t_new = self.tangent(system, &point, Some(tangent))?;
         let degrees = dot(&t_new, tangent).clamp(-1.0, 1.0).acos().to_degrees();
-        let quality = (distance / ds).max(degrees / MAX_TURN_DEGREES);
-        Ok((point, t_new, quality))
+        Ok((point, t_new, distance / ds, degrees))
+    }
+
+    /// Whether the path has left the range for good below the start frequency. A path that
+    /// turns back below the start (a fold: the response overhangs) is followed on, within the
+    /// point budget, since it usually turns again and comes back; only one that runs on down
+    /// to below the start minus half the range (or to a tenth of the start frequency) is
+    /// given up.
+    fn left_range(&self, point: &PathPoint) -> bool {
+        let a = &self.settings;
+        let floor = (a.freq_start_hz - 0.5 * (a.freq_end_hz - a.freq_start_hz))
+            .max(0.1 * a.freq_start_hz);
+        point.freq_hz() < floor
     }
 
     /// Follows the path from `x_guess` at the start frequency to the end frequency.
@@ -614,7 +631,8 @@ impl Continuation {
             let y: Vec<f64> = last
                 .x
                 .iter()
-                .map(|v| v / self.x_scale)
+                .zip(&self.x_scale)
+                .map(|(v, s)| v / s)
                 .chain(std::iter::once(last.omega / OMEGA_SCALE))
                 .collect();
             let predicted: Vec<f64> = (0..=n).map(|j| y[j] + ds * tangent[j]).collect();
@@ -623,7 +641,7 @@ impl Continuation {
                 let frac =
                     ((omega_end / OMEGA_SCALE - y[n]) / (predicted[n] - y[n])).clamp(0.0, 1.0);
                 let guess: Vec<f64> = (0..n)
-                    .map(|j| (y[j] + frac * (predicted[j] - y[j])) * self.x_scale)
+                    .map(|j| (y[j] + frac * (predicted[j] - y[j])) * self.x_scale[j])
                     .collect();
                 match self.solve_fixed(system, &guess, omega_end) {
                     Ok(mut p) => {
@@ -652,40 +670,30 @@ impl Continuation {
             let outcome = self
                 .correct(system, &predicted, &tangent)
                 .and_then(|(yc, it, rel)| {
-                    let distance = norm(
-                        &yc.iter()
-                            .zip(&predicted)
-                            .map(|(a, b)| a - b)
-                            .collect::<Vec<_>>(),
-                    );
-                    let point = PathPoint {
-                        omega: yc[n] * OMEGA_SCALE,
-                        x: yc[..n].iter().map(|v| v * self.x_scale).collect(),
-                        iterations: it,
-                        residual: rel,
-                        step: ds,
-                    };
-                    let t_new = self.tangent(system, &point, Some(&tangent))?;
-                    let degrees = dot(&t_new, &tangent).clamp(-1.0, 1.0).acos().to_degrees();
+                    let (point, t_new, far, degrees) =
+                        self.corrected_point(system, &yc, it, rel, ds, &predicted, &tangent)?;
                     // Step quality: > 1 means the corrector went far or the path turned sharply.
-                    let quality = (distance / ds).max(degrees / MAX_TURN_DEGREES);
+                    let quality = far.max(degrees / MAX_TURN_DEGREES);
                     if quality > 1.0 && ds > 2.0 * a.min_step {
                         // A corner of the piecewise-smooth path (a contact changing state) turns
                         // the tangent by the same angle whatever the step; a branch jump does not.
                         let corner = previous_quality.is_some_and(|q| quality >= 0.7 * q);
                         if !corner {
                             previous_quality = Some(quality);
-                            return Err(if distance / ds >= degrees / MAX_TURN_DEGREES {
-                                NewtonFailure::FarCorrection { distance, step: ds }
+                            return Err(if far >= degrees / MAX_TURN_DEGREES {
+                                NewtonFailure::FarCorrection {
+                                    distance: far * ds,
+                                    step: ds,
+                                }
                             } else {
                                 NewtonFailure::SharpTurn { degrees }
                             });
                         }
                     }
-                    Ok((point, t_new))
+                    Ok((point, t_new, degrees))
                 });
             match outcome {
-                Ok((point, t_new)) => {
+                Ok((point, t_new, degrees)) => {
                     previous_quality = None;
                     if t_new[n] * tangent[n] < 0.0 {
                         summary.turning_points.push(point.freq_hz());
@@ -693,15 +701,19 @@ impl Continuation {
                     }
                     let iterations = point.iterations;
                     observer.accepted(system, &point);
-                    let below = point.omega < omega_start;
+                    let left = self.left_range(&point);
                     summary.points.push(point);
                     tangent = t_new;
-                    if below {
+                    if left {
                         summary.end = PathEnd::LeftRangeBelow;
                         return Ok(summary);
                     }
-                    let factor =
-                        (a.target_iterations as f64 / iterations.max(1) as f64).clamp(0.5, 2.0);
+                    // The next step: shorter where Newton needed many iterations, and where
+                    // the path bends (the tangent turned by more than TARGET_TURN_DEGREES over
+                    // this step), so that peaks and anti-resonances get points on their flanks.
+                    let by_iterations = a.target_iterations as f64 / iterations.max(1) as f64;
+                    let by_turn = TARGET_TURN_DEGREES / degrees.max(1e-3);
+                    let factor = by_iterations.min(by_turn).clamp(0.5, 2.0);
                     ds = (ds * factor).clamp(a.min_step, a.max_step);
                 }
                 Err(reason) => {
@@ -722,11 +734,11 @@ impl Continuation {
                                     observer.turning_point(point.freq_hz());
                                 }
                                 observer.accepted(system, &point);
-                                let below = point.omega < omega_start;
+                                let left = self.left_range(&point);
                                 summary.points.push(point);
                                 tangent = t_new;
                                 previous_quality = None;
-                                if below {
+                                if left {
                                     summary.end = PathEnd::LeftRangeBelow;
                                     return Ok(summary);
                                 }
@@ -749,4 +761,13 @@ impl Continuation {
         summary.end = PathEnd::MaxPoints;
         Ok(summary)
     }
+}
+
+/// Norm of v scaled per entry: ‖(vᵢ / sᵢ)‖.
+fn scaled_norm(v: &[f64], scale: &[f64]) -> f64 {
+    v.iter()
+        .zip(scale)
+        .map(|(a, s)| (a / s) * (a / s))
+        .sum::<f64>()
+        .sqrt()
 }

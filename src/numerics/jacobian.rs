@@ -82,33 +82,41 @@ enum FactorKind {
     },
 }
 
-/// A factorisation of s·J alone (sparse LU, or an implicit Jacobian's own).
-enum InnerFactor {
-    /// Sparse LU of s·J.
+/// A factorisation of J S alone, S = diag(s) the column scale: a factorisation of J (sparse
+/// LU, or an implicit Jacobian's own) and s, since (J S)⁻¹ b = S⁻¹ J⁻¹ b.
+struct InnerFactor {
+    kind: InnerKind,
+    /// Column scale s (length n).
+    col_scale: Vec<f64>,
+}
+
+/// A factorisation of J.
+enum InnerKind {
+    /// Sparse LU of J.
     Sparse(Box<faer::sparse::linalg::solvers::Lu<usize, f64>>),
-    /// Factorisation of J, and the scale s.
-    Implicit(Box<dyn ImplicitFactor>, f64),
+    /// An implicit Jacobian's factorisation of J.
+    Implicit(Box<dyn ImplicitFactor>),
 }
 
 impl InnerFactor {
-    /// (s·J)⁻¹ b.
+    /// (J S)⁻¹ b.
     fn solve(&self, b: &[f64]) -> Vec<f64> {
         self.solve_with(b, false)
     }
 
-    /// (s·J)⁻¹ b, in single precision where the factorisation offers it (`fast`).
+    /// (J S)⁻¹ b, in single precision where the factorisation offers it (`fast`).
     fn solve_with(&self, b: &[f64], fast: bool) -> Vec<f64> {
-        match self {
-            InnerFactor::Sparse(lu) => {
+        let mut x = match &self.kind {
+            InnerKind::Sparse(lu) => {
                 let x = lu.solve(Mat::from_fn(b.len(), 1, |i, _| b[i]));
                 (0..b.len()).map(|i| x[(i, 0)]).collect()
             }
-            InnerFactor::Implicit(f, scale) => {
-                let mut x = f.solve(b, fast);
-                x.iter_mut().for_each(|v| *v /= scale);
-                x
-            }
-        }
+            InnerKind::Implicit(f) => f.solve(b, fast),
+        };
+        x.iter_mut()
+            .zip(&self.col_scale)
+            .for_each(|(v, s)| *v /= s);
+        x
     }
 }
 
@@ -373,8 +381,9 @@ impl AssembledJacobian {
                 solve_dense(&a, b)
             }
             Storage::Sparse | Storage::Schur => {
-                let lu = self.inner_factor(1.0)?;
-                let x = self.checked_solve(&lu, 1.0, b)?;
+                let ones = vec![1.0; self.n];
+                let lu = self.inner_factor(&ones)?;
+                let x = self.checked_solve(&lu, &ones, b)?;
                 Ok(x)
             }
         }
@@ -384,7 +393,7 @@ impl AssembledJacobian {
     /// `row`, `rhs` of length n + 1.
     pub fn solve_bordered(
         &mut self,
-        col_scale: f64,
+        col_scale: &[f64],
         col: &[f64],
         row: &[f64],
         rhs: &[f64],
@@ -401,7 +410,7 @@ impl AssembledJacobian {
     /// ([`BorderedFactor::solve`], without the refinement steps of [`Self::solve_bordered`]).
     pub fn factor_bordered(
         &mut self,
-        col_scale: f64,
+        col_scale: &[f64],
         col: &[f64],
         row: &[f64],
     ) -> Result<BorderedFactor, LinearSolveError> {
@@ -412,7 +421,7 @@ impl AssembledJacobian {
         let kind = match self.storage {
             Storage::Dense => {
                 let a = Mat::from_fn(n + 1, n + 1, |i, j| match (i < n, j < n) {
-                    (true, true) => self.values[i + j * n] * col_scale,
+                    (true, true) => self.values[i + j * n] * col_scale[j],
                     (true, false) => col[i],
                     (false, _) => row[j],
                 });
@@ -438,22 +447,28 @@ impl AssembledJacobian {
         Ok(BorderedFactor { kind })
     }
 
-    /// Factorisation of s·J: sparse LU, or the implicit Jacobian's own.
-    fn inner_factor(&mut self, col_scale: f64) -> Result<InnerFactor, LinearSolveError> {
-        match &self.implicit {
+    /// Factorisation of J S: sparse LU of J, or the implicit Jacobian's own, with the scale.
+    fn inner_factor(&mut self, col_scale: &[f64]) -> Result<InnerFactor, LinearSolveError> {
+        if col_scale.len() != self.n || col_scale.iter().any(|s| !s.is_finite() || *s == 0.0) {
+            return Err(LinearSolveError::NonFinite);
+        }
+        let kind = match &self.implicit {
             Some(r) => {
                 let f = r.factor(self.omega, &self.values)?;
                 self.factorisations += 1;
-                Ok(InnerFactor::Implicit(f, col_scale))
+                InnerKind::Implicit(f)
             }
-            None => Ok(InnerFactor::Sparse(Box::new(self.sparse_lu(col_scale)?))),
-        }
+            None => InnerKind::Sparse(Box::new(self.sparse_lu()?)),
+        };
+        Ok(InnerFactor {
+            kind,
+            col_scale: col_scale.to_vec(),
+        })
     }
 
-    /// Numeric LU of s·J with the shared symbolic factorisation.
+    /// Numeric LU of J with the shared symbolic factorisation.
     fn sparse_lu(
         &mut self,
-        col_scale: f64,
     ) -> Result<faer::sparse::linalg::solvers::Lu<usize, f64>, LinearSolveError> {
         if self.values.iter().any(|v| !v.is_finite()) {
             return Err(LinearSolveError::NonFinite);
@@ -465,8 +480,7 @@ impl AssembledJacobian {
             self.symbolic_lu = Some(symbolic);
         }
         let symbolic = self.symbolic_lu.clone().expect("set above");
-        let vals: Vec<f64> = self.values.iter().map(|v| v * col_scale).collect();
-        let matrix = SparseColMat::new(pattern, vals);
+        let matrix = SparseColMat::new(pattern, self.values.clone());
         let lu =
             faer::sparse::linalg::solvers::Lu::try_new_with_symbolic(symbolic, matrix.as_ref())
                 .map_err(|_| LinearSolveError::Singular { ratio: 0.0 })?;
@@ -475,20 +489,22 @@ impl AssembledJacobian {
     }
 
     /// y += s·J x.
-    fn mul_add(&self, col_scale: f64, x: &[f64], y: &mut [f64]) {
+    fn mul_add(&self, col_scale: &[f64], x: &[f64], y: &mut [f64]) {
+        let scaled: Vec<f64> = x.iter().zip(col_scale).map(|(v, s)| v * s).collect();
         if let Some(r) = &self.implicit {
-            r.mul_add(self.omega, &self.values, col_scale, x, y);
+            r.mul_add(self.omega, &self.values, 1.0, &scaled, y);
             return;
         }
         let p = self.pattern.as_ref().expect("sparse storage has a pattern");
         let (col_ptr, rows) = (p.col_ptr(), p.row_idx());
         for j in 0..self.n {
-            let xj = col_scale * x[j];
+            let xj = scaled[j];
             for k in col_ptr[j]..col_ptr[j + 1] {
                 y[rows[k]] += self.values[k] * xj;
             }
         }
     }
+
 
     /// Solves s·J x = b with a factorisation of s·J, with one refinement step, and refuses a
     /// solution whose residual exceeds 1e-6 of ‖b‖ (a numerically singular J can give finite
@@ -496,7 +512,7 @@ impl AssembledJacobian {
     fn checked_solve(
         &self,
         lu: &InnerFactor,
-        col_scale: f64,
+        col_scale: &[f64],
         b: &[f64],
     ) -> Result<Vec<f64>, LinearSolveError> {
         if b.iter().any(|v| !v.is_finite()) {
@@ -530,7 +546,7 @@ impl AssembledJacobian {
     /// docs), refined on the full bordered residual.
     fn solve_eliminated_bordered(
         &mut self,
-        col_scale: f64,
+        col_scale: &[f64],
         col: &[f64],
         row: &[f64],
         rhs: &[f64],
@@ -606,8 +622,9 @@ mod tests {
         let col = [0.5, -1.0, 2.0];
         let row = [1.0, 0.0, 1.0, 3.0];
         let rhs = [0.0, 1.0, 0.0, 1.0];
-        let yd = d.solve_bordered(2.0, &col, &row, &rhs).unwrap();
-        let ys = s.solve_bordered(2.0, &col, &row, &rhs).unwrap();
+        let scale = [2.0, 0.5, 3.0];
+        let yd = d.solve_bordered(&scale, &col, &row, &rhs).unwrap();
+        let ys = s.solve_bordered(&scale, &col, &row, &rhs).unwrap();
         for i in 0..4 {
             assert!((yd[i] - ys[i]).abs() < 1e-13, "{yd:?} vs {ys:?}");
         }

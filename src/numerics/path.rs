@@ -132,7 +132,8 @@ pub struct PathSummary {
 pub enum PathEnd {
     /// Reached the end frequency.
     EndFrequency,
-    /// The path turned back below the start frequency.
+    /// The path turned back below the start frequency and ran on far below it (see
+    /// `Continuation::left_range`): the range above was not covered.
     LeftRangeBelow,
     /// The point budget was used up.
     MaxPoints,

@@ -28,9 +28,10 @@ const STEP_RETRIES: [f64; 4] = [1.0, 0.5, 0.25, 2.0];
 
 /// Solves the FRF of one case and locates its peak (first output DOF) in `window` (Hz).
 ///
-/// If the continuation fails, it is repeated with the scene's initial and largest steps scaled
-/// by the factors 0.5, 0.25 and 2 in turn; the number of retries is recorded, and the first
-/// failure is returned when every attempt fails.
+/// If the continuation fails, or ends before the end of the range (an incomplete run: the
+/// curve would not cover the range the limits are asked for), it is repeated with the scene's
+/// initial and largest steps scaled by the factors 0.5, 0.25 and 2 in turn; the number of
+/// retries is recorded, and the first failure is returned when every attempt fails.
 pub fn solve_case(
     problem: &Problem,
     case: &LimitCase,
@@ -41,13 +42,19 @@ pub fn solve_case(
         case: case.name.clone(),
         source,
     };
-    let mut first_error = None;
+    let mut first_error: Option<LimitError> = None;
     for (retries, factor) in STEP_RETRIES.iter().enumerate() {
         let mut attempt = p.clone();
         let a = &mut attempt.analysis.continuation;
         a.max_step = (a.max_step * factor).max(a.min_step);
         a.initial_step = (a.initial_step * factor).clamp(a.min_step, a.max_step);
         match frf::solve(&attempt, &mut Silent) {
+            Ok(run) if !run.is_complete() => {
+                first_error.get_or_insert(LimitError::Incomplete {
+                    case: case.name.clone(),
+                    reason: run.incomplete_reason().unwrap_or_default(),
+                });
+            }
             Ok(run) => {
                 let peak = refine_peak(&p, &run.points, 0, window)
                     .map_err(err)?
@@ -67,9 +74,9 @@ pub fn solve_case(
                 });
             }
             Err(e) => {
-                first_error.get_or_insert(e);
+                first_error.get_or_insert(err(e));
             }
         }
     }
-    Err(err(first_error.expect("at least one attempt")))
+    Err(first_error.expect("at least one attempt"))
 }

@@ -23,6 +23,15 @@ pub enum LimitError {
         /// Cause.
         source: HbmError,
     },
+    /// A curve's continuation ended before the end of the range with every step setting
+    /// tried (see `FrfRun::incomplete_reason`).
+    #[error("curve `{case}` is incomplete: {reason}")]
+    Incomplete {
+        /// Case name.
+        case: String,
+        /// Why the range was not covered.
+        reason: String,
+    },
     /// No converged point of a curve lies in the peak window.
     #[error("curve `{case}`: no converged point in the peak window {lo_hz} .. {hi_hz} Hz")]
     NoPeak {

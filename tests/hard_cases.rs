@@ -1,0 +1,214 @@
+//! Hard cases of the paper's wedge-damper system (β = 120°, F0 = 120 N, 50-350 Hz unless
+//! changed): each is a full continuation that must reach the end of the range with every point
+//! converged and finite, and is checked against an independent expectation.
+//!
+//! The check shared by every case: wherever every contact is fully stuck over the period, the
+//! contact forces' dynamic parts are kₜu and kₙv exactly, so the response there must equal the
+//! linear response with all contacts stuck (closed form, `analysis::linear`), whatever the
+//! frame angles, gap, harmonics or pre-load.
+
+use fricbound::analysis::frf::{self, FrfRun, Silent};
+use fricbound::analysis::linear::{self, LinearCase};
+use fricbound::analysis::peaks;
+use fricbound::contact::ContactState;
+use fricbound::model::Problem;
+use fricbound::scene::{self, paper_wedge_scene};
+
+fn problem(overrides: &[&str]) -> Problem {
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    scene::parse(paper_wedge_scene(), "paper", &overrides)
+        .and_then(|s| s.validate("paper"))
+        .unwrap_or_else(|e| panic!("{overrides:?}: {e}"))
+}
+
+/// Solves the FRF and checks what every hard case must show: the run covers the range, its
+/// last point is at the end frequency exactly, every point converged with finite outputs, and
+/// fully stuck points equal the stuck linear response.
+fn solve_complete(p: &Problem, label: &str) -> FrfRun {
+    let run = frf::solve(p, &mut Silent).unwrap_or_else(|e| panic!("{label}: {e}"));
+    assert!(
+        run.is_complete(),
+        "{label}: {:?}",
+        run.incomplete_reason()
+    );
+    let range = &p.analysis.continuation;
+    assert_eq!(
+        run.points.last().map(|q| q.freq_hz),
+        Some(range.freq_end_hz),
+        "{label}: the last point is not at the end frequency"
+    );
+    for q in &run.points {
+        assert!(
+            q.residual <= range.residual_tolerance,
+            "{label}: point at {} Hz not converged ({:e})",
+            q.freq_hz,
+            q.residual
+        );
+        assert!(
+            q.amplitudes.iter().chain(&q.peaks).all(|v| v.is_finite()),
+            "{label}: non-finite output at {} Hz",
+            q.freq_hz
+        );
+        // The time-domain peak is at least the first-harmonic amplitude.
+        for (a, pk) in q.amplitudes.iter().zip(&q.peaks) {
+            assert!(*pk >= a * (1.0 - 1e-12), "{label}: peak {pk} < amplitude {a}");
+        }
+    }
+    let stuck: Vec<_> = run
+        .points
+        .iter()
+        .filter(|q| q.states.iter().all(|s| *s == ContactState::Stuck))
+        .collect();
+    let freqs: Vec<f64> = stuck.iter().map(|q| q.freq_hz).collect();
+    let linear = linear::frf(p, LinearCase::Stuck, &freqs).expect("stuck linear response");
+    let d = p.outputs[0];
+    for (q, lin) in stuck.iter().zip(&linear) {
+        let rel = (q.amplitudes[0] - lin[d]).abs() / lin[d];
+        assert!(
+            rel < 1e-6,
+            "{label}: fully stuck at {} Hz but {} ≠ stuck linear {} (rel {rel:e})",
+            q.freq_hz,
+            q.amplitudes[0],
+            lin[d]
+        );
+    }
+    run
+}
+
+/// The resonance peaks of the stuck linear reference of output 0 over the range: local maxima
+/// of a 0.5 Hz grid, each refined by golden-section search on the closed-form response.
+fn stuck_linear_peaks(p: &Problem) -> Vec<(f64, f64)> {
+    let d = p.outputs[0];
+    let amp = |f: f64| linear::frf(p, LinearCase::Stuck, &[f]).expect("linear")[0][d];
+    let range = &p.analysis.continuation;
+    let grid: Vec<f64> = (0..=((range.freq_end_hz - range.freq_start_hz) / 0.5) as usize)
+        .map(|i| range.freq_start_hz + 0.5 * i as f64)
+        .collect();
+    let a: Vec<f64> = grid.iter().map(|&f| amp(f)).collect();
+    (1..a.len() - 1)
+        .filter(|&i| a[i] > a[i - 1] && a[i] >= a[i + 1])
+        .map(|i| {
+            let ratio = (5f64.sqrt() - 1.0) / 2.0;
+            let (mut lo, mut hi) = (grid[i - 1], grid[i + 1]);
+            while hi - lo > 1e-9 {
+                let c = hi - ratio * (hi - lo);
+                let d = lo + ratio * (hi - lo);
+                if amp(c) >= amp(d) {
+                    hi = d;
+                } else {
+                    lo = c;
+                }
+            }
+            let f = 0.5 * (lo + hi);
+            (f, amp(f))
+        })
+        .collect()
+}
+
+/// Every refined peak of the FRF equals a peak of the stuck linear reference within 0.1 %, and
+/// every linear peak is found.
+fn peaks_match_stuck_linear(p: &Problem, run: &FrfRun, label: &str) {
+    let found = &peaks::path_peaks(p, &run.points).expect("peaks")[0];
+    let expected = stuck_linear_peaks(p);
+    assert_eq!(
+        found.len(),
+        expected.len(),
+        "{label}: peaks {:?} vs stuck linear {expected:?}",
+        found.iter().map(|k| (k.freq_hz, k.amplitude)).collect::<Vec<_>>()
+    );
+    for (k, (f, a)) in found.iter().zip(&expected) {
+        let rel = (k.amplitude - a).abs() / a;
+        assert!(
+            rel < 1e-3,
+            "{label}: peak {:.4e} at {:.3} Hz vs stuck linear {a:.4e} at {f:.3} Hz (rel {rel:.2e})",
+            k.amplitude,
+            k.freq_hz
+        );
+    }
+}
+
+/// F0 = 100 kN: every contact stays stuck, so the FRF is the stuck linear one, and continuation
+/// must not step over its four resonance peaks (a user sees all four at their linear height).
+#[test]
+fn very_high_preload_gives_the_stuck_linear_peaks() {
+    let p = problem(&["static_loads.0.value=-1e5"]);
+    let run = solve_complete(&p, "F0 = 1e5 N");
+    peaks_match_stuck_linear(&p, &run, "F0 = 1e5 N");
+}
+
+/// Contact stiffnesses a thousand times lower: the slip threshold μN/kₜ is a thousand times
+/// larger, the contacts stay stuck, and the FRF is the (softer) stuck linear one, peaks and all.
+#[test]
+fn soft_contacts_stay_stuck_and_give_the_stuck_linear_peaks() {
+    let p = problem(&[
+        "contacts.0.kt=300",
+        "contacts.0.kn=300",
+        "contacts.1.kt=300",
+        "contacts.1.kn=300",
+    ]);
+    let run = solve_complete(&p, "k × 1e-3");
+    peaks_match_stuck_linear(&p, &run, "k × 1e-3");
+}
+
+/// β = 60°, 90° and 180° (frames at 180° ∓ α, α = (180° − β)/2): the range is covered and the
+/// stuck stretches are linear; the flat damper (β = 180°) has no damper-induced coupling.
+#[test]
+fn other_apical_angles_cover_the_range() {
+    for (beta, left, right) in [(60, 120.0, 240.0), (90, 135.0, 225.0), (180, 180.0, 180.0)] {
+        let p = problem(&[
+            &format!("contacts.0.angle_deg={left}"),
+            &format!("contacts.1.angle_deg={right}"),
+        ]);
+        solve_complete(&p, &format!("β = {beta}°"));
+    }
+}
+
+/// μ = 0: no tangential force at all; wherever the contacts stay closed the system is linear
+/// with the normal springs only, so the FRF equals the stuck linear response of the same
+/// structure with kₜ → 0 there (most of the range; contacts lift off near resonances).
+#[test]
+fn frictionless_contacts_give_the_normal_spring_linear_system() {
+    let p = problem(&["contacts.0.mu=0", "contacts.1.mu=0"]);
+    let run = solve_complete(&p, "μ = 0");
+    let normal_only = problem(&["contacts.0.kt=1e-9", "contacts.1.kt=1e-9"]);
+    // Where a contact lifts off (near the 2nd resonance the blade-2 side does), the normal
+    // spring acts for part of the period only and the system is not linear there.
+    let closed: Vec<_> = run
+        .points
+        .iter()
+        .filter(|q| {
+            q.states
+                .iter()
+                .all(|s| !matches!(s, ContactState::StickSlipLiftoff | ContactState::Open))
+        })
+        .collect();
+    assert!(
+        closed.len() * 2 > run.points.len(),
+        "μ = 0: contacts closed at only {} of {} points",
+        closed.len(),
+        run.points.len()
+    );
+    let freqs: Vec<f64> = closed.iter().map(|q| q.freq_hz).collect();
+    let linear = linear::frf(&normal_only, LinearCase::Stuck, &freqs).expect("linear");
+    let d = p.outputs[0];
+    for (q, lin) in closed.iter().zip(&linear) {
+        let rel = (q.amplitudes[0] - lin[d]).abs() / lin[d];
+        assert!(rel < 1e-6, "μ = 0 at {} Hz: rel {rel:e}", q.freq_hz);
+    }
+}
+
+/// 25 harmonics with 4096 samples per period: a big harmonic balance (6 DOFs × 51 blocks) must
+/// still follow the whole path.
+#[test]
+fn many_harmonics_cover_the_range() {
+    let p = problem(&["harmonics.max=25", "harmonics.samples=4096"]);
+    solve_complete(&p, "H = 25");
+}
+
+/// A small initial gap on both contacts (1 µm): the pre-load closes it, and contacts graze
+/// (touch and part) in parts of the range; the path must still reach the end.
+#[test]
+fn grazing_contacts_cover_the_range() {
+    let p = problem(&["contacts.0.gap=1e-6", "contacts.1.gap=1e-6"]);
+    solve_complete(&p, "gap = 1 µm");
+}
