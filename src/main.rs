@@ -61,8 +61,15 @@ enum Command {
     },
 }
 
+/// Parses the arguments, runs the command and maps its result to the exit code: 0 complete
+/// ([`fricbound::cli::EXIT_COMPLETE`]), 1 error ([`fricbound::cli::EXIT_ERROR`], one `error:`
+/// line on stderr), 3 a run that wrote its results but did not cover the range or every case
+/// ([`fricbound::cli::EXIT_INCOMPLETE`], one `incomplete:` line on stderr); clap exits with 2
+/// on usage errors.
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // Why a run is incomplete, when it is.
+    let mut incomplete: Option<String> = None;
     let result = match cli.command {
         Command::Run {
             scene,
@@ -82,6 +89,7 @@ fn main() -> ExitCode {
                     if !quiet {
                         println!("{}", fricbound::cli::run_summary(&r));
                     }
+                    incomplete = r.incomplete;
                 })
                 .map_err(|e| e.to_string())
         }
@@ -105,11 +113,15 @@ fn main() -> ExitCode {
             .map(|text| print!("{text}"))
             .map_err(|e| e.to_string()),
     };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
+    match (result, incomplete) {
+        (Ok(()), None) => ExitCode::from(fricbound::cli::EXIT_COMPLETE),
+        (Ok(()), Some(reason)) => {
+            eprintln!("incomplete: {reason}");
+            ExitCode::from(fricbound::cli::EXIT_INCOMPLETE)
+        }
+        (Err(e), _) => {
             eprintln!("error: {e}");
-            ExitCode::FAILURE
+            ExitCode::from(fricbound::cli::EXIT_ERROR)
         }
     }
 }

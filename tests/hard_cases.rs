@@ -26,11 +26,7 @@ fn problem(overrides: &[&str]) -> Problem {
 /// fully stuck points equal the stuck linear response.
 fn solve_complete(p: &Problem, label: &str) -> FrfRun {
     let run = frf::solve(p, &mut Silent).unwrap_or_else(|e| panic!("{label}: {e}"));
-    assert!(
-        run.is_complete(),
-        "{label}: {:?}",
-        run.incomplete_reason()
-    );
+    assert!(run.is_complete(), "{label}: {:?}", run.incomplete_reason());
     let range = &p.analysis.continuation;
     assert_eq!(
         run.points.last().map(|q| q.freq_hz),
@@ -51,7 +47,10 @@ fn solve_complete(p: &Problem, label: &str) -> FrfRun {
         );
         // The time-domain peak is at least the first-harmonic amplitude.
         for (a, pk) in q.amplitudes.iter().zip(&q.peaks) {
-            assert!(*pk >= a * (1.0 - 1e-12), "{label}: peak {pk} < amplitude {a}");
+            assert!(
+                *pk >= a * (1.0 - 1e-12),
+                "{label}: peak {pk} < amplitude {a}"
+            );
         }
     }
     let stuck: Vec<_> = run
@@ -114,7 +113,10 @@ fn peaks_match_stuck_linear(p: &Problem, run: &FrfRun, label: &str) {
         found.len(),
         expected.len(),
         "{label}: peaks {:?} vs stuck linear {expected:?}",
-        found.iter().map(|k| (k.freq_hz, k.amplitude)).collect::<Vec<_>>()
+        found
+            .iter()
+            .map(|k| (k.freq_hz, k.amplitude))
+            .collect::<Vec<_>>()
     );
     for (k, (f, a)) in found.iter().zip(&expected) {
         let rel = (k.amplitude - a).abs() / a;

@@ -123,9 +123,13 @@ pub fn time_peak(set: &HarmonicSet, coef: &[f64], offset: f64) -> f64 {
     let grid = (16 * h_max).max(64);
     let value = |tau: f64| (offset + set.evaluate(coef, tau)).abs();
     let dt = 2.0 * PI / grid as f64;
-    let (best, _) = (0..grid)
-        .map(|k| (k, value(k as f64 * dt)))
-        .fold((0, f64::NEG_INFINITY), |acc, (k, v)| if v > acc.1 { (k, v) } else { acc });
+    let (best, _) =
+        (0..grid)
+            .map(|k| (k, value(k as f64 * dt)))
+            .fold(
+                (0, f64::NEG_INFINITY),
+                |acc, (k, v)| if v > acc.1 { (k, v) } else { acc },
+            );
     let ratio = (5f64.sqrt() - 1.0) / 2.0;
     let (mut lo, mut hi) = ((best as f64 - 1.0) * dt, (best as f64 + 1.0) * dt);
     let mut c = hi - ratio * (hi - lo);
@@ -223,9 +227,8 @@ fn arc_length_x_scale(
     }
     let x_ref = static_norm.hypot(dynamic_norm);
     let range = a.freq_end_hz - a.freq_start_hz;
-    let to_scale = |block_norm: f64| {
-        (block_norm.max(1e-3 * x_ref) / (0.25 * range)).max(f64::MIN_POSITIVE)
-    };
+    let to_scale =
+        |block_norm: f64| (block_norm.max(1e-3 * x_ref) / (0.25 * range)).max(f64::MIN_POSITIVE);
     let (static_scale, dynamic_scale) = (to_scale(static_norm), to_scale(dynamic_norm));
     let n = problem.model.n_dofs();
     let full: Vec<f64> = set

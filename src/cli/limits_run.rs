@@ -9,7 +9,8 @@ use crate::analysis::limits::{self, CaseCurve, LimitAnalysis, Regime};
 use crate::report::files::{self, frf_header, frf_row};
 use crate::report::limit_files;
 use crate::report::plot::{
-    figure_files, palette, plot_hysteresis, plot_limits, Curve, LimitFigure, Loop,
+    figure_files, palette, plot_hysteresis, plot_limits, plot_sweep, Curve, LimitFigure, Loop,
+    SweepFigure,
 };
 
 /// Writes one curve's path as `curve_<name>.csv` (same columns as `frf.csv`).
@@ -25,16 +26,62 @@ pub(super) fn write_curve(ctx: &RunContext<'_>, curve: &CaseCurve) -> Result<(),
     Ok(())
 }
 
+/// What the curve callback of a limit analysis collected, for the status and for the files of
+/// an analysis stopped by a failed curve.
+#[derive(Default)]
+struct Finished {
+    /// Limit and intermediate curves, as they finished.
+    curves: Vec<CaseCurve>,
+    /// Scanned cases with their peaks.
+    scanned: Vec<(limits::LimitCase, limits::Peak)>,
+    /// Names of every finished curve.
+    names: Vec<String>,
+    /// "curve `<name>`: <reason>" of every finished curve that did not cover the range.
+    incomplete: Vec<String>,
+}
+
+/// "curve `<name>`: <reason>" when a curve's path did not cover the range.
+pub(super) fn curve_incomplete(curve: &CaseCurve) -> Option<String> {
+    curve
+        .run
+        .incomplete_reason()
+        .map(|r| format!("curve `{}`: {r}", curve.case.name))
+}
+
+/// The incomplete curves of a finished analysis (limit and intermediate ones), "; "-joined;
+/// `None` when every one covered the range.
+pub(super) fn analysis_incomplete(a: &LimitAnalysis) -> Option<String> {
+    let reasons: Vec<String> = a
+        .limits
+        .iter()
+        .chain(&a.intermediate)
+        .filter_map(curve_incomplete)
+        .collect();
+    (!reasons.is_empty()).then(|| reasons.join("; "))
+}
+
 /// Runs the limit analysis of the context's scene.
+///
+/// A curve whose path did not reach the end frequency makes the run incomplete (status
+/// `incomplete: …` in `limits.json`, [`RunReport::incomplete`]); so does a curve that failed,
+/// which stops the analysis (the analysis layer returns no grid, classification or bound check
+/// then): every curve finished before is still written (`curve_*.csv`, `peaks.csv`,
+/// `limits.json`) and drawn (`limits_<dof>`), see [`write_stopped`].
 pub fn run_limits(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
     let problem = &ctx.problem;
     let settings = ctx.limits.clone().expect("called for scenes with [limits]");
-    let n_curves = 2
-        + settings.intermediate.len()
-        + settings.cases.len()
-        + settings.bound_scan.len().pow(problem.sides.len() as u32);
+    let limit_cases = limits::two_point_cases(problem);
+    let intermediate_cases = settings.intermediate_cases(problem);
+    let scanned_cases = limits::scan_cases(problem, &settings.bound_scan);
+    let n_curves = limit_cases.len() + intermediate_cases.len() + scanned_cases.len();
+    let kept: Vec<&str> = limit_cases
+        .iter()
+        .chain(&intermediate_cases)
+        .map(|c| c.name.as_str())
+        .collect();
     let bar = ctx.progress(n_curves as u64);
     let write_error: Mutex<Option<CommandError>> = Mutex::new(None);
+    let finished: Mutex<Finished> = Mutex::new(Finished::default());
     let started = std::time::Instant::now();
     let result = limits::analyse(problem, &settings, |curve| {
         if let Err(e) = write_curve(ctx, curve) {
@@ -42,6 +89,18 @@ pub fn run_limits(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
                 .lock()
                 .expect("no panics while holding the lock")
                 .get_or_insert(e);
+        }
+        {
+            let mut f = finished.lock().expect("no panics while holding the lock");
+            f.names.push(curve.case.name.clone());
+            if let Some(r) = curve_incomplete(curve) {
+                f.incomplete.push(r);
+            }
+            if kept.contains(&curve.case.name.as_str()) {
+                f.curves.push(curve.clone());
+            } else {
+                f.scanned.push((curve.case.clone(), curve.peak.clone()));
+            }
         }
         if let Some(bar) = &bar {
             bar.inc(1);
@@ -51,34 +110,208 @@ pub fn run_limits(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
-    let analysis = result.map_err(|source| CommandError::Limits {
-        scene: ctx.label.clone(),
-        source,
-    })?;
     if let Some(e) = write_error.into_inner().expect("lock not poisoned") {
         return Err(e);
     }
+    let mut finished = finished.into_inner().expect("lock not poisoned");
+    // Curves finish in any order on the worker threads: sorted for a reproducible status.
+    finished.incomplete.sort();
     let elapsed = started.elapsed().as_secs_f64();
-    write_analysis(ctx, &analysis, elapsed)?;
+    let analysis = match result {
+        Ok(a) => a,
+        Err(error) => {
+            let all: Vec<&limits::LimitCase> = limit_cases
+                .iter()
+                .chain(&intermediate_cases)
+                .chain(&scanned_cases)
+                .collect();
+            return write_stopped(ctx, &all, finished, &error, elapsed);
+        }
+    };
+    let incomplete = (!finished.incomplete.is_empty()).then(|| finished.incomplete.join("; "));
+    write_analysis(
+        ctx,
+        &analysis,
+        elapsed,
+        &super::status_text(incomplete.as_deref()),
+    )?;
     Ok(RunReport {
         dir: ctx.dir.clone(),
         summary: summary(&analysis, elapsed),
+        incomplete,
         outcome: RunOutcome::Limits(Box::new(analysis)),
         open: ctx.open.clone(),
         stuck: ctx.stuck.clone(),
     })
 }
 
-/// Writes the tables, hysteresis loops, JSON and figures of a finished analysis (the curve
-/// files are written as the curves come, by [`write_curve`]).
+/// Writes what a limit analysis stopped by a failed curve (`error`) finished: `peaks.csv` of
+/// the finished curves, `limits.json` with status `incomplete: <the failure; the curves not
+/// solved; the finished curves that did not cover the range>` and every finished limit and
+/// intermediate curve with its path, and `limits_<dof>` drawing those curves over the linear
+/// references (no band: the grid is not computed). `all` lists every case of the analysis.
+fn write_stopped(
+    ctx: &RunContext<'_>,
+    all: &[&limits::LimitCase],
+    mut finished: Finished,
+    error: &limits::LimitError,
+    elapsed: f64,
+) -> Result<RunReport, CommandError> {
+    let failed = match error {
+        limits::LimitError::Curve { case, .. }
+        | limits::LimitError::Contacts { case, .. }
+        | limits::LimitError::Incomplete { case, .. }
+        | limits::LimitError::NoPeak { case, .. } => case.as_str(),
+    };
+    let not_solved: Vec<&str> = all
+        .iter()
+        .map(|c| c.name.as_str())
+        .filter(|n| *n != failed && !finished.names.iter().any(|f| f == n))
+        .collect();
+    let mut reasons = vec![format!("{error}")];
+    if !not_solved.is_empty() {
+        reasons.push(format!(
+            "not solved after it: {}",
+            super::abbreviated_list(&not_solved)
+        ));
+    }
+    reasons.extend(finished.incomplete.iter().cloned());
+    let reason = reasons.join("; ");
+    // In the order of the analysis' cases.
+    let order = |name: &str| all.iter().position(|c| c.name == name);
+    finished.curves.sort_by_key(|c| order(&c.case.name));
+    finished.scanned.sort_by_key(|(c, _)| order(&c.name));
+    let n_limits = limits::two_point_cases(&ctx.problem).len();
+    let (limit_curves, intermediate): (Vec<&CaseCurve>, Vec<&CaseCurve>) = finished
+        .curves
+        .iter()
+        .partition(|c| order(&c.case.name).is_some_and(|i| i < n_limits));
+
+    let mut rows: Vec<(&limits::LimitCase, &str, &limits::Peak)> = Vec::new();
+    rows.extend(limit_curves.iter().map(|c| (&c.case, "limit", &c.peak)));
+    rows.extend(
+        intermediate
+            .iter()
+            .map(|c| (&c.case, "intermediate", &c.peak)),
+    );
+    rows.extend(finished.scanned.iter().map(|(c, p)| (c, "scan", p)));
+    files::write_atomic(
+        &ctx.dir.join("peaks.csv"),
+        limit_files::peaks_csv(&ctx.problem, &rows).as_bytes(),
+    )?;
+    let status = super::status_text(Some(&reason));
+    let json = serde_json::json!({
+        "info": ctx.info(),
+        "status": status,
+        "elapsed_s": elapsed,
+        "error": error.to_string(),
+        "not_solved": not_solved,
+        "limits": limit_curves.iter().map(|c| curve_json(c)).collect::<Vec<_>>(),
+        "intermediate": intermediate.iter().map(|c| curve_json(c)).collect::<Vec<_>>(),
+        "scan_peaks": finished.scanned,
+    });
+    let bytes = serde_json::to_vec_pretty(&json).expect("JSON values serialise");
+    files::write_atomic(&ctx.dir.join("limits.json"), &bytes)?;
+    plot_finished_curves(ctx, &limit_curves, &intermediate)?;
+    Ok(RunReport {
+        dir: ctx.dir.clone(),
+        summary: format!(
+            "limit analysis stopped after {elapsed:.2} s: {} of {} curves finished",
+            finished.names.len(),
+            all.len()
+        ),
+        incomplete: Some(reason),
+        outcome: RunOutcome::LimitCurves(finished.curves),
+        open: ctx.open.clone(),
+        stuck: ctx.stuck.clone(),
+    })
+}
+
+/// `limits_<dof>` of an analysis stopped by a failed curve: the finished limit (solid) and
+/// intermediate (dashed) curves over the linear references, without band or classification.
+fn plot_finished_curves(
+    ctx: &RunContext<'_>,
+    limit_curves: &[&CaseCurve],
+    intermediate: &[&CaseCurve],
+) -> Result<(), CommandError> {
+    let problem = &ctx.problem;
+    for (k, &d) in problem.outputs.iter().enumerate() {
+        let name = &problem.model.dof_names[d];
+        let series: Vec<(String, Vec<f64>, Vec<f64>, bool)> = limit_curves
+            .iter()
+            .map(|c| (format!("limit {}", c.case.name), c, false))
+            .chain(
+                intermediate
+                    .iter()
+                    .map(|c| (format!("intermediate {}", c.case.name), c, true)),
+            )
+            .map(|(label, c, dashed)| {
+                (
+                    label,
+                    c.run.points.iter().map(|p| p.freq_hz).collect(),
+                    c.run.points.iter().map(|p| p.amplitudes[k]).collect(),
+                    dashed,
+                )
+            })
+            .collect();
+        let open_y: Vec<f64> = ctx.open.amplitudes.iter().map(|r| r[k]).collect();
+        let stuck_y: Vec<f64> = ctx.stuck.amplitudes.iter().map(|r| r[k]).collect();
+        let mut curves: Vec<Curve> = series
+            .iter()
+            .enumerate()
+            .map(|(i, (label, x, y, dashed))| Curve {
+                label,
+                x,
+                y,
+                color: palette(i),
+                dashed: *dashed,
+                markers: false,
+            })
+            .collect();
+        curves.push(Curve {
+            label: "linear, contacts open",
+            x: &ctx.open.freqs_hz,
+            y: &open_y,
+            color: plotters::style::RGBColor(110, 110, 110),
+            dashed: true,
+            markers: false,
+        });
+        curves.push(Curve {
+            label: "linear, contacts stuck",
+            x: &ctx.stuck.freqs_hz,
+            y: &stuck_y,
+            color: plotters::style::RGBColor(40, 90, 170),
+            dashed: true,
+            markers: false,
+        });
+        let title = format!("{} (incomplete: finished curves only)", ctx.title());
+        let y_label = format!("{name} first-harmonic amplitude (m)");
+        let fig = SweepFigure {
+            title: &title,
+            x_label: "frequency (Hz)",
+            y_label: &y_label,
+            log_y: true,
+            bands: &[],
+            curves: &curves,
+        };
+        let (png, svg) = figure_files(&ctx.dir, &format!("limits_{name}"));
+        plot_sweep(&fig, &png, &svg)?;
+    }
+    Ok(())
+}
+
+/// Writes the tables, hysteresis loops, JSON (with `status`: `complete` or `incomplete: …`)
+/// and figures of a finished analysis (the curve files are written as the curves come, by
+/// [`write_curve`]).
 pub(super) fn write_analysis(
     ctx: &RunContext<'_>,
     analysis: &LimitAnalysis,
     elapsed: f64,
+    status: &str,
 ) -> Result<(), CommandError> {
     write_tables(ctx, analysis)?;
     write_hysteresis(ctx, analysis)?;
-    write_json(ctx, analysis, elapsed)?;
+    write_json(ctx, analysis, elapsed, status)?;
     // Each limit curve's peak on the mesh (FE scenes).
     for c in &analysis.limits {
         crate::report::mesh_results::write_point(
@@ -139,29 +372,39 @@ struct CurveJson<'a> {
     case: &'a limits::LimitCase,
     peak: &'a limits::Peak,
     continuation_retries: usize,
+    /// `complete`, or `incomplete: <why the path did not cover the range>`.
+    status: String,
     points: &'a [FrfPoint],
     turning_points_hz: &'a [f64],
 }
 
-/// Writes `limits.json`: run info, every curve with its peak and path, the grid, the bound
-/// check, the scanned peaks and the hysteresis loops.
-fn write_json(ctx: &RunContext<'_>, a: &LimitAnalysis, elapsed: f64) -> Result<(), CommandError> {
-    let curve = |c: &'_ CaseCurve| -> serde_json::Value {
-        serde_json::to_value(CurveJson {
-            case: &c.case,
-            peak: &c.peak,
-            continuation_retries: c.retries,
-            points: &c.run.points,
-            turning_points_hz: &c.run.turning_points,
-        })
-        .expect("result types serialise")
-    };
+/// One curve as written in `limits.json`.
+fn curve_json(c: &CaseCurve) -> serde_json::Value {
+    serde_json::to_value(CurveJson {
+        case: &c.case,
+        peak: &c.peak,
+        continuation_retries: c.retries,
+        status: super::status_text(c.run.incomplete_reason().as_deref()),
+        points: &c.run.points,
+        turning_points_hz: &c.run.turning_points,
+    })
+    .expect("result types serialise")
+}
+
+/// Writes `limits.json`: run info, status, every curve with its peak and path, the grid, the
+/// bound check, the scanned peaks and the hysteresis loops.
+fn write_json(
+    ctx: &RunContext<'_>,
+    a: &LimitAnalysis,
+    elapsed: f64,
+    status: &str,
+) -> Result<(), CommandError> {
     let json = serde_json::json!({
         "info": ctx.info(),
-        "status": "complete",
+        "status": status,
         "elapsed_s": elapsed,
-        "limits": a.limits.iter().map(curve).collect::<Vec<_>>(),
-        "intermediate": a.intermediate.iter().map(curve).collect::<Vec<_>>(),
+        "limits": a.limits.iter().map(curve_json).collect::<Vec<_>>(),
+        "intermediate": a.intermediate.iter().map(curve_json).collect::<Vec<_>>(),
         "grid": a.grid,
         "bound_check": a.bounds,
         "scan_peaks": a.scan_peaks,

@@ -101,6 +101,15 @@ pub enum CommandError {
         /// Output folder.
         dir: String,
     },
+    /// The problem is estimated to need more memory than the machine has available; refused
+    /// before anything was created or written.
+    #[error("{scene}: {reason}")]
+    TooLarge {
+        /// Scene label.
+        scene: String,
+        /// The estimate, the memory available and the fields to lower.
+        reason: String,
+    },
     /// A linear reference failed.
     #[error("{scene}: linear reference: {reason}")]
     Linear {
@@ -111,6 +120,16 @@ pub enum CommandError {
     },
 }
 
+/// Exit code of a run that covered what the scene asks for (and of every other command that
+/// succeeded).
+pub const EXIT_COMPLETE: u8 = 0;
+/// Exit code of an error: bad input, a failed solve, an I/O error, a problem too large for the
+/// machine. (clap exits with 2 on usage errors.)
+pub const EXIT_ERROR: u8 = 1;
+/// Exit code of a run that ran and wrote its results but did not cover the range or every case
+/// ([`RunReport::incomplete`]).
+pub const EXIT_INCOMPLETE: u8 = 3;
+
 /// Options of `fricbound run`.
 #[derive(Debug, Clone, Default)]
 pub struct RunOptions {
@@ -119,7 +138,8 @@ pub struct RunOptions {
     /// Scene text to solve instead of reading `scene` (which then only names it in messages
     /// and gives the default output folder).
     pub scene_text: Option<String>,
-    /// Output folder; default `out/<scene stem>`.
+    /// Output folder; default `out/<scene stem>`, or `out/<scene stem>-<hash>` with overrides
+    /// (see [`default_out_dir`]).
     pub out: Option<PathBuf>,
     /// `FIELD=VALUE` overrides.
     pub overrides: Vec<String>,
@@ -134,6 +154,11 @@ pub struct RunReport {
     pub dir: PathBuf,
     /// What was computed, in a few lines.
     pub summary: String,
+    /// Why the run did not cover what the scene asks for (the FRF did not reach the end
+    /// frequency; a limit curve or sweep case failed or is incomplete), `None` when it did. The
+    /// same text follows `incomplete: ` in the status of the run's JSON file; the binary prints
+    /// it on stderr and exits with [`EXIT_INCOMPLETE`].
+    pub incomplete: Option<String>,
     /// The results themselves.
     pub outcome: RunOutcome,
     /// Linear reference with contacts open.
@@ -149,6 +174,10 @@ pub enum RunOutcome {
     Frf(Box<frf::FrfRun>),
     /// A limit analysis.
     Limits(Box<crate::analysis::limits::LimitAnalysis>),
+    /// A limit analysis stopped by a curve that failed: the limit and intermediate curves
+    /// finished before, in the analysis' case order (the run is incomplete, see
+    /// [`RunReport::incomplete`]).
+    LimitCurves(Vec<crate::analysis::limits::CaseCurve>),
     /// A parameter sweep, points in [`crate::study::sweep::sweep_points`] order.
     Sweep(Vec<crate::study::sweep::SweepPoint>),
 }
@@ -158,6 +187,9 @@ pub enum RunOutcome {
 pub struct RunContext<'a> {
     /// Scene label (file name or the built-in default).
     pub label: String,
+    /// Title of the figures: the scene's title (or its label) with the overrides it was
+    /// solved with, see [`figure_title`].
+    pub title: String,
     /// The scene as solved (after overrides).
     pub scene: Scene,
     /// The checked problem.
@@ -177,13 +209,9 @@ pub struct RunContext<'a> {
 }
 
 impl RunContext<'_> {
-    /// Title for figures.
+    /// Title for figures (see [`figure_title`]).
     pub fn title(&self) -> &str {
-        if self.scene.title.is_empty() {
-            &self.label
-        } else {
-            &self.scene.title
-        }
+        &self.title
     }
 
     /// Run info for JSON files.
@@ -312,6 +340,13 @@ impl FrfObserver for RunObserver<'_> {
 }
 
 /// `fricbound run`: solves the scene and writes results, linear references and figures.
+///
+/// In order: the scene is read, overridden and checked; its size and cost are estimated and
+/// the run refused ([`CommandError::TooLarge`]) when one Newton iteration would need more
+/// memory than the machine has available ([`check_memory`]); only then is the output folder
+/// created and the result files of an earlier run removed from it
+/// ([`crate::report::owned::clear_results`]), so that a failed or incomplete run never sits
+/// beside an earlier run's results.
 pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
     let label = match &options.scene {
         Some(p) => p.display().to_string(),
@@ -327,22 +362,24 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
     };
     let scene = scene::parse(&scene_text, &label, &options.overrides)?;
     let (problem, limits) = scene.validate_with_limits(&label)?;
-    let stem = options
-        .scene
-        .as_deref()
-        .and_then(|p| p.file_stem())
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "paper-wedge".to_string());
+    check_memory(
+        &label,
+        &problem,
+        parallel_solves(&scene, &problem, limits.as_ref()),
+    )?;
     let dir = options
         .out
         .clone()
-        .unwrap_or_else(|| PathBuf::from("out").join(stem));
+        .unwrap_or_else(|| default_out_dir(options.scene.as_deref(), &options.overrides));
     create_dir(&dir)?;
+    crate::report::owned::clear_results(&dir)?;
     let (open, stuck) = linear_references(&label, &problem, &dir)?;
     crate::report::mesh_modes::write_stuck_modes(&dir, &problem, MESH_MODES)?;
+    let title = figure_title(&scene, &label, &options.overrides);
     let ctx = RunContext {
         scene_text,
         label,
+        title,
         scene,
         problem,
         limits,
@@ -358,6 +395,166 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
         return limits_run::run_limits(&ctx);
     }
     run_frf(&ctx)
+}
+
+/// Hex digits of the overrides' hash in a default output folder's name.
+const OVERRIDES_HASH_DIGITS: usize = 8;
+
+/// The default output folder of a run: `out/<scene stem>` (`out/paper-wedge` for the built-in
+/// scene), and with `--set` overrides `out/<scene stem>-<hash>`, the hash being the first
+/// [`OVERRIDES_HASH_DIGITS`] hex digits of the SHA-256 of the overrides joined by newlines, so
+/// that variants of a scene do not overwrite each other's results (nor the scene's own).
+pub fn default_out_dir(scene: Option<&Path>, overrides: &[String]) -> PathBuf {
+    let stem = scene
+        .and_then(|p| p.file_stem())
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "paper-wedge".to_string());
+    if overrides.is_empty() {
+        return PathBuf::from("out").join(stem);
+    }
+    let digest = Sha256::digest(overrides.join("\n").as_bytes());
+    let hash: String = digest
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect::<String>()
+        .chars()
+        .take(OVERRIDES_HASH_DIGITS)
+        .collect();
+    PathBuf::from("out").join(format!("{stem}-{hash}"))
+}
+
+/// The title of a run's figures: the scene's title (its label when it has none), followed by
+/// the overrides in brackets when there are any (`… [static_loads.0.value=5]`), so that a
+/// title naming a value of the scene file is never shown alone over a run solved with another.
+pub fn figure_title(scene: &Scene, label: &str, overrides: &[String]) -> String {
+    let base = if scene.title.is_empty() {
+        label
+    } else {
+        scene.title.as_str()
+    };
+    if overrides.is_empty() {
+        base.to_string()
+    } else {
+        format!("{base} [{}]", overrides.join(", "))
+    }
+}
+
+/// How many problems of the scene's size a run solves at the same time: one for an FRF, up to
+/// the rayon thread count for the curves of a limit analysis or the values of a sweep.
+fn parallel_solves(scene: &Scene, problem: &Problem, limits: Option<&LimitSettings>) -> usize {
+    let threads = rayon::current_num_threads().max(1);
+    if let Some(sweep) = &scene.sweep {
+        let series = sweep.series.as_ref().map_or(1, |s| s.values.len().max(1));
+        return threads.min(sweep.values.len().max(1) * series);
+    }
+    match limits {
+        Some(l) => {
+            let curves = 2
+                + l.intermediate.len()
+                + l.cases.len()
+                + l.bound_scan.len().pow(problem.sides.len() as u32);
+            threads.min(curves)
+        }
+        None => 1,
+    }
+}
+
+/// Where the available memory was read, for messages.
+const MEMINFO: &str = "/proc/meminfo";
+
+/// The memory available to a new process (bytes): `MemAvailable` of `/proc/meminfo`, lowered
+/// to the room left under the cgroup's limit (`/sys/fs/cgroup/memory.max` minus
+/// `memory.current`) when the process runs in a limited cgroup (a container). `None` when
+/// `/proc/meminfo` cannot be read or has no `MemAvailable` line (not Linux): the caller then
+/// skips the refusal.
+pub fn available_memory() -> Option<u64> {
+    let meminfo = std::fs::read_to_string(MEMINFO).ok()?;
+    let available = parse_mem_available(&meminfo)?;
+    let read = |f: &str| -> Option<u64> {
+        std::fs::read_to_string(Path::new("/sys/fs/cgroup").join(f))
+            .ok()?
+            .trim()
+            .parse()
+            .ok()
+    };
+    let cgroup_room =
+        read("memory.max").map(|max| max.saturating_sub(read("memory.current").unwrap_or(0)));
+    Some(cgroup_room.map_or(available, |room| room.min(available)))
+}
+
+/// `MemAvailable` of a `/proc/meminfo` text, in bytes (the file gives kB).
+pub fn parse_mem_available(meminfo: &str) -> Option<u64> {
+    meminfo.lines().find_map(|line| {
+        let rest = line.strip_prefix("MemAvailable:")?;
+        let mut parts = rest.split_whitespace();
+        let value: u64 = parts.next()?.parse().ok()?;
+        match parts.next() {
+            Some("kB") | None => Some(value * 1024),
+            Some(_) => None,
+        }
+    })
+}
+
+/// Refuses a problem whose estimated memory, one Newton iteration
+/// ([`crate::hbm::cost::estimate`]) times the solves that run at the same time, exceeds the
+/// memory available ([`available_memory`]); nothing is allocated in proportion to the problem
+/// before this check. When the available memory cannot be read the check is skipped.
+pub fn check_memory(label: &str, problem: &Problem, parallel: usize) -> Result<(), CommandError> {
+    let Some(available) = available_memory() else {
+        return Ok(());
+    };
+    let cost = crate::hbm::cost::estimate(problem);
+    match memory_refusal(problem, &cost, parallel, available as f64) {
+        Some(reason) => Err(CommandError::TooLarge {
+            scene: label.to_string(),
+            reason,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Why a problem of estimate `cost`, solved `parallel` times at once, does not fit in
+/// `available` bytes; `None` when it fits. Names the fields to lower.
+pub fn memory_refusal(
+    problem: &Problem,
+    cost: &crate::hbm::cost::CostEstimate,
+    parallel: usize,
+    available: f64,
+) -> Option<String> {
+    use crate::hbm::cost::{format_bytes, formulation_name};
+    let needed = cost.bytes() * parallel.max(1) as f64;
+    if needed <= available {
+        return None;
+    }
+    let max_h = problem.harmonics.iter().copied().max().unwrap_or(0);
+    Some(format!(
+        "refused: one Newton iteration is estimated to need {}{} ({} formulation: {} unknowns, \
+         factorised matrix of {} rows; AFT {} samples x {} coefficient blocks), more than the {} \
+         available ({MEMINFO}); lower harmonics.max (highest harmonic {max_h}, {} blocks), \
+         harmonics.samples ({}) or the model size ({} DOFs, {} contact points: coarser mesh, \
+         [reduction], fewer contact pairs){}",
+        format_bytes(needed),
+        if parallel > 1 {
+            format!(" for {parallel} curves solved at once")
+        } else {
+            String::new()
+        },
+        formulation_name(cost.formulation),
+        cost.unknowns,
+        cost.factored,
+        cost.samples,
+        cost.force_blocks,
+        format_bytes(available),
+        cost.blocks,
+        cost.samples,
+        cost.dofs,
+        cost.contacts,
+        if parallel > 1 {
+            ", or the curves solved at once (RAYON_NUM_THREADS)"
+        } else {
+            ""
+        },
+    ))
 }
 
 /// Stuck-contact modes written on the mesh for FE scenes (`modes_stuck.vtu`).
@@ -427,7 +624,12 @@ fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
     if let Some(e) = observer.writer.error.take() {
         return Err(e.into());
     }
-    observer.writer.write_solution("complete")?;
+    // Complete only when the path reached the end frequency; otherwise every finished point
+    // is still written and drawn, and the status says what was not covered.
+    let incomplete = run.incomplete_reason();
+    observer
+        .writer
+        .write_solution(&status_text(incomplete.as_deref()))?;
 
     let contact_names: Vec<String> = problem.contacts.iter().map(|c| c.name.clone()).collect();
     for (k, &d) in problem.outputs.iter().enumerate() {
@@ -475,6 +677,7 @@ fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
             run.elapsed_s,
             run.rejected_steps
         ),
+        incomplete,
         outcome: RunOutcome::Frf(Box::new(run)),
         open: ctx.open.clone(),
         stuck: ctx.stuck.clone(),
@@ -497,12 +700,18 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
     let _ = writeln!(
         s,
         "DOFs         {n}: {}",
-        problem.model.dof_names.join(", ")
+        abbreviated_list(&problem.model.dof_names)
     );
+    let harmonics = set.harmonics();
     let _ = writeln!(
         s,
-        "harmonics    {:?} ({} blocks), {} samples per period",
-        set.harmonics(),
+        "harmonics    [{}] ({}{} blocks), {} samples per period",
+        abbreviated_list(harmonics),
+        if harmonics.len() > CHECK_LISTED {
+            format!("{} harmonics, ", harmonics.len())
+        } else {
+            String::new()
+        },
         set.n_blocks(),
         problem.samples
     );
@@ -511,6 +720,49 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
         "unknowns     {} (+1 frequency in continuation)",
         n * set.n_blocks()
     );
+    let cost = crate::hbm::cost::estimate(&problem);
+    let _ = writeln!(
+        s,
+        "formulation  {}{}: {} Newton unknowns, factorised matrix of {} rows",
+        crate::hbm::cost::formulation_name(cost.formulation),
+        if problem.analysis.formulation == crate::model::Formulation::Auto {
+            " (auto)"
+        } else {
+            ""
+        },
+        cost.unknowns,
+        cost.factored
+    );
+    let _ = writeln!(s, "cost         {}", cost.summary());
+    let parallel = parallel_solves(&scene, &problem, limits.as_ref());
+    match available_memory() {
+        Some(available) => {
+            let verdict = match memory_refusal(&problem, &cost, parallel, available as f64) {
+                Some(_) => "`run` refuses this scene: lower harmonics.max, harmonics.samples or \
+                            the model size"
+                    .to_string(),
+                None => format!(
+                    "fits{}",
+                    if parallel > 1 {
+                        format!(" ({parallel} curves solved at once)")
+                    } else {
+                        String::new()
+                    }
+                ),
+            };
+            let _ = writeln!(
+                s,
+                "memory       {} available ({MEMINFO}): {verdict}",
+                crate::hbm::cost::format_bytes(available as f64)
+            );
+        }
+        None => {
+            let _ = writeln!(
+                s,
+                "memory       available memory unknown ({MEMINFO} unreadable): not checked"
+            );
+        }
+    }
     let _ = writeln!(
         s,
         "effects      normal load {:?}, lift-off {}, statics {:?}",
@@ -626,6 +878,29 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
 /// Most contacts and loads `check` lists one by one (FE scenes have hundreds).
 const CHECK_LISTED: usize = 12;
 
+/// Items shown at each end of a long list by [`abbreviated_list`].
+const LIST_ENDS: usize = 5;
+
+/// A list as "a, b, c", or for more than [`CHECK_LISTED`] items its first and last
+/// [`LIST_ENDS`] around "…" (a scene with 10 000 harmonics or DOFs must not print them all).
+pub fn abbreviated_list<T: std::fmt::Display>(items: &[T]) -> String {
+    let join = |part: &[T]| {
+        part.iter()
+            .map(|x| x.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if items.len() <= CHECK_LISTED {
+        join(items)
+    } else {
+        format!(
+            "{}, …, {}",
+            join(&items[..LIST_ENDS]),
+            join(&items[items.len() - LIST_ENDS..])
+        )
+    }
+}
+
 /// The line after a list cut at [`CHECK_LISTED`] items.
 fn more_line(s: &mut String, total: usize) {
     use std::fmt::Write as _;
@@ -634,7 +909,79 @@ fn more_line(s: &mut String, total: usize) {
     }
 }
 
-/// One-paragraph summary of a finished run.
+/// The status written into a run's JSON file: `complete`, or `incomplete: <reason>`.
+pub fn status_text(incomplete: Option<&str>) -> String {
+    match incomplete {
+        None => "complete".to_string(),
+        Some(reason) => format!("incomplete: {reason}"),
+    }
+}
+
+/// One-paragraph summary of a finished run: what was computed, whether it is incomplete, and
+/// the output folder.
 pub fn run_summary(r: &RunReport) -> String {
-    format!("{}\nresults in {}", r.summary, r.dir.display())
+    let status = match &r.incomplete {
+        Some(reason) => format!("\nincomplete: {reason}"),
+        None => String::new(),
+    };
+    format!("{}{status}\nresults in {}", r.summary, r.dir.display())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_mem_available() {
+        let text = "MemTotal:       24585944 kB\nMemFree:         1000000 kB\n\
+                    MemAvailable:   20000000 kB\nBuffers:          100 kB\n";
+        assert_eq!(parse_mem_available(text), Some(20_000_000 * 1024));
+        assert_eq!(parse_mem_available("MemTotal: 1 kB\n"), None);
+        assert_eq!(parse_mem_available("MemAvailable: lots\n"), None);
+    }
+
+    #[test]
+    fn abbreviates_long_lists() {
+        assert_eq!(abbreviated_list(&[0, 1, 2]), "0, 1, 2");
+        let long: Vec<usize> = (0..=10_000).collect();
+        assert_eq!(
+            abbreviated_list(&long),
+            "0, 1, 2, 3, 4, …, 9996, 9997, 9998, 9999, 10000"
+        );
+        let twelve: Vec<usize> = (0..CHECK_LISTED).collect();
+        assert_eq!(
+            abbreviated_list(&twelve).matches(", ").count(),
+            CHECK_LISTED - 1
+        );
+    }
+
+    /// The refusal compares the estimate (times the solves at once) with the memory given and
+    /// names the fields to lower.
+    #[test]
+    fn refuses_what_does_not_fit() {
+        let (_, _, problem, _) = load_scene(None, &[]).unwrap();
+        let cost = crate::hbm::cost::estimate(&problem);
+        assert!(memory_refusal(&problem, &cost, 1, 2.0 * cost.bytes()).is_none());
+        let why = memory_refusal(&problem, &cost, 1, 0.5 * cost.bytes()).unwrap();
+        for field in [
+            "harmonics.max",
+            "harmonics.samples",
+            "model size",
+            "dense formulation",
+        ] {
+            assert!(why.contains(field), "{field}: {why}");
+        }
+        // Four curves at once need four times the memory.
+        assert!(memory_refusal(&problem, &cost, 4, 2.0 * cost.bytes())
+            .unwrap()
+            .contains("RAYON_NUM_THREADS"));
+    }
+
+    #[test]
+    fn titles_carry_the_overrides() {
+        let (label, scene, _, _) = load_scene(None, &[]).unwrap();
+        assert_eq!(figure_title(&scene, &label, &[]), scene.title);
+        let t = figure_title(&scene, &label, &["static_loads.0.value=5".to_string()]);
+        assert_eq!(t, format!("{} [static_loads.0.value=5]", scene.title));
+    }
 }

@@ -81,6 +81,8 @@ fn write_point_analysis(
     );
     let sub = RunContext {
         label,
+        // The parent's title already carries the overrides.
+        title: scene.title.clone(),
         scene,
         problem: problem.clone(),
         limits: Some(limits.clone()),
@@ -93,7 +95,55 @@ fn write_point_analysis(
     for c in analysis.limits.iter().chain(&analysis.intermediate) {
         limits_run::write_curve(&sub, c)?;
     }
-    limits_run::write_analysis(&sub, analysis, f64::NAN)
+    let incomplete = limits_run::analysis_incomplete(analysis);
+    limits_run::write_analysis(
+        &sub,
+        analysis,
+        f64::NAN,
+        &super::status_text(incomplete.as_deref()),
+    )
+}
+
+/// Most sweep points named in an incomplete sweep's status (all are in `sweep.json`).
+const STATUS_POINTS: usize = 5;
+
+/// Why a sweep did not cover every value and case: per point in sweep order, its failed cases
+/// ([`SweepPoint::failures`]) and, with `output = "limits"`, the limit and intermediate curves
+/// that did not reach the end frequency; `None` when every point is complete. Lists the first
+/// [`STATUS_POINTS`] points and counts the others.
+fn sweep_incomplete(spec: &SweepSpec, points: &[SweepPoint]) -> Option<String> {
+    let lines: Vec<String> = points
+        .iter()
+        .filter_map(|p| {
+            let mut reasons = p.failures.clone();
+            if let Some(a) = &p.analysis {
+                reasons.extend(limits_run::analysis_incomplete(a));
+            }
+            (!reasons.is_empty()).then(|| {
+                format!(
+                    "{}: {}",
+                    point_label(spec, p.series, p.value),
+                    reasons.join("; ")
+                )
+            })
+        })
+        .collect();
+    if lines.is_empty() {
+        return None;
+    }
+    let mut text = format!(
+        "{} of {} sweep points not covered: {}",
+        lines.len(),
+        points.len(),
+        lines[..lines.len().min(STATUS_POINTS)].join(" | ")
+    );
+    if lines.len() > STATUS_POINTS {
+        text.push_str(&format!(
+            " | ... and {} more (see sweep.json)",
+            lines.len() - STATUS_POINTS
+        ));
+    }
+    Some(text)
 }
 
 /// Runs the sweep of the context's scene.
@@ -173,9 +223,10 @@ pub fn run_sweep(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
         .iter()
         .map(|p| p.analysis.as_ref().map(|a| a.variability()))
         .collect();
+    let incomplete = sweep_incomplete(&spec, &points);
     let json = serde_json::json!({
         "info": ctx.info(),
-        "status": "complete",
+        "status": super::status_text(incomplete.as_deref()),
         "elapsed_s": elapsed,
         "parameter": spec.parameter,
         "unit": spec.unit,
@@ -196,6 +247,7 @@ pub fn run_sweep(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
     Ok(RunReport {
         dir: ctx.dir.clone(),
         summary: summary(&spec, &points, elapsed),
+        incomplete,
         outcome: RunOutcome::Sweep(points),
         open: ctx.open.clone(),
         stuck: ctx.stuck.clone(),

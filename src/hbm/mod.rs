@@ -12,10 +12,12 @@
 //! | [`condensed`] | `CondensedHbm` | unknowns on the contact DOFs only, the rest eliminated per harmonic |
 //! | [`schur`] | `RelativeCoordinates`, `SchurJacobian` | all DOFs, each linear solve reduced to the relative contact coordinates |
 //! | [`operator`] | `HbmOperator` | the operator a run solves, dispatching to the formulation |
+//! | [`cost`] | `CostEstimate`, `estimate` | size of the unknowns, memory of one Newton iteration and time per point, estimated before anything is allocated |
 //! | [`statics`] | [`static_solve`] | the static pre-solve of the uncoupled mode |
 //! | [`error`] | [`HbmError`] | evaluation and solve errors |
 
 pub mod condensed;
+pub mod cost;
 pub mod error;
 pub mod formulation;
 pub mod operator;

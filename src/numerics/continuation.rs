@@ -571,7 +571,11 @@ impl Continuation {
         );
         let point = PathPoint {
             omega: yc[n] * OMEGA_SCALE,
-            x: yc[..n].iter().zip(&self.x_scale).map(|(v, s)| v * s).collect(),
+            x: yc[..n]
+                .iter()
+                .zip(&self.x_scale)
+                .map(|(v, s)| v * s)
+                .collect(),
             iterations,
             residual,
             step: ds,
@@ -588,8 +592,8 @@ impl Continuation {
     /// given up.
     fn left_range(&self, point: &PathPoint) -> bool {
         let a = &self.settings;
-        let floor = (a.freq_start_hz - 0.5 * (a.freq_end_hz - a.freq_start_hz))
-            .max(0.1 * a.freq_start_hz);
+        let floor =
+            (a.freq_start_hz - 0.5 * (a.freq_end_hz - a.freq_start_hz)).max(0.1 * a.freq_start_hz);
         point.freq_hz() < floor
     }
 

@@ -113,9 +113,7 @@ impl InnerFactor {
             }
             InnerKind::Implicit(f) => f.solve(b, fast),
         };
-        x.iter_mut()
-            .zip(&self.col_scale)
-            .for_each(|(v, s)| *v /= s);
+        x.iter_mut().zip(&self.col_scale).for_each(|(v, s)| *v /= s);
         x
     }
 }
@@ -504,7 +502,6 @@ impl AssembledJacobian {
             }
         }
     }
-
 
     /// Solves s·J x = b with a factorisation of s·J, with one refinement step, and refuses a
     /// solution whose residual exceeds 1e-6 of ‖b‖ (a numerically singular J can give finite

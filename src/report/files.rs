@@ -1,9 +1,9 @@
 //! Result files: `frf.csv`, `linear_open.csv`, `linear_stuck.csv` and `solution.json`.
 //!
-//! Files are replaced atomically (written to a temporary sibling, then renamed), and the FRF
-//! writer rewrites `frf.csv` after every converged point, so an interrupted run keeps every
-//! point finished so far. `solution.json` is rewritten at most every half second while running
-//! and once at the end.
+//! The FRF writer appends one row of `frf.csv` per converged point (flushed at once, so an
+//! interrupted run keeps every point finished so far) and rewrites `solution.json` whole, and
+//! atomically, at checkpoints and at the end ([`FrfWriter`]); the other files are replaced
+//! atomically (written to a temporary sibling, then renamed) by [`write_atomic`].
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -155,40 +155,87 @@ pub struct StepCut {
     pub reason: String,
 }
 
-/// Observer that streams an FRF run to `frf.csv` and `solution.json` in a folder.
+/// Points written to `solution.json` before the first count-based checkpoint, and the least
+/// number of new points between two count-based checkpoints.
+pub const CHECKPOINT_POINTS: usize = 50;
+
+/// Least time between two time-based checkpoints of `solution.json` (s).
+pub const CHECKPOINT_SECONDS: f64 = 2.0;
+
+/// Observer that streams an FRF run to `frf.csv` (one appended row per converged point) and
+/// `coefficients.bin` (large models), and writes the whole `solution.json` at checkpoints.
+///
+/// Output cost is linear in the number of points: a row is appended (and flushed, so an
+/// interrupted run keeps every finished point), and `solution.json`, which holds every point
+/// and so costs time proportional to the points so far, is rewritten (atomically) only at the
+/// first point, when the points have doubled since the last write (and at least
+/// [`CHECKPOINT_POINTS`] are new), when [`CHECKPOINT_SECONDS`] have passed and at least ten times
+/// the last write's duration, and at the end ([`Self::write_solution`]). The doubling makes
+/// the count-based writes cost at most twice the final one; the time-based ones cost at most a
+/// tenth of the run.
 pub struct FrfWriter {
     dir: PathBuf,
     header: String,
-    csv: String,
     info: RunInfo,
     points: Vec<FrfPoint>,
     turning_points: Vec<f64>,
     step_cuts: Vec<StepCut>,
     leaps: Vec<(f64, f64)>,
     started: Instant,
+    /// `frf.csv`, opened (truncated, header written) at the first point.
+    csv: Option<std::fs::File>,
+    /// `coefficients.bin`, opened (truncated) at the first point of a large model.
+    coefficients: Option<std::fs::File>,
+    /// When the last `solution.json` checkpoint was written.
     last_json: Option<Instant>,
-    /// Time the last `solution.json` write took (s); writes are spaced by at least ten times it.
+    /// Points in the last `solution.json` checkpoint.
+    last_json_points: usize,
+    /// Time the last `solution.json` write took (s).
     last_json_s: f64,
+    /// `solution.json` writes so far (checkpoints and final).
+    json_writes: usize,
     /// First write error met (writing stops being attempted after it).
     pub error: Option<WriteError>,
 }
 
+/// Opens `path` for writing, truncated.
+fn create_file(path: &Path) -> Result<std::fs::File, WriteError> {
+    std::fs::File::create(path).map_err(|source| WriteError {
+        path: path.display().to_string(),
+        source,
+    })
+}
+
+/// Appends `bytes` to the open file `file` (named `path` in errors), unbuffered: the bytes are
+/// with the operating system when this returns.
+fn append(file: &mut std::fs::File, path: &Path, bytes: &[u8]) -> Result<(), WriteError> {
+    use std::io::Write as _;
+    file.write_all(bytes)
+        .and_then(|()| file.flush())
+        .map_err(|source| WriteError {
+            path: path.display().to_string(),
+            source,
+        })
+}
+
 impl FrfWriter {
-    /// A writer into `dir` (which must exist).
+    /// A writer into `dir` (which must exist). Nothing is written before the first point.
     pub fn new(dir: &Path, problem: &Problem, info: RunInfo) -> Self {
-        let header = frf_header(problem);
         Self {
             dir: dir.to_path_buf(),
-            csv: header.clone(),
-            header,
+            header: frf_header(problem),
             info,
             points: Vec::new(),
             turning_points: Vec::new(),
             step_cuts: Vec::new(),
             leaps: Vec::new(),
             started: Instant::now(),
+            csv: None,
+            coefficients: None,
             last_json: None,
+            last_json_points: 0,
             last_json_s: 0.0,
+            json_writes: 0,
             error: None,
         }
     }
@@ -203,7 +250,13 @@ impl FrfWriter {
         &self.header
     }
 
-    /// Writes `solution.json` with a status line ("running", "complete", or a failure).
+    /// `solution.json` writes so far, checkpoints and final (for tests of the output cost).
+    pub fn json_writes(&self) -> usize {
+        self.json_writes
+    }
+
+    /// Writes `solution.json` (atomically) with a status line ("running", "complete",
+    /// "incomplete: …" or "failed: …").
     pub fn write_solution(&mut self, status: &str) -> Result<(), WriteError> {
         let write_started = Instant::now();
         let elapsed = self.started.elapsed().as_secs_f64();
@@ -247,28 +300,51 @@ impl FrfWriter {
         let json = serde_json::to_vec_pretty(&file).expect("result types serialise");
         let result = write_atomic(&self.dir.join("solution.json"), &json);
         self.last_json_s = write_started.elapsed().as_secs_f64();
+        self.last_json = Some(Instant::now());
+        self.last_json_points = self.points.len();
+        self.json_writes += 1;
         result
     }
 
-    /// Appends a point's coefficients to `coefficients.bin` (large models).
-    fn append_coefficients(&self, point: &FrfPoint) -> Result<(), WriteError> {
-        use std::io::Write as _;
+    /// Appends a point's row to `frf.csv` (creating it with its header at the first point).
+    fn append_row(&mut self, point: &FrfPoint) -> Result<(), WriteError> {
+        let path = self.dir.join("frf.csv");
+        if self.csv.is_none() {
+            let mut file = create_file(&path)?;
+            append(&mut file, &path, self.header.as_bytes())?;
+            self.csv = Some(file);
+        }
+        let file = self.csv.as_mut().expect("opened above");
+        append(file, &path, frf_row(point).as_bytes())
+    }
+
+    /// Appends a point's coefficients to `coefficients.bin` (large models; created at the
+    /// first point).
+    fn append_coefficients(&mut self, point: &FrfPoint) -> Result<(), WriteError> {
         let path = self.dir.join("coefficients.bin");
-        let err = |source| WriteError {
-            path: path.display().to_string(),
-            source,
-        };
-        let mut f = std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(&path)
-            .map_err(err)?;
+        if self.coefficients.is_none() {
+            self.coefficients = Some(create_file(&path)?);
+        }
         let bytes: Vec<u8> = point
             .coefficients
             .iter()
             .flat_map(|v| v.to_le_bytes())
             .collect();
-        f.write_all(&bytes).map_err(err)
+        let file = self.coefficients.as_mut().expect("opened above");
+        append(file, &path, &bytes)
+    }
+
+    /// Whether `solution.json` is due for a checkpoint (see the type's docs).
+    fn checkpoint_due(&self) -> bool {
+        let Some(last) = self.last_json else {
+            return true;
+        };
+        let n = self.points.len();
+        let new = n - self.last_json_points;
+        let by_count = new >= CHECKPOINT_POINTS && new >= self.last_json_points;
+        let since = last.elapsed().as_secs_f64();
+        let by_time = since >= CHECKPOINT_SECONDS.max(10.0 * self.last_json_s);
+        by_count || by_time
     }
 
     fn record(&mut self, r: Result<(), WriteError>) {
@@ -286,24 +362,15 @@ impl FrfObserver for FrfWriter {
         if self.error.is_some() {
             return;
         }
-        self.csv.push_str(&frf_row(point));
-        let r = write_atomic(&self.dir.join("frf.csv"), self.csv.as_bytes());
+        let r = self.append_row(point);
         self.record(r);
-        if point.coefficients.len() > INLINE_COEFFICIENTS {
-            if self.points.len() == 1 {
-                let _ = std::fs::remove_file(self.dir.join("coefficients.bin"));
-            }
+        if point.coefficients.len() > INLINE_COEFFICIENTS && self.error.is_none() {
             let r = self.append_coefficients(point);
             self.record(r);
         }
-        let spacing = (10.0 * self.last_json_s).max(0.5);
-        let due = self
-            .last_json
-            .is_none_or(|t| t.elapsed().as_secs_f64() >= spacing);
-        if due && self.error.is_none() {
+        if self.error.is_none() && self.checkpoint_due() {
             let r = self.write_solution("running");
             self.record(r);
-            self.last_json = Some(Instant::now());
         }
     }
 
@@ -321,5 +388,111 @@ impl FrfObserver for FrfWriter {
 
     fn leap(&mut self, from_hz: f64, to_hz: f64) {
         self.leaps.push((from_hz, to_hz));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::ContactState;
+
+    fn problem() -> Problem {
+        crate::scene::parse(crate::scene::PAPER_DEFAULT_SCENE, "paper", &[])
+            .and_then(|s| s.validate("paper"))
+            .expect("the built-in scene is valid")
+    }
+
+    fn info() -> RunInfo {
+        RunInfo {
+            version: "test".into(),
+            scene: "paper".into(),
+            scene_hash: String::new(),
+            dofs: Vec::new(),
+            blocks: Vec::new(),
+            contacts: Vec::new(),
+            outputs: Vec::new(),
+        }
+    }
+
+    fn point(k: usize) -> FrfPoint {
+        let f = 50.0 + 0.01 * k as f64;
+        FrfPoint {
+            freq_hz: f,
+            amplitudes: vec![1e-5 * (1.0 + (k as f64).sin())],
+            peaks: vec![2e-5 + 1e-9 * k as f64],
+            states: vec![ContactState::Stuck, ContactState::StickSlip],
+            newton_iterations: 1 + k % 4,
+            residual: 1e-12,
+            coefficients: vec![k as f64; 18],
+        }
+    }
+
+    /// The streamed `frf.csv` is the header and one row per point, byte for byte what a whole
+    /// rewrite would give, and `solution.json` is rewritten a number of times that grows with
+    /// the logarithm of the points (plus the time-based checkpoints), not with the points.
+    #[test]
+    fn streams_rows_and_checkpoints_the_json_rarely() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = problem();
+        let mut w = FrfWriter::new(dir.path(), &p, info());
+        assert!(
+            !dir.path().join("frf.csv").exists(),
+            "nothing before the first point"
+        );
+        let started = Instant::now();
+        let n = 5000;
+        let mut expected = frf_header(&p);
+        for k in 0..n {
+            let q = point(k);
+            expected.push_str(&frf_row(&q));
+            w.point(&q);
+            if k == 0 {
+                // Flushed at once: the first row is on disk before the next point.
+                let text = std::fs::read_to_string(dir.path().join("frf.csv")).unwrap();
+                assert_eq!(text, expected);
+                assert_eq!(w.json_writes(), 1, "solution.json at the first point");
+            }
+        }
+        assert!(w.error.is_none());
+        w.write_solution("complete").unwrap();
+        let text = std::fs::read_to_string(dir.path().join("frf.csv")).unwrap();
+        assert_eq!(text, expected);
+        // Count-based checkpoints at 1, 51, 102, 204, … 3264 points: 8, the final write, and
+        // at most one time-based write per CHECKPOINT_SECONDS of the test.
+        let time_based = (started.elapsed().as_secs_f64() / CHECKPOINT_SECONDS).ceil() as usize;
+        assert!(
+            w.json_writes() <= 9 + time_based,
+            "{} writes of solution.json for {n} points",
+            w.json_writes()
+        );
+        let json: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.path().join("solution.json")).unwrap())
+                .unwrap();
+        assert_eq!(json["status"], "complete");
+        assert_eq!(json["points"].as_array().unwrap().len(), n);
+    }
+
+    /// A point of a large model appends its coefficients to `coefficients.bin` instead of
+    /// inlining them.
+    #[test]
+    fn large_models_append_coefficients() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = problem();
+        let mut w = FrfWriter::new(dir.path(), &p, info());
+        for k in 0..3 {
+            let mut q = point(k);
+            q.coefficients = vec![k as f64; INLINE_COEFFICIENTS + 1];
+            w.point(&q);
+        }
+        w.write_solution("complete").unwrap();
+        let bytes = std::fs::read(dir.path().join("coefficients.bin")).unwrap();
+        assert_eq!(bytes.len(), 3 * (INLINE_COEFFICIENTS + 1) * 8);
+        let last = f64::from_le_bytes(bytes[bytes.len() - 8..].try_into().unwrap());
+        assert_eq!(last, 2.0);
+        let json: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.path().join("solution.json")).unwrap())
+                .unwrap();
+        assert!(json["points"][0].get("coefficients").is_none());
+        assert_eq!(json["coefficients_file"]["file"], "coefficients.bin");
     }
 }

@@ -7,6 +7,8 @@
 //!
 //! - [`files`]: CSV and JSON of one FRF ([`files::FrfWriter`], streamed as points converge),
 //!   the linear references, [`files::RunInfo`] and [`files::write_atomic`];
+//! - [`owned`]: the result files a run owns in its output folder, removed before it starts
+//!   ([`owned::clear_results`]);
 //! - [`limit_files`]: the tables of a limit analysis (limit curves on the grid, peaks,
 //!   hysteresis loops);
 //! - [`plot`]: the figures as PNG and SVG ([`plot::plot_frf`], [`plot::plot_limits`],
@@ -18,4 +20,5 @@ pub mod files;
 pub mod limit_files;
 pub mod mesh_modes;
 pub mod mesh_results;
+pub mod owned;
 pub mod plot;

@@ -1,9 +1,12 @@
 //! Validation of what is solved and reported: the `[analysis]` table (frequency range,
 //! continuation steps and limits, tolerances, Jacobian and formulation) built into the
-//! problem's [`Analysis`] settings, and the `[output]` table into the response DOFs.
+//! problem's [`Analysis`] settings, the frequency range bounded by what the model resolves,
+//! and the `[output]` table into the response DOFs.
 
-use crate::model::{Analysis, CHORD_MIN_UNKNOWNS};
+use crate::contact::ContactPoint;
+use crate::model::{Analysis, LinearModel, CHORD_MIN_UNKNOWNS};
 use crate::numerics::ContinuationSettings;
+use crate::scene::check_model::diagonal;
 use crate::scene::checker::{Checker, DofNames};
 use crate::scene::error::SceneError;
 use crate::scene::fe_input::FeStructure;
@@ -11,6 +14,66 @@ use crate::scene::schema::{AnalysisSpec, OutputSpec};
 
 /// Most continuation points or linear-reference points a scene may ask for.
 pub const MAX_POINTS: usize = 10_000_000;
+
+/// Largest ratio of the inertia (2π·f·h)²·Mᵢᵢ at the end frequency f and the highest balanced
+/// harmonic h to the stiffness K̃ᵢᵢ (contact springs stuck included) of every DOF i that a scene
+/// may ask for: above it every DOF's stiffness and the contact forces are lost in round-off
+/// next to its inertia, and the response is that of free masses.
+pub const MAX_INERTIA_RATIO: f64 = 1e12;
+
+/// Checks that the end frequency `analysis.freq_end_hz` (Hz, as given: checked before the
+/// rest of `[analysis]` so that an absurd frequency is explained by the model) lies below the
+/// highest frequency the model resolves at the highest balanced harmonic h:
+/// (2π·f·h)² ≤ [`MAX_INERTIA_RATIO`]·maxᵢ K̃ᵢᵢ/Mᵢᵢ over the DOFs with mass, K̃ the stiffness
+/// with every contact stuck (K plus kₜ t tᵀ + kₙ n nᵀ per point). Each ratio K̃ᵢᵢ/Mᵢᵢ is a
+/// Rayleigh quotient, so √(maxᵢ K̃ᵢᵢ/Mᵢᵢ)/2π is at or below the highest natural frequency of
+/// the stuck structure, and the bound is 10⁶ times it divided by h. A massless model sets no
+/// bound; a non-finite value is left to [`analysis`].
+pub(super) fn frequency_bound(
+    analysis: &AnalysisSpec,
+    harmonics: &[usize],
+    model: &LinearModel,
+    contacts: &[ContactPoint],
+    ck: &Checker,
+) -> Result<(), SceneError> {
+    let mut k = diagonal(&model.stiffness);
+    for c in contacts {
+        for (row, stiffness) in [(&c.tangential, c.law.kt), (&c.normal, c.law.kn)] {
+            for &(d, a) in row {
+                k[d] += stiffness * a * a;
+            }
+        }
+    }
+    let m = diagonal(&model.mass);
+    let ratio = k
+        .iter()
+        .zip(&m)
+        .filter(|(_, &mi)| mi > 0.0)
+        .map(|(ki, mi)| ki / mi)
+        .fold(0.0_f64, f64::max);
+    if ratio <= 0.0 {
+        return Ok(());
+    }
+    let h = harmonics.iter().copied().max().unwrap_or(1).max(1) as f64;
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let natural = ratio.sqrt() / two_pi;
+    let limit = (MAX_INERTIA_RATIO * ratio).sqrt() / (two_pi * h);
+    let f1 = analysis.freq_end_hz;
+    if f1.is_finite() && f1 > limit {
+        return Err(ck.err(
+            "analysis.freq_end_hz",
+            format!(
+                "{f1:e} Hz is above {limit:.4e} Hz, the highest frequency this model resolves: \
+                 at harmonic {h} the inertia (2π·f·h)²·Mᵢᵢ of every DOF would exceed its \
+                 stiffness Kᵢᵢ (contacts stuck) by more than {MAX_INERTIA_RATIO:e}, so K and the \
+                 contact forces are lost in round-off (the stiffest DOF for its mass has \
+                 √(Kᵢᵢ/Mᵢᵢ)/2π = {natural:.4e} Hz; the bound is {:e} times that over h)",
+                MAX_INERTIA_RATIO.sqrt()
+            ),
+        ));
+    }
+    Ok(())
+}
 
 /// The analysis settings of the `[analysis]` table: the frequency range (Hz), the arc-length
 /// steps (defaults from the range), iteration counts and tolerances.

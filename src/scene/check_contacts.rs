@@ -10,11 +10,14 @@ use crate::scene::schema::{ContactSpec, Scene};
 
 /// The contact points of the scene, `[[contacts]]` first and then the points of each
 /// `[[contact_patches]]` entry, with their damper sides in order of first appearance.
+/// `stiffness_scale` (N/m, the largest diagonal entry of K) bounds every kₜ and kₙ (see
+/// [`Checker::contact_stiffness`]).
 pub(super) fn contact_set(
     scene: &Scene,
     ck: &Checker,
     dofs: &DofNames,
     fe: Option<&FeStructure>,
+    stiffness_scale: f64,
 ) -> Result<(Vec<ContactPoint>, Vec<DamperSide>), SceneError> {
     if scene.contacts.is_empty() && scene.contact_patches.is_empty() {
         return Err(ck.err(
@@ -26,15 +29,23 @@ pub(super) fn contact_set(
     let mut contacts = Vec::new();
     let mut sides: Vec<DamperSide> = Vec::new();
     for (ci, c) in scene.contacts.iter().enumerate() {
-        let point = contact_point(ck, ci, c, &scene.contacts[..ci], dofs, &mut sides)?;
+        let point = contact_point(
+            ck,
+            ci,
+            c,
+            &scene.contacts[..ci],
+            dofs,
+            &mut sides,
+            stiffness_scale,
+        )?;
         contacts.push(point);
     }
 
     for (pi, p) in scene.contact_patches.iter().enumerate() {
         let f = |name: &str| format!("contact_patches[{pi}].{name}");
         ck.name(&f("side"), &p.side)?;
-        ck.positive(&f("kt"), p.kt)?;
-        ck.positive(&f("kn"), p.kn)?;
+        ck.contact_stiffness(&f("kt"), p.kt, stiffness_scale)?;
+        ck.contact_stiffness(&f("kn"), p.kn, stiffness_scale)?;
         ck.friction(&f("mu"), p.mu)?;
         ck.finite(&f("gap"), p.gap)?;
         ck.positive(&f("tolerance"), p.tolerance)?;
@@ -68,7 +79,7 @@ pub(super) fn contact_set(
 }
 
 /// Contact `ci` of `[[contacts]]` (the `earlier` ones are checked for a name clash), added to
-/// its damper side in `sides`.
+/// its damper side in `sides`; its kₜ and kₙ are bounded by `stiffness_scale` (N/m).
 fn contact_point(
     ck: &Checker,
     ci: usize,
@@ -76,6 +87,7 @@ fn contact_point(
     earlier: &[ContactSpec],
     dofs: &DofNames,
     sides: &mut Vec<DamperSide>,
+    stiffness_scale: f64,
 ) -> Result<ContactPoint, SceneError> {
     let f = |name: &str| format!("contacts[{ci}].{name}");
     ck.name(&f("name"), &c.name)?;
@@ -129,8 +141,8 @@ fn contact_point(
         ));
     }
     let (t, nv) = frame(ck, ci, c, dim)?;
-    let kt = ck.positive(&f("kt"), c.kt)?;
-    let kn = ck.positive(&f("kn"), c.kn)?;
+    let kt = ck.contact_stiffness(&f("kt"), c.kt, stiffness_scale)?;
+    let kn = ck.contact_stiffness(&f("kn"), c.kn, stiffness_scale)?;
     let mu = ck.friction(&f("mu"), c.mu)?;
     let gap = ck.finite(&f("gap"), c.gap)?;
     let m = ck.initial_state(&f("initial_state"), c.initial_state)?;

@@ -11,29 +11,34 @@ use crate::scene::schema::{HarmonicLoadSpec, HarmonicsSpec, StaticLoadSpec};
 /// Most AFT samples per period a scene may ask for (2²⁰).
 pub const MAX_SAMPLES: usize = 1 << 20;
 
-/// The static force (N) on each of the `n` DOFs: the sum of the `[[static_loads]]`.
+/// The static force (N) on each of the `n` DOFs: the sum of the `[[static_loads]]`; and the
+/// DOFs each entry loads (in entry order), so that later checks can name the entry that sets
+/// a body's load.
 pub(super) fn static_load(
     loads: &[StaticLoadSpec],
     ck: &Checker,
     dofs: &DofNames,
     fe: Option<&FeStructure>,
     n: usize,
-) -> Result<Vec<f64>, SceneError> {
+) -> Result<(Vec<f64>, Vec<Vec<usize>>), SceneError> {
     let mut static_load = vec![0.0; n];
+    let mut entry_dofs = Vec::with_capacity(loads.len());
     for (i, l) in loads.iter().enumerate() {
         let value = ck.finite(&format!("static_loads[{i}].value"), l.value)?;
-        for (d, w) in ck.load_targets(
+        let targets = ck.load_targets(
             &format!("static_loads[{i}]"),
             l.dof.as_deref(),
             l.group.as_deref(),
             l.direction.as_deref(),
             dofs,
             fe,
-        )? {
+        )?;
+        for &(d, w) in &targets {
             static_load[d] += w * value;
         }
+        entry_dofs.push(targets.into_iter().map(|(d, _)| d).collect());
     }
-    Ok(static_load)
+    Ok((static_load, entry_dofs))
 }
 
 /// The balanced dynamic harmonics (sorted, ≥ 1) of the `[harmonics]` table, after checking

@@ -1,7 +1,7 @@
 //! Validation of the linear structure: the `[model]` table built into a [`LinearModel`]
 //! (inline dense matrices, or an FE model through [`crate::scene::fe_input`]), the optional
-//! Craig-Bampton `[reduction]`, and the check that the structure with all contacts stuck can
-//! carry static loads.
+//! Craig-Bampton `[reduction]`, the model's stiffness scale that bounds contact stiffnesses,
+//! and the check that the structure with all contacts stuck can carry static loads.
 
 use faer::Mat;
 
@@ -13,6 +13,26 @@ use crate::scene::checker::Checker;
 use crate::scene::error::SceneError;
 use crate::scene::fe_input::{self, FeStructure, ReductionSpec};
 use crate::scene::schema::ModelSpec;
+
+/// The diagonal of a structural matrix (one pass over its stored entries).
+pub(super) fn diagonal(m: &StructuralMatrix) -> Vec<f64> {
+    let mut d = vec![0.0; m.n()];
+    m.for_each_nonzero(|i, j, v| {
+        if i == j {
+            d[i] += v;
+        }
+    });
+    d
+}
+
+/// The model's stiffness scale (N/m): the largest diagonal entry of K, 0 for a model without
+/// stiffness. It bounds the contact stiffnesses (a spring far stiffer than the structure
+/// swamps it in round-off) and sets the tolerance of rigid-body modes.
+pub(super) fn stiffness_scale(model: &LinearModel) -> f64 {
+    diagonal(&model.stiffness)
+        .into_iter()
+        .fold(0.0_f64, |a, v| a.max(v.abs()))
+}
 
 /// The linear structure: inline dense matrices, or an FE model (mesh or Matrix Market).
 pub(super) fn build_model(

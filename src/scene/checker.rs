@@ -9,6 +9,17 @@ use faer::Mat;
 use crate::scene::error::SceneError;
 use crate::scene::fe_input::{self, FeStructure};
 
+/// Largest magnitude of any real number in a scene (SI units): far beyond every physical
+/// stiffness, mass, force, length or frequency, and small enough that products and squares of
+/// a few scene values stay finite in double precision.
+pub const MAX_MAGNITUDE: f64 = 1e50;
+
+/// Largest ratio of a contact stiffness kₜ or kₙ (N/m) to the model's stiffness scale (the
+/// largest diagonal entry of K): above it the stuck structure's stiffness matrix
+/// K + kₜ t tᵀ + kₙ n nᵀ has a condition number above 10¹², and the structure is lost in
+/// round-off next to the contact spring.
+pub const MAX_CONTACT_STIFFNESS_RATIO: f64 = 1e12;
+
 /// Validation context: file name for messages.
 pub(super) struct Checker<'a> {
     /// Scene file, as named in messages.
@@ -21,13 +32,23 @@ impl Checker<'_> {
         SceneError::invalid(self.file, field, reason)
     }
 
-    /// `v`, if it is finite.
+    /// `v`, if it is finite and of magnitude at most [`MAX_MAGNITUDE`] (no quantity of a
+    /// scene comes near it in SI units, and it keeps products and squares of scene values far
+    /// from overflow).
     pub(super) fn finite(&self, field: &str, v: f64) -> Result<f64, SceneError> {
-        if v.is_finite() {
-            Ok(v)
-        } else {
-            Err(self.err(field, format!("must be a finite number, got {v}")))
+        if !v.is_finite() {
+            return Err(self.err(field, format!("must be a finite number, got {v}")));
         }
+        if v.abs() > MAX_MAGNITUDE {
+            return Err(self.err(
+                field,
+                format!(
+                    "{v:e} is out of range: scene values must have magnitude ≤ {MAX_MAGNITUDE:e} \
+                     (SI units; larger values overflow in the solver's products and norms)"
+                ),
+            ));
+        }
+        Ok(v)
     }
 
     /// `v`, if it is finite and > 0.
@@ -122,6 +143,32 @@ impl Checker<'_> {
         let max = eig.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
         let min = eig.iter().cloned().fold(f64::INFINITY, f64::min);
         Ok((min, max))
+    }
+
+    /// A contact stiffness `k` (N/m, kₜ or kₙ): finite, > 0, and no larger than
+    /// [`MAX_CONTACT_STIFFNESS_RATIO`] times `model_scale`, the largest diagonal entry of K
+    /// (N/m); a model without stiffness (`model_scale` = 0) sets no such bound. The ratio is
+    /// checked before [`MAX_MAGNITUDE`] so that an absurd stiffness is explained by the
+    /// structure it would swamp.
+    pub(super) fn contact_stiffness(
+        &self,
+        field: &str,
+        k: f64,
+        model_scale: f64,
+    ) -> Result<f64, SceneError> {
+        let limit = MAX_CONTACT_STIFFNESS_RATIO * model_scale;
+        if k.is_finite() && model_scale > 0.0 && k > limit {
+            return Err(self.err(
+                field,
+                format!(
+                    "{k:e} N/m is more than {MAX_CONTACT_STIFFNESS_RATIO:e} times the model's \
+                     stiffness scale (largest diagonal entry of K, {model_scale:e} N/m): the \
+                     stuck structure's stiffness matrix would lose the structure in round-off; \
+                     a contact that stiff is rigid, use at most {limit:e} N/m"
+                ),
+            ));
+        }
+        self.positive(field, k)
     }
 
     /// A friction coefficient μ (–): finite and ≥ 0.

@@ -5,7 +5,9 @@
 //! checked, and the validation that turns a scene into a checked [`Problem`](crate::model::Problem)
 //! plus the analysis settings the scene asks for (the limit analysis of a `[limits]` table).
 //! Every value is checked there, and an error names the file, the field (dotted path, e.g.
-//! `contacts[1].mu`) and the reason. FE scene input (meshes, Matrix Market files, contact
+//! `contacts[1].mu`) and the reason: ranges and consistency, the physical conditions a solve
+//! needs (a free body pressed onto its contacts, contact stiffnesses and frequencies the model
+//! resolves), and the scene at every point of a `[sweep]`. FE scene input (meshes, Matrix Market files, contact
 //! patches, group loads, Craig-Bampton reduction) is in [`fe_input`].
 //!
 //! Layers used: `analysis` (limit settings, contact stiffness of the stuck check), `hbm` (the
@@ -24,15 +26,19 @@
 //! - [`load_problem`]: load and validate in one go.
 //! - [`PAPER_DEFAULT_SCENE`], [`paper_wedge_scene`], [`default_scene_label`]: the built-in
 //!   paper scene.
-//! - [`MAX_SAMPLES`], [`MAX_POINTS`]: the largest sampling and point counts a scene may ask for.
+//! - [`MAX_SAMPLES`], [`MAX_POINTS`]: the largest sampling and point counts a scene may ask for;
+//!   [`MAX_MAGNITUDE`], [`MAX_CONTACT_STIFFNESS_RATIO`], [`MAX_INERTIA_RATIO`]: the bounds on
+//!   the magnitude of any number, on contact stiffnesses and on frequencies.
 
 mod check_analysis;
+mod check_bodies;
 mod check_contacts;
 mod check_limits;
 mod check_loads;
 mod check_model;
 mod check_sweep;
 mod checker;
+mod cone;
 pub mod error;
 pub mod fe_input;
 pub mod limits_schema;
@@ -41,8 +47,9 @@ pub mod paper;
 pub mod schema;
 pub mod validate;
 
-pub use check_analysis::MAX_POINTS;
+pub use check_analysis::{MAX_INERTIA_RATIO, MAX_POINTS};
 pub use check_loads::MAX_SAMPLES;
+pub use checker::{MAX_CONTACT_STIFFNESS_RATIO, MAX_MAGNITUDE};
 pub use error::SceneError;
 pub use limits_schema::{
     HysteresisSpec, LimitCaseSpec, LimitsSpec, SeriesSpec, SweepOutput, SweepSpec, SweepTarget,

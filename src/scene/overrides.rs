@@ -69,7 +69,7 @@ fn parse_message(e: &toml::de::Error, text: &str) -> String {
 }
 
 /// A possibly multi-line message on one line: trimmed lines joined by spaces.
-fn one_line(message: &str) -> String {
+pub(super) fn one_line(message: &str) -> String {
     message
         .trim()
         .lines()

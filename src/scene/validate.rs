@@ -1,7 +1,9 @@
 //! Validation at the door: a parsed [`Scene`] checked table by table, in a fixed order (model,
-//! contacts, loads, harmonics, analysis, output, limits, sweep, reduction, stuck structure),
-//! and built into a checked [`Problem`] plus the limit-analysis settings the scene asks for.
-//! The first bad value is reported with the file, its dotted field path and the reason.
+//! contacts, loads, harmonics, analysis and its frequency bound, output, limits, sweep table,
+//! how every free body is held, reduction, stuck structure, formulation, and last the scene
+//! at every sweep point), and built into a checked [`Problem`] plus the limit-analysis
+//! settings the scene asks for. The first bad value is reported with the file, its dotted
+//! field path and the reason.
 
 use std::path::Path;
 
@@ -10,12 +12,15 @@ use crate::contact::aft::MarchSettings;
 use crate::contact::ContactEffects;
 use crate::hbm::formulation::check_relative_coordinates;
 use crate::model::{Effects, FeOrigin, Formulation, Problem};
-use crate::scene::check_analysis::{analysis, outputs};
+use crate::scene::check_analysis::{analysis, frequency_bound, outputs};
+use crate::scene::check_bodies::check_held_bodies;
 use crate::scene::check_contacts::contact_set;
 use crate::scene::check_limits::limit_settings;
 use crate::scene::check_loads::{harmonic_loads, harmonic_set, static_load};
-use crate::scene::check_model::{build_model, check_stuck_structure, reduce_problem};
-use crate::scene::check_sweep::check_sweep;
+use crate::scene::check_model::{
+    build_model, check_stuck_structure, reduce_problem, stiffness_scale,
+};
+use crate::scene::check_sweep::{check_sweep, check_sweep_points};
 use crate::scene::checker::{Checker, DofNames};
 use crate::scene::error::SceneError;
 use crate::scene::overrides::load;
@@ -28,22 +33,35 @@ impl Scene {
     }
 
     /// Checks every value and builds the problem and, when the scene has a `[limits]` table,
-    /// the settings of its limit analysis. `file` names the scene in errors.
+    /// the settings of its limit analysis. `file` names the scene in errors. A scene with a
+    /// `[sweep]` table is also checked at every sweep point.
     pub fn validate_with_limits(
         &self,
         file: &str,
     ) -> Result<(Problem, Option<LimitSettings>), SceneError> {
+        let checked = self.validate_scene(file)?;
+        check_sweep_points(self, &Checker { file }, &|point: &Scene| {
+            point.validate_scene(file).map(|_| ())
+        })?;
+        Ok(checked)
+    }
+
+    /// Checks every value of this scene (the `[sweep]` table's own fields, not the scene at
+    /// its points) and builds the problem and the limit settings.
+    fn validate_scene(&self, file: &str) -> Result<(Problem, Option<LimitSettings>), SceneError> {
         let ck = Checker { file };
         let (model, fe) = build_model(&self.model, &ck)?;
+        let k_scale = stiffness_scale(&model);
         let dofs = DofNames::new(&model.dof_names);
         let dofs = &dofs;
         let n = model.n_dofs();
 
-        let (contacts, sides) = contact_set(self, &ck, dofs, fe.as_ref())?;
-        let static_load = static_load(&self.static_loads, &ck, dofs, fe.as_ref(), n)?;
+        let (contacts, sides) = contact_set(self, &ck, dofs, fe.as_ref(), k_scale)?;
+        let (static_load, load_dofs) = static_load(&self.static_loads, &ck, dofs, fe.as_ref(), n)?;
         let harmonics = harmonic_set(&self.harmonics, &ck)?;
         let harmonic_loads =
             harmonic_loads(&self.harmonic_loads, &ck, dofs, fe.as_ref(), &harmonics)?;
+        frequency_bound(&self.analysis, &harmonics, &model, &contacts, &ck)?;
         let analysis = analysis(&self.analysis, &ck)?;
         let outputs = outputs(&self.output, &ck, dofs, fe.as_ref())?;
 
@@ -81,8 +99,23 @@ impl Scene {
             }),
         };
         check_sweep(self, &ck)?;
+        // On the full model, before reduction; reported after the stuck-structure check, which
+        // names a body that even stuck contacts cannot hold.
+        let points: Vec<Vec<usize>> = self
+            .contacts
+            .iter()
+            .flat_map(|c| [&c.damper, &c.body])
+            .map(|names| {
+                names
+                    .iter()
+                    .filter_map(|name| problem.model.dof_index(name))
+                    .collect()
+            })
+            .collect();
+        let held = check_held_bodies(&ck, &problem, &points, &load_dofs);
         let problem = reduce_problem(self.reduction.as_ref(), &self.model, &ck, problem)?;
         check_stuck_structure(&ck, &problem)?;
+        held?;
         if problem.analysis.formulation == Formulation::Schur {
             check_relative_coordinates(&problem)
                 .map_err(|e| ck.err("analysis.formulation", e.to_string()))?;

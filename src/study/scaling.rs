@@ -376,35 +376,10 @@ impl SolverConfig {
     }
 }
 
-/// Unknowns of Newton's iteration on `p`: all DOFs per coefficient block, or the contact DOFs
-/// per block for the condensed formulation.
-pub fn unknowns(p: &Problem) -> usize {
-    let blocks = p.unknown_harmonics().n_blocks();
-    match p.formulation() {
-        Formulation::Condensed => p.contact_dofs().len() * blocks,
-        _ => p.model.n_dofs() * blocks,
-    }
-}
-
-/// Rows of the matrix factorised per Newton iteration on `p`: the unknowns, except for the
-/// schur formulation (2 relative coordinates per contact point and coefficient block).
-pub fn factored_size(p: &Problem) -> usize {
-    match p.formulation() {
-        Formulation::Schur => 2 * p.contacts.len() * p.unknown_harmonics().n_blocks(),
-        _ => unknowns(p),
-    }
-}
-
-/// Label of a formulation.
-pub fn formulation_name(f: Formulation) -> &'static str {
-    match f {
-        Formulation::Auto => "auto",
-        Formulation::Dense => "dense",
-        Formulation::Sparse => "sparse",
-        Formulation::Condensed => "condensed",
-        Formulation::Schur => "schur",
-    }
-}
+// The unknowns, the factorised size and the formulation names are counted where the
+// formulations live (`hbm::cost`, which also estimates memory and time from them); re-exported
+// here for the study and its callers.
+pub use crate::hbm::cost::{factored_size, formulation_name, unknowns};
 
 /// Label of a Jacobian strategy.
 pub fn jacobian_name(j: JacobianStrategy) -> &'static str {

@@ -3,8 +3,8 @@
 //! curve.
 
 use crate::analysis::frf::{FrfError, FrfPoint, PointSolver};
-pub use crate::analysis::peaks::Peak;
 use crate::analysis::peaks::refine_at;
+pub use crate::analysis::peaks::Peak;
 use crate::model::Problem;
 
 /// Locates the resonance peak of output `output` on a path: the largest interior local maximum

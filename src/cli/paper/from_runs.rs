@@ -226,8 +226,16 @@ fn consider(best: &mut Option<Located>, value: f64, figure: &str, at: String) {
 pub fn key_numbers(figures: &[FigureResult]) -> KeyNumbers {
     let mut k = KeyNumbers::default();
     for f in figures {
-        if let Err(e) = &f.outcome {
-            k.failures.push(format!("{}: {e}", f.job.id));
+        match &f.outcome {
+            Err(e) => k.failures.push(format!("{}: {e}", f.job.id)),
+            // A sweep's failed cases are listed per point below.
+            Ok(r) if !matches!(r.outcome, RunOutcome::Sweep(_)) => {
+                if let Some(reason) = &r.incomplete {
+                    k.failures
+                        .push(format!("{}: incomplete: {reason}", f.job.id));
+                }
+            }
+            Ok(_) => {}
         }
     }
     if let Some(r) = find(figures, "fig12").and_then(|f| f.report()) {
@@ -278,7 +286,7 @@ pub fn key_numbers(figures: &[FigureResult]) -> KeyNumbers {
                     }
                 }
             }
-            RunOutcome::Frf(_) => {}
+            RunOutcome::Frf(_) | RunOutcome::LimitCurves(_) => {}
         }
     }
     for row in &k.analyses {

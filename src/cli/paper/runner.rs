@@ -8,7 +8,7 @@ use std::time::Instant;
 use super::figures::{FigureResult, FIGURES};
 use super::from_runs::key_numbers;
 use super::markdown::markdown;
-use crate::cli::{create_dir, run, CommandError, RunOptions};
+use crate::cli::{create_dir, run, CommandError, RunOptions, RunOutcome};
 use crate::report::files;
 
 /// Options of `fricbound paper`.
@@ -60,7 +60,14 @@ pub fn paper(options: &PaperOptions) -> Result<PaperReport, CommandError> {
             },
             quiet: options.quiet,
         };
-        let outcome = run(&run_options).map_err(|e| e.to_string());
+        // A limit analysis stopped by a failed curve has no analysis to take numbers from: the
+        // figure failed (its finished curves are on disk).
+        let outcome = run(&run_options).map_err(|e| e.to_string()).and_then(|r| {
+            match (&r.outcome, &r.incomplete) {
+                (RunOutcome::LimitCurves(_), Some(reason)) => Err(format!("incomplete: {reason}")),
+                _ => Ok(r),
+            }
+        });
         if let (Err(e), false) = (&outcome, options.quiet) {
             eprintln!("{}: failed: {e}", job.id);
         }

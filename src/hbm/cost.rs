@@ -1,0 +1,465 @@
+//! Size and cost of a problem's harmonic balance, estimated before anything is allocated: the
+//! unknowns of Newton's iteration, the rows of the matrix it factorises, the memory one Newton
+//! iteration holds (Jacobian storage and factorisation, the formulation's eliminated blocks,
+//! the AFT buffers) and a rough time per continuation point.
+//!
+//! It belongs to the harmonic-balance layer because only this layer knows how each formulation
+//! ([`Formulation`], chosen by [`Problem::formulation`]) stores and factorises its matrices.
+//! `fricbound check` prints the estimate and `fricbound run` refuses a problem whose estimate
+//! exceeds the machine's available memory, instead of aborting on an allocation later.
+//!
+//! Everything here is counted from the problem's sizes (DOFs, coefficient blocks, AFT samples,
+//! contact points, non-zeros of the structural matrices); nothing is allocated in proportion
+//! to them, so a problem that would need terabytes is estimated in microseconds.
+//!
+//! **Memory model** (bytes, f64 = 8, complex = 16; m = unknowns, b = unknown coefficient
+//! blocks, b_f = AFT coefficient blocks (0th harmonic always included), N = samples per period,
+//! n = DOFs, c = contact points, d = DOFs touched by one contact point):
+//!
+//! - AFT workspace (one per operator, shared by all contact points): the sampled basis and its
+//!   projection (2·N·b_f values, the inverse-DFT and DFT matrices), the three derivative
+//!   matrices ∂T̂/∂û, ∂T̂/∂v̂, ∂N̂/∂v̂ (3·b_f²) and about 16 sample buffers of N values;
+//! - contact Jacobian blocks: d²·b² slots (index and value) per contact point (schur: one
+//!   (2·b)² block of values per contact point);
+//! - `dense`: the Jacobian, the bordered copy handed to the LU and its L and U factors,
+//!   4·m² values;
+//! - `sparse`: the Jacobian's non-zeros (b·nnz(K ∪ M) + 2·H·nnz(C) + c·d²·b², value and row
+//!   index each) and an LU factor assumed [`SPARSE_FILL`] times as large (the fill-in depends
+//!   on the ordering and is not known before the symbolic factorisation);
+//! - `condensed`: dense K, M, C (3·n²), per harmonic the kept LU of the linear DOFs' block in
+//!   the real 2n form and the coupling blocks (about 8·n_l² + 8·n_l·n_c + 4·n_c² values for
+//!   h ≥ 1, a quarter for h = 0) plus one such block in construction, and the dense Jacobian
+//!   on the m = n_c·b contact unknowns (4·m²);
+//! - `schur`: dense K, M, C and their congruences (6·n²), per dynamic harmonic the complex
+//!   elimination of everything but the n_q = 2c relative coordinates (n² complex values:
+//!   LU, coupling blocks and the Schur complement; n² real for h = 0), and the reduced matrix
+//!   of (n_q·b)² values with its single-precision copy; twice all of the factor part, since
+//!   the continuation keeps the previous factorisation while it builds the next one.
+//!
+//! **Time model** (an estimate, good to a factor of a few): per Newton iteration, the
+//! factorisation's floating-point operations (dense LU (2/3)·m³; complex LU 4× a real one;
+//! sparse LU 2·nnz(LU)²/m) at [`FACTOR_FLOPS_PER_S`], plus the scalar work (the AFT march of
+//! every contact point over [`MARCH_PERIODS`] periods with its FFTs and Gram matrices, the
+//! contact blocks, the assembly of the linear part) at [`SCALAR_FLOPS_PER_S`], plus
+//! [`OVERHEAD_S`]; times [`ITERATIONS_PER_POINT`] iterations per continuation point, or, when
+//! the corrector takes chord iterations, [`CHORD_FACTORISATIONS_PER_POINT`] factorisations and
+//! [`CHORD_EVALUATIONS_PER_POINT`] evaluations per point. The rates were calibrated on the
+//! 2-core development machine against measured runs of the paper scene (H = 1 to 600, dense
+//! and schur), the reduced blade pair (dense) and the unreduced one (sparse); README's Outputs
+//! section gives the comparison.
+
+use crate::model::{Formulation, Problem};
+
+/// Bytes of one f64.
+const F64: f64 = 8.0;
+/// Bytes of one complex f64.
+const C64: f64 = 16.0;
+/// Bytes of one stored index (usize).
+const INDEX: f64 = 8.0;
+
+/// Assumed ratio of the sparse LU factor's non-zeros to the Jacobian's (the fill-in). The
+/// time per point of the unreduced 5 000-DOF 2D blade pair fits 4-5; the Cholesky factors of
+/// the Craig-Bampton study (`reduction/README.md`, K alone) fill 6-7 times in 2D and about 16
+/// times in 3D, so 3D meshes may need more than this estimate.
+pub const SPARSE_FILL: f64 = 5.0;
+
+/// Factorisation rate assumed for the time estimate (flop/s): measured runs of the paper scene
+/// with 250-800 factorised rows (dense and schur) give 3.5-4.5 Gflop/s on the development
+/// machine, the copies into the bordered matrix included.
+pub const FACTOR_FLOPS_PER_S: f64 = 4.0e9;
+
+/// Rate of the scalar work (AFT march, FFTs, Jacobian assembly) assumed for the time estimate
+/// (flop/s, calibrated on the paper scene at H = 1 and 5, where it dominates).
+pub const SCALAR_FLOPS_PER_S: f64 = 2.0e9;
+
+/// Fixed cost of one Newton iteration (s): residual bookkeeping, small allocations.
+pub const OVERHEAD_S: f64 = 5.0e-6;
+
+/// Newton iterations per continuation point assumed for the time estimate, cut steps included
+/// (the paper scene averages 2.9-3.4 converged iterations per point; chord iterations of large
+/// problems make fewer factorisations).
+pub const ITERATIONS_PER_POINT: f64 = 3.5;
+
+/// Factorisations per continuation point with chord iterations (problems of at least the
+/// continuation's `chord_min_unknowns` unknowns carry a factorisation over several points;
+/// measured 0.2-0.25 on the paper scene with 2 400-4 800 factorised rows).
+pub const CHORD_FACTORISATIONS_PER_POINT: f64 = 0.25;
+
+/// Residual and contact-force evaluations per continuation point with chord iterations (three
+/// chord steps count as one Newton iteration; the paper scene averages about 2.2 such
+/// iterations per point).
+pub const CHORD_EVALUATIONS_PER_POINT: f64 = 7.0;
+
+/// Periods of the AFT march assumed per evaluation (the march repeats until the slider state
+/// repeats, usually after the second period).
+pub const MARCH_PERIODS: f64 = 2.0;
+
+/// Unknowns of Newton's iteration on `p`: all DOFs per coefficient block, or the contact DOFs
+/// per block for the condensed formulation.
+pub fn unknowns(p: &Problem) -> usize {
+    let blocks = p.unknown_harmonics().n_blocks();
+    match p.formulation() {
+        Formulation::Condensed => p.contact_dofs().len() * blocks,
+        _ => p.model.n_dofs() * blocks,
+    }
+}
+
+/// Rows of the matrix factorised per Newton iteration on `p`: the unknowns, except for the
+/// schur formulation (2 relative coordinates per contact point and coefficient block).
+pub fn factored_size(p: &Problem) -> usize {
+    match p.formulation() {
+        Formulation::Schur => 2 * p.contacts.len() * p.unknown_harmonics().n_blocks(),
+        _ => unknowns(p),
+    }
+}
+
+/// Name of a formulation as written in scenes (`analysis.formulation`).
+pub fn formulation_name(f: Formulation) -> &'static str {
+    match f {
+        Formulation::Auto => "auto",
+        Formulation::Dense => "dense",
+        Formulation::Sparse => "sparse",
+        Formulation::Condensed => "condensed",
+        Formulation::Schur => "schur",
+    }
+}
+
+/// The estimated size and cost of one problem's harmonic balance (see the module docs for the
+/// model behind each number).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct CostEstimate {
+    /// The formulation solved (the scene's choice, or what `auto` picks).
+    pub formulation: Formulation,
+    /// DOFs of the model.
+    pub dofs: usize,
+    /// Unknown coefficient blocks (0th harmonic when coupled, cos and sin per harmonic).
+    pub blocks: usize,
+    /// Coefficient blocks of the AFT (the 0th harmonic always included).
+    pub force_blocks: usize,
+    /// AFT samples per period.
+    pub samples: usize,
+    /// Contact points.
+    pub contacts: usize,
+    /// Unknowns of Newton's iteration ([`unknowns`]).
+    pub unknowns: usize,
+    /// Rows of the matrix factorised per Newton iteration ([`factored_size`]).
+    pub factored: usize,
+    /// Jacobian storage and its factorisation, with the formulation's eliminated blocks and
+    /// dense structural matrices (bytes).
+    pub solver_bytes: f64,
+    /// AFT workspace: sampled basis and projection, derivative matrices, sample buffers
+    /// (bytes).
+    pub aft_bytes: f64,
+    /// Contact Jacobian blocks and their slots in the Jacobian (bytes).
+    pub contact_bytes: f64,
+    /// Floating-point operations of the factorisation per Newton iteration.
+    pub factor_flops: f64,
+    /// Floating-point operations of the rest of a Newton iteration or chord step (AFT, contact
+    /// blocks, assembly of the linear part, one solve with the factors).
+    pub scalar_flops: f64,
+    /// Whether the corrector takes chord iterations (at least the continuation's
+    /// `chord_min_unknowns` unknowns): factorisations are then carried over points.
+    pub chord: bool,
+}
+
+impl CostEstimate {
+    /// Memory of one Newton iteration (bytes): solver, AFT and contact blocks.
+    pub fn bytes(&self) -> f64 {
+        self.solver_bytes + self.aft_bytes + self.contact_bytes
+    }
+
+    /// Estimated time of one factorisation (s).
+    pub fn seconds_per_factorisation(&self) -> f64 {
+        self.factor_flops / FACTOR_FLOPS_PER_S
+    }
+
+    /// Estimated time of one evaluation without factorisation (s): residual, contact forces
+    /// and their Jacobian, one solve.
+    pub fn seconds_per_evaluation(&self) -> f64 {
+        self.scalar_flops / SCALAR_FLOPS_PER_S + OVERHEAD_S
+    }
+
+    /// Factorisations and evaluations per continuation point: [`ITERATIONS_PER_POINT`] of each,
+    /// or with chord iterations [`CHORD_FACTORISATIONS_PER_POINT`] and
+    /// [`CHORD_EVALUATIONS_PER_POINT`].
+    pub fn per_point(&self) -> (f64, f64) {
+        if self.chord {
+            (CHORD_FACTORISATIONS_PER_POINT, CHORD_EVALUATIONS_PER_POINT)
+        } else {
+            (ITERATIONS_PER_POINT, ITERATIONS_PER_POINT)
+        }
+    }
+
+    /// Estimated time of one Newton iteration with a factorisation (s).
+    pub fn seconds_per_iteration(&self) -> f64 {
+        self.seconds_per_factorisation() + self.seconds_per_evaluation()
+    }
+
+    /// Estimated time of one continuation point (s), see [`Self::per_point`].
+    pub fn seconds_per_point(&self) -> f64 {
+        let (factorisations, evaluations) = self.per_point();
+        factorisations * self.seconds_per_factorisation()
+            + evaluations * self.seconds_per_evaluation()
+    }
+
+    /// One line for `fricbound check`: "memory per Newton iteration ≈ … MiB (…), time per
+    /// point ≈ … (estimate: … factorisations of …, … evaluations of …)".
+    pub fn summary(&self) -> String {
+        let (factorisations, evaluations) = self.per_point();
+        format!(
+            "memory per Newton iteration ≈ {} (solver {}, AFT {}, contact blocks {}), \
+             time per point ≈ {} (estimate: {factorisations} factorisations of {}, \
+             {evaluations} evaluations of {})",
+            format_bytes(self.bytes()),
+            format_bytes(self.solver_bytes),
+            format_bytes(self.aft_bytes),
+            format_bytes(self.contact_bytes),
+            format_seconds(self.seconds_per_point()),
+            format_seconds(self.seconds_per_factorisation()),
+            format_seconds(self.seconds_per_evaluation()),
+        )
+    }
+}
+
+/// Estimates the size and cost of `p`'s harmonic balance without allocating in proportion to
+/// it (see the module docs for the model).
+pub fn estimate(p: &Problem) -> CostEstimate {
+    let formulation = p.formulation();
+    let n = p.model.n_dofs() as f64;
+    let set = p.unknown_harmonics();
+    let b = set.n_blocks() as f64;
+    let force_blocks = p.force_harmonics().n_blocks();
+    let bf = force_blocks as f64;
+    let samples = p.samples as f64;
+    let c = p.contacts.len() as f64;
+    // Dynamic harmonics (h ≥ 1) of the unknowns, and whether the 0th is among them.
+    let dynamic = set.harmonics().iter().filter(|&&h| h > 0).count() as f64;
+    let has_static = set.constant_block().is_some();
+    let unknowns = unknowns(p);
+    let factored = factored_size(p);
+    let m = unknowns as f64;
+
+    // AFT: basis and projection, derivative matrices, sample buffers.
+    let aft_bytes = F64 * (2.0 * samples * bf + 3.0 * bf * bf + 16.0 * samples);
+    // Contact blocks: d² b² slots and values per contact point.
+    let d2: f64 = p
+        .contacts
+        .iter()
+        .map(|cp| {
+            let mut dofs: Vec<usize> = cp
+                .tangential
+                .iter()
+                .chain(&cp.normal)
+                .map(|&(d, _)| d)
+                .collect();
+            dofs.sort_unstable();
+            dofs.dedup();
+            (dofs.len() * dofs.len()) as f64
+        })
+        .sum();
+    let contact_bytes = match formulation {
+        // The schur Jacobian keeps each contact's (2·b)² block on its relative coordinates.
+        Formulation::Schur => F64 * 4.0 * c * b * b,
+        _ => (F64 + INDEX) * d2 * b * b,
+    };
+
+    let log2 = |x: f64| x.max(2.0).log2();
+    // The march (synthesis by inverse FFT, the law per sample, forward FFT) over a few
+    // periods per contact point, the Gram matrices of the analytic Jacobian (3 FFTs and b_f²
+    // reads each), and scattering the contact blocks into the Jacobian.
+    let aft_flops = c
+        * (MARCH_PERIODS * (10.0 * samples * log2(samples) + 20.0 * samples)
+            + 3.0 * (5.0 * samples * log2(samples) + bf * bf))
+        + d2 * b * b;
+
+    // Per formulation: memory, factorisation flops, and the flops of assembling the linear
+    // part and of one solve with the factors (each evaluation makes one).
+    let (solver_bytes, factor_flops, assembly_flops) = match formulation {
+        Formulation::Sparse => {
+            let nnz_km = p.model.stiffness.nnz().max(p.model.mass.nnz()) as f64;
+            let nnz_c = p.model.damping.nnz() as f64;
+            let nnz = b * nnz_km + 2.0 * dynamic * nnz_c + d2 * b * b;
+            let factor_nnz = SPARSE_FILL * nnz;
+            (
+                (F64 + INDEX) * (nnz + factor_nnz),
+                2.0 * factor_nnz * factor_nnz / m.max(1.0),
+                4.0 * nnz + 2.0 * factor_nnz,
+            )
+        }
+        Formulation::Condensed => {
+            let n_c = p.contact_dofs().len() as f64;
+            let n_l = n - n_c;
+            let per_dynamic = 8.0 * n_l * n_l + 8.0 * n_l * n_c + 4.0 * n_c * n_c;
+            let kept = dynamic * per_dynamic + if has_static { per_dynamic / 4.0 } else { 0.0 };
+            let bytes = F64 * (3.0 * n * n + kept + per_dynamic + 4.0 * m * m);
+            // Per iteration (ω moves in arc-length continuation): per harmonic the LU of the
+            // real 2n_l block, the solves for A_ll⁻¹ A_lc and the Schur product; then the
+            // dense LU on the contact unknowns.
+            let per_harmonic = |k: f64| {
+                let (l, cc) = (k * n_l, k * n_c);
+                2.0 / 3.0 * l * l * l + 2.0 * l * l * cc + 2.0 * cc * cc * l
+            };
+            let flops = dynamic * per_harmonic(2.0)
+                + if has_static { per_harmonic(1.0) } else { 0.0 }
+                + 2.0 / 3.0 * m * m * m;
+            (bytes, flops, 4.0 * m * m)
+        }
+        Formulation::Schur => {
+            let n_q = 2.0 * c;
+            let n_z = (n - n_q).max(0.0);
+            let q = factored as f64;
+            let per_harmonic = dynamic * C64 * n * n + if has_static { F64 * n * n } else { 0.0 };
+            let reduced = (F64 + 4.0) * q * q;
+            let bytes = F64 * 6.0 * n * n + 2.0 * (per_harmonic + reduced);
+            // Per harmonic: LU of the z block (complex: 4× real), the solves for W and the
+            // Schur product; then the dense LU of the reduced matrix.
+            let real = 2.0 / 3.0 * n_z * n_z * n_z + 2.0 * n_z * n_z * n_q + 2.0 * n_q * n_q * n_z;
+            let flops =
+                dynamic * 4.0 * real + if has_static { real } else { 0.0 } + 2.0 / 3.0 * q * q * q;
+            // The residual: a dense product per block with K, M, C; a solve: the reduced
+            // factors and the eliminated blocks of every harmonic.
+            (
+                bytes,
+                flops,
+                6.0 * n * n * b + 2.0 * q * q + 8.0 * dynamic * n * n,
+            )
+        }
+        Formulation::Dense | Formulation::Auto => {
+            (F64 * 4.0 * m * m, 2.0 / 3.0 * m * m * m, 4.0 * m * m)
+        }
+    };
+    CostEstimate {
+        formulation,
+        dofs: p.model.n_dofs(),
+        blocks: set.n_blocks(),
+        force_blocks,
+        samples: p.samples,
+        contacts: p.contacts.len(),
+        unknowns,
+        factored,
+        solver_bytes,
+        aft_bytes,
+        contact_bytes,
+        factor_flops,
+        scalar_flops: aft_flops + assembly_flops,
+        chord: unknowns >= p.analysis.continuation.chord_min_unknowns,
+    }
+}
+
+/// Bytes as MiB (or GiB from 10 GiB), e.g. "1.3 MiB", "51.2 GiB".
+pub fn format_bytes(bytes: f64) -> String {
+    const MIB: f64 = 1024.0 * 1024.0;
+    let mib = bytes / MIB;
+    if mib >= 10.0 * 1024.0 {
+        format!("{:.1} GiB", mib / 1024.0)
+    } else if mib >= 10.0 {
+        format!("{mib:.0} MiB")
+    } else {
+        format!("{mib:.2} MiB")
+    }
+}
+
+/// Seconds in a readable unit: "0.12 ms", "3.4 s", "2.1 h".
+pub fn format_seconds(s: f64) -> String {
+    if s < 1e-3 {
+        format!("{:.3} ms", s * 1e3)
+    } else if s < 1.0 {
+        format!("{:.1} ms", s * 1e3)
+    } else if s < 120.0 {
+        format!("{s:.1} s")
+    } else if s < 7200.0 {
+        format!("{:.0} min", s / 60.0)
+    } else {
+        format!("{:.1} h", s / 3600.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::harmonic::SampleBasis;
+    use crate::hbm::operator::HbmOperator;
+    use crate::numerics::ParametricResidual;
+
+    fn paper(overrides: &[&str]) -> Problem {
+        let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+        crate::scene::parse(crate::scene::PAPER_DEFAULT_SCENE, "paper", &o)
+            .and_then(|s| s.validate("paper"))
+            .expect("valid scene")
+    }
+
+    /// The counts agree with the operator actually built, and the AFT part with the sampled
+    /// basis the AFT allocates.
+    #[test]
+    fn counts_match_the_operator_and_the_aft() {
+        for overrides in [
+            &["harmonics.max=1"][..],
+            &["harmonics.max=5"][..],
+            &["harmonics.max=5", "analysis.formulation=condensed"][..],
+            &["harmonics.max=5", "analysis.formulation=schur"][..],
+            &["harmonics.max=5", "analysis.formulation=sparse"][..],
+        ] {
+            let p = paper(overrides);
+            let c = estimate(&p);
+            let op = HbmOperator::new(&p).expect("operator");
+            assert_eq!(c.unknowns, op.dim(), "{overrides:?}");
+            let basis = SampleBasis::new(&p.force_harmonics(), p.samples);
+            let basis_bytes = 8.0 * (basis.synthesis.len() + basis.projection.len()) as f64;
+            assert!(c.aft_bytes >= basis_bytes, "{overrides:?}");
+            assert!(c.aft_bytes < 2.0 * basis_bytes + 1e6, "{overrides:?}");
+            assert!(c.bytes() > 0.0 && c.seconds_per_point() > 0.0);
+        }
+    }
+
+    /// The default scene: a dense Jacobian of 18 unknowns, 4·18² values for the solver.
+    #[test]
+    fn dense_default_scene() {
+        let c = estimate(&paper(&[]));
+        assert_eq!(c.formulation, Formulation::Dense);
+        assert_eq!((c.unknowns, c.factored, c.blocks), (18, 18, 3));
+        assert_eq!(c.solver_bytes, 8.0 * 4.0 * 18.0 * 18.0);
+        assert!(!c.chord);
+        // About a tenth to a few tenths of a millisecond per point on a current machine.
+        assert!((1e-5..1e-2).contains(&c.seconds_per_point()), "{c:?}");
+    }
+
+    /// The issue's case is estimated in microseconds (nothing is allocated in proportion to
+    /// it) and at tens of gigabytes: the schur matrix of 80 004 rows alone holds 51 GB.
+    #[test]
+    fn huge_harmonic_count_is_estimated_without_allocating() {
+        let p = paper(&["harmonics.max=10000", "harmonics.samples=32768"]);
+        let started = std::time::Instant::now();
+        let c = estimate(&p);
+        assert!(started.elapsed().as_secs_f64() < 0.5);
+        assert_eq!(c.formulation, Formulation::Schur);
+        assert_eq!(
+            (c.unknowns, c.factored, c.force_blocks),
+            (120_006, 80_004, 20_001)
+        );
+        assert!(c.solver_bytes > 8.0 * 80_004.0 * 80_004.0);
+        assert!(c.aft_bytes > 2.0 * 8.0 * 32768.0 * 20_001.0);
+        assert!(c.chord);
+        assert!(c.summary().contains("GiB"), "{}", c.summary());
+    }
+
+    /// More harmonics cost more memory and time.
+    #[test]
+    fn cost_grows_with_the_harmonics() {
+        let small = estimate(&paper(&["harmonics.max=5"]));
+        let large = estimate(&paper(&["harmonics.max=50", "harmonics.samples=1024"]));
+        assert!(large.bytes() > small.bytes());
+        assert!(large.seconds_per_point() > small.seconds_per_point());
+    }
+
+    #[test]
+    fn formats() {
+        assert_eq!(format_bytes(1.5 * 1024.0 * 1024.0), "1.50 MiB");
+        assert_eq!(format_bytes(300.0 * 1024.0 * 1024.0), "300 MiB");
+        assert_eq!(format_bytes(51.0 * 1024.0 * 1024.0 * 1024.0), "51.0 GiB");
+        assert_eq!(format_seconds(2.5e-4), "0.250 ms");
+        assert_eq!(format_seconds(0.0123), "12.3 ms");
+        assert_eq!(format_seconds(3.45), "3.5 s");
+        assert_eq!(format_seconds(600.0), "10 min");
+        assert_eq!(format_seconds(36_000.0), "10.0 h");
+    }
+}

@@ -1,0 +1,523 @@
+//! What `fricbound run` leaves on disk and how it exits: honest completion (status and exit
+//! code 3 when the range or a case was not covered), result files of an earlier run removed
+//! before a run starts, a default folder per set of overrides, figure titles naming the
+//! overrides, and the size check that refuses a problem too large for the machine before
+//! anything is written; `fricbound check` prints that estimate without listing thousands of
+//! harmonics.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use fricbound::cli::{EXIT_COMPLETE, EXIT_ERROR, EXIT_INCOMPLETE};
+use fricbound::report::owned::is_owned;
+
+fn fricbound(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_fricbound"))
+        .args(args)
+        .output()
+        .expect("fricbound runs")
+}
+
+/// Runs the binary in `cwd` (for default output folders, which are relative).
+fn fricbound_in(cwd: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_fricbound"))
+        .current_dir(cwd)
+        .args(args)
+        .output()
+        .expect("fricbound runs")
+}
+
+fn scene(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("meshes/paper-wedge")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// File names in `dir`, sorted.
+fn names(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// Files of the user's that the tests put into output folders.
+const USER_FILES: &[&str] = &["notes.txt"];
+
+/// Every file a run wrote into `dir` (and its sub-folders) is one the next run will remove
+/// (the user's [`USER_FILES`] aside).
+fn assert_all_owned(dir: &Path) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let entry = entry.unwrap();
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if entry.file_type().unwrap().is_dir() {
+            assert!(entry.path().join("limits.json").is_file(), "{name}/");
+            assert_all_owned(&entry.path());
+        } else if !USER_FILES.contains(&name.as_str()) {
+            assert!(is_owned(&name), "{} is not in the owned list", name);
+        }
+    }
+}
+
+/// The case: the point budget of the default paper scene used up after two points.
+/// The run writes and draws the two points, says `incomplete: …` in solution.json and on
+/// stderr, and exits with 3.
+#[test]
+fn a_run_that_does_not_cover_the_range_is_incomplete_and_exits_3() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("budget");
+    let o = fricbound(&[
+        "run",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "analysis.max_points=2",
+    ]);
+    let stderr = text(&o.stderr);
+    assert_eq!(
+        o.status.code(),
+        Some(i32::from(EXIT_INCOMPLETE)),
+        "{stderr}"
+    );
+    assert!(
+        stderr.starts_with("incomplete: ") && stderr.contains("analysis.max_points = 2"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    let sol = json(&out.join("solution.json"));
+    let status = sol["status"].as_str().unwrap();
+    assert!(status.starts_with("incomplete: "), "{status}");
+    assert_eq!(
+        status,
+        format!("incomplete: {}", stderr["incomplete: ".len()..].trim_end())
+    );
+    let frf = std::fs::read_to_string(out.join("frf.csv")).unwrap();
+    assert_eq!(
+        frf.lines().count(),
+        3,
+        "header and the two finished points:\n{frf}"
+    );
+    assert_eq!(sol["points"].as_array().unwrap().len(), 2);
+    for ext in ["png", "svg"] {
+        assert!(
+            out.join(format!("frf_y2.{ext}")).is_file(),
+            "the points are drawn"
+        );
+    }
+
+    // The same scene with its budget covers the range: complete, exit code 0.
+    let full = dir.path().join("full");
+    let o = fricbound(&["run", "--quiet", "--out", full.to_str().unwrap()]);
+    assert_eq!(
+        o.status.code(),
+        Some(i32::from(EXIT_COMPLETE)),
+        "{}",
+        text(&o.stderr)
+    );
+    assert!(o.stderr.is_empty(), "{}", text(&o.stderr));
+    assert_eq!(json(&full.join("solution.json"))["status"], "complete");
+}
+
+/// A limit analysis whose curves cannot cover the range (point budget too small) is incomplete:
+/// status `incomplete: …` in limits.json naming the curve, exit code 3, and what finished is
+/// still written and drawn.
+#[test]
+fn an_incomplete_limit_analysis_exits_3_with_its_finished_results() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("limits");
+    let o = fricbound(&[
+        "run",
+        &scene("fig13-3rd.toml"),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "limits.grid_points=41",
+        "--set",
+        "limits.bound_scan=[]",
+        "--set",
+        "limits.intermediate=[0.0]",
+        "--set",
+        "analysis.max_step=0.25",
+        "--set",
+        "analysis.max_points=30",
+    ]);
+    let stderr = text(&o.stderr);
+    assert_eq!(
+        o.status.code(),
+        Some(i32::from(EXIT_INCOMPLETE)),
+        "{stderr}"
+    );
+    assert!(
+        stderr.starts_with("incomplete: ") && stderr.contains("curve `m"),
+        "{stderr}"
+    );
+    let status = json(&out.join("limits.json"))["status"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    assert!(
+        status.starts_with("incomplete: ") && status.contains("max_points = 30"),
+        "{status}"
+    );
+    for f in ["limits.json", "peaks.csv", "limits_y2.png", "limits_y2.svg"] {
+        assert!(out.join(f).is_file(), "{f}: {:?}", names(&out));
+    }
+    assert_all_owned(&out);
+}
+
+/// A sweep with failed cases is incomplete: sweep.json's status names the points, exit code 3,
+/// the tables and figures are written.
+#[test]
+fn a_sweep_with_failed_cases_exits_3() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sweep");
+    let o = fricbound(&[
+        "run",
+        &scene("fig16a-d.toml"),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "sweep.values=[60.0, 130.0]",
+        "--set",
+        "analysis.max_step=0.25",
+        "--set",
+        "analysis.max_points=20",
+    ]);
+    let stderr = text(&o.stderr);
+    assert_eq!(
+        o.status.code(),
+        Some(i32::from(EXIT_INCOMPLETE)),
+        "{stderr}"
+    );
+    let status = json(&out.join("sweep.json"))["status"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    assert!(
+        status.starts_with("incomplete: 2 of 2 sweep points") && status.contains("F0 = 60 N"),
+        "{status}"
+    );
+    for f in ["sweep.csv", "optimal_y2.png", "resonance_y2.svg"] {
+        assert!(out.join(f).is_file(), "{f}: {:?}", names(&out));
+    }
+    assert_all_owned(&out);
+
+    // With the default budget the same sweep is complete.
+    let ok = dir.path().join("sweep-ok");
+    let o = fricbound(&[
+        "run",
+        &scene("fig16a-d.toml"),
+        "--quiet",
+        "--out",
+        ok.to_str().unwrap(),
+        "--set",
+        "sweep.values=[60.0, 130.0]",
+        "--set",
+        "analysis.max_step=0.25",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(i32::from(EXIT_COMPLETE)),
+        "{}",
+        text(&o.stderr)
+    );
+    assert_eq!(json(&ok.join("sweep.json"))["status"], "complete");
+}
+
+/// A failed run into a folder that holds an earlier run's results: none of them remain (no
+/// figure, no frf.csv of the first run), files that are not results stay.
+#[test]
+fn a_failed_run_leaves_no_results_of_an_earlier_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("same");
+    let o = fricbound(&[
+        "run",
+        &scene("zoom-2nd.toml"),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let first = std::fs::read_to_string(out.join("frf.csv")).unwrap();
+    assert!(out.join("frf_y2.png").is_file());
+    assert_all_owned(&out);
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+
+    // The stall of tests/cli_run.rs: fails after some converged points.
+    let o = fricbound(&[
+        "run",
+        &scene("zoom-2nd.toml"),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "analysis.max_iterations=2",
+        "--set",
+        "analysis.min_step=0.05",
+        "--set",
+        "analysis.initial_step=0.1",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(i32::from(EXIT_ERROR)),
+        "{}",
+        text(&o.stderr)
+    );
+    let files = names(&out);
+    for gone in ["frf_y2.png", "frf_y2.svg"] {
+        assert!(
+            !files.contains(&gone.to_string()),
+            "{gone} of the first run: {files:?}"
+        );
+    }
+    let second = std::fs::read_to_string(out.join("frf.csv")).unwrap();
+    assert_ne!(second, first);
+    // The first run reached the end frequency (175 Hz); the stalled one did not.
+    let last_freq = |csv: &str| -> f64 {
+        let row = csv.lines().last().unwrap();
+        row.split(',').next().unwrap().parse().unwrap()
+    };
+    assert!((last_freq(&first) - 175.0).abs() < 1e-9);
+    assert!(last_freq(&second) < 175.0 - 1e-6, "{}", last_freq(&second));
+    let sol = json(&out.join("solution.json"));
+    assert!(sol["status"].as_str().unwrap().starts_with("failed:"));
+    assert_eq!(
+        sol["points"].as_array().unwrap().len(),
+        second.lines().count() - 1
+    );
+    assert_eq!(
+        std::fs::read_to_string(out.join("notes.txt")).unwrap(),
+        "mine"
+    );
+
+    // A limit analysis, then an FRF into the same folder: no limit-analysis file remains.
+    let o = fricbound(&[
+        "run",
+        &scene("fig13-3rd.toml"),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "limits.grid_points=41",
+        "--set",
+        "limits.bound_scan=[]",
+        "--set",
+        "analysis.max_step=0.25",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(out.join("limits.json").is_file() && out.join("curve_m+1.csv").is_file());
+    assert!(!out.join("frf.csv").exists() && !out.join("solution.json").exists());
+    assert_all_owned(&out);
+    let o = fricbound(&[
+        "run",
+        &scene("zoom-2nd.toml"),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "analysis.freq_end_hz=152",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let files = names(&out);
+    assert!(
+        !files.iter().any(|f| f.starts_with("limits")
+            || f.starts_with("curve_")
+            || f.starts_with("hysteresis")
+            || f == "peaks.csv"),
+        "{files:?}"
+    );
+    assert!(files.contains(&"notes.txt".to_string()));
+}
+
+/// `--set` variants get their own default folder `out/<stem>-<8 hex digits of the SHA-256 of
+/// the overrides>`, printed at the end of the run; the scene's own folder is left alone.
+#[test]
+fn overrides_get_their_own_default_folder() {
+    use sha2::{Digest, Sha256};
+    let dir = tempfile::tempdir().unwrap();
+    let overrides = ["analysis.freq_end_hz=152", "harmonics.max=2"];
+    let o = fricbound_in(
+        dir.path(),
+        &[
+            "run",
+            &scene("zoom-2nd.toml"),
+            "--set",
+            overrides[0],
+            "--set",
+            overrides[1],
+        ],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let hash: String = Sha256::digest(overrides.join("\n").as_bytes())
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    let expected = PathBuf::from("out").join(format!("zoom-2nd-{}", &hash[..8]));
+    let stdout = text(&o.stdout);
+    assert!(
+        stdout.contains(&format!("results in {}", expected.display())),
+        "{stdout}"
+    );
+    assert!(dir.path().join(&expected).join("frf.csv").is_file());
+    assert!(!dir.path().join("out/zoom-2nd").exists());
+
+    // The library function agrees, and tells other override sets and no overrides apart.
+    let scene_path = PathBuf::from("meshes/zoom-2nd.toml");
+    let owned: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    assert_eq!(
+        fricbound::cli::default_out_dir(Some(&scene_path), &owned),
+        expected
+    );
+    assert_eq!(
+        fricbound::cli::default_out_dir(Some(&scene_path), &[]),
+        PathBuf::from("out/zoom-2nd")
+    );
+    assert_ne!(
+        fricbound::cli::default_out_dir(Some(&scene_path), &owned[..1]),
+        expected
+    );
+    assert_eq!(
+        fricbound::cli::default_out_dir(None, &[]),
+        PathBuf::from("out/paper-wedge")
+    );
+}
+
+/// A figure's title names the overrides it was solved with next to the scene's title.
+#[test]
+fn figure_titles_name_the_overrides() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("titled");
+    let o = fricbound(&[
+        "run",
+        &scene("zoom-2nd.toml"),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "static_loads.0.value=-100",
+        "--set",
+        "analysis.freq_end_hz=152",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let svg = std::fs::read_to_string(out.join("frf_y2.svg")).unwrap();
+    assert!(
+        svg.contains("[static_loads.0.value=-100, analysis.freq_end_hz=152]"),
+        "the title names the overrides"
+    );
+    // Without overrides, the scene's title alone.
+    let plain = dir.path().join("plain");
+    let o = fricbound(&[
+        "run",
+        &scene("zoom-2nd.toml"),
+        "--quiet",
+        "--out",
+        plain.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let svg = std::fs::read_to_string(plain.join("frf_y2.svg")).unwrap();
+    assert!(!svg.contains("static_loads.0.value"));
+}
+
+/// The case: H = 10 000 with 32 768 samples aborted on a 5 GB allocation. It is now
+/// refused from the size estimate, before the output folder is created, with exit code 1 and a
+/// message naming the fields to lower. The run is made under a 4 GB address-space limit, so a
+/// run that allocated the AFT matrices (5 GB each) would abort instead of exiting with 1.
+#[test]
+fn a_problem_too_large_for_the_machine_is_refused_before_anything_is_written() {
+    let overrides = [
+        "harmonics.max=10000".to_string(),
+        "harmonics.samples=32768".to_string(),
+    ];
+    let (_, _, problem, _) = fricbound::cli::load_scene(None, &overrides).unwrap();
+    let cost = fricbound::hbm::cost::estimate(&problem);
+    assert_eq!(cost.force_blocks, 20_001);
+    // At least the two AFT matrices of 32 768 × 20 001 values.
+    assert!(cost.aft_bytes >= 2.0 * 32768.0 * 20001.0 * 8.0);
+    let Some(available) = fricbound::cli::available_memory() else {
+        eprintln!("no /proc/meminfo: the refusal is skipped by design, nothing to test");
+        return;
+    };
+    assert!(
+        cost.bytes() > available as f64,
+        "this machine has {available} bytes available, more than the estimate {}",
+        cost.bytes()
+    );
+
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("big");
+    let command = format!(
+        "ulimit -v 4000000 && exec '{}' run --quiet --out '{}' --set {} --set {}",
+        env!("CARGO_BIN_EXE_fricbound"),
+        out.display(),
+        overrides[0],
+        overrides[1]
+    );
+    let o = Command::new("sh").arg("-c").arg(&command).output().unwrap();
+    let stderr = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(i32::from(EXIT_ERROR)), "{stderr}");
+    assert!(stderr.starts_with("error: "), "{stderr}");
+    for field in [
+        "refused",
+        "harmonics.max",
+        "harmonics.samples",
+        "model size",
+        "available",
+    ] {
+        assert!(stderr.contains(field), "{field}: {stderr}");
+    }
+    assert!(!out.exists(), "nothing is created before the refusal");
+
+    // `check` says so too, with the estimate, and does not print 10 001 harmonics.
+    let o = fricbound(&["check", "--set", &overrides[0], "--set", &overrides[1]]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let stdout = text(&o.stdout);
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("harmonics "))
+        .unwrap();
+    assert!(line.len() < 200, "{line}");
+    assert!(
+        line.contains("[0, 1, 2, 3, 4, …, 9996, 9997, 9998, 9999, 10000]")
+            && line.contains("10001 harmonics, 20001 blocks"),
+        "{line}"
+    );
+    assert!(stdout.contains("memory per Newton iteration ≈"), "{stdout}");
+    assert!(stdout.contains("time per point ≈"), "{stdout}");
+    assert!(stdout.contains("`run` refuses this scene"), "{stdout}");
+    assert!(stdout.lines().all(|l| l.len() < 400), "{stdout}");
+}
+
+/// `check` on the default scene: the cost lines, and a scene that fits.
+#[test]
+fn check_prints_the_cost_of_a_small_scene() {
+    let o = fricbound(&["check"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let stdout = text(&o.stdout);
+    assert!(
+        stdout.contains("formulation  dense (auto): 18 Newton unknowns"),
+        "{stdout}"
+    );
+    let cost = stdout.lines().find(|l| l.starts_with("cost ")).unwrap();
+    assert!(
+        cost.contains("MiB") && cost.contains("(estimate: 3.5 factorisations of "),
+        "{cost}"
+    );
+    if fricbound::cli::available_memory().is_some() {
+        assert!(stdout.contains("): fits"), "{stdout}");
+    }
+}
