@@ -7,8 +7,8 @@
 //! Every value is checked there, and an error names the file, the field (dotted path, e.g.
 //! `contacts[1].mu`) and the reason: ranges and consistency, the physical conditions a solve
 //! needs (a free body pressed onto its contacts, contact stiffnesses and frequencies the model
-//! resolves), and the scene at every point of a `[sweep]`. FE scene input (meshes, Matrix Market files, contact
-//! patches, group loads, Craig-Bampton reduction) is in [`fe_input`].
+//! resolves), and the scene at every point of a `[sweep]`. FE scene input (meshes, Matrix
+//! Market files, contact patches, group loads, Craig-Bampton reduction) is in [`fe_input`].
 //!
 //! Layers used: `analysis` (limit settings, contact stiffness of the stuck check), `hbm` (the
 //! Schur formulation check), `model`, `fe`, `contact` and `numerics` (continuation settings).
