@@ -237,53 +237,9 @@ fn plot_finished_curves(
     let problem = &ctx.problem;
     for (k, &d) in problem.outputs.iter().enumerate() {
         let name = &problem.model.dof_names[d];
-        let series: Vec<(String, Vec<f64>, Vec<f64>, bool)> = limit_curves
-            .iter()
-            .map(|c| (format!("limit {}", c.case.name), c, false))
-            .chain(
-                intermediate
-                    .iter()
-                    .map(|c| (format!("intermediate {}", c.case.name), c, true)),
-            )
-            .map(|(label, c, dashed)| {
-                (
-                    label,
-                    c.run.points.iter().map(|p| p.freq_hz).collect(),
-                    c.run.points.iter().map(|p| p.amplitudes[k]).collect(),
-                    dashed,
-                )
-            })
-            .collect();
-        let open_y: Vec<f64> = ctx.open.amplitudes.iter().map(|r| r[k]).collect();
-        let stuck_y: Vec<f64> = ctx.stuck.amplitudes.iter().map(|r| r[k]).collect();
-        let mut curves: Vec<Curve> = series
-            .iter()
-            .enumerate()
-            .map(|(i, (label, x, y, dashed))| Curve {
-                label,
-                x,
-                y,
-                color: palette(i),
-                dashed: *dashed,
-                markers: false,
-            })
-            .collect();
-        curves.push(Curve {
-            label: "linear, contacts open",
-            x: &ctx.open.freqs_hz,
-            y: &open_y,
-            color: plotters::style::RGBColor(110, 110, 110),
-            dashed: true,
-            markers: false,
-        });
-        curves.push(Curve {
-            label: "linear, contacts stuck",
-            x: &ctx.stuck.freqs_hz,
-            y: &stuck_y,
-            color: plotters::style::RGBColor(40, 90, 170),
-            dashed: true,
-            markers: false,
-        });
+        let series = curve_series(limit_curves, intermediate, k);
+        let (open_y, stuck_y) = reference_ys(ctx, k);
+        let curves = curves_with_references(ctx, &series, &open_y, &stuck_y);
         let title = format!("{} (incomplete: finished curves only)", ctx.title());
         let y_label = format!("{name} first-harmonic amplitude (m)");
         let fig = SweepFigure {
@@ -447,54 +403,11 @@ fn plot(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandError> {
         .collect();
     for (k, &d) in problem.outputs.iter().enumerate() {
         let name = &problem.model.dof_names[d];
-        let series: Vec<(String, Vec<f64>, Vec<f64>, bool)> = a
-            .limits
-            .iter()
-            .map(|c| (format!("limit {}", c.case.name), c, false))
-            .chain(
-                a.intermediate
-                    .iter()
-                    .map(|c| (format!("intermediate {}", c.case.name), c, true)),
-            )
-            .map(|(label, c, dashed)| {
-                (
-                    label,
-                    c.run.points.iter().map(|p| p.freq_hz).collect(),
-                    c.run.points.iter().map(|p| p.amplitudes[k]).collect(),
-                    dashed,
-                )
-            })
-            .collect();
-        let open_y: Vec<f64> = ctx.open.amplitudes.iter().map(|r| r[k]).collect();
-        let stuck_y: Vec<f64> = ctx.stuck.amplitudes.iter().map(|r| r[k]).collect();
-        let mut curves: Vec<Curve> = series
-            .iter()
-            .enumerate()
-            .map(|(i, (label, x, y, dashed))| Curve {
-                label,
-                x,
-                y,
-                color: palette(i),
-                dashed: *dashed,
-                markers: false,
-            })
-            .collect();
-        curves.push(Curve {
-            label: "linear, contacts open",
-            x: &ctx.open.freqs_hz,
-            y: &open_y,
-            color: plotters::style::RGBColor(110, 110, 110),
-            dashed: true,
-            markers: false,
-        });
-        curves.push(Curve {
-            label: "linear, contacts stuck",
-            x: &ctx.stuck.freqs_hz,
-            y: &stuck_y,
-            color: plotters::style::RGBColor(40, 90, 170),
-            dashed: true,
-            markers: false,
-        });
+        let limit_curves: Vec<&CaseCurve> = a.limits.iter().collect();
+        let intermediate: Vec<&CaseCurve> = a.intermediate.iter().collect();
+        let series = curve_series(&limit_curves, &intermediate, k);
+        let (open_y, stuck_y) = reference_ys(ctx, k);
+        let curves = curves_with_references(ctx, &series, &open_y, &stuck_y);
         let fig = LimitFigure {
             title: ctx.title(),
             output_name: name,
@@ -594,4 +507,79 @@ pub(super) fn summary(a: &LimitAnalysis, elapsed: f64) -> String {
         let _ = writeln!(s, "  hysteresis not computed: {m}");
     }
     s.trim_end().to_string()
+}
+
+/// One drawn curve of a limit figure: label, frequencies (Hz), amplitudes (m), dashed.
+type CurveSeries = (String, Vec<f64>, Vec<f64>, bool);
+
+/// The limit curves (solid) and intermediate curves (dashed) of output `k` as plot series.
+fn curve_series(
+    limit_curves: &[&CaseCurve],
+    intermediate: &[&CaseCurve],
+    k: usize,
+) -> Vec<CurveSeries> {
+    limit_curves
+        .iter()
+        .map(|c| (format!("limit {}", c.case.name), c, false))
+        .chain(
+            intermediate
+                .iter()
+                .map(|c| (format!("intermediate {}", c.case.name), c, true)),
+        )
+        .map(|(label, c, dashed)| {
+            (
+                label,
+                c.run.points.iter().map(|p| p.freq_hz).collect(),
+                c.run.points.iter().map(|p| p.amplitudes[k]).collect(),
+                dashed,
+            )
+        })
+        .collect()
+}
+
+/// Amplitudes of output `k` of the linear references (contacts open, contacts stuck).
+fn reference_ys(ctx: &RunContext<'_>, k: usize) -> (Vec<f64>, Vec<f64>) {
+    (
+        ctx.open.amplitudes.iter().map(|r| r[k]).collect(),
+        ctx.stuck.amplitudes.iter().map(|r| r[k]).collect(),
+    )
+}
+
+/// The series as coloured curves, followed by the two linear references (dashed grey: open;
+/// dashed blue: stuck).
+fn curves_with_references<'a>(
+    ctx: &'a RunContext<'_>,
+    series: &'a [CurveSeries],
+    open_y: &'a [f64],
+    stuck_y: &'a [f64],
+) -> Vec<Curve<'a>> {
+    let mut curves: Vec<Curve> = series
+        .iter()
+        .enumerate()
+        .map(|(i, (label, x, y, dashed))| Curve {
+            label,
+            x,
+            y,
+            color: palette(i),
+            dashed: *dashed,
+            markers: false,
+        })
+        .collect();
+    curves.push(Curve {
+        label: "linear, contacts open",
+        x: &ctx.open.freqs_hz,
+        y: open_y,
+        color: plotters::style::RGBColor(110, 110, 110),
+        dashed: true,
+        markers: false,
+    });
+    curves.push(Curve {
+        label: "linear, contacts stuck",
+        x: &ctx.stuck.freqs_hz,
+        y: stuck_y,
+        color: plotters::style::RGBColor(40, 90, 170),
+        dashed: true,
+        markers: false,
+    });
+    curves
 }
