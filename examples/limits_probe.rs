@@ -26,10 +26,18 @@ fn main() {
         .unwrap_or_else(|e| panic!("{e}"));
     println!("time {:.3}s", t.elapsed().as_secs_f64());
     for c in a.limits.iter().chain(&a.intermediate) {
-        println!(
-            "{:>6} peak {:.4} Hz {:.5e} refined {} {:?}",
-            c.case.name, c.peak.freq_hz, c.peak.amplitude, c.peak.refined, c.peak.states
-        );
+        match &c.peak {
+            Some(p) => println!(
+                "{:>6} peak {:.4} Hz {:.5e} refined {} {:?} ({})",
+                c.case.name,
+                p.freq_hz,
+                p.amplitude,
+                p.refined,
+                p.states,
+                c.status.text()
+            ),
+            None => println!("{:>6} no peak ({})", c.case.name, c.status.text()),
+        }
     }
     let widest = a
         .grid

@@ -50,7 +50,7 @@ fn limit_peaks_agree_at_the_2nd_resonance_and_differ_at_the_3rd() {
     let second = paper(150.0, 175.0, &[]);
     let peaks: Vec<_> = limits::two_point_cases(&second)
         .iter()
-        .map(|c| limits::solve_case(&second, c, None).unwrap().peak)
+        .map(|c| limits::solve_case(&second, c, None).unwrap().peak.unwrap())
         .collect();
     let rel = (peaks[0].amplitude - peaks[1].amplitude).abs() / peaks[0].amplitude;
     assert!(peaks[0].refined && peaks[1].refined);
@@ -59,7 +59,7 @@ fn limit_peaks_agree_at_the_2nd_resonance_and_differ_at_the_3rd() {
     let third = paper(200.0, 235.0, &[]);
     let peaks: Vec<_> = limits::two_point_cases(&third)
         .iter()
-        .map(|c| limits::solve_case(&third, c, None).unwrap().peak)
+        .map(|c| limits::solve_case(&third, c, None).unwrap().peak.unwrap())
         .collect();
     let (hi, lo) = (
         peaks[0].amplitude.max(peaks[1].amplitude),
@@ -86,6 +86,7 @@ fn intermediate_peaks_lie_between_the_limit_peaks_at_high_preloads() {
                 limits::solve_case(&problem, c, None)
                     .unwrap()
                     .peak
+                    .unwrap()
                     .amplitude
             })
             .collect();
@@ -96,7 +97,8 @@ fn intermediate_peaks_lie_between_the_limit_peaks_at_high_preloads() {
         for m in [-0.5, 0.0, 0.5] {
             let peak = limits::solve_case(&problem, &LimitCase::uniform(&problem, m), None)
                 .unwrap()
-                .peak;
+                .peak
+                .unwrap();
             let slack = 1e-6 * hi;
             assert!(
                 peak.amplitude <= hi + slack && peak.amplitude >= lo - slack,
@@ -135,8 +137,8 @@ fn labels_agree_with_the_static_balance_of_the_damper() {
         let mut n0 = Vec::new();
         for (c, curve) in analysis.limits.iter().enumerate() {
             let p = curve.case.apply(&problem);
-            let x = fricbound::analysis::frf::interpolate_on_path(&curve.run.points, g.freq_hz)
-                .unwrap();
+            let x =
+                fricbound::analysis::frf::interpolate_on_path(&curve.points, g.freq_hz).unwrap();
             let mut solver = fricbound::analysis::frf::PointSolver::new(&p).unwrap();
             let point = solver.solve(&x, g.freq_hz).unwrap();
             let q0 = &point.coefficients[0..6];
@@ -271,7 +273,12 @@ fn per_side_cases_matter_only_on_the_stuck_side() {
     // A point's own m wins over its side's.
     assert_eq!(cases[2].contact_states, [-0.5, 0.0]);
 
-    let peak = |case: &LimitCase| limits::solve_case(&problem, case, None).unwrap().peak;
+    let peak = |case: &LimitCase| {
+        limits::solve_case(&problem, case, None)
+            .unwrap()
+            .peak
+            .unwrap()
+    };
     let left = peak(&cases[0]);
     let right = peak(&cases[1]);
     let uniform_half = peak(&LimitCase::uniform(&problem, 0.5));
@@ -320,12 +327,13 @@ fn hysteresis_loops_at_peaks_and_at_requested_frequencies() {
             .find(|c| c.case.name == set.case)
             .unwrap();
         let point = if set.at == "peak" {
-            assert_eq!(set.freq_hz, curve.peak.freq_hz);
-            assert_eq!(set.amplitude, curve.peak.amplitude);
+            let peak = curve.peak.as_ref().unwrap();
+            assert_eq!(set.freq_hz, peak.freq_hz);
+            assert_eq!(set.amplitude, peak.amplitude);
             None
         } else {
-            let x = fricbound::analysis::frf::interpolate_on_path(&curve.run.points, set.freq_hz)
-                .unwrap();
+            let x =
+                fricbound::analysis::frf::interpolate_on_path(&curve.points, set.freq_hz).unwrap();
             let p = curve.case.apply(&problem);
             let mut solver = fricbound::analysis::frf::PointSolver::new(&p).unwrap();
             Some(solver.solve(&x, set.freq_hz).unwrap())
@@ -335,10 +343,10 @@ fn hysteresis_loops_at_peaks_and_at_requested_frequencies() {
         }
         assert_eq!(set.loops.len(), 2);
         let states = if set.at == "peak" {
-            curve.peak.states.clone()
+            curve.peak.as_ref().unwrap().states.clone()
         } else {
-            let x = fricbound::analysis::frf::interpolate_on_path(&curve.run.points, set.freq_hz)
-                .unwrap();
+            let x =
+                fricbound::analysis::frf::interpolate_on_path(&curve.points, set.freq_hz).unwrap();
             let p = curve.case.apply(&problem);
             let mut solver = fricbound::analysis::frf::PointSolver::new(&p).unwrap();
             solver.solve(&x, set.freq_hz).unwrap().states
@@ -445,7 +453,7 @@ fn sweep_series_of_whole_limit_analyses_and_failed_points() {
         let a = p.analysis.as_ref().unwrap();
         assert_eq!(a.grid.len(), 21);
         for (peak, curve) in p.peaks.iter().zip(&a.limits) {
-            assert_eq!(peak.as_ref().unwrap(), &curve.peak);
+            assert_eq!(peak, &curve.peak);
         }
     }
     // The flat damper's limits coincide (no cross coupling), β = 120° differs (paper §4.3).
@@ -460,7 +468,8 @@ fn sweep_series_of_whole_limit_analyses_and_failed_points() {
         ratio(2)
     );
 
-    // A case that cannot be solved is recorded, and the sweep goes on.
+    // A case that cannot be solved is recorded, the point's other cases are still attempted,
+    // and the sweep goes on.
     let mut failing = o.clone();
     failing.push("analysis.max_iterations=1".into());
     failing.push("analysis.residual_tolerance=1e-300".into());
@@ -468,8 +477,16 @@ fn sweep_series_of_whole_limit_analyses_and_failed_points() {
     assert_eq!(points.len(), 4);
     for p in &points {
         assert!(p.peaks.iter().all(|q| q.is_none()));
-        assert_eq!(p.failures.len(), 1, "{:?}", p.failures);
-        assert!(p.failures[0].contains("no solution at the start frequency"));
+        assert_eq!(p.failures.len(), 2, "{:?}", p.failures);
+        for (f, case) in p.failures.iter().zip(["m+1", "m-1"]) {
+            assert!(
+                f.starts_with(&format!("curve `{case}` failed: "))
+                    && f.contains("no solution at the start frequency"),
+                "{f}"
+            );
+        }
         assert!(p.limit_amplitudes().is_none());
+        let a = p.analysis.as_ref().unwrap();
+        assert!(!a.is_complete() && a.band_points() == 0);
     }
 }

@@ -1300,3 +1300,128 @@ fn sweep_parameter_unusable_in_file_names() {
         "cannot appear in CSV column or file names",
     );
 }
+
+// Refusals that say why (issue 10, item 6): pre-loads and interferences that leave the damper
+// held by nothing, values out of proportion to the model, FE materials out of physical bounds,
+// and a sweep value given twice. Each is refused by `check` and `run` naming the field.
+
+/// The blade-pair FE scene with its mesh path made absolute (it is copied to a temporary
+/// folder).
+fn blade_pair_text() -> String {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/meshes/blade-pair");
+    let text = std::fs::read_to_string(format!("{dir}/blade-pair-2d.toml")).expect("scene");
+    text.replace(
+        "mesh = \"blade-pair-2d.msh\"",
+        &format!("mesh = {:?}", format!("{dir}/blade-pair-2d.msh")),
+    )
+}
+
+#[test]
+fn preload_that_pulls_the_damper_off_its_contacts() {
+    // +120 N lifts the damper out of the wedge (−120 N presses it in): with the contacts
+    // closed the static balance puts both in tension; opened, nothing holds the damper.
+    rejects_with(
+        paper_wedge_scene(),
+        &["static_loads.0.value=120"],
+        "static_loads[0].value",
+        &["the static load pulls it off them", "`left`, `right`"],
+    );
+}
+
+#[test]
+fn interference_on_one_side_without_preload_pushes_the_damper_out() {
+    // An interference on one face only pushes the damper away from it; nothing presses it back.
+    rejects_with(
+        paper_wedge_scene(),
+        &["static_loads.0.value=0", "contacts.0.gap=-1e-4"],
+        "contacts[0].gap",
+        &["the interferences (gap < 0) push it off them"],
+    );
+    // On both faces it clamps the damper: accepted.
+    let file = SceneFile::new(paper_wedge_scene());
+    scene::load_problem(
+        &file.path,
+        &strings(&[
+            "static_loads.0.value=0",
+            "contacts.0.gap=-1e-4",
+            "contacts.1.gap=-1e-4",
+        ]),
+    )
+    .expect("a damper clamped by interferences on both faces is held");
+}
+
+#[test]
+fn extreme_mass_and_gap() {
+    rejects_with(
+        paper_wedge_scene(),
+        &["model.mass.4.4=1e40"],
+        "model.mass[4][4]",
+        &["times the lightest DOF's mass"],
+    );
+    for (set, field) in [
+        ("contacts.0.gap=1e40", "contacts[0].gap"),
+        ("contacts.1.gap=-1e40", "contacts[1].gap"),
+    ] {
+        rejects_with(
+            paper_wedge_scene(),
+            &[set],
+            field,
+            &["times the model's displacement scale"],
+        );
+    }
+}
+
+#[test]
+fn fe_material_out_of_physical_bounds() {
+    let text = blade_pair_text();
+    for (set, field, reason) in [
+        (
+            "model.materials.0.poisson=0.5",
+            "model.materials[0].poisson",
+            "must lie in (-1, 0.5)",
+        ),
+        (
+            "model.materials.0.poisson=-1",
+            "model.materials[0].poisson",
+            "must lie in (-1, 0.5)",
+        ),
+        (
+            "model.materials.0.young=1e40",
+            "model.materials[0].young",
+            "outside the range of solids",
+        ),
+        (
+            "model.materials.0.young=-2.1e11",
+            "model.materials[0].young",
+            "outside the range of solids",
+        ),
+        (
+            "model.materials.0.density=1e40",
+            "model.materials[0].density",
+            "must be 0 (massless) or within",
+        ),
+        (
+            "model.materials.0.density=-7850",
+            "model.materials[0].density",
+            "must be 0 (massless) or within",
+        ),
+    ] {
+        let file = SceneFile::new(&text);
+        let err = library_error(&file, &[set]);
+        assert_invalid(&err, &file.label(), field, reason);
+        assert_cli_rejects(&file.label(), &[set], &[field, reason]);
+    }
+}
+
+#[test]
+fn sweep_value_given_twice() {
+    rejects_with(
+        &paper_sweep(
+            "[60.0, 90.0, 60.0]",
+            "{ field = \"static_loads.0.value\", scale = -1.0 }",
+        ),
+        &[],
+        "sweep.values[2]",
+        &["duplicate value 60 (also sweep.values[0])"],
+    );
+}

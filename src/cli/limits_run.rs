@@ -9,14 +9,15 @@ use crate::analysis::limits::{self, CaseCurve, LimitAnalysis, Regime};
 use crate::report::files::{self, frf_header, frf_row};
 use crate::report::limit_files;
 use crate::report::plot::{
-    figure_files, palette, plot_hysteresis, plot_limits, plot_sweep, Curve, LimitFigure, Loop,
-    SweepFigure,
+    figure_files, palette, plot_hysteresis, plot_limits, Curve, LimitFigure, Loop,
 };
 
-/// Writes one curve's path as `curve_<name>.csv` (same columns as `frf.csv`).
+/// Writes one curve's path as `curve_<name>.csv` (same columns as `frf.csv`): the whole path of
+/// a complete case, the finished points of an unfinished one (only the header when it failed at
+/// its first point).
 pub(super) fn write_curve(ctx: &RunContext<'_>, curve: &CaseCurve) -> Result<(), CommandError> {
     let mut text = frf_header(&ctx.problem);
-    for p in &curve.run.points {
+    for p in &curve.points {
         text.push_str(&frf_row(p));
     }
     files::write_atomic(
@@ -26,62 +27,52 @@ pub(super) fn write_curve(ctx: &RunContext<'_>, curve: &CaseCurve) -> Result<(),
     Ok(())
 }
 
-/// What the curve callback of a limit analysis collected, for the status and for the files of
-/// an analysis stopped by a failed curve.
-#[derive(Default)]
-struct Finished {
-    /// Limit and intermediate curves, as they finished.
-    curves: Vec<CaseCurve>,
-    /// Scanned cases with their peaks.
-    scanned: Vec<(limits::LimitCase, limits::Peak)>,
-    /// Names of every finished curve.
-    names: Vec<String>,
-    /// "curve `<name>`: <reason>" of every finished curve that did not cover the range.
-    incomplete: Vec<String>,
-}
+/// Most unfinished curves named in an analysis' status (all are in `limits.json`).
+const STATUS_CURVES: usize = 6;
 
-/// "curve `<name>`: <reason>" when a curve's path did not cover the range.
-pub(super) fn curve_incomplete(curve: &CaseCurve) -> Option<String> {
-    curve
-        .run
-        .incomplete_reason()
-        .map(|r| format!("curve `{}`: {r}", curve.case.name))
-}
-
-/// The incomplete curves of a finished analysis (limit and intermediate ones), "; "-joined;
-/// `None` when every one covered the range.
+/// Why an analysis did not cover what it asks for: every limit, intermediate or scanned case
+/// that is incomplete or failed ([`LimitAnalysis::unfinished`], the first [`STATUS_CURVES`]
+/// named, the others counted), and where the band exists when that is not the whole grid;
+/// `None` when every case covered the range.
 pub(super) fn analysis_incomplete(a: &LimitAnalysis) -> Option<String> {
-    let reasons: Vec<String> = a
-        .limits
-        .iter()
-        .chain(&a.intermediate)
-        .filter_map(curve_incomplete)
-        .collect();
-    (!reasons.is_empty()).then(|| reasons.join("; "))
+    let reasons = a.unfinished();
+    if reasons.is_empty() {
+        return None;
+    }
+    let mut text = reasons[..reasons.len().min(STATUS_CURVES)].join("; ");
+    if reasons.len() > STATUS_CURVES {
+        text.push_str(&format!(
+            "; ... and {} more unfinished curves (see limits.json)",
+            reasons.len() - STATUS_CURVES
+        ));
+    }
+    let band = a.band_points();
+    if band < a.grid.len() {
+        text.push_str(&format!(
+            "; the band exists at {band} of {} grid frequencies (both limit curves solved), NaN \
+             elsewhere",
+            a.grid.len()
+        ));
+    }
+    Some(text)
 }
 
 /// Runs the limit analysis of the context's scene.
 ///
-/// A curve whose path did not reach the end frequency makes the run incomplete (status
-/// `incomplete: …` in `limits.json`, [`RunReport::incomplete`]); so does a curve that failed,
-/// which stops the analysis (the analysis layer returns no grid, classification or bound check
-/// then): every curve finished before is still written (`curve_*.csv`, `peaks.csv`,
-/// `limits.json`) and drawn (`limits_<dof>`), see [`write_stopped`].
+/// Every case is attempted whatever the others do ([`limits::analyse`]). A case whose path did
+/// not reach the end frequency, or that failed, makes the run incomplete (status
+/// `incomplete: …` in `limits.json` naming the curves, [`RunReport::incomplete`], exit code 3);
+/// its finished points are still written (`curve_<name>.csv`) and drawn, `limits.json` gives
+/// every curve's status, and the band of `limits.csv` and of the figure exists where both limit
+/// curves were solved (NaN elsewhere).
 pub fn run_limits(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
     let problem = &ctx.problem;
     let settings = ctx.limits.clone().expect("called for scenes with [limits]");
-    let limit_cases = limits::two_point_cases(problem);
-    let intermediate_cases = settings.intermediate_cases(problem);
-    let scanned_cases = limits::scan_cases(problem, &settings.bound_scan);
-    let n_curves = limit_cases.len() + intermediate_cases.len() + scanned_cases.len();
-    let kept: Vec<&str> = limit_cases
-        .iter()
-        .chain(&intermediate_cases)
-        .map(|c| c.name.as_str())
-        .collect();
+    let n_curves = limits::two_point_cases(problem).len()
+        + settings.intermediate_cases(problem).len()
+        + limits::scan_cases(problem, &settings.bound_scan).len();
     let bar = ctx.progress(n_curves as u64);
     let write_error: Mutex<Option<CommandError>> = Mutex::new(None);
-    let finished: Mutex<Finished> = Mutex::new(Finished::default());
     let started = std::time::Instant::now();
     let result = limits::analyse(problem, &settings, |curve| {
         if let Err(e) = write_curve(ctx, curve) {
@@ -90,21 +81,12 @@ pub fn run_limits(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
                 .expect("no panics while holding the lock")
                 .get_or_insert(e);
         }
-        {
-            let mut f = finished.lock().expect("no panics while holding the lock");
-            f.names.push(curve.case.name.clone());
-            if let Some(r) = curve_incomplete(curve) {
-                f.incomplete.push(r);
-            }
-            if kept.contains(&curve.case.name.as_str()) {
-                f.curves.push(curve.clone());
-            } else {
-                f.scanned.push((curve.case.clone(), curve.peak.clone()));
-            }
-        }
         if let Some(bar) = &bar {
             bar.inc(1);
             bar.set_message(curve.case.name.clone());
+            if let Some(reason) = curve.unfinished_reason() {
+                bar.println(reason);
+            }
         }
     });
     if let Some(bar) = &bar {
@@ -113,22 +95,12 @@ pub fn run_limits(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
     if let Some(e) = write_error.into_inner().expect("lock not poisoned") {
         return Err(e);
     }
-    let mut finished = finished.into_inner().expect("lock not poisoned");
-    // Curves finish in any order on the worker threads: sorted for a reproducible status.
-    finished.incomplete.sort();
+    let analysis = result.map_err(|source| CommandError::Limits {
+        scene: ctx.label.clone(),
+        source,
+    })?;
     let elapsed = started.elapsed().as_secs_f64();
-    let analysis = match result {
-        Ok(a) => a,
-        Err(error) => {
-            let all: Vec<&limits::LimitCase> = limit_cases
-                .iter()
-                .chain(&intermediate_cases)
-                .chain(&scanned_cases)
-                .collect();
-            return write_stopped(ctx, &all, finished, &error, elapsed);
-        }
-    };
-    let incomplete = (!finished.incomplete.is_empty()).then(|| finished.incomplete.join("; "));
+    let incomplete = analysis_incomplete(&analysis);
     write_analysis(
         ctx,
         &analysis,
@@ -145,117 +117,6 @@ pub fn run_limits(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
     })
 }
 
-/// Writes what a limit analysis stopped by a failed curve (`error`) finished: `peaks.csv` of
-/// the finished curves, `limits.json` with status `incomplete: <the failure; the curves not
-/// solved; the finished curves that did not cover the range>` and every finished limit and
-/// intermediate curve with its path, and `limits_<dof>` drawing those curves over the linear
-/// references (no band: the grid is not computed). `all` lists every case of the analysis.
-fn write_stopped(
-    ctx: &RunContext<'_>,
-    all: &[&limits::LimitCase],
-    mut finished: Finished,
-    error: &limits::LimitError,
-    elapsed: f64,
-) -> Result<RunReport, CommandError> {
-    let failed = match error {
-        limits::LimitError::Curve { case, .. }
-        | limits::LimitError::Contacts { case, .. }
-        | limits::LimitError::Incomplete { case, .. }
-        | limits::LimitError::NoPeak { case, .. } => case.as_str(),
-    };
-    let not_solved: Vec<&str> = all
-        .iter()
-        .map(|c| c.name.as_str())
-        .filter(|n| *n != failed && !finished.names.iter().any(|f| f == n))
-        .collect();
-    let mut reasons = vec![format!("{error}")];
-    if !not_solved.is_empty() {
-        reasons.push(format!(
-            "not solved after it: {}",
-            super::abbreviated_list(&not_solved)
-        ));
-    }
-    reasons.extend(finished.incomplete.iter().cloned());
-    let reason = reasons.join("; ");
-    // In the order of the analysis' cases.
-    let order = |name: &str| all.iter().position(|c| c.name == name);
-    finished.curves.sort_by_key(|c| order(&c.case.name));
-    finished.scanned.sort_by_key(|(c, _)| order(&c.name));
-    let n_limits = limits::two_point_cases(&ctx.problem).len();
-    let (limit_curves, intermediate): (Vec<&CaseCurve>, Vec<&CaseCurve>) = finished
-        .curves
-        .iter()
-        .partition(|c| order(&c.case.name).is_some_and(|i| i < n_limits));
-
-    let mut rows: Vec<(&limits::LimitCase, &str, &limits::Peak)> = Vec::new();
-    rows.extend(limit_curves.iter().map(|c| (&c.case, "limit", &c.peak)));
-    rows.extend(
-        intermediate
-            .iter()
-            .map(|c| (&c.case, "intermediate", &c.peak)),
-    );
-    rows.extend(finished.scanned.iter().map(|(c, p)| (c, "scan", p)));
-    files::write_atomic(
-        &ctx.dir.join("peaks.csv"),
-        limit_files::peaks_csv(&ctx.problem, &rows).as_bytes(),
-    )?;
-    let status = super::status_text(Some(&reason));
-    let json = serde_json::json!({
-        "info": ctx.info(),
-        "status": status,
-        "elapsed_s": elapsed,
-        "error": error.to_string(),
-        "not_solved": not_solved,
-        "limits": limit_curves.iter().map(|c| curve_json(c)).collect::<Vec<_>>(),
-        "intermediate": intermediate.iter().map(|c| curve_json(c)).collect::<Vec<_>>(),
-        "scan_peaks": finished.scanned,
-    });
-    let bytes = serde_json::to_vec_pretty(&json).expect("JSON values serialise");
-    files::write_atomic(&ctx.dir.join("limits.json"), &bytes)?;
-    plot_finished_curves(ctx, &limit_curves, &intermediate)?;
-    Ok(RunReport {
-        dir: ctx.dir.clone(),
-        summary: format!(
-            "limit analysis stopped after {elapsed:.2} s: {} of {} curves finished",
-            finished.names.len(),
-            all.len()
-        ),
-        incomplete: Some(reason),
-        outcome: RunOutcome::LimitCurves(finished.curves),
-        open: ctx.open.clone(),
-        stuck: ctx.stuck.clone(),
-    })
-}
-
-/// `limits_<dof>` of an analysis stopped by a failed curve: the finished limit (solid) and
-/// intermediate (dashed) curves over the linear references, without band or classification.
-fn plot_finished_curves(
-    ctx: &RunContext<'_>,
-    limit_curves: &[&CaseCurve],
-    intermediate: &[&CaseCurve],
-) -> Result<(), CommandError> {
-    let problem = &ctx.problem;
-    for (k, &d) in problem.outputs.iter().enumerate() {
-        let name = &problem.model.dof_names[d];
-        let series = curve_series(limit_curves, intermediate, k);
-        let (open_y, stuck_y) = reference_ys(ctx, k);
-        let curves = curves_with_references(ctx, &series, &open_y, &stuck_y);
-        let title = format!("{} (incomplete: finished curves only)", ctx.title());
-        let y_label = format!("{name} first-harmonic amplitude (m)");
-        let fig = SweepFigure {
-            title: &title,
-            x_label: "frequency (Hz)",
-            y_label: &y_label,
-            log_y: true,
-            bands: &[],
-            curves: &curves,
-        };
-        let (png, svg) = figure_files(&ctx.dir, &format!("limits_{name}"));
-        plot_sweep(&fig, &png, &svg)?;
-    }
-    Ok(())
-}
-
 /// Writes the tables, hysteresis loops, JSON (with `status`: `complete` or `incomplete: …`)
 /// and figures of a finished analysis (the curve files are written as the curves come, by
 /// [`write_curve`]).
@@ -268,36 +129,38 @@ pub(super) fn write_analysis(
     write_tables(ctx, analysis)?;
     write_hysteresis(ctx, analysis)?;
     write_json(ctx, analysis, elapsed, status)?;
-    // Each limit curve's peak on the mesh (FE scenes).
+    // Each limit curve's peak on the mesh (FE scenes), where the curve has one.
     for c in &analysis.limits {
+        let Some(peak) = &c.peak else { continue };
         crate::report::mesh_results::write_point(
             &ctx.dir,
             &format!("peak_{}", c.case.name),
             &ctx.problem,
-            &c.peak.coefficients,
-            &c.peak.states,
+            &peak.coefficients,
+            &peak.states,
         )?;
     }
     plot(ctx, analysis)
 }
 
-/// Writes `limits.csv` (the limit curves on the grid) and `peaks.csv` (the peak of every
-/// limit, intermediate and scanned curve).
+/// Writes `limits.csv` (the limit curves on the grid: amplitudes, band and regime where they
+/// were solved, NaN / `unknown` elsewhere) and `peaks.csv` (peak and status of every limit,
+/// intermediate and scanned case).
 fn write_tables(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandError> {
     let cases: Vec<_> = a.limits.iter().map(|c| c.case.clone()).collect();
     files::write_atomic(
         &ctx.dir.join("limits.csv"),
         limit_files::limits_csv(&ctx.problem, &cases, &a.grid).as_bytes(),
     )?;
-    let mut rows: Vec<(&limits::LimitCase, &str, &limits::Peak)> = Vec::new();
+    let mut rows: Vec<limit_files::PeakRow> = Vec::new();
     for c in &a.limits {
-        rows.push((&c.case, "limit", &c.peak));
+        rows.push((&c.case, "limit", c.peak.as_ref(), &c.status));
     }
     for c in &a.intermediate {
-        rows.push((&c.case, "intermediate", &c.peak));
+        rows.push((&c.case, "intermediate", c.peak.as_ref(), &c.status));
     }
-    for (c, p) in &a.scan_peaks {
-        rows.push((c, "scan", p));
+    for c in &a.scanned {
+        rows.push((&c.case, "scan", c.peak.as_ref(), &c.status));
     }
     files::write_atomic(
         &ctx.dir.join("peaks.csv"),
@@ -326,10 +189,11 @@ fn write_hysteresis(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), Comma
 #[derive(serde::Serialize)]
 struct CurveJson<'a> {
     case: &'a limits::LimitCase,
-    peak: &'a limits::Peak,
+    /// `complete`, `incomplete: <why the path did not cover the range>` or `failed: <cause>`.
+    status: &'a limits::CurveStatus,
+    peak: Option<&'a limits::Peak>,
     continuation_retries: usize,
-    /// `complete`, or `incomplete: <why the path did not cover the range>`.
-    status: String,
+    /// The whole path, or the finished points of an unfinished case.
     points: &'a [FrfPoint],
     turning_points_hz: &'a [f64],
 }
@@ -338,17 +202,52 @@ struct CurveJson<'a> {
 fn curve_json(c: &CaseCurve) -> serde_json::Value {
     serde_json::to_value(CurveJson {
         case: &c.case,
-        peak: &c.peak,
+        status: &c.status,
+        peak: c.peak.as_ref(),
         continuation_retries: c.retries,
-        status: super::status_text(c.run.incomplete_reason().as_deref()),
-        points: &c.run.points,
-        turning_points_hz: &c.run.turning_points,
+        points: &c.points,
+        turning_points_hz: &c.turning_points,
     })
     .expect("result types serialise")
 }
 
-/// Writes `limits.json`: run info, status, every curve with its peak and path, the grid, the
-/// bound check, the scanned peaks and the hysteresis loops.
+/// The status of every case in one list, in case order (limit, intermediate, scan): name, kind,
+/// status, points finished and the highest frequency reached (Hz; NaN without points; not for
+/// scanned cases, whose paths are not kept).
+fn curve_statuses(a: &LimitAnalysis) -> Vec<serde_json::Value> {
+    let reach = |c: &CaseCurve| {
+        c.points
+            .iter()
+            .map(|p| p.freq_hz)
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    let curve = |c: &CaseCurve, kind: &str| {
+        let reached = reach(c);
+        serde_json::json!({
+            "case": c.case.name,
+            "kind": kind,
+            "status": c.status.text(),
+            "points": c.points.len(),
+            "reached_hz": reached.is_finite().then_some(reached),
+        })
+    };
+    a.limits
+        .iter()
+        .map(|c| curve(c, "limit"))
+        .chain(a.intermediate.iter().map(|c| curve(c, "intermediate")))
+        .chain(a.scanned.iter().map(|c| {
+            serde_json::json!({
+                "case": c.case.name,
+                "kind": "scan",
+                "status": c.status.text(),
+            })
+        }))
+        .collect()
+}
+
+/// Writes `limits.json`: run info, status, every case's status (`curves`), every limit and
+/// intermediate curve with its peak and path (finished points of an unfinished one), where the
+/// band exists, the grid, the bound check, the scanned cases and the hysteresis loops.
 fn write_json(
     ctx: &RunContext<'_>,
     a: &LimitAnalysis,
@@ -359,11 +258,18 @@ fn write_json(
         "info": ctx.info(),
         "status": status,
         "elapsed_s": elapsed,
+        "curves": curve_statuses(a),
         "limits": a.limits.iter().map(curve_json).collect::<Vec<_>>(),
         "intermediate": a.intermediate.iter().map(curve_json).collect::<Vec<_>>(),
+        "band": {
+            "grid_points": a.grid.len(),
+            "defined_points": a.band_points(),
+            "note": "lower/upper (and the regime) exist at the grid frequencies where both \
+                     limit curves were solved; NaN (unknown) elsewhere",
+        },
         "grid": a.grid,
         "bound_check": a.bounds,
-        "scan_peaks": a.scan_peaks,
+        "scanned": a.scanned,
         "hysteresis": a.loops,
         "hysteresis_missing": a.loops_missing,
     });
@@ -401,6 +307,12 @@ fn plot(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandError> {
             }
         })
         .collect();
+    // An unfinished analysis says so in its title: some curves end early or are missing.
+    let title = if a.is_complete() {
+        ctx.title().to_string()
+    } else {
+        format!("{} (incomplete: see limits.json)", ctx.title())
+    };
     for (k, &d) in problem.outputs.iter().enumerate() {
         let name = &problem.model.dof_names[d];
         let limit_curves: Vec<&CaseCurve> = a.limits.iter().collect();
@@ -409,7 +321,7 @@ fn plot(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandError> {
         let (open_y, stuck_y) = reference_ys(ctx, k);
         let curves = curves_with_references(ctx, &series, &open_y, &stuck_y);
         let fig = LimitFigure {
-            title: ctx.title(),
+            title: &title,
             output_name: name,
             band_x: &grid_x,
             band_lower: &lower,
@@ -465,21 +377,32 @@ pub(super) fn summary(a: &LimitAnalysis, elapsed: f64) -> String {
     use std::fmt::Write as _;
     let mut s = format!("limit analysis in {elapsed:.2} s\n");
     for c in a.limits.iter().chain(&a.intermediate) {
+        let peak = match &c.peak {
+            Some(p) => format!(
+                "peak {:.5e} m at {:.4} Hz{}",
+                p.amplitude,
+                p.freq_hz,
+                if p.refined {
+                    ""
+                } else {
+                    " (no local maximum in the peak window)"
+                }
+            ),
+            None => "no peak".to_string(),
+        };
         let _ = writeln!(
             s,
-            "  {:<24} peak {:.5e} m at {:.4} Hz{}{}",
+            "  {:<24} {peak}{}{}",
             c.case.name,
-            c.peak.amplitude,
-            c.peak.freq_hz,
-            if c.peak.refined {
-                ""
-            } else {
-                " (no local maximum in the peak window)"
-            },
             if c.retries > 0 {
                 format!(" ({} continuation retries)", c.retries)
             } else {
                 String::new()
+            },
+            if c.status.is_complete() {
+                String::new()
+            } else {
+                format!(" [{}]", c.status.text())
             }
         );
     }
@@ -529,8 +452,8 @@ fn curve_series(
         .map(|(label, c, dashed)| {
             (
                 label,
-                c.run.points.iter().map(|p| p.freq_hz).collect(),
-                c.run.points.iter().map(|p| p.amplitudes[k]).collect(),
+                c.points.iter().map(|p| p.freq_hz).collect(),
+                c.points.iter().map(|p| p.amplitudes[k]).collect(),
                 dashed,
             )
         })

@@ -107,25 +107,20 @@ fn write_point_analysis(
 /// Most sweep points named in an incomplete sweep's status (all are in `sweep.json`).
 const STATUS_POINTS: usize = 5;
 
-/// Why a sweep did not cover every value and case: per point in sweep order, its failed cases
-/// ([`SweepPoint::failures`]) and, with `output = "limits"`, the limit and intermediate curves
-/// that did not reach the end frequency; `None` when every point is complete. Lists the first
-/// [`STATUS_POINTS`] points and counts the others.
+/// Why a sweep did not cover every value and case: per point in sweep order, its cases that
+/// failed or did not reach the end frequency ([`SweepPoint::failures`]: limit and intermediate
+/// cases, and with `output = "limits"` the scanned ones); `None` when every point is complete.
+/// Lists the first [`STATUS_POINTS`] points and counts the others.
 fn sweep_incomplete(spec: &SweepSpec, points: &[SweepPoint]) -> Option<String> {
     let lines: Vec<String> = points
         .iter()
-        .filter_map(|p| {
-            let mut reasons = p.failures.clone();
-            if let Some(a) = &p.analysis {
-                reasons.extend(limits_run::analysis_incomplete(a));
-            }
-            (!reasons.is_empty()).then(|| {
-                format!(
-                    "{}: {}",
-                    point_label(spec, p.series, p.value),
-                    reasons.join("; ")
-                )
-            })
+        .filter(|p| !p.failures.is_empty())
+        .map(|p| {
+            format!(
+                "{}: {}",
+                point_label(spec, p.series, p.value),
+                p.failures.join("; ")
+            )
         })
         .collect();
     if lines.is_empty() {
@@ -278,7 +273,7 @@ fn summary(spec: &SweepSpec, points: &[SweepPoint], elapsed: f64) -> String {
     if failed > 0 {
         let _ = write!(
             s,
-            "\n  {failed} of {} points have failed cases (see sweep.csv)",
+            "\n  {failed} of {} points have failed or incomplete cases (see sweep.csv)",
             points.len()
         );
     }
@@ -514,8 +509,8 @@ fn plot_bands(
                     .map(|c| {
                         (
                             format!("{label}: limit {}", c.case.name),
-                            c.run.points.iter().map(|q| q.freq_hz).collect(),
-                            c.run.points.iter().map(|q| q.amplitudes[k]).collect(),
+                            c.points.iter().map(|q| q.freq_hz).collect(),
+                            c.points.iter().map(|q| q.amplitudes[k]).collect(),
                         )
                     })
                     .collect();

@@ -3,9 +3,12 @@
 //! * `limits.csv`: the common grid: `freq_hz`, per limit case `<case>_amp`, `lower_amp`,
 //!   `upper_amp`, `regime` (`unique`, `multiple`, `unknown`), `stuck_sides`, `slipping_sides`,
 //!   per limit case `<case>_N0_slipping` (N) and `<case>_label`, per limit case and contact
-//!   `<case>_<contact>_state`.
-//! * `peaks.csv`: one row per curve: `curve`, `kind` (limit, intermediate, scan), `m_<contact>`
-//!   per contact point, `peak_freq_hz`, `peak_amp`, `refined`.
+//!   `<case>_<contact>_state`. A limit curve that did not cover the range has NaN amplitudes
+//!   (and empty states) where it has no solution; the band (`lower_amp`, `upper_amp`) is NaN
+//!   and the regime `unknown` wherever either limit curve is missing.
+//! * `peaks.csv`: one row per case: `curve`, `kind` (limit, intermediate, scan), `m_<contact>`
+//!   per contact point, `peak_freq_hz`, `peak_amp`, `refined` (empty where the case has no
+//!   finished point in the peak window), `status` (`complete`, `incomplete: …`, `failed: …`).
 //! * `hysteresis_<curve>_<where>.csv`: `tau`, then per contact `u` (m), `T` (N), `v` (m), `N`
 //!   (N) samples over one period.
 //! * `sweep.csv`: `[<series>,]<parameter>`, per case `<case>_peak_amp` (m) and
@@ -18,7 +21,7 @@
 
 use std::fmt::Write as _;
 
-use crate::analysis::limits::{GridPoint, HysteresisLoop, LimitCase, Peak, Regime};
+use crate::analysis::limits::{CurveStatus, GridPoint, HysteresisLoop, LimitCase, Peak, Regime};
 use crate::model::Problem;
 use crate::study::sweep::SweepPoint;
 
@@ -96,23 +99,34 @@ pub fn limits_csv(problem: &Problem, cases: &[LimitCase], grid: &[GridPoint]) ->
     s
 }
 
-/// `peaks.csv` text from (case, kind, peak) rows.
-pub fn peaks_csv(problem: &Problem, rows: &[(&LimitCase, &str, &Peak)]) -> String {
+/// One row of `peaks.csv`: the case, its kind (`limit`, `intermediate`, `scan`), its peak
+/// (`None`: no finished point in the peak window) and how it ended.
+pub type PeakRow<'a> = (&'a LimitCase, &'a str, Option<&'a Peak>, &'a CurveStatus);
+
+/// `peaks.csv` text: one row per case, empty peak cells where the case has no peak, and its
+/// status (`complete`, `incomplete: …`, `failed: …`, quoted).
+pub fn peaks_csv(problem: &Problem, rows: &[PeakRow<'_>]) -> String {
     let mut s = String::from("curve,kind");
     for contact in &problem.contacts {
         let _ = write!(s, ",m_{}", contact.name);
     }
-    s.push_str(",peak_freq_hz,peak_amp,refined\n");
-    for (case, kind, peak) in rows {
+    s.push_str(",peak_freq_hz,peak_amp,refined,status\n");
+    for (case, kind, peak, status) in rows {
         let _ = write!(s, "{},{kind}", case.name);
         for m in &case.contact_states {
             let _ = write!(s, ",{m}");
         }
-        let _ = writeln!(
-            s,
-            ",{:.10e},{:.10e},{}",
-            peak.freq_hz, peak.amplitude, peak.refined
-        );
+        match peak {
+            Some(peak) => {
+                let _ = write!(
+                    s,
+                    ",{:.10e},{:.10e},{}",
+                    peak.freq_hz, peak.amplitude, peak.refined
+                );
+            }
+            None => s.push_str(",,,"),
+        }
+        let _ = writeln!(s, ",\"{}\"", status.text().replace('"', "'"));
     }
     s
 }

@@ -27,6 +27,7 @@
 
 use std::collections::HashMap;
 
+use faer::prelude::Solve;
 use faer::Mat;
 
 use crate::fe::Mesh;
@@ -231,6 +232,200 @@ pub(super) fn check_held_bodies(
                 ),
             ));
         }
+    }
+    check_static_contacts(ck, problem, load_dofs, &body_of, &body_dofs, &contacts_of)
+}
+
+/// Largest model (DOFs) on which [`check_static_contacts`] solves the static balance densely;
+/// larger models are not checked.
+const STATIC_DENSE_LIMIT: usize = 2000;
+
+/// Static normal forces of this magnitude or less, relative to the static force scale (the
+/// largest static load or interference force kₙ·|gap|), count as zero.
+const NORMAL_TOLERANCE: f64 = 1e-9;
+
+/// Refuses a free body that the static pre-load or the interferences push off every contact.
+///
+/// The static balance is solved with every contact closed and stuck (normal and tangential
+/// springs kₙ, kₜ, N = kₙ(aₙ·q − gap)); the contacts left in tension (N < 0: the load pulls
+/// the damper off them, or an interference on the other side pushes it away) are opened and
+/// the balance solved again, until no closed contact is in tension. A free body (K alone
+/// leaves it rigid-body modes) whose contacts then all carry no compression is held by
+/// nothing: N = 0 on every contact, so μN = 0 and no static state exists (the harmonic
+/// balance would fail with a singular matrix at its first point). Stuck tangential springs
+/// hold more than friction can (|T| ≤ μN is not imposed), so a body released here is free in
+/// the real problem too; a balance that does not settle is let through. Checked with lift-off
+/// (the default) on models of at most [`STATIC_DENSE_LIMIT`] DOFs.
+fn check_static_contacts(
+    ck: &Checker,
+    problem: &Problem,
+    load_dofs: &[Vec<usize>],
+    body_of: &[usize],
+    body_dofs: &[Vec<usize>],
+    contacts_of: &[Vec<usize>],
+) -> Result<(), SceneError> {
+    let n = problem.model.n_dofs();
+    let contacts = &problem.contacts;
+    let interference = |c: usize| contacts[c].gap < 0.0;
+    let load_scale = problem
+        .static_load
+        .iter()
+        .fold(0.0_f64, |a, v| a.max(v.abs()));
+    let gap_scale = contacts
+        .iter()
+        .fold(0.0_f64, |a, c| a.max(c.law.kn * c.gap.abs()));
+    let force_scale = load_scale.max(gap_scale);
+    if n > STATIC_DENSE_LIMIT || force_scale == 0.0 || contacts.is_empty() {
+        return Ok(());
+    }
+    let k_structure = {
+        let mut k = Mat::<f64>::zeros(n, n);
+        for (i, j, v) in problem.model.stiffness.triplets() {
+            k[(i, j)] += v;
+        }
+        k
+    };
+    let tol = NORMAL_TOLERANCE * force_scale;
+    let mut closed = vec![true; contacts.len()];
+    let mut normal = vec![0.0; contacts.len()];
+    for _ in 0..=contacts.len() {
+        let mut k = k_structure.clone();
+        let mut rhs = Mat::<f64>::from_fn(n, 1, |i, _| problem.static_load[i]);
+        for (_, contact) in contacts.iter().enumerate().filter(|(c, _)| closed[*c]) {
+            for (rows, stiffness) in [
+                (&contact.normal, contact.law.kn),
+                (&contact.tangential, contact.law.kt),
+            ] {
+                for &(p, ap) in rows {
+                    for &(q, aq) in rows {
+                        k[(p, q)] += stiffness * ap * aq;
+                    }
+                }
+            }
+            for &(p, ap) in &contact.normal {
+                rhs[(p, 0)] += contact.law.kn * contact.gap * ap;
+            }
+        }
+        // Singular: a body lost every contact (the structure is positive definite with all of
+        // them stuck, checked before).
+        let q = k.llt(faer::Side::Lower).ok().map(|llt| llt.solve(&rhs));
+        let mut opened = false;
+        for (c, contact) in contacts.iter().enumerate() {
+            normal[c] = match &q {
+                Some(q) if closed[c] => {
+                    let v: f64 = contact.normal.iter().map(|&(d, a)| a * q[(d, 0)]).sum();
+                    contact.law.kn * (v - contact.gap)
+                }
+                _ => 0.0,
+            };
+            if closed[c] && normal[c] < -tol {
+                closed[c] = false;
+                opened = true;
+            }
+        }
+        if q.is_none() || !opened {
+            break;
+        }
+    }
+    let k_scale = stiffness_scale(&problem.model);
+    for (b, dofs) in body_dofs.iter().enumerate() {
+        let touching = &contacts_of[b];
+        let pressed: Vec<usize> = touching
+            .iter()
+            .copied()
+            .filter(|&c| closed[c] && normal[c] > tol)
+            .collect();
+        let body_loaded = dofs
+            .iter()
+            .any(|&d| problem.static_load[d].abs() > LOAD_TOLERANCE * load_scale);
+        // A loaded body with pressed contacts is left to the cone test of the caller; a body
+        // that only loads on other bodies press (or release) is not judged here: the stuck
+        // balance cannot show that they do not squeeze it.
+        if touching.is_empty()
+            || (!pressed.is_empty() && body_loaded)
+            || (!body_loaded && load_scale > 0.0)
+        {
+            continue;
+        }
+        let Some(modes) = rigid_modes(problem, dofs, RIGID_TOLERANCE * k_scale) else {
+            continue;
+        };
+        if modes.is_empty() {
+            continue;
+        }
+        if !pressed.is_empty() {
+            // Unloaded body: its pressed contacts must balance each other on its rigid-body
+            // motion, some N > 0 with |T| ≤ μN summing to zero; otherwise friction cannot keep
+            // the interference from pushing the body out.
+            let local: HashMap<usize, usize> =
+                dofs.iter().enumerate().map(|(k, &d)| (d, k)).collect();
+            let project = |rows: &[(usize, f64)]| -> Vec<f64> {
+                modes
+                    .iter()
+                    .map(|mode| {
+                        rows.iter()
+                            .filter_map(|&(d, a)| local.get(&d).map(|&k| mode[k] * a))
+                            .sum()
+                    })
+                    .collect()
+            };
+            let mut generators: Vec<Vec<f64>> = Vec::new();
+            for &c in &pressed {
+                let (nn, tt) = (
+                    project(&contacts[c].normal),
+                    project(&contacts[c].tangential),
+                );
+                for sign in [1.0, -1.0] {
+                    generators.push(
+                        nn.iter()
+                            .zip(&tt)
+                            .map(|(a, t)| a + sign * contacts[c].law.mu * t)
+                            .collect(),
+                    );
+                }
+            }
+            let balanced = (0..generators.len()).any(|k| {
+                let others: Vec<Vec<f64>> = generators
+                    .iter()
+                    .enumerate()
+                    .filter(|(j, _)| *j != k)
+                    .map(|(_, g)| g.clone())
+                    .collect();
+                let target: Vec<f64> = generators[k].iter().map(|v| -v).collect();
+                cone_membership(&others, &target) != Membership::Outside
+            });
+            if balanced {
+                continue;
+            }
+        }
+        let body = BodyName::new(problem, dofs, touching);
+        let loaded = body_loaded;
+        let field = if loaded {
+            load_field(load_dofs, |d| body_of[d] == b, |_| true)
+        } else {
+            touching
+                .iter()
+                .chain(&(0..contacts.len()).collect::<Vec<_>>())
+                .find(|&&c| interference(c))
+                .map_or_else(|| "contacts".to_string(), |&c| format!("contacts[{c}].gap"))
+        };
+        let cause = if loaded {
+            "the static load pulls it off them"
+        } else {
+            "the interferences (gap < 0) push it off them and nothing presses it back"
+        };
+        return Err(ck.err(
+            field,
+            format!(
+                "{body} is held only by its contacts {} and {cause}: with the contacts closed \
+                 and stuck the static balance puts them in tension (N < 0), and with those \
+                 contacts opened none is left pressed, so μN = 0 everywhere and no static state \
+                 exists; a pre-load must press the body onto its contacts (check the sign of \
+                 the static loads and that each contact normal points from the damper into the \
+                 body), or interferences must clamp it from opposite sides",
+                body.contacts
+            ),
+        ));
     }
     Ok(())
 }

@@ -258,3 +258,47 @@ fn push_coefficient(row: &mut Vec<(usize, f64)>, dof: usize, value: f64) {
         None => row.push((dof, value)),
     }
 }
+
+/// Largest |gap| relative to the model's displacement scale, the largest load (static or
+/// harmonic amplitude, N) over the stiffness scale (largest diagonal entry of K, N/m): a gap
+/// that much larger than any displacement the loads can cause never closes (or, as an
+/// interference, swamps every other force).
+pub const MAX_GAP_RATIO: f64 = 1e6;
+
+/// Refuses a contact gap out of proportion to the model's displacement scale (see
+/// [`MAX_GAP_RATIO`]); models without loads or stiffness set no bound.
+pub(super) fn check_gap_scale(
+    ck: &Checker,
+    problem: &crate::model::Problem,
+    fields: &[String],
+) -> Result<(), SceneError> {
+    let force = problem
+        .static_load
+        .iter()
+        .map(|f| f.abs())
+        .chain(problem.harmonic_loads.iter().map(|h| h.cos.hypot(h.sin)))
+        .fold(0.0_f64, f64::max);
+    let k = crate::scene::check_model::stiffness_scale(&problem.model);
+    if force == 0.0 || k == 0.0 {
+        return Ok(());
+    }
+    let scale = force / k;
+    for (c, contact) in problem.contacts.iter().enumerate() {
+        if contact.gap.abs() > MAX_GAP_RATIO * scale {
+            return Err(ck.err(
+                fields
+                    .get(c)
+                    .cloned()
+                    .unwrap_or_else(|| "contacts".to_string()),
+                format!(
+                    "{:e} m is more than {MAX_GAP_RATIO:e} times the model's displacement scale \
+                     ({scale:e} m: the largest load over the largest diagonal entry of K): such \
+                     a gap never closes, and such an interference swamps every other force; \
+                     check the units (m)",
+                    contact.gap
+                ),
+            ));
+        }
+    }
+    Ok(())
+}

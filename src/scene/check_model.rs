@@ -96,6 +96,7 @@ pub(super) fn build_model(
         None => Mat::zeros(n, n),
     };
     ck.semidefinite("model.mass", &mass)?;
+    mass_spread(ck, &mass)?;
     ck.semidefinite("model.stiffness", &stiffness)?;
     ck.semidefinite("model.damping", &damping)?;
     Ok((
@@ -170,6 +171,37 @@ pub(super) fn check_stuck_structure(ck: &Checker, problem: &Problem) -> Result<(
             };
             k.sp_cholesky(faer::Side::Lower).map_err(|_| singular())?;
         }
+    }
+    Ok(())
+}
+
+/// Largest ratio of two positive diagonal entries of an inline mass matrix: beyond it the
+/// light DOFs are lost in the round-off of the heavy ones (a mass of 1e40 kg beside 0.1 kg
+/// makes the structure's dynamics meaningless).
+pub const MAX_MASS_RATIO: f64 = 1e12;
+
+/// Refuses an inline mass matrix whose positive diagonal entries span more than
+/// [`MAX_MASS_RATIO`], naming the largest entry.
+fn mass_spread(ck: &Checker, mass: &Mat<f64>) -> Result<(), SceneError> {
+    let diag: Vec<f64> = (0..mass.nrows()).map(|i| mass[(i, i)]).collect();
+    let positive = diag.iter().copied().filter(|&m| m > 0.0);
+    let min = positive.clone().fold(f64::INFINITY, f64::min);
+    let Some((i, &max)) = diag
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .filter(|(_, &m)| m > 0.0)
+    else {
+        return Ok(());
+    };
+    if max > MAX_MASS_RATIO * min {
+        return Err(ck.err(
+            format!("model.mass[{i}][{i}]"),
+            format!(
+                "{max:e} kg is more than {MAX_MASS_RATIO:e} times the lightest DOF's mass \
+                 ({min:e} kg): the light DOFs would be lost in round-off; check the units (kg)"
+            ),
+        ));
     }
     Ok(())
 }

@@ -42,6 +42,16 @@ pub(super) fn check_sweep(scene: &Scene, ck: &Checker) -> Result<(), SceneError>
         }
         for (i, v) in values.iter().enumerate() {
             ck.finite(&format!("{table}.values[{i}]"), *v)?;
+            // The same value twice would solve the same scene twice and write both into one
+            // folder and one row of the tables.
+            if let Some(j) = values[..i].iter().position(|w| w == v) {
+                return Err(ck.err(
+                    format!("{table}.values[{i}]"),
+                    format!(
+                        "duplicate value {v} (also {table}.values[{j}]): each value is solved once"
+                    ),
+                ));
+            }
         }
         if targets.is_empty() {
             return Err(ck.err(format!("{table}.targets"), "must name at least one field"));

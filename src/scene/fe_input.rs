@@ -203,6 +203,7 @@ pub fn build_structure(
                     }
                     (false, t) => t.unwrap_or(1.0),
                 };
+                check_material(file, i, m)?;
                 let material = Material {
                     young_modulus: m.young,
                     poisson_ratio: m.poisson,
@@ -436,4 +437,56 @@ pub fn group_load(
             (r, w)
         })
         .collect())
+}
+
+/// Range of Young's modulus accepted for a solid (Pa): from soft foams and gels (1 kPa) to
+/// above diamond (1.2 TPa). Values outside are a unit error or a typo (SI units: Pa).
+pub const YOUNG_RANGE_PA: (f64, f64) = (1e3, 1e13);
+
+/// Range of a non-zero density accepted for a solid (kg/m³): from aerogels (1 kg/m³, with
+/// margin) to above osmium (22 590 kg/m³). Zero is allowed (a massless group).
+pub const DENSITY_RANGE: (f64, f64) = (0.1, 1e5);
+
+/// Checks one `[[model.materials]]` entry's physical bounds, naming the field: Young's modulus
+/// in [`YOUNG_RANGE_PA`], Poisson's ratio in (−1, 0.5) (the elastic energy is positive
+/// definite only there), density 0 or in [`DENSITY_RANGE`].
+fn check_material(file: &str, i: usize, m: &MaterialSpec) -> Result<(), SceneError> {
+    let field = |name: &str| format!("model.materials[{i}].{name}");
+    let (e_lo, e_hi) = YOUNG_RANGE_PA;
+    if !(m.young.is_finite() && m.young >= e_lo && m.young <= e_hi) {
+        return Err(SceneError::invalid(
+            file,
+            field("young"),
+            format!(
+                "Young's modulus {:e} Pa is outside the range of solids, {e_lo:e} .. {e_hi:e} Pa \
+                 (SI units: steel is 2.1e11 Pa)",
+                m.young
+            ),
+        ));
+    }
+    if !(m.poisson.is_finite() && m.poisson > -1.0 && m.poisson < 0.5) {
+        return Err(SceneError::invalid(
+            file,
+            field("poisson"),
+            format!(
+                "Poisson's ratio {} must lie in (-1, 0.5): at 0.5 the material is incompressible \
+                 and at -1 it has no shear stiffness, and outside the elastic energy is not \
+                 positive",
+                m.poisson
+            ),
+        ));
+    }
+    let (r_lo, r_hi) = DENSITY_RANGE;
+    if !(m.density.is_finite() && (m.density == 0.0 || (m.density >= r_lo && m.density <= r_hi))) {
+        return Err(SceneError::invalid(
+            file,
+            field("density"),
+            format!(
+                "density {:e} kg/m^3 must be 0 (massless) or within {r_lo} .. {r_hi:e} kg/m^3 (SI \
+                 units: steel is 7850 kg/m^3)",
+                m.density
+            ),
+        ));
+    }
+    Ok(())
 }

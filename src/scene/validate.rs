@@ -14,7 +14,7 @@ use crate::hbm::formulation::check_relative_coordinates;
 use crate::model::{Effects, FeOrigin, Formulation, Problem};
 use crate::scene::check_analysis::{analysis, frequency_bound, outputs};
 use crate::scene::check_bodies::check_held_bodies;
-use crate::scene::check_contacts::contact_set;
+use crate::scene::check_contacts::{check_gap_scale, contact_set};
 use crate::scene::check_limits::limit_settings;
 use crate::scene::check_loads::{harmonic_loads, harmonic_set, static_load};
 use crate::scene::check_model::{
@@ -99,6 +99,13 @@ impl Scene {
             }),
         };
         check_sweep(self, &ck)?;
+        // Inline contacts only (patch gaps come from the mesh's geometry).
+        if self.contacts.len() == problem.contacts.len() {
+            let fields: Vec<String> = (0..self.contacts.len())
+                .map(|i| format!("contacts[{i}].gap"))
+                .collect();
+            check_gap_scale(&ck, &problem, &fields)?;
+        }
         // On the full model, before reduction; reported after the stuck-structure check, which
         // names a body that even stuck contacts cannot hold.
         let points: Vec<Vec<usize>> = self

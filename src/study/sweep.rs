@@ -10,8 +10,10 @@
 //!
 //! Every sweep point is independent: points run in parallel with rayon, each on its own scene,
 //! and results do not depend on the thread count. A case that cannot be solved at one point
-//! (e.g. a continuation that stalls at a low pre-load) is recorded with its reason and does not
-//! stop the sweep; an override that makes the scene invalid does.
+//! (e.g. a continuation that stalls at a low pre-load) or that does not cover the range is
+//! recorded with its reason ([`SweepPoint::failures`]), the other cases of the point are still
+//! solved, and the sweep goes on; an override that makes the scene invalid stops it (`check`
+//! refuses such sweeps up front).
 
 use rayon::prelude::*;
 
@@ -43,13 +45,17 @@ pub struct SweepPoint {
     pub series: Option<f64>,
     /// Case names: the two limit cases, then the intermediate ones.
     pub cases: Vec<String>,
-    /// Resonance peak of each case (first output DOF); `None` where the case failed.
+    /// Resonance peak of each case (first output DOF); `None` where the case failed or did not
+    /// cover the range (an unfinished path's highest point need not be the peak).
     pub peaks: Vec<Option<Peak>>,
-    /// Continuation retries of each case (see [`limits::solve_case`]).
+    /// Continuation retries of each case (see [`limits::attempt_case`]).
     pub retries: Vec<usize>,
-    /// Why cases failed, one line each; empty when everything was solved.
+    /// Every case (limit, intermediate and, with `output = "limits"`, scanned) that failed or
+    /// did not cover the range, one line each ("curve `<name>` failed: …", "curve `<name>`
+    /// incomplete: …"); empty when everything was solved.
     pub failures: Vec<String>,
-    /// The whole limit analysis (output `limits` only; not serialised).
+    /// The whole limit analysis (output `limits` only, with the finished points of unfinished
+    /// curves; not serialised).
     #[serde(skip)]
     pub analysis: Option<Box<LimitAnalysis>>,
 }
@@ -184,12 +190,12 @@ pub fn solve_value(
     match output {
         SweepOutput::Peaks => {
             for (k, case) in cases.iter().enumerate() {
-                match limits::solve_case(problem, case, settings.peak_window_hz) {
-                    Ok(curve) => {
-                        point.peaks[k] = Some(curve.peak);
-                        point.retries[k] = curve.retries;
-                    }
-                    Err(e) => point.failures.push(e.to_string()),
+                let curve = limits::attempt_case(problem, case, settings.peak_window_hz);
+                point.retries[k] = curve.retries;
+                point.failures.extend(curve.unfinished_reason());
+                // The peak of an unfinished curve is not the case's: its path may stop short.
+                if curve.status.is_complete() {
+                    point.peaks[k] = curve.peak;
                 }
             }
         }
@@ -201,9 +207,12 @@ pub fn solve_value(
                     .chain(&analysis.intermediate)
                     .enumerate()
                 {
-                    point.peaks[k] = Some(c.peak.clone());
+                    if c.status.is_complete() {
+                        point.peaks[k] = c.peak.clone();
+                    }
                     point.retries[k] = c.retries;
                 }
+                point.failures.extend(analysis.unfinished());
                 point.analysis = Some(Box::new(analysis));
             }
             Err(e) => point.failures.push(e.to_string()),

@@ -18,11 +18,13 @@ pub struct BoundCheck {
     pub max_excess_below: f64,
     /// Where (frequency in Hz, case name), if any excess.
     pub below_at: Option<(f64, String)>,
-    /// Largest refined peak of a scanned curve above the largest limit peak (relative).
+    /// Largest refined peak of a scanned curve above the largest limit peak (relative; over
+    /// the scanned curves and limit curves that have a peak).
     pub peak_excess_above: f64,
     /// Smallest refined peak of a scanned curve below the smallest limit peak (relative).
     pub peak_excess_below: f64,
-    /// Grid points compared.
+    /// Grid points compared: those where the scanned curve and both limit curves were solved
+    /// (unfinished curves are compared where they exist).
     pub compared: usize,
     /// Contact states where the excess above the upper limit is largest.
     pub above_states: Option<ExcessStates>,
@@ -40,11 +42,13 @@ pub struct ExcessStates {
     pub limits: Vec<Vec<ContactState>>,
 }
 
-/// Compares scanned curves (on the grid) and their peaks with the limits.
+/// Compares scanned curves (on the grid) and their peaks with the limits: pointwise where the
+/// band and the scanned curve exist, peaks where the scanned curve has one (`limit_peaks`: the
+/// peak amplitudes of the limit curves that have one, m; the peak check is skipped when empty).
 pub fn check_bounds(
     grid: &[GridPoint],
     limit_peaks: &[f64],
-    scanned: &[(LimitCase, Vec<GridSolution>, Peak)],
+    scanned: &[(LimitCase, Vec<GridSolution>, Option<Peak>)],
 ) -> BoundCheck {
     let mut b = BoundCheck {
         max_excess_above: 0.0,
@@ -87,6 +91,9 @@ pub fn check_bounds(
                 b.below_states = Some(states());
             }
         }
+        let Some(peak) = peak.as_ref().filter(|_| !limit_peaks.is_empty()) else {
+            continue;
+        };
         b.peak_excess_above = b
             .peak_excess_above
             .max((peak.amplitude - peak_hi) / peak_hi);

@@ -1,24 +1,83 @@
 //! One solved case: the continuation of the case's frequency response (retried with other
-//! steps when it fails) and its resonance peak.
+//! steps when it fails or stops early), its resonance peak, and how it ended
+//! ([`CurveStatus`]): a case that does not cover the range keeps the points it finished.
 
-use crate::analysis::frf::{self, FrfRun, Silent};
+use crate::analysis::frf::{self, FrfObserver, FrfPoint};
 use crate::model::Problem;
 
 use super::case::LimitCase;
 use super::error::LimitError;
 use super::peak::{refine_peak, Peak};
 
-/// One solved curve.
+/// How the continuation of one case ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CurveStatus {
+    /// The path reached the end frequency.
+    Complete,
+    /// The path ended before the end frequency (point budget used up, left the range below the
+    /// start, no progress) with every step setting tried; `reason` says where and why.
+    Incomplete {
+        /// Why the range was not covered (see `FrfRun::incomplete_reason`).
+        reason: String,
+    },
+    /// The continuation failed (no solution at the start, a stall), or the curve cannot be
+    /// used (no converged point in the peak window, its grid solves could not be set up).
+    Failed {
+        /// Cause.
+        error: LimitError,
+    },
+}
+
+/// Serialised as its [`CurveStatus::text`].
+impl serde::Serialize for CurveStatus {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(&self.text())
+    }
+}
+
+impl CurveStatus {
+    /// Whether the case covered the range.
+    pub fn is_complete(&self) -> bool {
+        matches!(self, CurveStatus::Complete)
+    }
+
+    /// `complete`, `incomplete: <reason>` or `failed: <cause>` (the text of `limits.json`).
+    pub fn text(&self) -> String {
+        match self {
+            CurveStatus::Complete => "complete".to_string(),
+            CurveStatus::Incomplete { reason } => format!("incomplete: {reason}"),
+            CurveStatus::Failed { error } => format!("failed: {}", error.cause()),
+        }
+    }
+}
+
+/// One attempted case: the points its continuation finished (all of them when complete), its
+/// resonance peak and how it ended.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CaseCurve {
     /// The case.
     pub case: LimitCase,
-    /// The continuation run.
-    pub run: FrfRun,
-    /// Resonance peak of the first output DOF in the peak window.
-    pub peak: Peak,
-    /// Continuation retries with other step settings before the run succeeded (0: none).
+    /// Converged points in path order: the whole path of a complete case, the points finished
+    /// before the path stopped or failed otherwise (empty when it failed at its first point).
+    pub points: Vec<FrfPoint>,
+    /// Turning-point frequencies of the path (Hz).
+    pub turning_points: Vec<f64>,
+    /// Resonance peak of the first output DOF in the peak window; `None` when no finished point
+    /// lies in it.
+    pub peak: Option<Peak>,
+    /// Continuation retries with other step settings after the first attempt (0: none).
     pub retries: usize,
+    /// How the case ended.
+    pub status: CurveStatus,
+}
+
+impl CaseCurve {
+    /// "curve `<name>` incomplete: <reason>" or "curve `<name>` failed: <cause>" when the case
+    /// did not cover the range; `None` when it did.
+    pub fn unfinished_reason(&self) -> Option<String> {
+        (!self.status.is_complete())
+            .then(|| format!("curve `{}` {}", self.case.name, self.status.text()))
+    }
 }
 
 /// Factors on the scene's continuation steps (initial and largest) tried in turn when a curve
@@ -26,57 +85,140 @@ pub struct CaseCurve {
 /// changing state) usually passes it when the corner is approached with other steps.
 const STEP_RETRIES: [f64; 4] = [1.0, 0.5, 0.25, 2.0];
 
+/// Collects the path as it comes, so that the points of a continuation that fails are kept.
+#[derive(Default)]
+struct Collect {
+    points: Vec<FrfPoint>,
+    turning_points: Vec<f64>,
+}
+
+impl FrfObserver for Collect {
+    fn point(&mut self, point: &FrfPoint) {
+        self.points.push(point.clone());
+    }
+    fn turning_point(&mut self, freq_hz: f64) {
+        self.turning_points.push(freq_hz);
+    }
+}
+
+/// One attempt: its points, turning points and status (before the peak is sought).
+struct Attempt {
+    points: Vec<FrfPoint>,
+    turning_points: Vec<f64>,
+    status: CurveStatus,
+}
+
+impl Attempt {
+    /// Highest frequency the attempt reached (Hz; −∞ without points).
+    fn reach_hz(&self) -> f64 {
+        self.points
+            .iter()
+            .map(|p| p.freq_hz)
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+}
+
 /// Solves the FRF of one case and locates its peak (first output DOF) in `window` (Hz).
+/// Never fails: how the case ended is in [`CaseCurve::status`].
 ///
 /// If the continuation fails, or ends before the end of the range (an incomplete run: the
 /// curve would not cover the range the limits are asked for), it is repeated with the scene's
 /// initial and largest steps scaled by the factors 0.5, 0.25 and 2 in turn; the number of
-/// retries is recorded, and the first failure is returned when every attempt fails.
+/// retries is recorded. When no attempt covers the range, the attempt that reached the highest
+/// frequency is kept (the first of equals) with its finished points and its status
+/// (`Incomplete` or `Failed`). A path that covers the range but has no point in the peak
+/// window is `Failed` with [`LimitError::NoPeak`] (its points are kept).
+pub fn attempt_case(problem: &Problem, case: &LimitCase, window: Option<(f64, f64)>) -> CaseCurve {
+    let p = case.apply(problem);
+    let mut best: Option<(usize, Attempt)> = None;
+    for (retries, factor) in STEP_RETRIES.iter().enumerate() {
+        let mut attempt_problem = p.clone();
+        let a = &mut attempt_problem.analysis.continuation;
+        a.max_step = (a.max_step * factor).max(a.min_step);
+        a.initial_step = (a.initial_step * factor).clamp(a.min_step, a.max_step);
+        let mut collect = Collect::default();
+        let attempt = match frf::solve(&attempt_problem, &mut collect) {
+            Ok(run) => Attempt {
+                status: match run.incomplete_reason() {
+                    None => CurveStatus::Complete,
+                    Some(reason) => CurveStatus::Incomplete { reason },
+                },
+                points: run.points,
+                turning_points: run.turning_points,
+            },
+            Err(source) => Attempt {
+                points: collect.points,
+                turning_points: collect.turning_points,
+                status: CurveStatus::Failed {
+                    error: LimitError::Curve {
+                        case: case.name.clone(),
+                        source,
+                    },
+                },
+            },
+        };
+        let complete = attempt.status.is_complete();
+        if best
+            .as_ref()
+            .is_none_or(|(_, b)| complete || attempt.reach_hz() > b.reach_hz())
+        {
+            best = Some((retries, attempt));
+        }
+        if complete {
+            break;
+        }
+    }
+    let (retries, attempt) = best.expect("STEP_RETRIES is not empty");
+    let mut status = attempt.status;
+    let peak = match refine_peak(&p, &attempt.points, 0, window) {
+        Ok(peak) => peak,
+        Err(source) => {
+            if status.is_complete() {
+                status = CurveStatus::Failed {
+                    error: LimitError::Curve {
+                        case: case.name.clone(),
+                        source,
+                    },
+                };
+            }
+            None
+        }
+    };
+    if peak.is_none() && status.is_complete() {
+        let (lo_hz, hi_hz) = window.unwrap_or((f64::NAN, f64::NAN));
+        status = CurveStatus::Failed {
+            error: LimitError::NoPeak {
+                case: case.name.clone(),
+                lo_hz,
+                hi_hz,
+            },
+        };
+    }
+    CaseCurve {
+        case: case.clone(),
+        points: attempt.points,
+        turning_points: attempt.turning_points,
+        peak,
+        retries,
+        status,
+    }
+}
+
+/// As [`attempt_case`], for callers that need the whole curve: the curve when it covered the
+/// range (its peak is then `Some`), otherwise the error of its status ([`LimitError::Incomplete`]
+/// or the failure).
 pub fn solve_case(
     problem: &Problem,
     case: &LimitCase,
     window: Option<(f64, f64)>,
 ) -> Result<CaseCurve, LimitError> {
-    let p = case.apply(problem);
-    let err = |source| LimitError::Curve {
-        case: case.name.clone(),
-        source,
-    };
-    let mut first_error: Option<LimitError> = None;
-    for (retries, factor) in STEP_RETRIES.iter().enumerate() {
-        let mut attempt = p.clone();
-        let a = &mut attempt.analysis.continuation;
-        a.max_step = (a.max_step * factor).max(a.min_step);
-        a.initial_step = (a.initial_step * factor).clamp(a.min_step, a.max_step);
-        match frf::solve(&attempt, &mut Silent) {
-            Ok(run) if !run.is_complete() => {
-                first_error.get_or_insert(LimitError::Incomplete {
-                    case: case.name.clone(),
-                    reason: run.incomplete_reason().unwrap_or_default(),
-                });
-            }
-            Ok(run) => {
-                let peak = refine_peak(&p, &run.points, 0, window)
-                    .map_err(err)?
-                    .ok_or_else(|| {
-                        let (lo_hz, hi_hz) = window.unwrap_or((f64::NAN, f64::NAN));
-                        LimitError::NoPeak {
-                            case: case.name.clone(),
-                            lo_hz,
-                            hi_hz,
-                        }
-                    })?;
-                return Ok(CaseCurve {
-                    case: case.clone(),
-                    run,
-                    peak,
-                    retries,
-                });
-            }
-            Err(e) => {
-                first_error.get_or_insert(err(e));
-            }
-        }
+    let curve = attempt_case(problem, case, window);
+    match curve.status {
+        CurveStatus::Complete => Ok(curve),
+        CurveStatus::Incomplete { reason } => Err(LimitError::Incomplete {
+            case: case.name.clone(),
+            reason,
+        }),
+        CurveStatus::Failed { error } => Err(error),
     }
-    Err(first_error.expect("at least one attempt"))
 }

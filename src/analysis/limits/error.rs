@@ -1,5 +1,6 @@
-//! Errors of a limit analysis: a curve that cannot be solved, contact forces that cannot be
-//! evaluated, a curve with no converged point in the peak window.
+//! Errors of a limit analysis: an operator that cannot be built, a curve that cannot be
+//! solved, contact forces that cannot be evaluated, a curve with no converged point in the peak
+//! window.
 
 use crate::analysis::frf::FrfError;
 use crate::hbm::HbmError;
@@ -7,6 +8,9 @@ use crate::hbm::HbmError;
 /// Errors of a limit analysis.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum LimitError {
+    /// The harmonic-balance operator of the problem cannot be built (no case can be solved).
+    #[error("the harmonic-balance system cannot be set up: {0}")]
+    Setup(HbmError),
     /// A curve could not be solved.
     #[error("curve `{case}`: {source}")]
     Curve {
@@ -42,4 +46,30 @@ pub enum LimitError {
         /// Window end (Hz).
         hi_hz: f64,
     },
+}
+
+impl LimitError {
+    /// The case the error belongs to (`None` for [`LimitError::Setup`]).
+    pub fn case(&self) -> Option<&str> {
+        match self {
+            LimitError::Setup(_) => None,
+            LimitError::Curve { case, .. }
+            | LimitError::Contacts { case, .. }
+            | LimitError::Incomplete { case, .. }
+            | LimitError::NoPeak { case, .. } => Some(case),
+        }
+    }
+
+    /// The message without the case's name (for texts that name the case already).
+    pub fn cause(&self) -> String {
+        match self {
+            LimitError::Setup(e) => e.to_string(),
+            LimitError::Curve { source, .. } => source.to_string(),
+            LimitError::Contacts { source, .. } => source.to_string(),
+            LimitError::Incomplete { reason, .. } => reason.clone(),
+            LimitError::NoPeak { lo_hz, hi_hz, .. } => {
+                format!("no converged point in the peak window {lo_hz} .. {hi_hz} Hz")
+            }
+        }
+    }
 }

@@ -5,7 +5,6 @@ use crate::hbm::{HbmError, HbmSystem};
 use crate::model::Problem;
 
 use super::curve::CaseCurve;
-use super::error::LimitError;
 use super::grid::on_grid;
 
 /// Where hysteresis loops are wanted, on every limit and intermediate curve.
@@ -41,47 +40,61 @@ pub struct LoopSet {
     pub loops: Vec<HysteresisLoop>,
 }
 
-/// The requested loops of one curve, and the requests it has no solution for.
+/// The requested loops of one curve, and the requests it has no solution for (as text: no
+/// peak, a frequency outside its finished path, a solve or contact evaluation that failed).
 pub(super) fn curve_loops(
     problem: &Problem,
     curve: &CaseCurve,
     request: &HysteresisRequest,
-) -> Result<(Vec<LoopSet>, Vec<String>), LimitError> {
+) -> (Vec<LoopSet>, Vec<String>) {
     let p = curve.case.apply(problem);
-    let contacts_err = |source| LimitError::Contacts {
-        case: curve.case.name.clone(),
-        source,
-    };
+    let name = &curve.case.name;
     let mut sets = Vec::new();
     let mut missing = Vec::new();
     if request.at_peaks {
-        sets.push(LoopSet {
-            case: curve.case.name.clone(),
-            at: "peak".to_string(),
-            freq_hz: curve.peak.freq_hz,
-            amplitude: curve.peak.amplitude,
-            loops: hysteresis(&p, &curve.peak.coefficients).map_err(contacts_err)?,
-        });
-    }
-    if !request.freqs_hz.is_empty() {
-        let solved = on_grid(problem, &curve.case, &curve.run.points, &request.freqs_hz)?;
-        for (&f, s) in request.freqs_hz.iter().zip(solved) {
-            match s {
-                Some((point, _)) => sets.push(LoopSet {
-                    case: curve.case.name.clone(),
-                    at: format!("{f} Hz"),
-                    freq_hz: f,
-                    amplitude: point.amplitudes[0],
-                    loops: hysteresis(&p, &point.coefficients).map_err(contacts_err)?,
+        match &curve.peak {
+            Some(peak) => match hysteresis(&p, &peak.coefficients) {
+                Ok(loops) => sets.push(LoopSet {
+                    case: name.clone(),
+                    at: "peak".to_string(),
+                    freq_hz: peak.freq_hz,
+                    amplitude: peak.amplitude,
+                    loops,
                 }),
-                None => missing.push(format!(
-                    "curve `{}` has no solution at {f} Hz (outside its path or Newton failed)",
-                    curve.case.name
-                )),
-            }
+                Err(e) => missing.push(format!("curve `{name}` at its peak: {e}")),
+            },
+            None => missing.push(format!("curve `{name}` has no peak in the peak window")),
         }
     }
-    Ok((sets, missing))
+    if request.freqs_hz.is_empty() {
+        return (sets, missing);
+    }
+    let solved = match on_grid(problem, &curve.case, &curve.points, &request.freqs_hz) {
+        Ok(solved) => solved,
+        Err(e) => {
+            missing.push(format!("{e}"));
+            return (sets, missing);
+        }
+    };
+    for (&f, s) in request.freqs_hz.iter().zip(solved) {
+        let Some((point, _)) = s else {
+            missing.push(format!(
+                "curve `{name}` has no solution at {f} Hz (outside its path or Newton failed)"
+            ));
+            continue;
+        };
+        match hysteresis(&p, &point.coefficients) {
+            Ok(loops) => sets.push(LoopSet {
+                case: name.clone(),
+                at: format!("{f} Hz"),
+                freq_hz: f,
+                amplitude: point.amplitudes[0],
+                loops,
+            }),
+            Err(e) => missing.push(format!("curve `{name}` at {f} Hz: {e}")),
+        }
+    }
+    (sets, missing)
 }
 
 /// Time histories over one period of every contact at coefficients x: (u, T, v, N) samples.

@@ -21,6 +21,10 @@
 //! Whether the limits really bound the other solutions is checked, not assumed: a scan over
 //! intermediate states per side reports the largest excursion outside the band.
 //!
+//! Every case is attempted whatever the others do: a curve that fails or stops before the end
+//! frequency keeps its finished points and says how it ended ([`CurveStatus`]); the band and
+//! the classification exist where both limit curves were solved.
+//!
 //! The files, in the order they build on each other:
 //!
 //! | file | job |
@@ -28,12 +32,12 @@
 //! | `error` | [`LimitError`] |
 //! | `case` | the cases: [`LimitCase`], [`CaseSpec`], [`two_point_cases`], [`scan_cases`] |
 //! | `peak` | resonance peaks: [`Peak`], [`refine_peak`], [`linear_resonance`] |
-//! | `curve` | one solved case: [`CaseCurve`], [`solve_case`] |
+//! | `curve` | one attempted case: [`CaseCurve`], [`CurveStatus`], [`attempt_case`], [`solve_case`] |
 //! | `side` | damper sides: [`SideStatics`], [`SideState`], [`LimitLabel`], [`Regime`] |
 //! | `grid` | the common grid: [`GridPoint`], [`on_grid`], [`classify`] |
 //! | `bounds` | the bound check: [`BoundCheck`], [`check_bounds`] |
 //! | `loops` | contact loops: [`HysteresisLoop`], [`hysteresis`], [`LoopSet`] |
-//! | `run` | the analysis: [`LimitSettings`], [`analyse`], [`LimitAnalysis`], [`Variability`] |
+//! | `run` | the analysis: [`LimitSettings`], [`analyse`], [`LimitAnalysis`], [`ScannedCase`], [`Variability`] |
 //!
 //! Every item is re-exported here, so callers name it `limits::Item` whatever file holds it.
 
@@ -49,10 +53,10 @@ pub mod side;
 
 pub use bounds::{check_bounds, BoundCheck, ExcessStates};
 pub use case::{scan_cases, signed, two_point_cases, CaseSpec, LimitCase};
-pub use curve::{solve_case, CaseCurve};
+pub use curve::{attempt_case, solve_case, CaseCurve, CurveStatus};
 pub use error::LimitError;
 pub use grid::{classify, on_grid, GridPoint, GridSolution};
 pub use loops::{hysteresis, HysteresisLoop, HysteresisRequest, LoopSet};
 pub use peak::{linear_resonance, refine_peak, Peak};
-pub use run::{analyse, LimitAnalysis, LimitSettings, Variability};
+pub use run::{analyse, LimitAnalysis, LimitSettings, ScannedCase, Variability};
 pub use side::{side_states, side_statics, LimitLabel, Regime, SideState, SideStatics};

@@ -1,15 +1,18 @@
 //! The limit analysis itself: its settings, the run (limit, intermediate and scanned curves,
-//! grid classification, bound check, hysteresis loops) and the size of the variability found.
+//! each attempted whatever the others do; grid classification, bound check, hysteresis loops)
+//! and the size of the variability found.
 
 use rayon::prelude::*;
 
 use crate::model::Problem;
 
+use crate::hbm::HbmSystem;
+
 use super::bounds::{check_bounds, BoundCheck};
 use super::case::{scan_cases, two_point_cases, CaseSpec, LimitCase};
-use super::curve::{solve_case, CaseCurve};
+use super::curve::{attempt_case, CaseCurve, CurveStatus};
 use super::error::LimitError;
-use super::grid::{classify, on_grid, GridPoint};
+use super::grid::{classify, on_grid, GridPoint, GridSolution};
 use super::loops::{curve_loops, HysteresisRequest, LoopSet};
 use super::peak::Peak;
 use super::side::Regime;
@@ -55,26 +58,44 @@ impl LimitSettings {
     }
 }
 
-/// Everything a limit analysis computes.
+/// One case of the bound scan as it ended: its peak (where its finished path has one) and
+/// status; the path itself is not kept.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ScannedCase {
+    /// The case.
+    pub case: LimitCase,
+    /// Resonance peak of the first output DOF in the peak window, if the path has a point there.
+    pub peak: Option<Peak>,
+    /// Continuation retries with other step settings.
+    pub retries: usize,
+    /// How the case ended (`complete`, `incomplete: …`, `failed: …` in JSON).
+    pub status: CurveStatus,
+}
+
+/// Everything a limit analysis computes. Every case is attempted whatever the others do: a
+/// case that fails or stops early keeps its finished points and says so in its status, and the
+/// grid, band and bound check use what exists (the band only where both limit curves were
+/// solved, NaN elsewhere).
 #[derive(Debug, Clone, PartialEq)]
 pub struct LimitAnalysis {
-    /// The two limit curves (m = +1, m = −1 on every side).
+    /// The two limit curves (m = +1, m = −1 on every side), in that order, whatever their status.
     pub limits: Vec<CaseCurve>,
-    /// Intermediate curves.
+    /// Intermediate curves, in the order of [`LimitSettings::intermediate_cases`].
     pub intermediate: Vec<CaseCurve>,
     /// Common grid with classification and band.
     pub grid: Vec<GridPoint>,
     /// Bound check of the scan (None when no scan was asked for).
     pub bounds: Option<BoundCheck>,
-    /// Scanned cases with their peaks.
-    pub scan_peaks: Vec<(LimitCase, Peak)>,
+    /// Scanned cases with their peaks and status, in scan order.
+    pub scanned: Vec<ScannedCase>,
     /// Requested hysteresis loops.
     pub loops: Vec<LoopSet>,
     /// Requested loops that could not be computed (no solution of the curve there), as text.
     pub loops_missing: Vec<String>,
 }
 
-/// Size of the variability of one limit analysis (first output DOF).
+/// Size of the variability of one limit analysis (first output DOF). Values that need a limit
+/// curve's peak are NaN when that curve has none.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Variability {
     /// Larger resonance-peak amplitude of the two limit curves (m).
@@ -85,7 +106,8 @@ pub struct Variability {
     pub peak_ratio: f64,
     /// 100·(higher − lower)/lower resonance frequency of the two limit curves (%).
     pub peak_freq_change_pct: f64,
-    /// Widest band, max over the grid of upper − lower limit (m).
+    /// Widest band, max over the grid of upper − lower limit (m; over the grid points where the
+    /// band exists).
     pub widest_band: f64,
     /// Frequency of the widest band (Hz).
     pub widest_band_hz: f64,
@@ -98,9 +120,22 @@ pub struct Variability {
 impl LimitAnalysis {
     /// The size of the variability: limit peaks, their ratio and frequency change, widest band.
     pub fn variability(&self) -> Variability {
-        let (a, b) = (&self.limits[0].peak, &self.limits[1].peak);
-        let (upper_peak, lower_peak) = (a.amplitude.max(b.amplitude), a.amplitude.min(b.amplitude));
-        let (f_hi, f_lo) = (a.freq_hz.max(b.freq_hz), a.freq_hz.min(b.freq_hz));
+        let peak = |i: usize| {
+            self.limits
+                .get(i)
+                .and_then(|c| c.peak.as_ref())
+                .map_or((f64::NAN, f64::NAN), |p| (p.amplitude, p.freq_hz))
+        };
+        let (a, b) = (peak(0), peak(1));
+        let both = |x: f64, y: f64, f: fn(f64, f64) -> f64| {
+            if x.is_nan() || y.is_nan() {
+                f64::NAN
+            } else {
+                f(x, y)
+            }
+        };
+        let (upper_peak, lower_peak) = (both(a.0, b.0, f64::max), both(a.0, b.0, f64::min));
+        let (f_hi, f_lo) = (both(a.1, b.1, f64::max), both(a.1, b.1, f64::min));
         let (widest_band, widest_band_hz) = self
             .grid
             .iter()
@@ -122,14 +157,58 @@ impl LimitAnalysis {
             grid_points: self.grid.len(),
         }
     }
+
+    /// Grid frequencies where the band exists (both limit curves solved there).
+    pub fn band_points(&self) -> usize {
+        self.grid
+            .iter()
+            .filter(|g| g.lower.is_finite() && g.upper.is_finite())
+            .count()
+    }
+
+    /// Whether every case (limit, intermediate, scanned) covered the range.
+    pub fn is_complete(&self) -> bool {
+        self.limits
+            .iter()
+            .chain(&self.intermediate)
+            .all(|c| c.status.is_complete())
+            && self.scanned.iter().all(|c| c.status.is_complete())
+    }
+
+    /// "curve `<name>` incomplete: …" / "curve `<name>` failed: …" of every case that did not
+    /// cover the range, limit curves first, then intermediate and scanned ones; empty when the
+    /// analysis is complete.
+    pub fn unfinished(&self) -> Vec<String> {
+        self.limits
+            .iter()
+            .chain(&self.intermediate)
+            .filter_map(CaseCurve::unfinished_reason)
+            .chain(
+                self.scanned
+                    .iter()
+                    .filter(|c| !c.status.is_complete())
+                    .map(|c| format!("curve `{}` {}", c.case.name, c.status.text())),
+            )
+            .collect()
+    }
 }
 
 /// Runs the two-point limit analysis, intermediate curves, the bound scan and the requested
 /// hysteresis loops. Curves are solved in parallel (rayon); results do not depend on the
 /// thread count.
 ///
-/// `on_curve` is called as each limit, intermediate or scanned curve is solved (from worker
+/// Every case is attempted ([`attempt_case`]), whatever the others do: a case that fails or
+/// stops before the end frequency keeps its finished points and its status, the grid is solved
+/// on whatever path each limit curve has (the band and regime are NaN / `unknown` where one of
+/// them has no solution), the bound check compares what exists, and loops that cannot be
+/// computed are listed in [`LimitAnalysis::loops_missing`]. See [`LimitAnalysis::unfinished`].
+///
+/// `on_curve` is called as each limit, intermediate or scanned case ends (from worker
 /// threads), so callers can write results as they come.
+///
+/// # Errors
+/// [`LimitError::Setup`] when the problem's harmonic-balance system cannot be built (checked
+/// once, before any curve: no case could be solved).
 pub fn analyse<F>(
     problem: &Problem,
     settings: &LimitSettings,
@@ -138,6 +217,7 @@ pub fn analyse<F>(
 where
     F: Fn(&CaseCurve) + Sync,
 {
+    HbmSystem::new(problem).map_err(LimitError::Setup)?;
     let a = &problem.analysis.continuation;
     let n = settings.grid_points.max(2);
     let grid: Vec<f64> = (0..n)
@@ -145,49 +225,76 @@ where
         .collect();
     let window = settings.peak_window_hz;
     let limit_cases = two_point_cases(problem);
-    let intermediate_cases = settings.intermediate_cases(problem);
+    let n_limits = limit_cases.len();
+    let mut curve_cases = limit_cases;
+    curve_cases.extend(settings.intermediate_cases(problem));
     let scanned_cases = scan_cases(problem, &settings.bound_scan);
 
-    // Solves one case and hands the curve to `on_curve` at once.
-    let solve = |c: &LimitCase| -> Result<CaseCurve, LimitError> {
-        let curve = solve_case(problem, c, window)?;
+    // Attempts one case and hands the curve to `on_curve` at once.
+    let attempt = |c: &LimitCase| -> CaseCurve {
+        let curve = attempt_case(problem, c, window);
         on_curve(&curve);
-        Ok(curve)
+        curve
     };
-    let solve_all = |cases: &[LimitCase]| -> Result<Vec<CaseCurve>, LimitError> {
-        cases.par_iter().map(solve).collect()
-    };
-    let limits = solve_all(&limit_cases)?;
-    let intermediate = solve_all(&intermediate_cases)?;
-    let limits_on_grid: Vec<_> = limits
-        .par_iter()
-        .map(|c| on_grid(problem, &c.case, &c.run.points, &grid))
-        .collect::<Result<_, _>>()?;
+    let mut limits: Vec<CaseCurve> = curve_cases.par_iter().map(attempt).collect();
+    let intermediate = limits.split_off(n_limits);
+    // Each limit curve on the grid, where its (possibly unfinished) path brackets the grid
+    // frequency; a curve whose grid solves cannot be set up is unsolved everywhere and failed.
+    let limits_on_grid: Vec<Vec<GridSolution>> = limits
+        .par_iter_mut()
+        .map(|c| match on_grid(problem, &c.case, &c.points, &grid) {
+            Ok(sols) => sols,
+            Err(error) => {
+                if c.status.is_complete() {
+                    c.status = CurveStatus::Failed { error };
+                }
+                vec![None; grid.len()]
+            }
+        })
+        .collect();
     let grid_points = classify(problem, &grid, &limits_on_grid);
 
-    let (bounds, scan_peaks) = if scanned_cases.is_empty() {
+    let (bounds, scanned) = if scanned_cases.is_empty() {
         (None, Vec::new())
     } else {
-        let scanned: Vec<_> = scanned_cases
+        let results: Vec<(ScannedCase, Vec<GridSolution>)> = scanned_cases
             .par_iter()
             .map(|c| {
-                let curve = solve(c)?;
-                let sols = on_grid(problem, c, &curve.run.points, &grid)?;
-                Ok((c.clone(), sols, curve.peak))
+                let mut curve = attempt(c);
+                let sols = match on_grid(problem, c, &curve.points, &grid) {
+                    Ok(sols) => sols,
+                    Err(error) => {
+                        if curve.status.is_complete() {
+                            curve.status = CurveStatus::Failed { error };
+                        }
+                        vec![None; grid.len()]
+                    }
+                };
+                let scanned = ScannedCase {
+                    case: curve.case,
+                    peak: curve.peak,
+                    retries: curve.retries,
+                    status: curve.status,
+                };
+                (scanned, sols)
             })
-            .collect::<Result<_, LimitError>>()?;
-        let limit_peaks: Vec<f64> = limits.iter().map(|c| c.peak.amplitude).collect();
-        let check = check_bounds(&grid_points, &limit_peaks, &scanned);
-        (
-            Some(check),
-            scanned.into_iter().map(|(c, _, p)| (c, p)).collect(),
-        )
+            .collect();
+        let limit_peaks: Vec<f64> = limits
+            .iter()
+            .filter_map(|c| c.peak.as_ref().map(|p| p.amplitude))
+            .collect();
+        let compared: Vec<(LimitCase, Vec<GridSolution>, Option<Peak>)> = results
+            .iter()
+            .map(|(s, sols)| (s.case.clone(), sols.clone(), s.peak.clone()))
+            .collect();
+        let check = check_bounds(&grid_points, &limit_peaks, &compared);
+        (Some(check), results.into_iter().map(|(s, _)| s).collect())
     };
     let per_curve: Vec<(Vec<LoopSet>, Vec<String>)> = limits
         .par_iter()
         .chain(intermediate.par_iter())
         .map(|c| curve_loops(problem, c, &settings.hysteresis))
-        .collect::<Result<_, _>>()?;
+        .collect();
     let (mut loops, mut loops_missing) = (Vec::new(), Vec::new());
     for (l, m) in per_curve {
         loops.extend(l);
@@ -198,7 +305,7 @@ where
         intermediate,
         grid: grid_points,
         bounds,
-        scan_peaks,
+        scanned,
         loops,
         loops_missing,
     })

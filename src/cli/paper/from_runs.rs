@@ -52,24 +52,37 @@ fn resonances(curve: &LinearCurve) -> Vec<f64> {
 }
 
 /// The row of one limit analysis of figure `figure` (at sweep point `at`, value `value`):
-/// limit peaks, their ratio and frequency change, band, states and bound check.
-fn analysis_row(figure: &str, at: String, value: Option<f64>, a: &LimitAnalysis) -> AnalysisRow {
+/// limit peaks, their ratio and frequency change, band, states and bound check. `None` unless
+/// every case of the analysis covered the range (an unfinished analysis has no numbers to
+/// compare with the paper; its cases are listed as failures).
+fn analysis_row(
+    figure: &str,
+    at: String,
+    value: Option<f64>,
+    a: &LimitAnalysis,
+) -> Option<AnalysisRow> {
+    if !a.is_complete() {
+        return None;
+    }
     let v = a.variability();
-    let (p, q) = (&a.limits[0], &a.limits[1]);
-    let (up, lo) = if p.peak.amplitude >= q.peak.amplitude {
-        (p, q)
+    let (p, q) = (a.limits[0].peak.as_ref()?, a.limits[1].peak.as_ref()?);
+    let (up, lo) = if p.amplitude >= q.amplitude {
+        ((&a.limits[0].case, p), (&a.limits[1].case, q))
     } else {
-        (q, p)
+        ((&a.limits[1].case, q), (&a.limits[0].case, p))
     };
-    let peak_states = a
-        .limits
+    let intermediate_peaks: Vec<(&str, &crate::analysis::limits::Peak)> = a
+        .intermediate
         .iter()
-        .map(|c| {
+        .filter_map(|c| Some((c.case.name.as_str(), c.peak.as_ref()?)))
+        .collect();
+    let peak_states = [(&a.limits[0].case, p), (&a.limits[1].case, q)]
+        .iter()
+        .map(|(case, peak)| {
             format!(
                 "{}: {}",
-                c.case.name,
-                c.peak
-                    .states
+                case.name,
+                peak.states
                     .iter()
                     .map(|s| s.label())
                     .collect::<Vec<_>>()
@@ -78,7 +91,7 @@ fn analysis_row(figure: &str, at: String, value: Option<f64>, a: &LimitAnalysis)
         })
         .collect();
     // A side stuck at every grid frequency in both limit curves (paper Fig. 14a).
-    let always_stuck_side = (0..a.limits[0].peak.states.len())
+    let always_stuck_side = (0..p.states.len())
         .find(|&contact| {
             !a.grid.is_empty()
                 && a.grid.iter().all(|g| {
@@ -90,14 +103,12 @@ fn analysis_row(figure: &str, at: String, value: Option<f64>, a: &LimitAnalysis)
         })
         .map(|c| format!("contact {}", c + 1));
     let (hi, low) = (v.upper_peak, v.lower_peak);
-    let intermediates_outside = a
-        .intermediate
+    let intermediates_outside = intermediate_peaks
         .iter()
-        .filter(|c| {
-            c.peak.amplitude > hi * (1.0 + PEAK_TOLERANCE)
-                || c.peak.amplitude < low * (1.0 - PEAK_TOLERANCE)
+        .filter(|(_, c)| {
+            c.amplitude > hi * (1.0 + PEAK_TOLERANCE) || c.amplitude < low * (1.0 - PEAK_TOLERANCE)
         })
-        .map(|c| format!("{} ({:.4e} m)", c.case.name, c.peak.amplitude))
+        .map(|(name, c)| format!("{name} ({:.4e} m)", c.amplitude))
         .collect();
     let bound = a.bounds.as_ref().map(|b| BoundRow {
         above_pct: 100.0 * b.max_excess_above,
@@ -107,11 +118,7 @@ fn analysis_row(figure: &str, at: String, value: Option<f64>, a: &LimitAnalysis)
         peak_above_pct: 100.0 * b.peak_excess_above,
         peak_below_pct: 100.0 * b.peak_excess_below,
         above_stuck_limit_vs_slipping: b.above_states.as_ref().is_some_and(|st| {
-            let upper = if a.limits[0].peak.amplitude >= a.limits[1].peak.amplitude {
-                0
-            } else {
-                1
-            };
+            let upper = if p.amplitude >= q.amplitude { 0 } else { 1 };
             st.limits.get(upper).is_some_and(|l| {
                 !l.is_empty() && l.iter().all(|&x| x == crate::contact::ContactState::Stuck)
             }) && st
@@ -120,22 +127,22 @@ fn analysis_row(figure: &str, at: String, value: Option<f64>, a: &LimitAnalysis)
                 .any(|&x| x != crate::contact::ContactState::Stuck)
         }),
     });
-    AnalysisRow {
+    Some(AnalysisRow {
         figure: figure.to_string(),
         at,
         value,
-        upper: (up.case.name.clone(), up.peak.amplitude, up.peak.freq_hz),
-        lower: (lo.case.name.clone(), lo.peak.amplitude, lo.peak.freq_hz),
+        upper: (up.0.name.clone(), up.1.amplitude, up.1.freq_hz),
+        lower: (lo.0.name.clone(), lo.1.amplitude, lo.1.freq_hz),
         ratio: v.peak_ratio,
         freq_change_pct: v.peak_freq_change_pct,
-        refined: p.peak.refined && q.peak.refined,
+        refined: p.refined && q.refined,
         widest_band: (v.widest_band, v.widest_band_hz),
         multiple_share: v.multiple_points as f64 / v.grid_points.max(1) as f64,
         peak_states,
         always_stuck_side,
         intermediates_outside,
         bound,
-    }
+    })
 }
 
 /// One row per sweep point: the peaks of every case, and the ratio and frequency change of
@@ -256,7 +263,7 @@ pub fn key_numbers(figures: &[FigureResult]) -> KeyNumbers {
                     }
                 }
                 k.analyses
-                    .push(analysis_row(f.job.id, String::new(), None, a));
+                    .extend(analysis_row(f.job.id, String::new(), None, a));
             }
             RunOutcome::Sweep(points) => {
                 let spec = sweep_spec(f.job);
@@ -282,11 +289,11 @@ pub fn key_numbers(figures: &[FigureResult]) -> KeyNumbers {
                     if let Some(a) = &p.analysis {
                         let at = at_label(&spec, p.value);
                         k.analyses
-                            .push(analysis_row(f.job.id, at, Some(p.value), a));
+                            .extend(analysis_row(f.job.id, at, Some(p.value), a));
                     }
                 }
             }
-            RunOutcome::Frf(_) | RunOutcome::LimitCurves(_) => {}
+            RunOutcome::Frf(_) => {}
         }
     }
     for row in &k.analyses {

@@ -60,11 +60,13 @@ pub fn paper(options: &PaperOptions) -> Result<PaperReport, CommandError> {
             },
             quiet: options.quiet,
         };
-        // A limit analysis stopped by a failed curve has no analysis to take numbers from: the
-        // figure failed (its finished curves are on disk).
+        // A limit analysis with a failed or incomplete case has no numbers to compare with the
+        // paper: the figure failed (what it finished is on disk).
         let outcome = run(&run_options).map_err(|e| e.to_string()).and_then(|r| {
             match (&r.outcome, &r.incomplete) {
-                (RunOutcome::LimitCurves(_), Some(reason)) => Err(format!("incomplete: {reason}")),
+                (RunOutcome::Limits(a), Some(reason)) if !a.is_complete() => {
+                    Err(format!("incomplete: {reason}"))
+                }
                 _ => Ok(r),
             }
         });
