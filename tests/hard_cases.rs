@@ -7,7 +7,8 @@
 //! linear response with all contacts stuck (closed form, `analysis::linear`), whatever the
 //! frame angles, gap, harmonics or pre-load.
 
-use fricbound::analysis::frf::{self, FrfRun, Silent};
+use fricbound::analysis::frf::{self, FrfPoint, FrfRun, Silent};
+use fricbound::analysis::limits;
 use fricbound::analysis::linear::{self, LinearCase};
 use fricbound::analysis::peaks;
 use fricbound::contact::ContactState;
@@ -27,13 +28,19 @@ fn problem(overrides: &[&str]) -> Problem {
 fn solve_complete(p: &Problem, label: &str) -> FrfRun {
     let run = frf::solve(p, &mut Silent).unwrap_or_else(|e| panic!("{label}: {e}"));
     assert!(run.is_complete(), "{label}: {:?}", run.incomplete_reason());
+    check_points(p, &run.points, label);
+    run
+}
+
+/// The checks of [`solve_complete`] on the points of a path that reached the end frequency.
+fn check_points(p: &Problem, points: &[FrfPoint], label: &str) {
     let range = &p.analysis.continuation;
     assert_eq!(
-        run.points.last().map(|q| q.freq_hz),
+        points.last().map(|q| q.freq_hz),
         Some(range.freq_end_hz),
         "{label}: the last point is not at the end frequency"
     );
-    for q in &run.points {
+    for q in points {
         assert!(
             q.residual <= range.residual_tolerance,
             "{label}: point at {} Hz not converged ({:e})",
@@ -53,8 +60,7 @@ fn solve_complete(p: &Problem, label: &str) -> FrfRun {
             );
         }
     }
-    let stuck: Vec<_> = run
-        .points
+    let stuck: Vec<_> = points
         .iter()
         .filter(|q| q.states.iter().all(|s| *s == ContactState::Stuck))
         .collect();
@@ -71,7 +77,6 @@ fn solve_complete(p: &Problem, label: &str) -> FrfRun {
             lin[d]
         );
     }
-    run
 }
 
 /// The resonance peaks of the stuck linear reference of output 0 over the range: local maxima
@@ -213,4 +218,150 @@ fn many_harmonics_cover_the_range() {
 fn grazing_contacts_cover_the_range() {
     let p = problem(&["contacts.0.gap=1e-6", "contacts.1.gap=1e-6"]);
     solve_complete(&p, "gap = 1 µm");
+}
+
+/// The resonance frequencies of the linear reference `case` of output 0 (local maxima of a
+/// 0.25 Hz grid over the range).
+fn linear_resonances(p: &Problem, case: LinearCase) -> Vec<f64> {
+    let d = p.outputs[0];
+    let range = &p.analysis.continuation;
+    let grid: Vec<f64> = (0..=((range.freq_end_hz - range.freq_start_hz) / 0.25) as usize)
+        .map(|i| range.freq_start_hz + 0.25 * i as f64)
+        .collect();
+    let a: Vec<f64> = linear::frf(p, case, &grid)
+        .expect("linear response")
+        .iter()
+        .map(|row| row[d])
+        .collect();
+    (1..a.len() - 1)
+        .filter(|&i| a[i] > a[i - 1] && a[i] >= a[i + 1])
+        .map(|i| grid[i])
+        .collect()
+}
+
+/// F0 = 1 N and 5 N against a 20 N excitation: the damper is barely held, bounces and slips,
+/// and the path folds back (at about 66 and 80 Hz) through corners of the sampled contact law.
+/// A user sees the whole range covered (the run follows the folds and, where the path does
+/// not come back, goes on from the branch past the fold, filling it back toward the fold).
+/// At 1 N the damper hardly holds the blades: every resonance of the open-contact linear
+/// system has an FRF peak within 1 % of its frequency.
+#[test]
+fn low_preloads_cover_the_range() {
+    for f0 in [1.0, 5.0] {
+        let label = format!("F0 = {f0} N");
+        let p = problem(&[&format!("static_loads.0.value={}", -f0)]);
+        let run = solve_complete(&p, &label);
+        if f0 > 1.0 {
+            continue;
+        }
+        let found = &peaks::path_peaks(&p, &run.points).expect("peaks")[0];
+        let open = linear_resonances(&p, LinearCase::Open);
+        assert!(!open.is_empty());
+        for fo in open {
+            let off = found
+                .iter()
+                .map(|k| (k.freq_hz - fo).abs() / fo)
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                off < 0.01,
+                "{label}: no FRF peak within 1 % of the open-contact resonance at {fo} Hz \
+                 (peaks {:?})",
+                found.iter().map(|k| k.freq_hz).collect::<Vec<_>>()
+            );
+        }
+    }
+}
+
+/// μ = 5: the friction limit is ten times the paper's, the contacts hardly slip; a user sees
+/// the whole range, with the response on the stuck linear one wherever the contacts stay stuck.
+#[test]
+fn high_friction_covers_the_range() {
+    let p = problem(&["contacts.0.mu=5", "contacts.1.mu=5"]);
+    solve_complete(&p, "μ = 5");
+}
+
+/// No blade damping (C = 0; the damper has none either): only friction dissipates, so the
+/// resonances are held by slip alone. A user sees the whole range, every point converged.
+#[test]
+fn no_structural_damping_covers_the_range() {
+    let p = problem(&[
+        "model.damping.0.0=0",
+        "model.damping.1.1=0",
+        "model.damping.2.2=0",
+        "model.damping.3.3=0",
+    ]);
+    solve_complete(&p, "C = 0");
+}
+
+/// A start exactly on resonances of the stuck structure (224.94, 399.93 Hz and the nearly
+/// undamped damper mode at 555.07 Hz, where the stuck linear guess is near-singular), and a
+/// range across that damper mode (50-600 Hz): each run starts and covers its range.
+#[test]
+fn starts_on_resonances_and_ranges_across_the_damper_mode_cover_the_range() {
+    for (start, end) in [
+        (224.94, 350.0),
+        (399.93, 450.0),
+        (555.07, 600.0),
+        (50.0, 600.0),
+    ] {
+        let p = problem(&[
+            &format!("analysis.freq_start_hz={start}"),
+            &format!("analysis.freq_end_hz={end}"),
+        ]);
+        solve_complete(&p, &format!("{start}-{end} Hz"));
+    }
+}
+
+/// A limit scene solved as `fricbound run` would: every curve (m = ±1 per side and the
+/// intermediate ones) must cover the range with the checks of [`check_points`], and the band
+/// they form must exist over the whole grid with its upper edge above its lower one.
+fn limits_complete(path: &str, overrides: &[&str], label: &str) {
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let file = format!("{}/{path}", env!("CARGO_MANIFEST_DIR"));
+    let (p, settings) = scene::load(std::path::Path::new(&file), &overrides)
+        .and_then(|s| s.validate_with_limits(&file))
+        .unwrap_or_else(|e| panic!("{label}: {e}"));
+    let settings = settings.expect("a limit scene");
+    let analysis = limits::analyse(&p, &settings, |_| {}).unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        analysis.is_complete(),
+        "{label}: not every curve is complete"
+    );
+    for curve in analysis.limits.iter().chain(&analysis.intermediate) {
+        let q = curve.case.apply(&p);
+        check_points(&q, &curve.points, &format!("{label}, {}", curve.case.name));
+    }
+    for g in &analysis.grid {
+        assert!(
+            g.upper.is_finite() && g.lower.is_finite() && g.upper >= g.lower,
+            "{label}: band at {} Hz: {} .. {}",
+            g.freq_hz,
+            g.lower,
+            g.upper
+        );
+    }
+}
+
+/// The paper's Fig. 13 limit scene (3rd resonance, β = 120°) at F0 = 5 N instead of 120 N: the
+/// damper is barely held and slips or lifts off over most of the range. A user sees both limit
+/// curves and the intermediate ones cover 200-235 Hz and a band over the whole grid.
+#[test]
+fn limit_scene_at_a_low_preload_covers_the_range() {
+    limits_complete(
+        "meshes/paper-wedge/fig13-3rd.toml",
+        &["static_loads.0.value=-5"],
+        "Fig. 13, F0 = 5 N",
+    );
+}
+
+/// The 2D FE blade pair (Craig-Bampton, a patch of contact pairs per damper side) with a
+/// tenth of its pre-load (5 N instead of 50 N): pairs open and close along the patches, and a
+/// user sees both limit curves and the intermediate one cover 700-1100 Hz.
+#[test]
+fn fe_blade_pair_limits_at_a_low_preload_cover_the_range() {
+    limits_complete(
+        "meshes/blade-pair/blade-pair-2d-limits.toml",
+        &["static_loads.0.value=5"],
+        "FE blade pair, 5 N",
+    );
 }

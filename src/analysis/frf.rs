@@ -10,10 +10,12 @@ use crate::contact::ContactState;
 use crate::hbm::operator::HbmOperator;
 use crate::hbm::{HbmError, HbmSystem};
 use crate::model::Problem;
+use crate::numerics::continuation::AdaptiveScale;
 use crate::numerics::linalg::LinearSolveError;
+use crate::numerics::path::NoObserver;
 use crate::numerics::{
-    Continuation, ContinuationError, NewtonFailure, Observer, ParametricResidual, PathEnd,
-    PathPoint,
+    Continuation, ContinuationError, ContinuationSettings, NewtonFailure, Observer,
+    ParametricResidual, PathEnd, PathPoint,
 };
 
 /// One converged point of a nonlinear frequency response.
@@ -35,6 +37,26 @@ pub struct FrfPoint {
     pub coefficients: Vec<f64>,
 }
 
+/// A jump of an FRF run to another branch past a fold the path did not come back from.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Jump {
+    /// Highest frequency the path reached before the jump (Hz).
+    pub from_hz: f64,
+    /// Lowest frequency of the new branch's points (Hz): the branch was followed back down
+    /// toward `from_hz` as far as it goes. Frequencies between the two were not computed on
+    /// any branch (none when they are equal).
+    pub to_hz: f64,
+    /// Index of the new branch's first point in the run's points.
+    pub first_point: usize,
+}
+
+impl Jump {
+    /// Width of the stretch not computed on any branch (Hz).
+    pub fn uncovered_hz(&self) -> f64 {
+        (self.to_hz - self.from_hz).max(0.0)
+    }
+}
+
 /// Receives the events of an FRF run.
 pub trait FrfObserver {
     /// A point converged.
@@ -45,6 +67,9 @@ pub trait FrfObserver {
     fn turning_point(&mut self, _freq_hz: f64) {}
     /// The path could not be followed from `from_hz` and was resumed at `to_hz` (Hz).
     fn leap(&mut self, _from_hz: f64, _to_hz: f64) {}
+    /// The path turned back at a fold and did not return; it goes on on another branch, whose
+    /// points come next (see [`Jump`]).
+    fn jump(&mut self, _jump: &Jump) {}
 }
 
 /// Observer that ignores everything.
@@ -62,6 +87,8 @@ pub struct FrfRun {
     pub rejected_steps: usize,
     /// Stretches leapt over: (last point before, first point after), Hz.
     pub leaps: Vec<(f64, f64)>,
+    /// Jumps to another branch after a fold the path did not come back from.
+    pub jumps: Vec<Jump>,
     /// Why the run ended.
     pub end: PathEnd,
     /// Wall time of the run (s).
@@ -69,6 +96,11 @@ pub struct FrfRun {
 }
 
 impl FrfRun {
+    /// Indices of the points where a branch reached by a jump starts.
+    pub fn branch_starts(&self) -> Vec<usize> {
+        self.jumps.iter().map(|j| j.first_point).collect()
+    }
+
     /// Whether the path reached the end frequency: only then does the run cover the range.
     pub fn is_complete(&self) -> bool {
         self.end == PathEnd::EndFrequency
@@ -93,6 +125,10 @@ impl FrfRun {
                 "the point budget (analysis.max_points = {}) was used up at {last:.4} Hz; \
                  frequencies above {highest:.4} Hz were never reached",
                 self.points.len()
+            )),
+            PathEnd::NoProgress => Some(format!(
+                "the path wandered back and forth below {highest:.4} Hz without getting \
+                 higher (last point at {last:.4} Hz); frequencies above were never reached"
             )),
         }
     }
@@ -245,6 +281,58 @@ fn arc_length_x_scale(
     Ok(system.restrict(&full))
 }
 
+/// The groups of [`arc_length_x_scale`] (static block, dynamic blocks) as an adaptive scale:
+/// each grows with its block's norm along the path, at the same climb (a quarter of the range).
+fn adaptive_scale(problem: &Problem, set: &HarmonicSet, system: &HbmOperator<'_>) -> AdaptiveScale {
+    let a = &problem.analysis.continuation;
+    let n = problem.model.n_dofs();
+    let full: Vec<f64> = set
+        .blocks()
+        .iter()
+        .flat_map(|b| {
+            let g = if *b == Block::Constant { 0.0 } else { 1.0 };
+            std::iter::repeat_n(g, n)
+        })
+        .collect();
+    AdaptiveScale {
+        group_of: system.restrict(&full).iter().map(|&g| g as usize).collect(),
+        climb: 0.25 * (a.freq_end_hz - a.freq_start_hz),
+    }
+}
+
+/// For each output DOF, the indices of its first-harmonic cosine and sine among the operator's
+/// unknowns (outputs the operator does not carry are left out), for the step length to follow
+/// the output amplitudes ([`Continuation::with_amplitude_steps`]).
+fn output_amplitude_groups(
+    problem: &Problem,
+    set: &HarmonicSet,
+    system: &HbmOperator<'_>,
+) -> Vec<Vec<usize>> {
+    let n = problem.model.n_dofs();
+    let blocks: Vec<usize> = [set.cos_block(1), set.sin_block(1)]
+        .into_iter()
+        .flatten()
+        .collect();
+    problem
+        .outputs
+        .iter()
+        .filter_map(|&d| {
+            let mut marker = vec![0.0; n * set.n_blocks()];
+            for &j in &blocks {
+                marker[j * n + d] = 1.0;
+            }
+            let group: Vec<usize> = system
+                .restrict(&marker)
+                .iter()
+                .enumerate()
+                .filter(|(_, &v)| v == 1.0)
+                .map(|(i, _)| i)
+                .collect();
+            (!group.is_empty()).then_some(group)
+        })
+        .collect()
+}
+
 struct Adapter<'o, O: FrfObserver> {
     observer: &'o mut O,
     points: Vec<FrfPoint>,
@@ -303,34 +391,236 @@ impl<O: FrfObserver> Observer<HbmOperator<'_>> for Adapter<'_, O> {
     }
 }
 
+/// Point budget of the fill of a branch back toward the fold (see [`solve`]).
+const FILL_POINTS: usize = 500;
+/// Most jumps to another branch in one run (see [`solve`]).
+const MAX_JUMPS: usize = 8;
+/// How far past the highest frequency a path reached a jump lands, as fractions of the range,
+/// tried in turn until a point converges there.
+const JUMP_FRACTIONS: &[f64] = &[0.0005, 0.002, 0.005, 0.01, 0.02, 0.03, 0.05, 0.1, 0.2];
+
 /// Solves the nonlinear frequency response of a problem over its analysis range.
+///
+/// The path is followed from the start frequency. A path that turns back at a fold and does not
+/// come back toward the end (it leaves the range below the start, or wanders without reaching
+/// a higher frequency) is not the whole answer: as in a stepped-sine test sweeping
+/// up, the response then jumps to another branch. The run solves a point just past the highest
+/// frequency reached (see [`jump_target`]) and
+/// follows the path on from it, up to [`MAX_JUMPS`] times. The new branch is first followed
+/// back down toward the highest frequency reached, to fill the gap (those points come first,
+/// in rising frequency). Each jump is reported ([`FrfRun::jumps`], [`FrfObserver::jump`]) with
+/// the frequencies its ends reached: the stretch between them was not computed on any branch
+/// (empty when the fill got back to the highest frequency).
 pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfRun, FrfError> {
     let started = Instant::now();
     let mut system = HbmOperator::new(problem)?;
     let set = system.unknowns().clone();
-    let omega0 = 2.0 * PI * problem.analysis.continuation.freq_start_hz;
-    let guess = system.restrict(&linear::stuck_guess(problem, &set, omega0)?);
-    let continuation = Continuation::new(
-        problem.analysis.continuation,
-        arc_length_x_scale(problem, &set, &system)?,
-    );
+    let settings = problem.analysis.continuation;
+    let omega0 = 2.0 * PI * settings.freq_start_hz;
+    let mut x_scale = arc_length_x_scale(problem, &set, &system)?;
+    let mut guess = start_guess(problem, &set, &mut system, &x_scale, omega0)?;
     let mut adapter = Adapter {
         observer,
         points: Vec::new(),
         failure: None,
     };
-    let summary = continuation.run(&mut system, &guess, &mut adapter)?;
-    if let Some(e) = adapter.failure {
-        return Err(FrfError::Setup(e));
+    let mut run = FrfRun {
+        points: Vec::new(),
+        turning_points: Vec::new(),
+        rejected_steps: 0,
+        leaps: Vec::new(),
+        jumps: Vec::new(),
+        end: PathEnd::MaxPoints,
+        elapsed_s: 0.0,
+    };
+    let mut start_hz = settings.freq_start_hz;
+    loop {
+        let segment = ContinuationSettings {
+            freq_start_hz: start_hz,
+            max_points: settings.max_points.saturating_sub(adapter.points.len()),
+            ..settings
+        };
+        let mut continuation = Continuation::new(segment, x_scale.clone())
+            .with_adaptive_scale(adaptive_scale(problem, &set, &system))
+            .with_amplitude_steps(output_amplitude_groups(problem, &set, &system));
+        let outcome = continuation.run(&mut system, &guess, &mut adapter);
+        // The next branch starts with the scale this one grew to.
+        x_scale.clone_from(&continuation.x_scale);
+        if let Some(e) = adapter.failure.take() {
+            return Err(FrfError::Setup(e));
+        }
+        match outcome {
+            Ok(summary) => {
+                run.turning_points.extend(summary.turning_points);
+                run.rejected_steps += summary.rejected_steps;
+                run.leaps.extend(summary.leaps);
+                run.end = summary.end;
+            }
+            // A stall is not a fold: the path goes on past it, but could not be followed.
+            Err(e) => return Err(e.into()),
+        }
+        let turned_back = matches!(run.end, PathEnd::LeftRangeBelow | PathEnd::NoProgress);
+        let budget = settings.max_points.saturating_sub(adapter.points.len());
+        if !turned_back || run.jumps.len() >= MAX_JUMPS || budget < 2 {
+            break;
+        }
+        let highest = adapter
+            .points
+            .iter()
+            .map(|p| p.freq_hz)
+            .fold(f64::NEG_INFINITY, f64::max);
+        match jump_target(
+            problem,
+            &set,
+            &mut system,
+            &continuation,
+            &adapter.points,
+            highest,
+        )? {
+            Some((freq_hz, x)) => {
+                // Fill the gap on the new branch, back down toward the highest frequency
+                // reached, and report those points first (in rising frequency) so that the
+                // path reads on from the jump.
+                let budget = settings.max_points.saturating_sub(adapter.points.len());
+                let fill = ContinuationSettings {
+                    freq_start_hz: freq_hz,
+                    freq_end_hz: highest,
+                    max_points: (budget / 2).min(FILL_POINTS),
+                    ..settings
+                };
+                let mut back = Adapter {
+                    observer: &mut Silent,
+                    points: Vec::new(),
+                    failure: None,
+                };
+                let mut filler = Continuation::new(fill, x_scale.clone())
+                    .with_adaptive_scale(adaptive_scale(problem, &set, &system));
+                let filled = filler.run(&mut system, &x, &mut back);
+                if let Ok(summary) = &filled {
+                    run.turning_points.extend(&summary.turning_points);
+                    run.rejected_steps += summary.rejected_steps;
+                }
+                // The filled stretch runs from the start of the new branch down to the
+                // lowest frequency it reached; the first point (at the jump target) is solved
+                // again by the branch's own run.
+                let reached = back
+                    .points
+                    .iter()
+                    .map(|p| p.freq_hz)
+                    .fold(freq_hz, f64::min);
+                let jump = Jump {
+                    from_hz: highest,
+                    to_hz: reached,
+                    first_point: adapter.points.len(),
+                };
+                adapter.observer.jump(&jump);
+                run.jumps.push(jump);
+                for p in back.points.iter().skip(1).rev() {
+                    adapter.observer.point(p);
+                    adapter.points.push(p.clone());
+                }
+                start_hz = freq_hz;
+                guess = x;
+            }
+            None => break,
+        }
     }
-    Ok(FrfRun {
-        points: adapter.points,
-        turning_points: summary.turning_points,
-        rejected_steps: summary.rejected_steps,
-        leaps: summary.leaps,
-        end: summary.end,
-        elapsed_s: started.elapsed().as_secs_f64(),
-    })
+    run.points = adapter.points;
+    run.elapsed_s = started.elapsed().as_secs_f64();
+    Ok(run)
+}
+
+/// The starting guess at ω0 (rad/s): the stuck linear solution, or where Newton does not
+/// converge from it (a low pre-load: the contacts open for most of the period) the solution
+/// converged from the open-contact guess ([`linear::open_guess`]), else the end of a short
+/// continuation onto ω0 from a point solved a little off it ([`START_OFFSETS`]). When none converges the
+/// stuck guess is returned and the run reports its failure at the start.
+fn start_guess(
+    problem: &Problem,
+    set: &HarmonicSet,
+    system: &mut HbmOperator<'_>,
+    x_scale: &[f64],
+    omega0: f64,
+) -> Result<Vec<f64>, FrfError> {
+    let stuck = system.restrict(&linear::stuck_guess(problem, set, omega0)?);
+    let newton = Continuation::new(problem.analysis.continuation, x_scale.to_vec());
+    if newton.solve_fixed(system, &stuck, omega0).is_ok() {
+        return Ok(stuck);
+    }
+    let open = system.restrict(&linear::open_guess(problem, set, omega0)?);
+    if let Ok(p) = newton.solve_fixed(system, &open, omega0) {
+        return Ok(p.x);
+    }
+    // On (or next to) a resonance of the stuck structure the stuck guess is near-singular:
+    // start a little off it, where the guess is sound, and follow the path onto ω0 (from
+    // below, then from above).
+    for offset in START_OFFSETS {
+        for sign in [-1.0, 1.0] {
+            let f0 = omega0 / (2.0 * PI);
+            let from_hz = f0 * (1.0 + sign * offset);
+            let near = system.restrict(&linear::stuck_guess(problem, set, 2.0 * PI * from_hz)?);
+            let settings = ContinuationSettings {
+                freq_start_hz: from_hz,
+                freq_end_hz: f0,
+                max_points: START_APPROACH_POINTS,
+                ..problem.analysis.continuation
+            };
+            let mut approach = Continuation::new(settings, x_scale.to_vec());
+            if let Ok(summary) = approach.run(system, &near, &mut NoObserver) {
+                if summary.end == PathEnd::EndFrequency {
+                    if let Some(p) = summary.points.last() {
+                        return Ok(p.x.clone());
+                    }
+                }
+            }
+        }
+    }
+    Ok(stuck)
+}
+
+/// Relative frequency offsets at which a start on a resonance of the stuck structure is first
+/// solved (see [`start_guess`]).
+const START_OFFSETS: &[f64] = &[1e-2, 5e-2];
+/// Point budget of the approach onto the start frequency (see [`start_guess`]).
+const START_APPROACH_POINTS: usize = 200;
+
+/// A converged point just past `highest` (Hz) on whatever branch Newton finds there, for the
+/// path to go on from after a fold it did not come back from: at each of [`JUMP_FRACTIONS`] of
+/// the range past `highest` (capped at the end frequency), from the stuck linear guess there,
+/// the open-contact one (harmonics of the open structure on the stuck static state), then from
+/// the highest point solved so far. Returns the frequency and the operator's
+/// unknowns, or None when no guess converges.
+fn jump_target(
+    problem: &Problem,
+    set: &HarmonicSet,
+    system: &mut HbmOperator<'_>,
+    continuation: &Continuation,
+    points: &[FrfPoint],
+    highest: f64,
+) -> Result<Option<(f64, Vec<f64>)>, FrfError> {
+    let settings = &problem.analysis.continuation;
+    let range = settings.freq_end_hz - settings.freq_start_hz;
+    let top = points.iter().find(|p| p.freq_hz == highest);
+    for fraction in JUMP_FRACTIONS {
+        let freq_hz = (highest + fraction * range).min(settings.freq_end_hz);
+        if freq_hz <= highest {
+            return Ok(None);
+        }
+        let omega = 2.0 * PI * freq_hz;
+        let mut guesses = vec![
+            system.restrict(&linear::stuck_guess(problem, set, omega)?),
+            system.restrict(&linear::open_guess(problem, set, omega)?),
+        ];
+        if let Some(p) = top {
+            guesses.push(system.restrict(&p.coefficients));
+        }
+        for g in guesses {
+            if let Ok(p) = continuation.solve_fixed(system, &g, omega) {
+                return Ok(Some((freq_hz, p.x)));
+            }
+        }
+    }
+    Ok(None)
 }
 
 /// Solves single points of a problem at fixed frequencies (Newton from a given guess), reusing

@@ -224,10 +224,32 @@ pub fn stuck_guess(
     set: &crate::contact::harmonic::HarmonicSet,
     omega: f64,
 ) -> Result<Vec<f64>, LinearSolveError> {
+    linear_guess(problem, set, omega, LinearCase::Stuck)
+}
+
+/// A guess for a nonlinear solve where the contacts carry little (a low pre-load, a damper that
+/// bounces): the static block of [`stuck_guess`] (the pre-load pressing the contacts) with the
+/// harmonics of the open-contact linear response, zero on the DOFs open contacts leave without
+/// load (a free damper).
+pub fn open_guess(
+    problem: &Problem,
+    set: &crate::contact::harmonic::HarmonicSet,
+    omega: f64,
+) -> Result<Vec<f64>, LinearSolveError> {
+    linear_guess(problem, set, omega, LinearCase::Open)
+}
+
+/// The linear guess with the stuck static block and the harmonics of `dynamic` contacts.
+fn linear_guess(
+    problem: &Problem,
+    set: &crate::contact::harmonic::HarmonicSet,
+    omega: f64,
+    dynamic: LinearCase,
+) -> Result<Vec<f64>, LinearSolveError> {
     let n = problem.model.n_dofs();
     let k = case_stiffness(problem, LinearCase::Stuck);
     let mut x = vec![0.0; n * set.n_blocks()];
-    let all: Vec<usize> = (0..n).collect();
+    let k_dynamic = case_stiffness(problem, dynamic);
     for &h in set.harmonics() {
         if h == 0 {
             let mut rhs = problem.static_load.clone();
@@ -241,7 +263,11 @@ pub fn stuck_guess(
             x[j * n..(j + 1) * n].copy_from_slice(&q0);
         } else if problem.harmonic_loads.iter().any(|l| l.harmonic == h) {
             // Harmonics without a load have a zero linear response (x stays zero).
-            let (qc, qs) = harmonic_response(problem, &k, &all, h, omega)?;
+            let dofs: Vec<usize> = match dynamic {
+                LinearCase::Stuck => (0..n).collect(),
+                LinearCase::Open => connected_to_loads(problem, &k_dynamic, h),
+            };
+            let (qc, qs) = harmonic_response(problem, &k_dynamic, &dofs, h, omega)?;
             for (j, b) in set.blocks().iter().enumerate() {
                 match *b {
                     Block::Cos(hh) if hh == h => x[j * n..(j + 1) * n].copy_from_slice(&qc),

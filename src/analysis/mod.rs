@@ -23,6 +23,9 @@
 //!   [`linear::LinearCurve`]; [`linear::stuck_guess`] seeds the nonlinear solve.
 //! - [`peaks::path_peaks`]: every resonance peak of every output along a path, told from the
 //!   sampled law's wiggles by its prominence and refined along the path ([`peaks::Peak`]).
+//! - [`peaks::path_extrema`]: the same for resonances and anti-resonances (local minima) of
+//!   every output of an FRF run, with the path points they were refined from
+//!   ([`peaks::PathExtremum`]); a failed refinement reports the path point, never an error.
 //! - [`limits::analyse`]: the limit analysis (limit, intermediate and scanned curves, grid
 //!   classification, bound check, hysteresis loops) as a [`limits::LimitAnalysis`].
 //! - [`limits::solve_case`]: one case's curve and its refined resonance peak.

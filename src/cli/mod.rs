@@ -29,9 +29,10 @@ use std::path::{Path, PathBuf};
 use indicatif::{ProgressBar, ProgressStyle};
 use sha2::{Digest, Sha256};
 
-use crate::analysis::frf::{self, FrfError, FrfObserver, FrfPoint};
+use crate::analysis::frf::{self, FrfError, FrfObserver, FrfPoint, Jump};
 use crate::analysis::limits::LimitSettings;
 use crate::analysis::linear::{self, LinearCase};
+use crate::analysis::peaks::{self, ExtremumKind};
 use crate::contact::harmonic::Block;
 use crate::model::Problem;
 use crate::numerics::NewtonFailure;
@@ -174,10 +175,6 @@ pub enum RunOutcome {
     Frf(Box<frf::FrfRun>),
     /// A limit analysis.
     Limits(Box<crate::analysis::limits::LimitAnalysis>),
-    /// A limit analysis stopped by a curve that failed: the limit and intermediate curves
-    /// finished before, in the analysis' case order (the run is incomplete, see
-    /// [`RunReport::incomplete`]).
-    LimitCurves(Vec<crate::analysis::limits::CaseCurve>),
     /// A parameter sweep, points in [`crate::study::sweep::sweep_points`] order.
     Sweep(Vec<crate::study::sweep::SweepPoint>),
 }
@@ -323,6 +320,27 @@ impl FrfObserver for RunObserver<'_> {
     }
     fn turning_point(&mut self, freq_hz: f64) {
         self.writer.turning_point(freq_hz);
+    }
+    fn jump(&mut self, jump: &Jump) {
+        self.writer.jump(jump);
+        // Always said, quiet or not: the curve holds two branches from here on.
+        let uncovered = if jump.uncovered_hz() > 0.0 {
+            format!(
+                "; {:.4}-{:.4} Hz not computed on any branch",
+                jump.from_hz, jump.to_hz
+            )
+        } else {
+            String::new()
+        };
+        let msg = format!(
+            "the path turned back at a fold below {:.4} Hz and did not return: it goes on on \
+             the branch found past it, followed back down to {:.4} Hz{uncovered}",
+            jump.from_hz, jump.to_hz
+        );
+        match &self.bar {
+            Some(bar) if !bar.is_hidden() => bar.println(msg),
+            _ => eprintln!("{msg}"),
+        }
     }
     fn leap(&mut self, from_hz: f64, to_hz: f64) {
         self.writer.leap(from_hz, to_hz);
@@ -608,6 +626,15 @@ fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
     if let Some(bar) = &observer.bar {
         bar.finish_and_clear();
     }
+    // The refined resonances and anti-resonances of what was computed, complete or not (a
+    // failed refinement reports the path point, never fails the run), within each branch of
+    // the path (the branch starts of a failed run are not known: one branch).
+    let branch_starts = result
+        .as_ref()
+        .map(frf::FrfRun::branch_starts)
+        .unwrap_or_default();
+    let extrema = peaks::path_extrema(problem, observer.writer.points(), &branch_starts);
+    observer.writer.write_peaks(&extrema)?;
     let run = match result {
         Ok(run) => run,
         Err(source) => {
@@ -640,6 +667,7 @@ fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
             output_name: name,
             contact_names: &contact_names,
             points: &run.points,
+            branch_starts: &branch_starts,
             open: &ctx.open,
             stuck: &ctx.stuck,
         };
@@ -669,13 +697,23 @@ fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
             .collect::<Vec<_>>()
             .join(", ")
     };
+    let count = |kind: ExtremumKind| extrema.iter().filter(|e| e.kind == kind).count();
+    let unrefined = extrema.iter().filter(|e| !e.peak.refined).count();
+    let unrefined = if unrefined > 0 {
+        format!(" ({unrefined} could not be refined: path values)")
+    } else {
+        String::new()
+    };
     Ok(RunReport {
         dir: dir.clone(),
         summary: format!(
-            "{} converged points in {:.3} s ({} step cuts); turning points: {turning}",
+            "{} converged points in {:.3} s ({} step cuts); turning points: {turning}\n\
+             {} resonance peaks and {} anti-resonances refined{unrefined}",
             run.points.len(),
             run.elapsed_s,
-            run.rejected_steps
+            run.rejected_steps,
+            count(ExtremumKind::Resonance),
+            count(ExtremumKind::AntiResonance),
         ),
         incomplete,
         outcome: RunOutcome::Frf(Box::new(run)),

@@ -14,7 +14,9 @@
 //! corrector (iteration limit, divergence, singular Jacobian, failed AFT) is not a result: the
 //! step is cut and the reason reported to the observer; below the minimum step the run ends
 //! with [`ContinuationError::Stalled`]. Turning points (sign changes of dω/ds) are reported and
-//! traversed. The last point is solved at exactly the end frequency.
+//! traversed. The last point is solved at exactly the end frequency. A path runs down in
+//! frequency when the end frequency is below the start (e.g. to fill in, back toward a fold, a
+//! branch found past it).
 //!
 //! On large problems (at least [`ContinuationSettings::chord_min_unknowns`] unknowns) the corrector takes
 //! chord iterations: the bordered Newton matrix factorised at one iterate is reused for the
@@ -83,6 +85,26 @@ pub struct Continuation {
     /// Chord corrector only: the last factorisation made, and the points since it was made,
     /// for the next corrector to start from (storages whose border is eliminated by blocks).
     carried: std::cell::RefCell<Option<(BorderedFactor, usize)>>,
+    /// How the scale follows the response along the path, if it does.
+    adaptive: Option<AdaptiveScale>,
+    /// Groups of unknowns whose norm (an output's amplitude) the step length watches.
+    amplitudes: Vec<Vec<usize>>,
+}
+
+/// Groups of unknowns whose arc-length scale grows with the response along the path.
+///
+/// A scale fixed from a first estimate of the response (e.g. the stuck linear one) becomes far
+/// too small where the nonlinear response is much larger (a damper bouncing at a low
+/// pre-load): the arc length is then spent on the change of x and the path crawls in
+/// frequency, thousands of steps for a few hertz. With groups, after each accepted point the
+/// scale of group g becomes ‖x_g‖ / `climb` wherever that is more than twice the current one
+/// (scales only grow, so the path's resolution where the response is small is kept).
+#[derive(Debug, Clone, PartialEq)]
+pub struct AdaptiveScale {
+    /// The group of each unknown (0-based).
+    pub group_of: Vec<usize>,
+    /// Arc length (Hz-equivalent) over which the response climbs from zero to its norm.
+    pub climb: f64,
 }
 
 const OMEGA_SCALE: f64 = 2.0 * PI;
@@ -96,6 +118,22 @@ const CHORD_STEPS_PER_ITERATION: usize = 3;
 const CHORD_CONTRACTION: f64 = 0.5;
 /// Continuation points a factorisation may be carried over to (see [`Continuation::correct`]).
 const CARRY_POINTS: usize = 8;
+/// Change of ln(amplitude) of a watched output per step the step length aims at (see
+/// [`Continuation::with_amplitude_steps`]): about 10 %.
+const TARGET_LOG_AMPLITUDE_CHANGE: f64 = 0.1;
+/// Steps tried to turn a sharp corner of the path, as multiples of the minimum step (see
+/// [`Continuation::corner`]).
+const CORNER_STEPS: &[f64] = &[4.0, 64.0, 1024.0];
+/// Fewest points a path may take without progress before it is given up (see
+/// [`Continuation::stagnation_points`]).
+const MIN_STAGNATION_POINTS: usize = 200;
+/// A point found past a corner whose chord from the corner makes a cosine above this with the
+/// reversed incoming tangent, and whose tangent makes a cosine above
+/// [`CORNER_SAME_PIECE_COSINE`] with the incoming one, lies back on the incoming piece of the
+/// path and is rejected.
+const CORNER_BACKWARD_COSINE: f64 = 0.95;
+/// See [`CORNER_BACKWARD_COSINE`] (cos 0.5°).
+const CORNER_SAME_PIECE_COSINE: f64 = 0.999_96;
 /// Largest turn of the tangent in one step before the step is cut (unless it is a corner).
 const MAX_TURN_DEGREES: f64 = 45.0;
 /// Turn of the tangent per step the step length aims at: a step that turned the tangent by
@@ -111,7 +149,74 @@ impl Continuation {
             x_scale,
             last_factor: std::cell::RefCell::new(None),
             carried: std::cell::RefCell::new(None),
+            adaptive: None,
+            amplitudes: Vec::new(),
         }
+    }
+
+    /// This driver with steps that also follow the amplitudes ‖x_g‖ of these groups of
+    /// unknowns (e.g. the first-harmonic cosine and sine of each output DOF): a step over which
+    /// one changed by more than [`TARGET_LOG_AMPLITUDE_CHANGE`] in ln is followed by a shorter
+    /// one. Near an anti-resonance an output's coefficients are small and add almost nothing
+    /// to the arc length, so without this the path crosses the dip in full steps and the
+    /// plotted curve cuts through it.
+    pub fn with_amplitude_steps(mut self, groups: Vec<Vec<usize>>) -> Self {
+        self.amplitudes = groups;
+        self
+    }
+
+    /// The largest |ln(a_after / a_before)| over the watched amplitudes (0 without any).
+    fn log_amplitude_change(&self, before: &[f64], after: &[f64]) -> f64 {
+        let amplitude = |x: &[f64], g: &[usize]| g.iter().map(|&i| x[i] * x[i]).sum::<f64>();
+        self.amplitudes
+            .iter()
+            .map(|g| {
+                let (a, b) = (amplitude(before, g), amplitude(after, g));
+                if a > 0.0 && b > 0.0 {
+                    0.5 * (b / a).ln().abs()
+                } else {
+                    0.0
+                }
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// This driver with scales that grow with the response along the path (see
+    /// [`AdaptiveScale`]).
+    pub fn with_adaptive_scale(mut self, adaptive: AdaptiveScale) -> Self {
+        self.adaptive = Some(adaptive);
+        self
+    }
+
+    /// Grows the scale of each group whose norm at `x` (m) has outgrown it (see
+    /// [`AdaptiveScale`]) and carries the unit tangent over to the new scaled space. Kept
+    /// factorisations are dropped: they were built in the old one.
+    fn adapt_scale(&mut self, x: &[f64], tangent: &mut [f64]) {
+        let Some(adaptive) = &self.adaptive else {
+            return;
+        };
+        let groups = adaptive.group_of.iter().copied().max().map_or(0, |g| g + 1);
+        let mut norms = vec![0.0_f64; groups];
+        let mut current = vec![0.0_f64; groups];
+        for (i, &g) in adaptive.group_of.iter().enumerate() {
+            norms[g] += x[i] * x[i];
+            current[g] = current[g].max(self.x_scale[i]);
+        }
+        let wanted: Vec<f64> = norms.iter().map(|v| v.sqrt() / adaptive.climb).collect();
+        if !(0..groups).any(|g| wanted[g] > 2.0 * current[g]) {
+            return;
+        }
+        for (i, &g) in adaptive.group_of.iter().enumerate() {
+            if wanted[g] > 2.0 * current[g] {
+                let new = wanted[g];
+                tangent[i] *= self.x_scale[i] / new;
+                self.x_scale[i] = new;
+            }
+        }
+        let length = norm(tangent);
+        tangent.iter_mut().for_each(|v| *v /= length);
+        *self.last_factor.borrow_mut() = None;
+        *self.carried.borrow_mut() = None;
     }
 
     /// Keeps the chord corrector's last factorisation for the tangent at its point.
@@ -271,7 +376,7 @@ impl Continuation {
     }
 
     /// Unit tangent in scaled space at a converged point, oriented along `previous` (or
-    /// towards increasing ω when there is none).
+    /// towards the end frequency when there is none).
     fn tangent<S: ParametricResidual>(
         &self,
         system: &mut S,
@@ -316,7 +421,7 @@ impl Continuation {
         t.iter_mut().for_each(|v| *v /= nt);
         let orientation = match previous {
             Some(p) => dot(&t, p),
-            None => t[n],
+            None => self.direction() * t[n],
         };
         if orientation < 0.0 {
             t.iter_mut().for_each(|v| *v = -*v);
@@ -521,11 +626,10 @@ impl Continuation {
         tangent: &[f64],
     ) -> Result<Option<(PathPoint, Vec<f64>)>, ContinuationError> {
         let n = y.len() - 1;
-        let omega_end = self.settings.freq_end_hz * OMEGA_SCALE;
         for &fraction in LEAPS {
             let ds = fraction * self.settings.max_step;
             let predicted: Vec<f64> = (0..=n).map(|j| y[j] + ds * tangent[j]).collect();
-            if predicted[n] * OMEGA_SCALE >= omega_end {
+            if self.past_end(&predicted) {
                 continue;
             }
             let Ok((yc, it, rel)) = self.correct(system, &predicted, tangent) else {
@@ -543,6 +647,79 @@ impl Continuation {
                     .collect::<Vec<_>>(),
             );
             if distance <= ds && dot(&t_new, tangent) > 0.0 {
+                return Ok(Some((point, t_new)));
+            }
+        }
+        Ok(None)
+    }
+
+    /// Tries to turn a corner of the piecewise-smooth path at `y`, where the corrector fails at
+    /// every step down to the minimum because the path leaves `y` in a direction far from the
+    /// incoming tangent (a contact sample changing state at `y`: the sampled Jenkins law makes
+    /// the residual only piecewise smooth, and at a sharp corner, e.g. a fold whose two
+    /// branches meet at an angle, the hyperplane normal to the incoming tangent does not meet
+    /// the outgoing branch at all).
+    ///
+    /// Past the corner (at `y + ds·t_in`) the Jacobian is that of the outgoing piece; its null
+    /// direction t_out is the outgoing tangent up to sign. Both signs are corrected on the
+    /// hyperplane normal to them at `y ± ds·t_out`; a corrected point that lies back along the
+    /// incoming branch (its chord from `y` within [`CORNER_BACKWARD_COSINE`] of −t_in) or
+    /// further than the step from its prediction is rejected. Returns the point and its tangent
+    /// oriented along the chord from `y`.
+    fn corner<S: ParametricResidual>(
+        &self,
+        system: &mut S,
+        y: &[f64],
+        tangent: &[f64],
+    ) -> Result<Option<(PathPoint, Vec<f64>)>, ContinuationError> {
+        let n = y.len() - 1;
+        for &multiple in CORNER_STEPS {
+            let ds = (multiple * self.settings.min_step).min(self.settings.max_step);
+            let beyond: Vec<f64> = (0..=n).map(|j| y[j] + ds * tangent[j]).collect();
+            let probe = PathPoint {
+                omega: beyond[n] * OMEGA_SCALE,
+                x: (0..n).map(|j| beyond[j] * self.x_scale[j]).collect(),
+                iterations: 0,
+                residual: f64::NAN,
+                step: ds,
+            };
+            let Ok(outgoing) = self.tangent(system, &probe, Some(tangent)) else {
+                continue;
+            };
+            for sign in [1.0, -1.0] {
+                let direction: Vec<f64> = outgoing.iter().map(|v| sign * v).collect();
+                let predicted: Vec<f64> = (0..=n).map(|j| y[j] + ds * direction[j]).collect();
+                if self.past_end(&predicted) {
+                    continue;
+                }
+                let Ok((yc, it, rel)) = self.correct(system, &predicted, &direction) else {
+                    continue;
+                };
+                let chord: Vec<f64> = yc.iter().zip(y).map(|(a, b)| a - b).collect();
+                let length = norm(&chord);
+                let off = norm(
+                    &yc.iter()
+                        .zip(&predicted)
+                        .map(|(a, b)| a - b)
+                        .collect::<Vec<_>>(),
+                );
+                if length == 0.0 || off > ds {
+                    continue;
+                }
+                let chord: Vec<f64> = chord.iter().map(|v| v / length).collect();
+                let Ok((point, t_new, _, _)) =
+                    self.corrected_point(system, &yc, it, rel, ds, &predicted, &chord)
+                else {
+                    continue;
+                };
+                // Back along the incoming piece: the chord points back and the tangent there
+                // is the incoming one. A sharp fold's outgoing piece may run back close to
+                // the incoming one, but with its own tangent.
+                if -dot(&chord, tangent) > CORNER_BACKWARD_COSINE
+                    && dot(&t_new, tangent).abs() > CORNER_SAME_PIECE_COSINE
+                {
+                    continue;
+                }
                 return Ok(Some((point, t_new)));
             }
         }
@@ -585,26 +762,78 @@ impl Continuation {
         Ok((point, t_new, distance / ds, degrees))
     }
 
-    /// Whether the path has left the range for good below the start frequency. A path that
-    /// turns back below the start (a fold: the response overhangs) is followed on, within the
-    /// point budget, since it usually turns again and comes back; only one that runs on down
-    /// to below the start minus half the range (or to a tenth of the start frequency) is
+    /// Whether the path has left the range for good behind the start frequency. A path that
+    /// turns back behind the start (a fold: the response overhangs) is followed on, within the
+    /// point budget, since it usually turns again and comes back; only one that runs on to
+    /// half the range behind the start (or, running up, to a tenth of the start frequency) is
     /// given up.
     fn left_range(&self, point: &PathPoint) -> bool {
         let a = &self.settings;
-        let floor =
-            (a.freq_start_hz - 0.5 * (a.freq_end_hz - a.freq_start_hz)).max(0.1 * a.freq_start_hz);
-        point.freq_hz() < floor
+        let behind = self.direction() * (a.freq_start_hz - point.freq_hz());
+        let range = (a.freq_end_hz - a.freq_start_hz).abs();
+        behind > 0.5 * range || (self.direction() > 0.0 && point.freq_hz() < 0.1 * a.freq_start_hz)
+    }
+
+    /// +1 when the path runs up in frequency (end above start), −1 when it runs down.
+    fn direction(&self) -> f64 {
+        if self.settings.freq_end_hz < self.settings.freq_start_hz {
+            -1.0
+        } else {
+            1.0
+        }
+    }
+
+    /// Whether a predicted y (scaled, ω last) lands at or past the end frequency in the
+    /// direction of travel.
+    fn past_end(&self, predicted: &[f64]) -> bool {
+        let n = predicted.len() - 1;
+        self.direction() * (predicted[n] - self.settings.freq_end_hz) >= 0.0
+    }
+
+    /// Points a path may take without reaching a frequency above the highest one so far before
+    /// it is given up as wandering ([`PathEnd::NoProgress`]): a fifth of the point budget, at
+    /// least [`MIN_STAGNATION_POINTS`].
+    fn stagnation_points(&self) -> usize {
+        (self.settings.max_points / 5).max(MIN_STAGNATION_POINTS)
+    }
+
+    /// Takes a converged point with its tangent onto the path: reports it (and a turning point
+    /// when dω/ds changed sign from `tangent`), makes its tangent the current one and lets the
+    /// scale follow the response. Returns true when the point left the range for good (the
+    /// summary's end is then set).
+    fn accept<S: ParametricResidual, O: Observer<S>>(
+        &mut self,
+        system: &mut S,
+        observer: &mut O,
+        summary: &mut PathSummary,
+        point: PathPoint,
+        t_new: Vec<f64>,
+        tangent: &mut Vec<f64>,
+    ) -> bool {
+        let n = t_new.len() - 1;
+        if t_new[n] * tangent[n] < 0.0 {
+            summary.turning_points.push(point.freq_hz());
+            observer.turning_point(point.freq_hz());
+        }
+        observer.accepted(system, &point);
+        let left = self.left_range(&point);
+        *tangent = t_new;
+        self.adapt_scale(&point.x, tangent);
+        summary.points.push(point);
+        if left {
+            summary.end = PathEnd::LeftRangeBelow;
+        }
+        left
     }
 
     /// Follows the path from `x_guess` at the start frequency to the end frequency.
     pub fn run<S: ParametricResidual, O: Observer<S>>(
-        &self,
+        &mut self,
         system: &mut S,
         x_guess: &[f64],
         observer: &mut O,
     ) -> Result<PathSummary, ContinuationError> {
-        let a = &self.settings;
+        let a = self.settings;
         let omega_start = a.freq_start_hz * OMEGA_SCALE;
         let omega_end = a.freq_end_hz * OMEGA_SCALE;
         let n = system.dim();
@@ -630,7 +859,22 @@ impl Continuation {
         };
         let mut ds = a.initial_step.clamp(a.min_step, a.max_step);
         let mut previous_quality: Option<f64> = None;
+        // The frequency furthest toward the end reached (times the direction) and the point
+        // count when it was reached.
+        let dir = self.direction();
+        let mut furthest = (dir * a.freq_start_hz, 1usize);
         while summary.points.len() < a.max_points {
+            if summary.points.len() - furthest.1 > self.stagnation_points() {
+                summary.end = PathEnd::NoProgress;
+                return Ok(summary);
+            }
+            let reached = summary
+                .points
+                .last()
+                .map_or(f64::NEG_INFINITY, |p| dir * p.freq_hz());
+            if reached > furthest.0 {
+                furthest = (reached, summary.points.len());
+            }
             let last = summary.points.last().expect("at least the first point");
             let y: Vec<f64> = last
                 .x
@@ -640,7 +884,7 @@ impl Continuation {
                 .chain(std::iter::once(last.omega / OMEGA_SCALE))
                 .collect();
             let predicted: Vec<f64> = (0..=n).map(|j| y[j] + ds * tangent[j]).collect();
-            if predicted[n] * OMEGA_SCALE >= omega_end {
+            if self.past_end(&predicted) {
                 // Land exactly on the end frequency from the linearly interpolated guess.
                 let frac =
                     ((omega_end / OMEGA_SCALE - y[n]) / (predicted[n] - y[n])).clamp(0.0, 1.0);
@@ -699,17 +943,8 @@ impl Continuation {
             match outcome {
                 Ok((point, t_new, degrees)) => {
                     previous_quality = None;
-                    if t_new[n] * tangent[n] < 0.0 {
-                        summary.turning_points.push(point.freq_hz());
-                        observer.turning_point(point.freq_hz());
-                    }
                     let iterations = point.iterations;
-                    observer.accepted(system, &point);
-                    let left = self.left_range(&point);
-                    summary.points.push(point);
-                    tangent = t_new;
-                    if left {
-                        summary.end = PathEnd::LeftRangeBelow;
+                    if self.accept(system, observer, &mut summary, point, t_new, &mut tangent) {
                         return Ok(summary);
                     }
                     // The next step: shorter where Newton needed many iterations, and where
@@ -717,7 +952,14 @@ impl Continuation {
                     // this step), so that peaks and anti-resonances get points on their flanks.
                     let by_iterations = a.target_iterations as f64 / iterations.max(1) as f64;
                     let by_turn = TARGET_TURN_DEGREES / degrees.max(1e-3);
-                    let factor = by_iterations.min(by_turn).clamp(0.5, 2.0);
+                    let by_amplitude = match &summary.points[..] {
+                        [.., before, after] => {
+                            TARGET_LOG_AMPLITUDE_CHANGE
+                                / self.log_amplitude_change(&before.x, &after.x).max(1e-6)
+                        }
+                        _ => f64::INFINITY,
+                    };
+                    let factor = by_iterations.min(by_turn).min(by_amplitude).clamp(0.5, 2.0);
                     ds = (ds * factor).clamp(a.min_step, a.max_step);
                 }
                 Err(reason) => {
@@ -729,34 +971,30 @@ impl Continuation {
                         // the pieces of the sampled, piecewise-smooth contact law): try to land
                         // on it further on, with a fully converged point, before giving up.
                         let from = last.freq_hz();
-                        match self.leap(system, &y, &tangent)? {
-                            Some((point, t_new)) => {
-                                observer.leap(from, point.freq_hz());
-                                summary.leaps.push((from, point.freq_hz()));
-                                if t_new[n] * tangent[n] < 0.0 {
-                                    summary.turning_points.push(point.freq_hz());
-                                    observer.turning_point(point.freq_hz());
-                                }
-                                observer.accepted(system, &point);
-                                let left = self.left_range(&point);
-                                summary.points.push(point);
-                                tangent = t_new;
-                                previous_quality = None;
-                                if left {
-                                    summary.end = PathEnd::LeftRangeBelow;
-                                    return Ok(summary);
-                                }
-                                ds = a.initial_step.clamp(a.min_step, a.max_step);
-                                continue;
-                            }
+                        let resumed = match self.corner(system, &y, &tangent)? {
+                            Some(found) => Some(found),
                             None => {
-                                return Err(ContinuationError::Stalled {
-                                    freq_hz: from,
-                                    step: ds,
-                                    reason,
-                                })
+                                let leapt = self.leap(system, &y, &tangent)?;
+                                if let Some((point, _)) = &leapt {
+                                    observer.leap(from, point.freq_hz());
+                                    summary.leaps.push((from, point.freq_hz()));
+                                }
+                                leapt
                             }
+                        };
+                        let Some((point, t_new)) = resumed else {
+                            return Err(ContinuationError::Stalled {
+                                freq_hz: from,
+                                step: ds,
+                                reason,
+                            });
+                        };
+                        previous_quality = None;
+                        if self.accept(system, observer, &mut summary, point, t_new, &mut tangent) {
+                            return Ok(summary);
                         }
+                        ds = a.initial_step.clamp(a.min_step, a.max_step);
+                        continue;
                     }
                     ds = new_ds;
                 }
@@ -774,4 +1012,136 @@ fn scaled_norm(v: &[f64], scale: &[f64]) -> f64 {
         .map(|(a, s)| (a / s) * (a / s))
         .sum::<f64>()
         .sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::numerics::path::NoObserver;
+
+    /// R(x, ω) = ω/2π − g(x): a path whose frequency is the piecewise-linear g of the single
+    /// unknown x. g rises to 15 Hz at x = 1, falls steeply to 13 Hz at x = 1.2 and rises on:
+    /// a Z with two folds that are sharp corners (the tangent turns by about 163°), as a
+    /// contact sample opening or closing makes them in the sampled contact law.
+    struct ZPath;
+
+    fn g(x: f64) -> (f64, f64) {
+        if x < 1.0 {
+            (10.0 + 5.0 * x, 5.0)
+        } else if x < 1.2 {
+            (15.0 - 10.0 * (x - 1.0), -10.0)
+        } else {
+            (13.0 + 5.0 * (x - 1.2), 5.0)
+        }
+    }
+
+    #[derive(Debug, Clone, thiserror::Error)]
+    #[error("never")]
+    struct Never;
+
+    impl ParametricResidual for ZPath {
+        type Error = Never;
+        fn dim(&self) -> usize {
+            1
+        }
+        fn residual_scale(&self) -> f64 {
+            1.0
+        }
+        fn residual(&mut self, x: &[f64], omega: f64, r: &mut [f64]) -> Result<(), Never> {
+            r[0] = omega / OMEGA_SCALE - g(x[0]).0;
+            Ok(())
+        }
+        fn new_jacobian(&mut self) -> AssembledJacobian {
+            AssembledJacobian::dense(1)
+        }
+        fn residual_and_jacobian(
+            &mut self,
+            x: &[f64],
+            omega: f64,
+            r: &mut [f64],
+            jac: &mut AssembledJacobian,
+            dr: &mut [f64],
+        ) -> Result<(), Never> {
+            self.residual(x, omega, r)?;
+            jac.clear();
+            let slot = jac.slot(0, 0);
+            jac.add_at(slot, -g(x[0]).1);
+            dr[0] = 1.0 / OMEGA_SCALE;
+            Ok(())
+        }
+    }
+
+    fn settings(start: f64, end: f64) -> ContinuationSettings {
+        ContinuationSettings {
+            freq_start_hz: start,
+            freq_end_hz: end,
+            initial_step: 0.05,
+            min_step: 1e-4,
+            max_step: 0.2,
+            max_points: 2000,
+            target_iterations: 4,
+            max_iterations: 12,
+            residual_tolerance: 1e-12,
+            step_tolerance: 1e-10,
+            chord_min_unknowns: usize::MAX,
+        }
+    }
+
+    /// Both sharp folds of the Z are turned: the path reaches the end, passing through the
+    /// steep middle piece, with a turning point at each fold, every point on the path.
+    #[test]
+    fn sharp_corner_folds_are_turned() {
+        let mut c = Continuation::new(settings(10.0, 18.0), vec![1.0]);
+        let summary = c.run(&mut ZPath, &[0.0], &mut NoObserver).unwrap();
+        assert_eq!(summary.end, PathEnd::EndFrequency);
+        assert_eq!(
+            summary.turning_points.len(),
+            2,
+            "{:?}",
+            summary.turning_points
+        );
+        assert!(summary
+            .points
+            .iter()
+            .any(|p| p.x[0] > 1.01 && p.x[0] < 1.19));
+        for p in &summary.points {
+            assert!((p.freq_hz() - g(p.x[0]).0).abs() < 1e-9);
+        }
+        let last = summary.points.last().unwrap();
+        assert_eq!(last.freq_hz(), 18.0);
+        assert!((last.x[0] - 2.2).abs() < 1e-9);
+    }
+
+    /// With the end below the start the path runs down in frequency, through the same folds,
+    /// and ends exactly at the end frequency.
+    #[test]
+    fn a_path_runs_down_when_the_end_is_below_the_start() {
+        let mut c = Continuation::new(settings(18.0, 10.0), vec![1.0]);
+        let summary = c.run(&mut ZPath, &[2.2], &mut NoObserver).unwrap();
+        assert_eq!(summary.end, PathEnd::EndFrequency);
+        assert_eq!(summary.turning_points.len(), 2);
+        let last = summary.points.last().unwrap();
+        assert_eq!(last.freq_hz(), 10.0);
+        assert!(last.x[0].abs() < 1e-9);
+    }
+
+    /// The scale of a group grows with its norm along the path and the tangent is carried over
+    /// to the new scaled space as the same direction.
+    #[test]
+    fn adaptive_scale_grows_and_keeps_the_tangent_direction() {
+        let mut c = Continuation::new(settings(10.0, 18.0), vec![1.0, 1.0]).with_adaptive_scale(
+            AdaptiveScale {
+                group_of: vec![0, 1],
+                climb: 1.0,
+            },
+        );
+        let mut t = vec![0.6, 0.0, 0.8];
+        let raw = |c: &Continuation, t: &[f64]| (t[0] * c.x_scale[0], t[2]);
+        let before = raw(&c, &t);
+        c.adapt_scale(&[10.0, 1.5], &mut t);
+        assert_eq!(c.x_scale, vec![10.0, 1.0]);
+        let after = raw(&c, &t);
+        assert!((before.0 / before.1 - after.0 / after.1).abs() < 1e-12);
+        assert!((norm(&t) - 1.0).abs() < 1e-12);
+    }
 }

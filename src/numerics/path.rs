@@ -137,4 +137,8 @@ pub enum PathEnd {
     LeftRangeBelow,
     /// The point budget was used up.
     MaxPoints,
+    /// The path wandered without reaching a higher frequency for
+    /// `Continuation::stagnation_points` points (back and forth through folds of the sampled
+    /// contact law): the range above was not covered.
+    NoProgress,
 }

@@ -1,8 +1,11 @@
-//! Result files: `frf.csv`, `linear_open.csv`, `linear_stuck.csv` and `solution.json`.
+//! Result files: `frf.csv`, `linear_open.csv`, `linear_stuck.csv`, `peaks.csv` and
+//! `solution.json`.
 //!
 //! The FRF writer appends one row of `frf.csv` per converged point (flushed at once, so an
 //! interrupted run keeps every point finished so far) and rewrites `solution.json` whole, and
-//! atomically, at checkpoints and at the end ([`FrfWriter`]); the other files are replaced
+//! atomically, at checkpoints and at the end ([`FrfWriter`]); after the continuation it writes
+//! the refined resonances and anti-resonances of every output to `peaks.csv` and to the
+//! `peaks` array of `solution.json` ([`FrfWriter::write_peaks`]). The other files are replaced
 //! atomically (written to a temporary sibling, then renamed) by [`write_atomic`].
 
 use std::fmt::Write as _;
@@ -11,8 +14,10 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::analysis::frf::{FrfObserver, FrfPoint};
+use crate::analysis::frf::{FrfObserver, FrfPoint, Jump};
 use crate::analysis::linear::LinearCurve;
+use crate::analysis::peaks::{ExtremumKind, PathExtremum};
+use crate::contact::ContactState;
 use crate::model::Problem;
 use crate::numerics::NewtonFailure;
 
@@ -84,6 +89,47 @@ pub fn linear_csv(problem: &Problem, curve: &LinearCurve) -> String {
     s
 }
 
+/// Header of an FRF run's `peaks.csv`: `dof`, `kind` (`resonance` or `anti-resonance`),
+/// `freq_hz` and `amplitude` (the refined extremum: Hz, first-harmonic amplitude in m),
+/// `refined` (`true`, or `false` when the refinement failed and the values are the path
+/// point's), `path_index`, `path_freq_hz` and `path_amplitude` (the point of the solved path
+/// the extremum was refined from: its index in path order, Hz, m), then `<contact>_state` at
+/// the refined extremum per contact of `contacts`.
+pub fn peaks_header(contacts: &[String]) -> String {
+    let mut h =
+        String::from("dof,kind,freq_hz,amplitude,refined,path_index,path_freq_hz,path_amplitude");
+    for c in contacts {
+        let _ = write!(h, ",{c}_state");
+    }
+    h.push('\n');
+    h
+}
+
+/// An FRF run's `peaks.csv` ([`peaks_header`], then one row per extremum, in the order of
+/// `extrema`); `outputs` names the output DOFs, `contacts` the contacts.
+pub fn peaks_csv(outputs: &[String], contacts: &[String], extrema: &[PathExtremum]) -> String {
+    let mut s = peaks_header(contacts);
+    for e in extrema {
+        let dof = outputs.get(e.output).map_or("?", String::as_str);
+        let _ = write!(
+            s,
+            "{dof},{},{:.10e},{:.10e},{},{},{:.10e},{:.10e}",
+            e.kind.label(),
+            e.peak.freq_hz,
+            e.peak.amplitude,
+            e.peak.refined,
+            e.path_index,
+            e.path_freq_hz,
+            e.path_amplitude
+        );
+        for state in &e.peak.states {
+            let _ = write!(s, ",{}", state.label());
+        }
+        s.push('\n');
+    }
+    s
+}
+
 /// Run metadata stored in `solution.json`.
 #[derive(Debug, Clone, Serialize)]
 pub struct RunInfo {
@@ -112,10 +158,37 @@ struct SolutionFile<'a> {
     turning_points_hz: &'a [f64],
     step_cuts: &'a [StepCut],
     leaps_hz: &'a [(f64, f64)],
+    /// Jumps to another branch past a fold (highest frequency before, lowest of the new
+    /// branch, its first point's index).
+    jumps: &'a [Jump],
     /// Where the coefficients are when they are not inline (large models).
     #[serde(skip_serializing_if = "Option::is_none")]
     coefficients_file: Option<CoefficientsFile>,
+    /// Refined resonances and anti-resonances, once computed (after the continuation).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    peaks: Option<&'a [PeakRecord]>,
     points: Vec<PointRecord<'a>>,
+}
+
+/// One resonance or anti-resonance as written in `solution.json` (the columns of
+/// `peaks.csv`, see [`peaks_header`]).
+#[derive(Debug, Clone, Serialize)]
+struct PeakRecord {
+    /// Output DOF name.
+    dof: String,
+    kind: ExtremumKind,
+    /// Refined frequency (Hz).
+    freq_hz: f64,
+    /// Refined first-harmonic amplitude (m).
+    amplitude: f64,
+    /// False when the refinement failed (the values are then the path point's).
+    refined: bool,
+    /// Contact states at the refined extremum.
+    states: Vec<ContactState>,
+    /// The path point it was refined from: index, frequency (Hz), amplitude (m).
+    path_index: usize,
+    path_freq_hz: f64,
+    path_amplitude: f64,
 }
 
 /// Most coefficients per point kept inline in `solution.json`; larger models append them to
@@ -181,6 +254,9 @@ pub struct FrfWriter {
     turning_points: Vec<f64>,
     step_cuts: Vec<StepCut>,
     leaps: Vec<(f64, f64)>,
+    jumps: Vec<Jump>,
+    /// Refined extrema, set by [`Self::write_peaks`].
+    peaks: Option<Vec<PeakRecord>>,
     started: Instant,
     /// `frf.csv`, opened (truncated, header written) at the first point.
     csv: Option<std::fs::File>,
@@ -229,6 +305,8 @@ impl FrfWriter {
             turning_points: Vec::new(),
             step_cuts: Vec::new(),
             leaps: Vec::new(),
+            jumps: Vec::new(),
+            peaks: None,
             started: Instant::now(),
             csv: None,
             coefficients: None,
@@ -276,6 +354,7 @@ impl FrfWriter {
             turning_points_hz: &self.turning_points,
             step_cuts: &self.step_cuts,
             leaps_hz: &self.leaps,
+            jumps: &self.jumps,
             coefficients_file: (!inline).then(|| CoefficientsFile {
                 file: "coefficients.bin",
                 values_per_point: self.points[0].coefficients.len(),
@@ -283,6 +362,7 @@ impl FrfWriter {
                          point's Fourier coefficients harmonic-major (blocks of info.blocks, each \
                          holding every DOF of info.dofs)",
             }),
+            peaks: self.peaks.as_deref(),
             points: self
                 .points
                 .iter()
@@ -304,6 +384,31 @@ impl FrfWriter {
         self.last_json_points = self.points.len();
         self.json_writes += 1;
         result
+    }
+
+    /// Writes `peaks.csv` (atomically) with the refined resonances and anti-resonances of the
+    /// run's outputs ([`peaks_csv`]), and keeps them for the `peaks` array of `solution.json`,
+    /// written by the next [`Self::write_solution`].
+    pub fn write_peaks(&mut self, extrema: &[PathExtremum]) -> Result<(), WriteError> {
+        let outputs = &self.info.outputs;
+        self.peaks = Some(
+            extrema
+                .iter()
+                .map(|e| PeakRecord {
+                    dof: outputs.get(e.output).cloned().unwrap_or_default(),
+                    kind: e.kind,
+                    freq_hz: e.peak.freq_hz,
+                    amplitude: e.peak.amplitude,
+                    refined: e.peak.refined,
+                    states: e.peak.states.clone(),
+                    path_index: e.path_index,
+                    path_freq_hz: e.path_freq_hz,
+                    path_amplitude: e.path_amplitude,
+                })
+                .collect(),
+        );
+        let csv = peaks_csv(outputs, &self.info.contacts, extrema);
+        write_atomic(&self.dir.join("peaks.csv"), csv.as_bytes())
     }
 
     /// Appends a point's row to `frf.csv` (creating it with its header at the first point).
@@ -388,6 +493,10 @@ impl FrfObserver for FrfWriter {
 
     fn leap(&mut self, from_hz: f64, to_hz: f64) {
         self.leaps.push((from_hz, to_hz));
+    }
+
+    fn jump(&mut self, jump: &Jump) {
+        self.jumps.push(*jump);
     }
 }
 

@@ -2,7 +2,8 @@
 //! that a failed or incomplete run never sits beside an earlier run's results.
 //!
 //! The list is collected from the writers: [`crate::report::files`] (`frf.csv`,
-//! `solution.json`, `coefficients.bin`, the linear references), the figures of
+//! `solution.json`, `coefficients.bin`, the linear references, and an FRF run's `peaks.csv` of
+//! refined resonances and anti-resonances), the figures of
 //! [`crate::report::plot`] as `fricbound run` names them (`frf_*`, `limits_*`, `hysteresis_*`,
 //! `optimal_*`, `resonance_*`, `bands_*`, PNG and SVG), the limit-analysis tables of
 //! [`crate::report::limit_files`] (`limits.csv`, `peaks.csv`, `curve_*.csv`,
@@ -21,7 +22,7 @@ use std::path::{Path, PathBuf};
 
 use crate::report::files::WriteError;
 
-/// Result files of fixed names.
+/// Result files of fixed names (`peaks.csv` is written by FRF runs and limit analyses alike).
 pub const OWNED_FILES: &[&str] = &[
     "frf.csv",
     "solution.json",

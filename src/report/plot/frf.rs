@@ -28,6 +28,9 @@ pub struct FrfFigure<'a> {
     pub contact_names: &'a [String],
     /// Converged nonlinear points in path order.
     pub points: &'a [FrfPoint],
+    /// Indices into `points` where a new branch starts (after a jump past a fold): the line is
+    /// broken there instead of drawn across the jump.
+    pub branch_starts: &'a [usize],
     /// Linear reference with all contacts open.
     pub open: &'a LinearCurve,
     /// Linear reference with all contacts stuck.
@@ -38,16 +41,37 @@ pub struct FrfFigure<'a> {
 /// linear open and stuck references (dashed lines), on a log amplitude axis, and below the main
 /// chart one horizontal strip per contact showing its state at each point (colour legend: stuck,
 /// stick-slip, stick-slip-liftoff, open). Writes both files.
+///
+/// The frequency axis spans the analysis range (the references' grid): points a path reached
+/// outside it (a fold followed below the start) are left out, and the line is broken there and
+/// at every branch start.
 pub fn plot_frf(fig: &FrfFigure, png: &Path, svg: &Path) -> Result<(), PlotError> {
     let out = fig.output_index;
+    let range = fig
+        .open
+        .freqs_hz
+        .iter()
+        .chain(&fig.stuck.freqs_hz)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &f| {
+            (lo.min(f), hi.max(f))
+        });
+    let in_range = |f: f64| range.0 > range.1 || (range.0..=range.1).contains(&f);
     let nonlinear = Line {
         label: "nonlinear (harmonic balance)".to_string(),
         runs: valid_runs(
-            fig.points.iter().map(|p| {
-                (
-                    p.freq_hz,
-                    p.amplitudes.get(out).copied().unwrap_or(f64::NAN),
-                )
+            fig.points.iter().enumerate().flat_map(|(i, p)| {
+                let amplitude = p.amplitudes.get(out).copied().unwrap_or(f64::NAN);
+                let value = if in_range(p.freq_hz) {
+                    (p.freq_hz, amplitude)
+                } else {
+                    (f64::NAN, f64::NAN)
+                };
+                // A NaN point ends the run: one before each branch start.
+                let gap = fig
+                    .branch_starts
+                    .contains(&i)
+                    .then_some((f64::NAN, f64::NAN));
+                gap.into_iter().chain(std::iter::once(value))
             }),
             true,
         ),
@@ -75,8 +99,7 @@ pub fn plot_frf(fig: &FrfFigure, png: &Path, svg: &Path) -> Result<(), PlotError
         nonlinear,
     ];
 
-    let mut freqs: Vec<f64> = points(&curves).map(|p| p.0).collect();
-    freqs.extend(fig.points.iter().map(|p| p.freq_hz));
+    let freqs: Vec<f64> = points(&curves).map(|p| p.0).collect();
     let x = linear_range(freqs.iter().copied(), 0.0);
     let y = log_range(points(&curves).map(|p| p.1));
 
@@ -89,7 +112,7 @@ pub fn plot_frf(fig: &FrfFigure, png: &Path, svg: &Path) -> Result<(), PlotError
             marks: fig
                 .points
                 .iter()
-                .filter(|p| p.freq_hz.is_finite())
+                .filter(|p| p.freq_hz.is_finite() && in_range(p.freq_hz))
                 .filter_map(|p| p.states.get(c).map(|&s| (p.freq_hz, state_color(s))))
                 .collect(),
         })
@@ -183,6 +206,7 @@ mod tests {
             output_name: name,
             contact_names: names,
             points,
+            branch_starts: &[],
             open,
             stuck,
         }

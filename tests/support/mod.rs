@@ -1,0 +1,64 @@
+//! Shared helpers of the tests that run the `fricbound` binary (`tests/cli_run.rs`,
+//! `tests/outputs.rs`): running it, naming the paper scenes, reading what it wrote.
+// Not every test file uses every helper.
+#![allow(dead_code)]
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// Runs the binary with `args` in the test's working folder.
+pub fn fricbound(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_fricbound"))
+        .args(args)
+        .output()
+        .expect("fricbound runs")
+}
+
+/// Runs the binary in `cwd` (for default output folders, which are relative).
+pub fn fricbound_in(cwd: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_fricbound"))
+        .current_dir(cwd)
+        .args(args)
+        .output()
+        .expect("fricbound runs")
+}
+
+/// Path of the paper scene `name` in `meshes/paper-wedge`.
+pub fn scene(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("meshes/paper-wedge")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+/// Process output as text.
+pub fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// A JSON result file, parsed.
+pub fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// File names in `dir`, sorted.
+pub fn names(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// A CSV result file as its header line and rows of cells.
+pub fn csv(path: &Path) -> (String, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap_or_default().to_string();
+    let rows = lines
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect();
+    (header, rows)
+}
