@@ -661,6 +661,11 @@ fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
     let contact_names: Vec<String> = problem.contacts.iter().map(|c| c.name.clone()).collect();
     for (k, &d) in problem.outputs.iter().enumerate() {
         let name = &problem.model.dof_names[d];
+        let refined: Vec<(usize, f64, f64)> = extrema
+            .iter()
+            .filter(|e| e.output == k && e.peak.refined)
+            .map(|e| (e.path_index, e.peak.freq_hz, e.peak.amplitude))
+            .collect();
         let fig = FrfFigure {
             title: ctx.title(),
             output_index: k,
@@ -668,6 +673,7 @@ fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
             contact_names: &contact_names,
             points: &run.points,
             branch_starts: &branch_starts,
+            extrema: &refined,
             open: &ctx.open,
             stuck: &ctx.stuck,
         };

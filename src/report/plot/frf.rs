@@ -31,10 +31,55 @@ pub struct FrfFigure<'a> {
     /// Indices into `points` where a new branch starts (after a jump past a fold): the line is
     /// broken there instead of drawn across the jump.
     pub branch_starts: &'a [usize],
+    /// Refined extrema of this output (resonances and anti-resonances) as (index of the path
+    /// point each was refined from, frequency in Hz, amplitude in m): spliced into the line
+    /// next to that point, so that the curve passes through the extrema instead of cutting
+    /// across a dip or a peak between two path points.
+    pub extrema: &'a [(usize, f64, f64)],
     /// Linear reference with all contacts open.
     pub open: &'a LinearCurve,
     /// Linear reference with all contacts stuck.
     pub stuck: &'a LinearCurve,
+}
+
+/// The nonlinear line of output `out` in path order: the path points, a NaN before each branch
+/// start (which ends a run of the line), and each refined extremum next to its path point, on
+/// the side of the neighbour whose frequency brackets it with the point's.
+fn spliced_line<'a>(fig: &'a FrfFigure, out: usize) -> impl Iterator<Item = (f64, f64)> + 'a {
+    let value = move |p: &FrfPoint| {
+        (
+            p.freq_hz,
+            p.amplitudes.get(out).copied().unwrap_or(f64::NAN),
+        )
+    };
+    let between = |f: f64, a: f64, b: f64| a.min(b) <= f && f <= a.max(b);
+    fig.points.iter().enumerate().flat_map(move |(i, p)| {
+        let gap = fig
+            .branch_starts
+            .contains(&i)
+            .then_some((f64::NAN, f64::NAN));
+        let here = fig.extrema.iter().filter(move |e| e.0 == i);
+        let before = here
+            .clone()
+            .filter(move |e| {
+                i > 0
+                    && !fig.branch_starts.contains(&i)
+                    && between(e.1, fig.points[i - 1].freq_hz, p.freq_hz)
+            })
+            .map(|e| (e.1, e.2));
+        let after = here
+            .filter(move |e| {
+                !(i > 0
+                    && !fig.branch_starts.contains(&i)
+                    && between(e.1, fig.points[i - 1].freq_hz, p.freq_hz))
+                    && e.1 != p.freq_hz
+            })
+            .map(|e| (e.1, e.2));
+        gap.into_iter()
+            .chain(before)
+            .chain(std::iter::once(value(p)))
+            .chain(after)
+    })
 }
 
 /// Draws the nonlinear FRF (first-harmonic amplitude, path order, as a line with markers) over the
@@ -59,19 +104,12 @@ pub fn plot_frf(fig: &FrfFigure, png: &Path, svg: &Path) -> Result<(), PlotError
     let nonlinear = Line {
         label: "nonlinear (harmonic balance)".to_string(),
         runs: valid_runs(
-            fig.points.iter().enumerate().flat_map(|(i, p)| {
-                let amplitude = p.amplitudes.get(out).copied().unwrap_or(f64::NAN);
-                let value = if in_range(p.freq_hz) {
-                    (p.freq_hz, amplitude)
+            spliced_line(fig, out).map(|(f, a)| {
+                if in_range(f) {
+                    (f, a)
                 } else {
                     (f64::NAN, f64::NAN)
-                };
-                // A NaN point ends the run: one before each branch start.
-                let gap = fig
-                    .branch_starts
-                    .contains(&i)
-                    .then_some((f64::NAN, f64::NAN));
-                gap.into_iter().chain(std::iter::once(value))
+                }
             }),
             true,
         ),
@@ -207,9 +245,33 @@ mod tests {
             contact_names: names,
             points,
             branch_starts: &[],
+            extrema: &[],
             open,
             stuck,
         }
+    }
+
+    /// Refined extrema go next to their path point on the side whose neighbour brackets them,
+    /// and a branch start puts a break (NaN) before its point, never an extremum across it.
+    #[test]
+    fn extrema_are_spliced_in_path_order_and_branches_break_the_line() {
+        let points: Vec<FrfPoint> = [(1.0, 1.0), (2.0, 3.0), (3.0, 1.0), (2.5, 2.0), (4.0, 1.0)]
+            .iter()
+            .map(|&(f, a)| point(f, a, Vec::new()))
+            .collect();
+        let (open, stuck) = (curve(120.0, 0.01), curve(190.0, 0.01));
+        let names: Vec<String> = Vec::new();
+        let extrema = [(1, 2.2, 3.5), (1, 1.8, 2.9), (3, 2.4, 1.9)];
+        let mut fig = figure("t", (0, "x"), &names, &points, (&open, &stuck));
+        fig.branch_starts = &[3];
+        fig.extrema = &extrema;
+        let line: Vec<(f64, f64)> = spliced_line(&fig, 0).collect();
+        let freqs: Vec<f64> = line.iter().map(|p| p.0).collect();
+        assert_eq!(freqs.len(), 9);
+        assert_eq!(&freqs[..5], &[1.0, 1.8, 2.0, 2.2, 3.0]);
+        assert!(freqs[5].is_nan());
+        // The branch's first point has no neighbour before it: its extremum goes after it.
+        assert_eq!(&freqs[6..], &[2.5, 2.4, 4.0]);
     }
 
     #[test]
