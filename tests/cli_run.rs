@@ -160,39 +160,7 @@ fn failed_continuation_keeps_finished_points_and_exits_nonzero() {
 /// direction: its normal load is the constant kn·1e-4 = 10 N. With μ = 0 it transmits nothing
 /// (the structure alone); with μ = 100 (slip force 1000 N, far above kt times any amplitude
 /// reached) it stays stuck and adds kt = 10⁵ N/m to x1. Either way the response is linear.
-const TWO_DOF: &str = r#"
-[model]
-dofs = ["x1", "x2"]
-mass = [[1.0, 0.0], [0.0, 0.1]]
-stiffness = [[1.1e4, -1.0e3], [-1.0e3, 1.0e3]]
-damping = [[2.0, 0.0], [0.0, 0.5]]
-
-[[contacts]]
-name = "ground"
-damper = ["x1"]
-tangent = [1.0]
-normal = [0.0]
-kt = 1.0e5
-kn = 1.0e5
-mu = 0.0
-gap = -1.0e-4
-
-[[harmonic_loads]]
-dof = "x1"
-harmonic = 1
-cos = 1.0
-
-[harmonics]
-max = 1
-samples = 64
-
-[analysis]
-freq_start_hz = 5.0
-freq_end_hz = 70.0
-
-[output]
-dofs = ["x1", "x2"]
-"#;
+const TWO_DOF: &str = include_str!("data/two-dof-grounded.toml");
 
 /// First-harmonic amplitudes |X1|, |X2| of (K − ω²M + iωC) X = (1, 0) for the two-DOF scene
 /// with `k11` on x1's diagonal, at `f` Hz (Cramer's rule on the 2 × 2 complex system).

@@ -326,39 +326,7 @@ mod tests {
     /// (μ = 0, normal direction zero), so the harmonic balance is exactly linear. Resonances at
     /// 13.6 and 18.6 Hz; x1 has an anti-resonance at √(k₂/m₂)/2π = 15.9 Hz, and x2's amplitude
     /// a shallow minimum between the resonances (16.3 Hz; a local minimum, not a zero).
-    const TWO_DOF: &str = r#"
-[model]
-dofs = ["x1", "x2"]
-mass = [[1.0, 0.0], [0.0, 0.1]]
-stiffness = [[1.1e4, -1.0e3], [-1.0e3, 1.0e3]]
-damping = [[2.0, 0.0], [0.0, 0.5]]
-
-[[contacts]]
-name = "ground"
-damper = ["x1"]
-tangent = [1.0]
-normal = [0.0]
-kt = 1.0e5
-kn = 1.0e5
-mu = 0.0
-gap = -1.0e-4
-
-[[harmonic_loads]]
-dof = "x1"
-harmonic = 1
-cos = 1.0
-
-[harmonics]
-max = 1
-samples = 64
-
-[analysis]
-freq_start_hz = 5.0
-freq_end_hz = 40.0
-
-[output]
-dofs = ["x1", "x2"]
-"#;
+    const TWO_DOF: &str = include_str!("../../tests/data/two-dof-grounded.toml");
 
     fn problem() -> Problem {
         crate::scene::parse(TWO_DOF, "two-dof", &[])
