@@ -365,3 +365,17 @@ fn fe_blade_pair_limits_at_a_low_preload_cover_the_range() {
         "FE blade pair, 5 N",
     );
 }
+
+/// Open gaps of 1 mm on both faces: at rest the damper hangs free above its contacts and the
+/// pre-load must slide it 1 mm down into the wedge. The linear guesses leave it hanging (a
+/// singular Jacobian); the run starts from the static state with the contacts. A user sees
+/// the whole range, with the damper seated (no point has both contacts open all period).
+#[test]
+fn open_gaps_that_the_preload_closes_cover_the_range() {
+    let p = problem(&["contacts.0.gap=1e-3", "contacts.1.gap=1e-3"]);
+    let run = solve_complete(&p, "gap = 1 mm");
+    assert!(run
+        .points
+        .iter()
+        .all(|q| q.states.iter().any(|s| *s != ContactState::Open)));
+}

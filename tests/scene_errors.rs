@@ -1351,6 +1351,19 @@ fn interference_on_one_side_without_preload_pushes_the_damper_out() {
 }
 
 #[test]
+fn open_gaps_that_the_preload_closes_are_accepted() {
+    // Gaps of 1 mm on both faces: the pre-load pushes the damper 1 mm down onto them (it slides
+    // into the wedge). A stuck-contact static balance would hold it off with its tangential
+    // springs; the scene must not be refused.
+    let file = SceneFile::new(paper_wedge_scene());
+    scene::load_problem(
+        &file.path,
+        &strings(&["contacts.0.gap=1e-3", "contacts.1.gap=1e-3"]),
+    )
+    .expect("a damper pressed onto open gaps is held once they close");
+}
+
+#[test]
 fn extreme_mass_and_gap() {
     rejects_with(
         paper_wedge_scene(),

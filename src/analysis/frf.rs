@@ -532,7 +532,8 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
 
 /// The starting guess at ω0 (rad/s): the stuck linear solution, or where Newton does not
 /// converge from it (a low pre-load: the contacts open for most of the period) the solution
-/// converged from the open-contact guess ([`linear::open_guess`]), else the end of a short
+/// converged from the open-contact guess ([`linear::open_guess`]), else from either on the
+/// static state with the contacts ([`contact_statics`]), else the end of a short
 /// continuation onto ω0 from a point solved a little off it ([`START_OFFSETS`]). When none converges the
 /// stuck guess is returned and the run reports its failure at the start.
 fn start_guess(
@@ -550,6 +551,25 @@ fn start_guess(
     let open = system.restrict(&linear::open_guess(problem, set, omega0)?);
     if let Ok(p) = newton.solve_fixed(system, &open, omega0) {
         return Ok(p.x);
+    }
+    // Contacts open at rest (gaps the pre-load must close): the linear guesses leave the
+    // damper where it hangs free. Solve the statics with the contacts first, then the linear
+    // harmonics on that static state.
+    if let Some(statics) = contact_statics(problem, set)? {
+        for dynamic in [
+            linear::stuck_guess(problem, set, omega0)?,
+            linear::open_guess(problem, set, omega0)?,
+        ] {
+            let n = problem.model.n_dofs();
+            let mut guess = dynamic;
+            if let Some(j) = set.constant_block() {
+                guess[j * n..(j + 1) * n].copy_from_slice(&statics);
+            }
+            let guess = system.restrict(&guess);
+            if let Ok(p) = newton.solve_fixed(system, &guess, omega0) {
+                return Ok(p.x);
+            }
+        }
     }
     // On (or next to) a resonance of the stuck structure the stuck guess is near-singular:
     // start a little off it, where the guess is sound, and follow the path onto ω0 (from
@@ -576,6 +596,35 @@ fn start_guess(
         }
     }
     Ok(stuck)
+}
+
+/// The static state with the contacts (m), when the unknowns include the 0th harmonic: the
+/// harmonic balance of the 0th harmonic alone (normal springs with lift-off, and the
+/// tangential force m μ N of each contact's initial state, since nothing moves), solved by
+/// Newton from the sliding static state ([`linear::sliding_static`]), else from the stuck
+/// static guess. None when neither converges.
+fn contact_statics(problem: &Problem, set: &HarmonicSet) -> Result<Option<Vec<f64>>, FrfError> {
+    if !set.has_constant() {
+        return Ok(None);
+    }
+    let mut statics = problem.clone();
+    statics.harmonics = Vec::new();
+    let static_set = HarmonicSet::new(vec![0]);
+    let mut system = HbmOperator::new(&statics)?;
+    let mut guesses = Vec::new();
+    if let Ok(q) = linear::sliding_static(&statics) {
+        guesses.push(system.restrict(&q));
+    }
+    guesses.push(system.restrict(&linear::stuck_guess(&statics, &static_set, 0.0)?));
+    let scale = vec![1.0; guesses[0].len()];
+    let newton = Continuation::new(statics.analysis.continuation, scale);
+    let omega = 2.0 * PI * statics.analysis.continuation.freq_start_hz;
+    for guess in guesses {
+        if let Ok(p) = newton.solve_fixed(&mut system, &guess, omega) {
+            return Ok(Some(system.expand(&p.x, omega)?));
+        }
+    }
+    Ok(None)
 }
 
 /// Relative frequency offsets at which a start on a resonance of the stuck structure is first

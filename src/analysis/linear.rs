@@ -38,6 +38,26 @@ pub fn contact_stiffness(problem: &Problem) -> Vec<(usize, usize, f64)> {
     k
 }
 
+/// Static state (m) with every contact replaced by its normal spring only (no tangential
+/// spring: the contacts slide freely), pressed by the static loads and the gap pre-loads
+/// kₙ g aₙ: where the rest position leaves gaps open, the damper slides onto its contacts
+/// here instead of being held off them by stuck tangential springs. An error when the
+/// structure is singular without the tangential springs (a flat damper free to slide).
+pub fn sliding_static(problem: &Problem) -> Result<Vec<f64>, LinearSolveError> {
+    let n = problem.model.n_dofs();
+    let mut k = problem.model.stiffness.triplets();
+    let mut rhs = problem.static_load.clone();
+    for c in &problem.contacts {
+        for &(p, ap) in &c.normal {
+            for &(q, aq) in &c.normal {
+                k.push((p, q, c.law.kn * ap * aq));
+            }
+            rhs[p] += c.law.kn * c.gap * ap;
+        }
+    }
+    solve_triplets(n, &k, &rhs, problem.model.stiffness.is_sparse())
+}
+
 /// Stiffness of a linear case as triplets (duplicates to be summed).
 fn case_stiffness(problem: &Problem, case: LinearCase) -> Vec<(usize, usize, f64)> {
     let mut k = problem.model.stiffness.triplets();
