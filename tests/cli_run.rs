@@ -4,19 +4,13 @@
 
 mod support;
 
-use support::{csv, fricbound, json, scene, text};
+use support::{csv, json, run_scene, scene, text};
 
 #[test]
 fn run_writes_all_results() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("zoom");
-    let o = fricbound(&[
-        "run",
-        &scene("zoom-2nd.toml"),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = run_scene(&scene("zoom-2nd.toml"), &out, &[]);
     assert!(
         o.status.success(),
         "stderr: {}",
@@ -93,17 +87,11 @@ fn run_writes_all_results() {
 fn set_overrides_change_the_solve() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("h3");
-    let o = fricbound(&[
-        "run",
+    let o = run_scene(
         &scene("zoom-2nd.toml"),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-        "--set",
-        "harmonics.max=3",
-        "--set",
-        "analysis.freq_end_hz=160",
-    ]);
+        &out,
+        &["harmonics.max=3", "analysis.freq_end_hz=160"],
+    );
     assert!(
         o.status.success(),
         "stderr: {}",
@@ -126,19 +114,15 @@ fn failed_continuation_keeps_finished_points_and_exits_nonzero() {
     // first stick-slip transition, after some converged stuck points.
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("stall");
-    let o = fricbound(&[
-        "run",
+    let o = run_scene(
         &scene("zoom-2nd.toml"),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-        "--set",
-        "analysis.max_iterations=2",
-        "--set",
-        "analysis.min_step=0.05",
-        "--set",
-        "analysis.initial_step=0.1",
-    ]);
+        &out,
+        &[
+            "analysis.max_iterations=2",
+            "analysis.min_step=0.05",
+            "analysis.initial_step=0.1",
+        ],
+    );
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success(), "expected a stall");
     assert!(
@@ -201,17 +185,7 @@ fn linear_extremum(k11: f64, output: usize, sign: f64, mut lo: f64, mut hi: f64)
 fn run_two_dof(out: &std::path::Path, overrides: &[&str]) -> Option<i32> {
     let scene_file = out.with_extension("toml");
     std::fs::write(&scene_file, TWO_DOF).unwrap();
-    let mut args = vec![
-        "run",
-        scene_file.to_str().unwrap(),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ];
-    for o in overrides {
-        args.extend(["--set", o]);
-    }
-    let o = fricbound(&args);
+    let o = run_scene(scene_file.to_str().unwrap(), out, overrides);
     assert!(!text(&o.stderr).contains("panicked"), "{}", text(&o.stderr));
     o.status.code()
 }

@@ -12,7 +12,7 @@ use std::process::Command;
 
 use fricbound::cli::{EXIT_COMPLETE, EXIT_ERROR, EXIT_INCOMPLETE};
 use fricbound::report::owned::is_owned;
-use support::{fricbound, fricbound_in, json, names, scene, text};
+use support::{fricbound, fricbound_in, json, names, run_scene, scene, text};
 
 /// Files of the user's that the tests put into output folders.
 const USER_FILES: &[&str] = &["notes.txt"];
@@ -99,23 +99,17 @@ fn a_run_that_does_not_cover_the_range_is_incomplete_and_exits_3() {
 fn an_incomplete_limit_analysis_exits_3_with_its_finished_results() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("limits");
-    let o = fricbound(&[
-        "run",
+    let o = run_scene(
         &scene("fig13-3rd.toml"),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-        "--set",
-        "limits.grid_points=41",
-        "--set",
-        "limits.bound_scan=[]",
-        "--set",
-        "limits.intermediate=[0.0]",
-        "--set",
-        "analysis.max_step=0.25",
-        "--set",
-        "analysis.max_points=30",
-    ]);
+        &out,
+        &[
+            "limits.grid_points=41",
+            "limits.bound_scan=[]",
+            "limits.intermediate=[0.0]",
+            "analysis.max_step=0.25",
+            "analysis.max_points=30",
+        ],
+    );
     let stderr = text(&o.stderr);
     assert_eq!(
         o.status.code(),
@@ -146,19 +140,15 @@ fn an_incomplete_limit_analysis_exits_3_with_its_finished_results() {
 fn a_sweep_with_failed_cases_exits_3() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("sweep");
-    let o = fricbound(&[
-        "run",
+    let o = run_scene(
         &scene("fig16a-d.toml"),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-        "--set",
-        "sweep.values=[60.0, 130.0]",
-        "--set",
-        "analysis.max_step=0.25",
-        "--set",
-        "analysis.max_points=20",
-    ]);
+        &out,
+        &[
+            "sweep.values=[60.0, 130.0]",
+            "analysis.max_step=0.25",
+            "analysis.max_points=20",
+        ],
+    );
     let stderr = text(&o.stderr);
     assert_eq!(
         o.status.code(),
@@ -180,17 +170,11 @@ fn a_sweep_with_failed_cases_exits_3() {
 
     // With the default budget the same sweep is complete.
     let ok = dir.path().join("sweep-ok");
-    let o = fricbound(&[
-        "run",
+    let o = run_scene(
         &scene("fig16a-d.toml"),
-        "--quiet",
-        "--out",
-        ok.to_str().unwrap(),
-        "--set",
-        "sweep.values=[60.0, 130.0]",
-        "--set",
-        "analysis.max_step=0.25",
-    ]);
+        &ok,
+        &["sweep.values=[60.0, 130.0]", "analysis.max_step=0.25"],
+    );
     assert_eq!(
         o.status.code(),
         Some(i32::from(EXIT_COMPLETE)),
@@ -206,13 +190,7 @@ fn a_sweep_with_failed_cases_exits_3() {
 fn a_failed_run_leaves_no_results_of_an_earlier_run() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("same");
-    let o = fricbound(&[
-        "run",
-        &scene("zoom-2nd.toml"),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = run_scene(&scene("zoom-2nd.toml"), &out, &[]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let first = std::fs::read_to_string(out.join("frf.csv")).unwrap();
     assert!(out.join("frf_y2.png").is_file());
@@ -220,19 +198,15 @@ fn a_failed_run_leaves_no_results_of_an_earlier_run() {
     std::fs::write(out.join("notes.txt"), "mine").unwrap();
 
     // The stall of tests/cli_run.rs: fails after some converged points.
-    let o = fricbound(&[
-        "run",
+    let o = run_scene(
         &scene("zoom-2nd.toml"),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-        "--set",
-        "analysis.max_iterations=2",
-        "--set",
-        "analysis.min_step=0.05",
-        "--set",
-        "analysis.initial_step=0.1",
-    ]);
+        &out,
+        &[
+            "analysis.max_iterations=2",
+            "analysis.min_step=0.05",
+            "analysis.initial_step=0.1",
+        ],
+    );
     assert_eq!(
         o.status.code(),
         Some(i32::from(EXIT_ERROR)),
@@ -267,32 +241,20 @@ fn a_failed_run_leaves_no_results_of_an_earlier_run() {
     );
 
     // A limit analysis, then an FRF into the same folder: no limit-analysis file remains.
-    let o = fricbound(&[
-        "run",
+    let o = run_scene(
         &scene("fig13-3rd.toml"),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-        "--set",
-        "limits.grid_points=41",
-        "--set",
-        "limits.bound_scan=[]",
-        "--set",
-        "analysis.max_step=0.25",
-    ]);
+        &out,
+        &[
+            "limits.grid_points=41",
+            "limits.bound_scan=[]",
+            "analysis.max_step=0.25",
+        ],
+    );
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(out.join("limits.json").is_file() && out.join("curve_m+1.csv").is_file());
     assert!(!out.join("frf.csv").exists() && !out.join("solution.json").exists());
     assert_all_owned(&out);
-    let o = fricbound(&[
-        "run",
-        &scene("zoom-2nd.toml"),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-        "--set",
-        "analysis.freq_end_hz=152",
-    ]);
+    let o = run_scene(&scene("zoom-2nd.toml"), &out, &["analysis.freq_end_hz=152"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let files = names(&out);
     assert!(
@@ -366,17 +328,11 @@ fn overrides_get_their_own_default_folder() {
 fn figure_titles_name_the_overrides() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("titled");
-    let o = fricbound(&[
-        "run",
+    let o = run_scene(
         &scene("zoom-2nd.toml"),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-        "--set",
-        "static_loads.0.value=-100",
-        "--set",
-        "analysis.freq_end_hz=152",
-    ]);
+        &out,
+        &["static_loads.0.value=-100", "analysis.freq_end_hz=152"],
+    );
     assert!(o.status.success(), "{}", text(&o.stderr));
     let svg = std::fs::read_to_string(out.join("frf_y2.svg")).unwrap();
     assert!(
@@ -385,13 +341,7 @@ fn figure_titles_name_the_overrides() {
     );
     // Without overrides, the scene's title alone.
     let plain = dir.path().join("plain");
-    let o = fricbound(&[
-        "run",
-        &scene("zoom-2nd.toml"),
-        "--quiet",
-        "--out",
-        plain.to_str().unwrap(),
-    ]);
+    let o = run_scene(&scene("zoom-2nd.toml"), &plain, &[]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let svg = std::fs::read_to_string(plain.join("frf_y2.svg")).unwrap();
     assert!(!svg.contains("static_loads.0.value"));

@@ -419,6 +419,9 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
     let omega0 = 2.0 * PI * settings.freq_start_hz;
     let mut x_scale = arc_length_x_scale(problem, &set, &system)?;
     let mut guess = start_guess(problem, &set, &mut system, &x_scale, omega0)?;
+    // How the scale grows and which amplitudes the steps follow: the same on every branch.
+    let adaptive = adaptive_scale(problem, &set, &system);
+    let amplitude_groups = output_amplitude_groups(problem, &set, &system);
     let mut adapter = Adapter {
         observer,
         points: Vec::new(),
@@ -441,8 +444,8 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
             ..settings
         };
         let mut continuation = Continuation::new(segment, x_scale.clone())
-            .with_adaptive_scale(adaptive_scale(problem, &set, &system))
-            .with_amplitude_steps(output_amplitude_groups(problem, &set, &system));
+            .with_adaptive_scale(adaptive.clone())
+            .with_amplitude_steps(amplitude_groups.clone());
         let outcome = continuation.run(&mut system, &guess, &mut adapter);
         // The next branch starts with the scale this one grew to.
         x_scale.clone_from(&continuation.x_scale);
@@ -494,7 +497,8 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
                     failure: None,
                 };
                 let mut filler = Continuation::new(fill, x_scale.clone())
-                    .with_adaptive_scale(adaptive_scale(problem, &set, &system));
+                    .with_adaptive_scale(adaptive.clone())
+                    .with_amplitude_steps(amplitude_groups.clone());
                 let filled = filler.run(&mut system, &x, &mut back);
                 if let Ok(summary) = &filled {
                     run.turning_points.extend(&summary.turning_points);

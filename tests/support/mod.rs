@@ -62,3 +62,13 @@ pub fn csv(path: &Path) -> (String, Vec<Vec<String>>) {
         .collect();
     (header, rows)
 }
+
+/// Runs `fricbound run SCENE --quiet --out OUT` with each override as `--set`.
+pub fn run_scene(scene: &str, out: &Path, overrides: &[&str]) -> Output {
+    let out = out.to_str().expect("a UTF-8 output path");
+    let mut args = vec!["run", scene, "--quiet", "--out", out];
+    for o in overrides {
+        args.extend(["--set", o]);
+    }
+    fricbound(&args)
+}
