@@ -11,6 +11,7 @@ use crate::hbm::operator::HbmOperator;
 use crate::hbm::{HbmError, HbmSystem};
 use crate::model::Problem;
 use crate::numerics::continuation::AdaptiveScale;
+use crate::numerics::golden;
 use crate::numerics::linalg::LinearSolveError;
 use crate::numerics::path::NoObserver;
 use crate::numerics::{
@@ -37,23 +38,45 @@ pub struct FrfPoint {
     pub coefficients: Vec<f64>,
 }
 
-/// A jump of an FRF run to another branch past a fold the path did not come back from.
+/// A jump of an FRF run from one branch to another: where the path turned back at a fold and
+/// did not come back, the run goes on on a branch found past the highest frequency reached, and
+/// solves further branches inside any stretch that neither branch reached.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Jump {
-    /// Highest frequency the path reached before the jump (Hz).
+    /// Highest frequency of the branch before the jump (Hz).
     pub from_hz: f64,
-    /// Lowest frequency of the new branch's points (Hz): the branch was followed back down
-    /// toward `from_hz` as far as it goes. Frequencies between the two were not computed on
-    /// any branch (none when they are equal).
+    /// Lowest frequency of the branch after the jump (Hz): a branch found past a fold is
+    /// followed back down toward `from_hz` as far as it goes. Frequencies between the two were
+    /// not computed on any branch (none when `to_hz` ≤ `from_hz`).
     pub to_hz: f64,
-    /// Index of the new branch's first point in the run's points.
+    /// Index of the next branch's first point in the run's points.
     pub first_point: usize,
+    /// Why the run changed branch.
+    pub kind: JumpKind,
+}
+
+/// Why an FRF run changed branch (see [`Jump`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum JumpKind {
+    /// The path turned back at a fold and did not come back; the run went on on a branch
+    /// solved just past the highest frequency reached.
+    PastFold,
+    /// A branch solved inside a stretch that the branches on either side of it did not reach
+    /// (Newton from blends of the two ends' coefficients, then followed both ways).
+    Bridge,
 }
 
 impl Jump {
-    /// Width of the stretch not computed on any branch (Hz).
+    /// Width of the stretch not computed on any branch (Hz); stretches narrower than 10⁻⁹ of
+    /// the frequency (round-off of a branch followed onto an end frequency) count as none.
     pub fn uncovered_hz(&self) -> f64 {
-        (self.to_hz - self.from_hz).max(0.0)
+        let gap = self.to_hz - self.from_hz;
+        if gap > 1e-9 * self.to_hz.abs() {
+            gap
+        } else {
+            0.0
+        }
     }
 }
 
@@ -101,9 +124,10 @@ impl FrfRun {
         self.jumps.iter().map(|j| j.first_point).collect()
     }
 
-    /// Whether the path reached the end frequency: only then does the run cover the range.
+    /// Whether the run covers the range: the path reached the end frequency, and every
+    /// stretch it jumped over at a fold was computed on some branch.
     pub fn is_complete(&self) -> bool {
-        self.end == PathEnd::EndFrequency
+        self.incomplete_reason().is_none()
     }
 
     /// Why the run did not cover the range (None when it did), for the run's status line
@@ -116,7 +140,22 @@ impl FrfRun {
             .map(|p| p.freq_hz)
             .fold(f64::NEG_INFINITY, f64::max);
         match self.end {
-            PathEnd::EndFrequency => None,
+            PathEnd::EndFrequency => {
+                let gaps: Vec<String> = self
+                    .jumps
+                    .iter()
+                    .filter(|j| j.uncovered_hz() > 0.0)
+                    .map(|j| format!("{:.4}-{:.4} Hz", j.from_hz, j.to_hz))
+                    .collect();
+                (!gaps.is_empty()).then(|| {
+                    format!(
+                        "no solution was found at {}: the path turned back at a fold there and \
+                         neither the branch found past it nor a branch solved inside reached \
+                         those frequencies",
+                        gaps.join(", ")
+                    )
+                })
+            }
             PathEnd::LeftRangeBelow => Some(format!(
                 "the path turned back and left the range below the start frequency at \
                  {last:.4} Hz; frequencies above {highest:.4} Hz were never reached"
@@ -166,30 +205,16 @@ pub fn time_peak(set: &HarmonicSet, coef: &[f64], offset: f64) -> f64 {
                 (0, f64::NEG_INFINITY),
                 |acc, (k, v)| if v > acc.1 { (k, v) } else { acc },
             );
-    let ratio = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut lo, mut hi) = ((best as f64 - 1.0) * dt, (best as f64 + 1.0) * dt);
-    let mut c = hi - ratio * (hi - lo);
-    let mut d = lo + ratio * (hi - lo);
-    let (mut vc, mut vd) = (value(c), value(d));
-    let mut peak = value(best as f64 * dt).max(vc).max(vd);
-    while hi - lo > 1e-12 {
-        if vc >= vd {
-            hi = d;
-            d = c;
-            vd = vc;
-            c = hi - ratio * (hi - lo);
-            vc = value(c);
-            peak = peak.max(vc);
-        } else {
-            lo = c;
-            c = d;
-            vc = vd;
-            d = lo + ratio * (hi - lo);
-            vd = value(d);
-            peak = peak.max(vd);
-        }
-    }
-    peak
+    let search = golden::maximise(
+        (best as f64 - 1.0) * dt,
+        (best as f64 + 1.0) * dt,
+        1e-12,
+        |tau| Some((value(tau), ())),
+    );
+    search
+        .best
+        .map_or(f64::NEG_INFINITY, |(_, v, _)| v)
+        .max(value(best as f64 * dt))
 }
 
 /// Output quantities of a converged point.
@@ -464,7 +489,12 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
         }
         let turned_back = matches!(run.end, PathEnd::LeftRangeBelow | PathEnd::NoProgress);
         let budget = settings.max_points.saturating_sub(adapter.points.len());
-        if !turned_back || run.jumps.len() >= MAX_JUMPS || budget < 2 {
+        let past_folds = run
+            .jumps
+            .iter()
+            .filter(|j| j.kind == JumpKind::PastFold)
+            .count();
+        if !turned_back || past_folds >= MAX_JUMPS || budget < 2 {
             break;
         }
         let highest = adapter
@@ -472,66 +502,236 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
             .iter()
             .map(|p| p.freq_hz)
             .fold(f64::NEG_INFINITY, f64::max);
-        match jump_target(
+        let Some((freq_hz, x)) = jump_target(
             problem,
             &set,
             &mut system,
             &continuation,
             &adapter.points,
             highest,
-        )? {
-            Some((freq_hz, x)) => {
-                // Fill the gap on the new branch, back down toward the highest frequency
-                // reached, and report those points first (in rising frequency) so that the
-                // path reads on from the jump.
-                let budget = settings.max_points.saturating_sub(adapter.points.len());
-                let fill = ContinuationSettings {
-                    freq_start_hz: freq_hz,
-                    freq_end_hz: highest,
-                    max_points: (budget / 2).min(FILL_POINTS),
-                    ..settings
-                };
-                let mut back = Adapter {
-                    observer: &mut Silent,
-                    points: Vec::new(),
-                    failure: None,
-                };
-                let mut filler = Continuation::new(fill, x_scale.clone())
-                    .with_adaptive_scale(adaptive.clone())
-                    .with_amplitude_steps(amplitude_groups.clone());
-                let filled = filler.run(&mut system, &x, &mut back);
-                if let Ok(summary) = &filled {
-                    run.turning_points.extend(&summary.turning_points);
-                    run.rejected_steps += summary.rejected_steps;
-                }
-                // The filled stretch runs from the start of the new branch down to the
-                // lowest frequency it reached; the first point (at the jump target) is solved
-                // again by the branch's own run.
-                let reached = back
-                    .points
-                    .iter()
-                    .map(|p| p.freq_hz)
-                    .fold(freq_hz, f64::min);
-                let jump = Jump {
-                    from_hz: highest,
-                    to_hz: reached,
-                    first_point: adapter.points.len(),
-                };
-                adapter.observer.jump(&jump);
-                run.jumps.push(jump);
-                for p in back.points.iter().skip(1).rev() {
-                    adapter.observer.point(p);
-                    adapter.points.push(p.clone());
-                }
-                start_hz = freq_hz;
-                guess = x;
-            }
-            None => break,
+        )?
+        else {
+            break;
+        };
+        let branching = Branching {
+            settings,
+            x_scale: &x_scale,
+            adaptive: &adaptive,
+            amplitude_groups: &amplitude_groups,
+        };
+        // Fill the gap on the new branch, back down toward the highest frequency reached, and
+        // report those points first (in rising frequency) so that the path reads on from the
+        // jump. The fill's first point (at the jump target) is solved again by the branch's
+        // own run.
+        let budget = settings.max_points.saturating_sub(adapter.points.len());
+        let (mut fill, summary) = branching.follow(
+            &mut system,
+            &x,
+            freq_hz,
+            highest,
+            (budget / 2).min(FILL_POINTS),
+        );
+        if let Some(summary) = &summary {
+            run.turning_points.extend(&summary.turning_points);
+            run.rejected_steps += summary.rejected_steps;
         }
+        // A stretch neither branch reached: solve branches inside it, between the highest
+        // point before the jump and the lowest point of the new branch.
+        let top = adapter
+            .points
+            .iter()
+            .rev()
+            .find(|p| p.freq_hz == highest)
+            .cloned();
+        let bottom = fill
+            .iter()
+            .min_by(|a, b| a.freq_hz.total_cmp(&b.freq_hz))
+            .cloned();
+        fill.reverse();
+        fill.pop();
+        let bridges = match (top, bottom) {
+            (Some(top), Some(bottom)) if bottom.freq_hz > highest => {
+                let budget = settings
+                    .max_points
+                    .saturating_sub(adapter.points.len() + fill.len())
+                    / 2;
+                branching.bridge(&mut system, &top, &bottom, budget)
+            }
+            _ => Vec::new(),
+        };
+        let mut reached = highest;
+        let mut kind = JumpKind::PastFold;
+        for branch in bridges.into_iter().chain([fill]) {
+            let lowest = branch
+                .iter()
+                .map(|p| p.freq_hz)
+                .fold(f64::INFINITY, f64::min);
+            let jump = Jump {
+                from_hz: reached,
+                // A fill that solved nothing below the jump target starts there.
+                to_hz: if lowest.is_finite() { lowest } else { freq_hz },
+                first_point: adapter.points.len(),
+                kind,
+            };
+            adapter.observer.jump(&jump);
+            run.jumps.push(jump);
+            for p in branch {
+                reached = reached.max(p.freq_hz);
+                adapter.observer.point(&p);
+                adapter.points.push(p);
+            }
+            kind = JumpKind::Bridge;
+        }
+        start_hz = freq_hz;
+        guess = x;
     }
     run.points = adapter.points;
     run.elapsed_s = started.elapsed().as_secs_f64();
     Ok(run)
+}
+
+/// Point budget of each direction of a bridge branch (see [`Branching::bridge`]).
+const BRIDGE_POINTS: usize = 300;
+/// Most branches solved inside the stretches left uncovered by one jump.
+const MAX_BRIDGES: usize = 8;
+/// Where in an uncovered stretch a bridge branch is sought, as fractions of the stretch, in
+/// the order tried.
+const BRIDGE_FRACTIONS: &[f64] = &[0.5, 0.25, 0.75, 0.1, 0.9];
+/// Weights w of the blends (1 − w)·lower end + w·upper end of the stretch's end points'
+/// coefficients tried as Newton guesses, in the order tried.
+const BRIDGE_BLENDS: &[f64] = &[0.5, 0.25, 0.75, 0.0, 1.0];
+
+/// What the branches of one run share: the settings, the arc-length scale, how it grows and
+/// which amplitudes the steps follow.
+struct Branching<'a> {
+    settings: ContinuationSettings,
+    x_scale: &'a [f64],
+    adaptive: &'a AdaptiveScale,
+    amplitude_groups: &'a [Vec<usize>],
+}
+
+impl Branching<'_> {
+    /// Follows the path silently from `x` (the operator's unknowns, converged at `from_hz`)
+    /// toward `to_hz` (below or above) with at most `max_points` points. Returns the points in
+    /// path order (the first is the start point) and the summary, None when the continuation
+    /// failed (its points up to the failure are kept).
+    fn follow(
+        &self,
+        system: &mut HbmOperator<'_>,
+        x: &[f64],
+        from_hz: f64,
+        to_hz: f64,
+        max_points: usize,
+    ) -> (Vec<FrfPoint>, Option<crate::numerics::PathSummary>) {
+        let settings = ContinuationSettings {
+            freq_start_hz: from_hz,
+            freq_end_hz: to_hz,
+            max_points,
+            ..self.settings
+        };
+        let mut collect = Adapter {
+            observer: &mut Silent,
+            points: Vec::new(),
+            failure: None,
+        };
+        let mut continuation = Continuation::new(settings, self.x_scale.to_vec())
+            .with_adaptive_scale(self.adaptive.clone())
+            .with_amplitude_steps(self.amplitude_groups.to_vec());
+        let summary = continuation.run(system, x, &mut collect).ok();
+        (collect.points, summary)
+    }
+
+    /// Branches inside the stretch between `below` (the highest point of the branch before a
+    /// jump) and `above` (the lowest point of the branch after it), which neither reached.
+    ///
+    /// At a fold of the sampled contact law's solution curve, two branches can fold away from
+    /// each other with solutions between them on neither (a damper bouncing at a low
+    /// pre-load). Newton from blends of the two ends' coefficients ([`BRIDGE_BLENDS`]) at
+    /// points inside the stretch ([`BRIDGE_FRACTIONS`]) finds such solutions; each is followed
+    /// down toward `below` and up toward `above`, and what is still uncovered on either side
+    /// is bridged in turn, up to [`MAX_BRIDGES`] branches and `budget` points. Returns the
+    /// branches found, each in path order from its lowest point up, sorted by their lowest
+    /// frequency.
+    fn bridge(
+        &self,
+        system: &mut HbmOperator<'_>,
+        below: &FrfPoint,
+        above: &FrfPoint,
+        budget: usize,
+    ) -> Vec<Vec<FrfPoint>> {
+        let mut branches: Vec<Vec<FrfPoint>> = Vec::new();
+        let mut gaps = vec![(below.clone(), above.clone())];
+        let mut used = 0;
+        let solver = Continuation::new(self.settings, self.x_scale.to_vec());
+        while let Some((lo, hi)) = gaps.pop() {
+            if branches.len() >= MAX_BRIDGES || used + 2 > budget {
+                break;
+            }
+            let Some((freq_hz, x)) = solve_between(system, &solver, &lo, &hi) else {
+                continue;
+            };
+            let per_side = BRIDGE_POINTS.min((budget - used) / 2);
+            let (mut down, _) = self.follow(system, &x, freq_hz, lo.freq_hz, per_side);
+            let (up, _) = self.follow(system, &x, freq_hz, hi.freq_hz, per_side);
+            down.reverse();
+            // Both directions start with the point at `freq_hz`: keep one.
+            let branch: Vec<FrfPoint> = down.into_iter().chain(up.into_iter().skip(1)).collect();
+            used += branch.len();
+            let by_freq = |a: &&FrfPoint, b: &&FrfPoint| a.freq_hz.total_cmp(&b.freq_hz);
+            let (Some(low), Some(high)) =
+                (branch.iter().min_by(by_freq), branch.iter().max_by(by_freq))
+            else {
+                continue;
+            };
+            let gap_below = Jump {
+                from_hz: lo.freq_hz,
+                to_hz: low.freq_hz,
+                first_point: 0,
+                kind: JumpKind::Bridge,
+            };
+            if gap_below.uncovered_hz() > 0.0 {
+                gaps.push((lo.clone(), low.clone()));
+            }
+            let gap_above = Jump {
+                from_hz: high.freq_hz,
+                to_hz: hi.freq_hz,
+                ..gap_below
+            };
+            if gap_above.uncovered_hz() > 0.0 {
+                gaps.push((high.clone(), hi.clone()));
+            }
+            branches.push(branch);
+        }
+        branches.sort_by(|a, b| a[0].freq_hz.total_cmp(&b[0].freq_hz));
+        branches
+    }
+}
+
+/// A converged point strictly between `lo` and `hi` (Hz and operator unknowns), by Newton at
+/// fixed frequency from blends of their coefficients (see [`Branching::bridge`]).
+fn solve_between(
+    system: &mut HbmOperator<'_>,
+    solver: &Continuation,
+    lo: &FrfPoint,
+    hi: &FrfPoint,
+) -> Option<(f64, Vec<f64>)> {
+    for fraction in BRIDGE_FRACTIONS {
+        let freq_hz = lo.freq_hz + fraction * (hi.freq_hz - lo.freq_hz);
+        let omega = 2.0 * PI * freq_hz;
+        for w in BRIDGE_BLENDS {
+            let blend: Vec<f64> = lo
+                .coefficients
+                .iter()
+                .zip(&hi.coefficients)
+                .map(|(a, b)| (1.0 - w) * a + w * b)
+                .collect();
+            let guess = system.restrict(&blend);
+            if let Ok(p) = solver.solve_fixed(system, &guess, omega) {
+                return Some((freq_hz, p.x));
+            }
+        }
+    }
+    None
 }
 
 /// The starting guess at ω0 (rad/s): the stuck linear solution, or where Newton does not
@@ -795,4 +995,40 @@ pub fn interpolate_on_path(points: &[FrfPoint], freq_hz: f64) -> Option<Vec<f64>
                 .collect(),
         )
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run_with_jumps(jumps: Vec<Jump>) -> FrfRun {
+        FrfRun {
+            points: Vec::new(),
+            turning_points: Vec::new(),
+            rejected_steps: 0,
+            leaps: Vec::new(),
+            jumps,
+            end: PathEnd::EndFrequency,
+            elapsed_s: 0.0,
+        }
+    }
+
+    /// A path that reached the end frequency but jumped over a stretch at a fold that no branch
+    /// reached does not cover the range; one whose jumps left nothing uncovered (or only the
+    /// round-off of a branch followed onto an end frequency) does.
+    #[test]
+    fn an_uncovered_stretch_makes_the_run_incomplete() {
+        let jump = |from_hz: f64, to_hz: f64| Jump {
+            from_hz,
+            to_hz,
+            first_point: 0,
+            kind: JumpKind::PastFold,
+        };
+        assert!(run_with_jumps(vec![jump(66.0, 66.0)]).is_complete());
+        assert!(run_with_jumps(vec![jump(66.0, 66.0 + 1e-12)]).is_complete());
+        let gap = run_with_jumps(vec![jump(66.0, 66.0), jump(151.84, 152.14)]);
+        assert!(!gap.is_complete());
+        let reason = gap.incomplete_reason().unwrap();
+        assert!(reason.contains("151.8400-152.1400 Hz"), "{reason}");
+    }
 }

@@ -18,6 +18,7 @@
 use crate::analysis::frf::{FrfError, FrfPoint, PointSolver};
 use crate::contact::ContactState;
 use crate::model::Problem;
+use crate::numerics::golden;
 
 /// Smallest prominence of a peak, relative to its amplitude: local maxima that stand out less
 /// are wiggles of the sampled contact law (about 10⁻⁴) or numerical noise.
@@ -194,38 +195,24 @@ pub fn refine_extremum_at(
         }
         keep(&q, &mut best_point);
     }
-    let ratio = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut lo, mut hi) = ((best_s - step).max(0.0), (best_s + step).min(2.0));
-    let mut c = hi - ratio * (hi - lo);
-    let mut d = lo + ratio * (hi - lo);
-    let (mut pc, mut pd) = (eval(c), eval(d));
-    let mut all_solved = pc.is_some() && pd.is_some();
-    keep(&pc, &mut best_point);
-    keep(&pd, &mut best_point);
-    while all_solved && hi - lo > 2e-7 {
-        if value(&pc) >= value(&pd) {
-            hi = d;
-            d = c;
-            pd = pc;
-            c = hi - ratio * (hi - lo);
-            pc = eval(c);
-            all_solved &= pc.is_some();
-            keep(&pc, &mut best_point);
-        } else {
-            lo = c;
-            c = d;
-            pc = pd;
-            d = lo + ratio * (hi - lo);
-            pd = eval(d);
-            all_solved &= pd.is_some();
-            keep(&pd, &mut best_point);
+    let search = golden::maximise(
+        (best_s - step).max(0.0),
+        (best_s + step).min(2.0),
+        2e-7,
+        |s| {
+            let q = eval(s)?;
+            Some((sign * q.amplitudes[output], q))
+        },
+    );
+    if !search.complete {
+        return Peak::from_point(p1, output, false);
+    }
+    if let Some((_, v, q)) = search.best {
+        if v > sign * best_point.amplitudes[output] {
+            best_point = q;
         }
     }
-    if all_solved {
-        Peak::from_point(&best_point, output, true)
-    } else {
-        Peak::from_point(p1, output, false)
-    }
+    Peak::from_point(&best_point, output, true)
 }
 
 /// Every peak of every output along a solved path, refined ([`peak_indices`], [`refine_at`]):
@@ -352,19 +339,11 @@ mod tests {
     }
 
     /// Golden-section search of sign × |X_output| between `lo` and `hi` (Hz): (f, |X|).
-    fn linear_extremum(output: usize, sign: f64, mut lo: f64, mut hi: f64) -> (f64, f64) {
-        let g = |f: f64| sign * linear_amplitudes(f)[output];
-        let ratio = (5f64.sqrt() - 1.0) / 2.0;
-        while hi - lo > 1e-10 {
-            let c = hi - ratio * (hi - lo);
-            let d = lo + ratio * (hi - lo);
-            if g(c) >= g(d) {
-                hi = d;
-            } else {
-                lo = c;
-            }
-        }
-        let f = 0.5 * (lo + hi);
+    fn linear_extremum(output: usize, sign: f64, lo: f64, hi: f64) -> (f64, f64) {
+        let search = golden::maximise(lo, hi, 1e-10, |f| {
+            Some((sign * linear_amplitudes(f)[output], ()))
+        });
+        let (f, _, _) = search.best.expect("the linear FRF evaluates everywhere");
         (f, linear_amplitudes(f)[output])
     }
 

@@ -29,7 +29,7 @@ use std::path::{Path, PathBuf};
 use indicatif::{ProgressBar, ProgressStyle};
 use sha2::{Digest, Sha256};
 
-use crate::analysis::frf::{self, FrfError, FrfObserver, FrfPoint, Jump};
+use crate::analysis::frf::{self, FrfError, FrfObserver, FrfPoint, Jump, JumpKind};
 use crate::analysis::limits::LimitSettings;
 use crate::analysis::linear::{self, LinearCase};
 use crate::analysis::peaks::{self, ExtremumKind};
@@ -332,11 +332,18 @@ impl FrfObserver for RunObserver<'_> {
         } else {
             String::new()
         };
-        let msg = format!(
-            "the path turned back at a fold below {:.4} Hz and did not return: it goes on on \
-             the branch found past it, followed back down to {:.4} Hz{uncovered}",
-            jump.from_hz, jump.to_hz
-        );
+        let msg = match jump.kind {
+            JumpKind::PastFold => format!(
+                "the path turned back at a fold below {:.4} Hz and did not return: it goes on \
+                 on a branch found past it, from {:.4} Hz{uncovered}",
+                jump.from_hz, jump.to_hz
+            ),
+            JumpKind::Bridge => format!(
+                "a branch solved between the fold's two sides goes on from {:.4} Hz (the \
+                 previous branch reached {:.4} Hz){uncovered}",
+                jump.to_hz, jump.from_hz
+            ),
+        };
         match &self.bar {
             Some(bar) if !bar.is_hidden() => bar.println(msg),
             _ => eprintln!("{msg}"),
@@ -550,7 +557,7 @@ pub fn memory_refusal(
          factorised matrix of {} rows; AFT {} samples x {} coefficient blocks), more than the {} \
          available ({MEMINFO}); lower harmonics.max (highest harmonic {max_h}, {} blocks), \
          harmonics.samples ({}) or the model size ({} DOFs, {} contact points: coarser mesh, \
-         [reduction], fewer contact pairs){}",
+         [reduction], fewer contact pairs){}{}",
         format_bytes(needed),
         if parallel > 1 {
             format!(" for {parallel} curves solved at once")
@@ -569,6 +576,14 @@ pub fn memory_refusal(
         cost.contacts,
         if parallel > 1 {
             ", or the curves solved at once (RAYON_NUM_THREADS)"
+        } else {
+            ""
+        },
+        if cost.formulation == crate::model::Formulation::Condensed
+            && problem.model.stiffness.is_sparse()
+        {
+            ", or change analysis.formulation: `condensed` holds K, M and C of the whole model \
+             dense, `sparse` (or `auto`) keeps them sparse"
         } else {
             ""
         },
@@ -1019,6 +1034,23 @@ mod tests {
         assert!(memory_refusal(&problem, &cost, 4, 2.0 * cost.bytes())
             .unwrap()
             .contains("RAYON_NUM_THREADS"));
+        assert!(!why.contains("analysis.formulation"), "{why}");
+    }
+
+    /// A sparse FE model asked to run `condensed` (which holds K, M and C dense: the 18 574-DOF
+    /// blade pair needs 54 GiB) is also told that another formulation keeps them sparse.
+    #[test]
+    fn a_condensed_fe_model_is_pointed_to_a_sparse_formulation() {
+        let scene =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("meshes/blade-pair/blade-pair-2d.toml");
+        let overrides = [
+            "reduction=".to_string(),
+            "analysis.formulation=condensed".to_string(),
+        ];
+        let (_, _, problem, _) = load_scene(Some(&scene), &overrides).unwrap();
+        let cost = crate::hbm::cost::estimate(&problem);
+        let why = memory_refusal(&problem, &cost, 1, 0.5 * cost.bytes()).unwrap();
+        assert!(why.contains("analysis.formulation"), "{why}");
     }
 
     #[test]

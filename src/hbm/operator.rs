@@ -90,6 +90,15 @@ impl ParametricResidual for HbmOperator<'_> {
         self.full_ref().load_norm()
     }
 
+    fn round_off(&mut self, x: &[f64], lambda: f64) -> f64 {
+        match self {
+            HbmOperator::Full(s) => s.round_off(x, lambda),
+            // The condensed residual is formed after the elimination: its round-off level is
+            // not estimated (none is claimed).
+            HbmOperator::Condensed(_) => 0.0,
+        }
+    }
+
     fn residual(&mut self, x: &[f64], lambda: f64, r: &mut [f64]) -> Result<(), HbmError> {
         match self {
             HbmOperator::Full(s) => s.residual(x, lambda, r),

@@ -275,6 +275,34 @@ impl<'p> HbmSystem<'p> {
         }
     }
 
+    /// Round-off level of the residual at (x, ω) (N): ε ‖ |K||q_j| + (hω)²|M||q_j| +
+    /// hω|C||q_partner| + |F_j| ‖ over the coefficient blocks j (entries and coefficients taken
+    /// by absolute value), the size of the rounding errors of the linear part's sums. The
+    /// contact forces add terms of the size of the forces themselves, which the loads they
+    /// balance already count. Costs one pass over the nonzeros of K, M and C per block.
+    pub fn round_off(&self, x: &[f64], omega: f64) -> f64 {
+        let n = self.problem.model.n_dofs();
+        let m = &self.problem.model;
+        let blocks = self.unknowns.blocks();
+        let mut sum: Vec<f64> = self.excitation.iter().map(|f| f.abs()).collect();
+        for (j, b) in blocks.iter().enumerate() {
+            let hw = b.harmonic() as f64 * omega;
+            let (q, y) = (&x[j * n..(j + 1) * n], j * n);
+            m.stiffness
+                .for_each_nonzero(|p, c, v| sum[y + p] += (v * q[c]).abs());
+            if hw != 0.0 {
+                m.mass
+                    .for_each_nonzero(|p, c, v| sum[y + p] += (hw * hw * v * q[c]).abs());
+            }
+            if let Some((pj, _)) = self.partner(*b) {
+                let qp = &x[pj * n..(pj + 1) * n];
+                m.damping
+                    .for_each_nonzero(|p, c, v| sum[y + p] += (hw * v * qp[c]).abs());
+            }
+        }
+        f64::EPSILON * sum.iter().map(|v| v * v).sum::<f64>().sqrt()
+    }
+
     /// The block coupled to `b` through damping and the sign of that coupling: the cosine
     /// block of harmonic h gets +hωC q_sh, the sine block −hωC q_ch.
     fn partner(&self, b: Block) -> Option<(usize, f64)> {
@@ -533,6 +561,9 @@ impl ParametricResidual for HbmSystem<'_> {
     }
     fn residual_scale(&self) -> f64 {
         self.load_norm()
+    }
+    fn round_off(&mut self, x: &[f64], lambda: f64) -> f64 {
+        HbmSystem::round_off(self, x, lambda)
     }
     fn residual(&mut self, x: &[f64], lambda: f64, r: &mut [f64]) -> Result<(), Self::Error> {
         HbmSystem::residual(self, x, lambda, r)

@@ -113,6 +113,12 @@ const LEAPS: &[f64] = &[0.02, 0.1, 0.5];
 /// Chord iterations of the corrector counted as one Newton iteration (for step adaptation and
 /// reports), and the factor of the iteration limit allowed with chord iterations.
 const CHORD_STEPS_PER_ITERATION: usize = 3;
+/// Newton accepts a residual within this many times the operator's round-off level (see
+/// `Continuation::tolerance_at`): iterates at that level only move through rounding errors.
+const ROUND_OFF_FACTOR: f64 = 4.0;
+/// Relative residual below which the round-off level is looked at; a level above it would be
+/// a badly scaled residual, not round-off.
+const ROUND_OFF_CHECK_BELOW: f64 = 1e-6;
 /// A chord iteration must cut the relative residual at least by this factor, else the
 /// Jacobian is recomputed and factorised at the current iterate.
 const CHORD_CONTRACTION: f64 = 0.5;
@@ -224,11 +230,28 @@ impl Continuation {
         *self.last_factor.borrow_mut() = factor.map(|f| (tangent.to_vec(), f));
     }
 
+    /// The residual tolerance at the iterate (x, ω), relative to the residual scale: the
+    /// settings' `residual_tolerance`, raised to [`ROUND_OFF_FACTOR`] times the operator's
+    /// round-off level ([`ParametricResidual::round_off`]) where that is larger, since no
+    /// Newton step can bring the residual below it. The level is looked at only while the
+    /// residual `rel` is above the tolerance and below [`ROUND_OFF_CHECK_BELOW`].
+    fn tolerance_at<S: ParametricResidual>(
+        &self,
+        system: &mut S,
+        (x, omega): (&[f64], f64),
+        rel: f64,
+    ) -> f64 {
+        let tolerance = self.settings.residual_tolerance;
+        if rel <= tolerance || rel > ROUND_OFF_CHECK_BELOW {
+            return tolerance;
+        }
+        tolerance.max(ROUND_OFF_FACTOR * system.round_off(x, omega) / system.residual_scale())
+    }
+
     /// Convergence test of a Newton iterate: the relative residual at tolerance and the scaled
     /// step below its tolerance.
-    fn converged(&self, relative_residual: f64, step: f64) -> bool {
-        relative_residual <= self.settings.residual_tolerance
-            && step <= self.settings.step_tolerance.max(1e-14)
+    fn converged(&self, relative_residual: f64, step: f64, tolerance: f64) -> bool {
+        relative_residual <= tolerance && step <= self.settings.step_tolerance.max(1e-14)
     }
 
     /// The residual at an iterate of a chord iteration, returned relative to the load: with a
@@ -299,7 +322,8 @@ impl Continuation {
                 r_current,
                 previous,
             )?;
-            let at_tolerance = rel <= self.settings.residual_tolerance;
+            let tolerance = self.tolerance_at(system, (&x, omega), rel);
+            let at_tolerance = rel <= tolerance;
             let neg: Vec<f64> = r.iter().map(|v| -v).collect();
             let dx = match &factor {
                 Some(f) => {
@@ -355,7 +379,7 @@ impl Continuation {
             } else {
                 it
             };
-            if stalled_at_tolerance || self.converged(rel, alpha * step_norm) {
+            if stalled_at_tolerance || self.converged(rel, alpha * step_norm, tolerance) {
                 // Leave the operator evaluated at the returned point.
                 system
                     .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
@@ -496,6 +520,7 @@ impl Continuation {
                 r_current,
                 previous,
             )?;
+            let tolerance = self.tolerance_at(system, (&x, omega), rel);
             if first.is_nan() {
                 first = rel;
             } else if rel > 1e4 * first.max(self.settings.residual_tolerance) {
@@ -536,7 +561,7 @@ impl Continuation {
             } else {
                 it
             };
-            if rel <= self.settings.residual_tolerance {
+            if rel <= tolerance {
                 // At tolerance, a Newton step that does not lower the residual only moves
                 // through round-off (amplified by the Jacobian's condition number near a
                 // lightly damped resonance): the point is converged.
@@ -588,7 +613,7 @@ impl Continuation {
                 y[j] += dy[j];
             }
             let step = norm(&dy);
-            if self.converged(rel, step) {
+            if self.converged(rel, step, tolerance) {
                 self.keep_factor(factor.take(), tangent);
                 return Ok((y, it, rel));
             }
@@ -602,7 +627,7 @@ impl Continuation {
                     .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
                 let rel_new = norm(&r) / scale;
                 r_current = true;
-                if rel_new <= self.settings.residual_tolerance {
+                if rel_new <= tolerance {
                     self.keep_factor(factor.take(), tangent);
                     return Ok((y, it, rel_new));
                 }

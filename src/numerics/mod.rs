@@ -11,12 +11,14 @@
 //! | [`jacobian`] | [`AssembledJacobian`], [`BorderedFactor`], [`ImplicitJacobian`] | Jacobian storage (dense, sparse, implicit) and bordered solves |
 //! | [`derivatives`] | `finite_difference_jacobian`, `check_operator_jacobian` | finite-difference Jacobians and derivative checks |
 //! | [`continuation`] | [`Continuation`], [`ContinuationSettings`] | Newton at fixed λ, predictor-corrector continuation in λ |
+//! | [`golden`] | [`golden::maximise`] | golden-section search for a maximum where evaluations may fail |
 //! | [`broyden`] | `BroydenUpdates` | secant updates of a factorised Newton matrix (chord steps) |
 //! | [`path`] | [`PathPoint`], [`PathSummary`], [`Observer`], [`NewtonFailure`] | what continuation produces and reports |
 
 pub mod broyden;
 pub mod continuation;
 pub mod derivatives;
+pub mod golden;
 pub mod jacobian;
 pub mod linalg;
 pub mod path;

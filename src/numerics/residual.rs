@@ -13,6 +13,15 @@ pub trait ParametricResidual {
     fn dim(&self) -> usize;
     /// Norm that makes residuals relative (e.g. the load norm).
     fn residual_scale(&self) -> f64;
+    /// Round-off level of ‖R(x, λ)‖ (absolute, same norm as the residual): the size below
+    /// which floating-point evaluation cannot bring the residual, because R sums terms much
+    /// larger than itself that cancel (an FE body displaced as a whole by a gap: each row of
+    /// K q sums entries of about 10¹¹ N/m times 10⁻⁴ m to nearly zero). Newton accepts a point
+    /// whose residual is within a few times this level even where the relative tolerance asks
+    /// for less ([`crate::numerics::continuation`]). The default, 0, claims no such level.
+    fn round_off(&mut self, _x: &[f64], _lambda: f64) -> f64 {
+        0.0
+    }
     /// R(x, λ) into r.
     fn residual(&mut self, x: &[f64], lambda: f64, r: &mut [f64]) -> Result<(), Self::Error>;
     /// An empty Jacobian with the operator's storage and pattern.
