@@ -467,23 +467,22 @@ dofs = ["{tip}.y"]
     }
 }
 
-#[test]
-fn rayleigh_damped_modes_have_the_closed_form_damping_ratios() {
-    let dir = tempfile::tempdir().unwrap();
+/// `modes` of a Rayleigh-damped (α = 3 1/s, β = 2e-5 s) inline 2-DOF model with stiffness
+/// `k`, contacts open and stuck (a grounded contact on `b`).
+fn damped_two_dof(dir: &Path, k: [[f64; 2]; 2]) -> (fricbound::cli::modes::ModesReport, f64, f64) {
     let (alpha, beta) = (3.0, 2.0e-5);
     let m = [[2.0, 0.0], [0.0, 1.0]];
-    let k = [[3.0e5, -1.0e5], [-1.0e5, 1.0e5]];
     let c: Vec<Vec<f64>> = (0..2)
         .map(|i| (0..2).map(|j| alpha * m[i][j] + beta * k[i][j]).collect())
         .collect();
     let scene = write(
-        dir.path(),
+        dir,
         "damped.toml",
         &format!(
             r#"[model]
 dofs = ["a", "b"]
 mass = [[2.0, 0.0], [0.0, 1.0]]
-stiffness = [[3.0e5, -1.0e5], [-1.0e5, 1.0e5]]
+stiffness = [[{}, {}], [{}, {}]]
 damping = [[{}, {}], [{}, {}]]
 
 [[contacts]]
@@ -512,25 +511,35 @@ freq_end_hz = 100.0
 [output]
 dofs = ["b"]
 "#,
-            c[0][0], c[0][1], c[1][0], c[1][1]
+            k[0][0], k[0][1], k[1][0], k[1][1], c[0][0], c[0][1], c[1][0], c[1][1]
         ),
     );
     let report = modes(&ModesOptions {
         scene,
         count: 2,
         contacts: ContactCases::Both,
-        out: Some(dir.path().join("out")),
+        out: Some(dir.join("out")),
         overrides: Vec::new(),
     })
     .unwrap();
+    (report, alpha, beta)
+}
+
+#[test]
+fn rayleigh_damped_modes_have_the_closed_form_damping_ratios() {
+    let dir = tempfile::tempdir().unwrap();
+    let (report, alpha, beta) = damped_two_dof(dir.path(), [[3.0e5, -1.0e5], [-1.0e5, 1.0e5]]);
     // Contacts open: C = αM + βK is proportional. (Stuck, the contact spring is in K but not
     // in C, so the closed form does not apply; the modes are still listed.)
-    assert_eq!(report.cases[1].full_damped.as_ref().map(Vec::len), Some(2));
+    assert_eq!(
+        report.cases[1].full_damped.as_ref().map(|d| d.modes.len()),
+        Some(2)
+    );
     for case in &report.cases[..1] {
         assert_eq!(case.full.case, LinearCase::Open);
         let damped = case.full_damped.as_ref().expect("damped model");
-        assert_eq!(damped.len(), 2);
-        for (d, u) in damped.iter().zip(&case.full.modes) {
+        assert_eq!((damped.modes.len(), damped.rigid), (2, 0));
+        for (d, u) in damped.modes.iter().zip(&case.full.modes) {
             let omega = u.eigenvalue.sqrt();
             let zeta = alpha / (2.0 * omega) + beta * omega / 2.0;
             let fd = omega * (1.0 - zeta * zeta).sqrt() / (2.0 * std::f64::consts::PI);
@@ -544,4 +553,32 @@ dofs = ["b"]
     }
     let csv = std::fs::read_to_string(report.dir.join("damped_modes.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 4, "{csv}");
+}
+
+#[test]
+fn a_free_body_has_rigid_modes_at_zero_and_its_damped_rigid_eigenvalues_counted_apart() {
+    let dir = tempfile::tempdir().unwrap();
+    // Free-free pair: held only by the contact when stuck.
+    let (report, alpha, beta) = damped_two_dof(dir.path(), [[1.0e5, -1.0e5], [-1.0e5, 1.0e5]]);
+    let open = &report.cases[0];
+    assert_eq!(open.full.case, LinearCase::Open);
+    assert!(open.full.modes[0].rigid && open.full.modes[0].frequency_hz == 0.0);
+    assert!(!open.full.modes[1].rigid);
+    // The elastic mode: ω² = k (1/m_a + 1/m_b).
+    let omega2 = 1.0e5 * (1.0 / 2.0 + 1.0);
+    assert!((open.full.modes[1].eigenvalue - omega2).abs() < 1e-9 * omega2);
+    let damped = open.full_damped.as_ref().unwrap();
+    // s = 0 and s = −α for the rigid motion; one elastic mode.
+    assert_eq!((damped.rigid, damped.modes.len()), (2, 1));
+    let omega = omega2.sqrt();
+    let zeta = alpha / (2.0 * omega) + beta * omega / 2.0;
+    assert!(
+        (damped.modes[0].damping_ratio - zeta).abs() < 1e-9,
+        "{damped:?}"
+    );
+    let stuck = &report.cases[1];
+    assert!(stuck.full.modes.iter().all(|m| !m.rigid));
+    let text = &report.text;
+    assert!(text.contains("1 rigid-body mode(s) at 0 Hz"), "{text}");
+    assert!(text.contains("0 (rigid body)"), "{text}");
 }

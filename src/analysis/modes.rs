@@ -5,8 +5,9 @@
 //!
 //! Undamped modes solve K φ = λ M φ, λ = ω² (rad²/s²), f = ω/2π (Hz). Problems of at most
 //! [`DENSE_MAX_DOFS`] DOFs are solved densely (all eigenvalues, faer); larger ones by the
-//! reduction crate's shift-invert block Lanczos with the shift −(2π·1 Hz)² (K − σM is then
-//! positive definite even where a body is free), and the result is checked by a Sturm count
+//! reduction crate's shift-invert block Lanczos with the shift
+//! σ = −max((2π·1 Hz)², 10⁻⁶ λ_scale) (K − σM is then positive definite, and well conditioned,
+//! even where a body is free), and the result is checked by a Sturm count
 //! of the full model between the last mode kept and the next one: a missed mode is an error.
 //!
 //! Rigid-body modes: with contacts open a wedge damper is a free body, K is singular and the
@@ -19,14 +20,14 @@
 //! reported (a symmetric structure's pairs are not cut in half).
 //!
 //! Damped modes (state space, dense, at most [`DAMPED_MAX_DOFS`] DOFs): the eigenvalues s of
-//! [[0, I], [−M⁻¹K, −M⁻¹C]] with Im s ≥ 0, ordered by |s|; natural frequency |s|/2π, damped
+//! [[0, I], [−M⁻¹K, −M⁻¹C]] (formed balanced, see [`damped_modes`]) with Im s ≥ 0, rigid-body
+//! ones (two real eigenvalues per rigid-body mode) counted apart, the others ordered by |s|; natural frequency |s|/2π, damped
 //! frequency Im s/2π, damping ratio ζ = −Re s/|s|. For Rayleigh damping C = αM + βK this is
 //! ζ = α/(2ω) + βω/2 per mode (the check of the tests). A real s (an overdamped motion, or a
 //! free body's motion damped by αM) has ζ = 1.
 
 use std::time::Instant;
 
-use faer::prelude::Solve;
 use faer::{c64, Mat};
 use fricbound_reduction::{Ordering, ReductionError};
 
@@ -46,8 +47,13 @@ pub const RIGID_TOLERANCE: f64 = 1e-9;
 /// Relative distance within which two eigenvalues are copies of a repeated one.
 pub const CLUSTER_RTOL: f64 = 1e-6;
 
-/// Shift of the Lanczos solve, −(2π·1 Hz)² (rad²/s²).
-const LANCZOS_SHIFT: f64 = -(2.0 * std::f64::consts::PI) * (2.0 * std::f64::consts::PI);
+/// Smallest magnitude of the Lanczos shift, (2π·1 Hz)² (rad²/s²).
+const LANCZOS_SHIFT_MIN: f64 = (2.0 * std::f64::consts::PI) * (2.0 * std::f64::consts::PI);
+
+/// Magnitude of the Lanczos shift relative to λ_scale: with a free body, K − σM has pivots
+/// of about |σ|/λ_scale relative to its diagonal, which must stay far above the factorisation's
+/// singularity threshold (10⁻¹¹).
+const LANCZOS_SHIFT_RELATIVE: f64 = 1e-6;
 
 /// Extra eigenpairs asked of Lanczos beyond `count` (to find the end of a repeated cluster
 /// and the next distinct eigenvalue for the Sturm check).
@@ -228,9 +234,9 @@ pub fn natural_modes(
         let ks = sparse(n, &k);
         let ms = sparse(n, &problem.model.mass.triplets());
         let asked = (count + LANCZOS_EXTRA).min(n);
-        let eig =
-            fricbound_reduction::lowest_eigenpairs(ks.as_ref(), ms.as_ref(), asked, LANCZOS_SHIFT)
-                .map_err(eigen)?;
+        let shift = -(LANCZOS_SHIFT_RELATIVE * scale).max(LANCZOS_SHIFT_MIN);
+        let eig = fricbound_reduction::lowest_eigenpairs(ks.as_ref(), ms.as_ref(), asked, shift)
+            .map_err(eigen)?;
         let kept = kept_count(&eig.values, count, scale);
         let last = eig.values[kept - 1];
         let sigma = match eig.values.get(kept) {
@@ -301,39 +307,84 @@ pub fn is_damped(problem: &Problem) -> bool {
     any
 }
 
-/// The lowest `count` damped modes of the problem in a contact case (module docs); `None`
-/// when the problem is undamped or larger than [`DAMPED_MAX_DOFS`].
+/// The damped modes of a problem in one contact case.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DampedModes {
+    /// The lowest elastic damped modes, by natural frequency.
+    pub modes: Vec<DampedMode>,
+    /// Rigid-body eigenvalues left out of `modes`: two real ones per rigid-body mode of the
+    /// undamped problem (s = 0, and 0 or −α under Rayleigh damping).
+    pub rigid: usize,
+}
+
+/// The lowest `count` elastic damped modes of the problem in a contact case (module docs);
+/// `None` when the problem is undamped or larger than [`DAMPED_MAX_DOFS`].
+///
+/// The state-space matrix is formed in the undamped modal coordinates, scaled so that it is
+/// balanced: with K Φ = M Φ Λ (Φᵀ M Φ = I), Ω = Λ^½, C̃ = Φᵀ C Φ and the states z₁ = Ω η,
+/// z₂ = η̇ (q = Φ η), ż = [[0, Ω], [−Ω, −C̃]] z. Its eigenvalues are those of
+/// [[0, I], [−M⁻¹K, −M⁻¹C]], but every entry is of the size of a frequency, where the
+/// unscaled form mixes 1 with K/M (10¹³ for a steel mesh) and loses digits.
 pub fn damped_modes(
     problem: &Problem,
     case: LinearCase,
     count: usize,
-) -> Result<Option<Vec<DampedMode>>, ModesError> {
+) -> Result<Option<DampedModes>, ModesError> {
     let n = problem.model.n_dofs();
     if n > DAMPED_MAX_DOFS || !is_damped(problem) {
         return Ok(None);
     }
+    let triplets = case_stiffness(problem, case);
+    let scale = eigenvalue_scale(&triplets, &problem.model.mass);
     let mut k = Mat::<f64>::zeros(n, n);
-    for (i, j, v) in case_stiffness(problem, case) {
+    for (i, j, v) in triplets {
         k[(i, j)] += v;
     }
     let m = problem.model.mass.to_dense();
-    let c = problem.model.damping.to_dense();
-    let llt = m
-        .llt(faer::Side::Lower)
+    let (lambda, phi) = fricbound_reduction::dense_generalized_eigenvalues(k.as_ref(), m.as_ref())
         .map_err(|_| ModesError::MassSingular)?;
-    let mk = llt.solve(&k);
-    let mc = llt.solve(&c);
+    let omega: Vec<f64> = lambda.iter().map(|l| l.max(0.0).sqrt()).collect();
+    let c = problem.model.damping.to_dense();
+    let c_modal = phi.transpose() * &c * &phi;
     let a = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
         (true, true) => 0.0,
-        (true, false) => f64::from(u8::from(j - n == i)),
-        (false, true) => -mk[(i - n, j)],
-        (false, false) => -mc[(i - n, j - n)],
+        (true, false) => {
+            if j - n == i {
+                omega[i]
+            } else {
+                0.0
+            }
+        }
+        (false, true) => {
+            if i - n == j {
+                -omega[j]
+            } else {
+                0.0
+            }
+        }
+        (false, false) => -c_modal[(i - n, j - n)],
     });
-    let values = a.eigenvalues().map_err(|_| ModesError::DampedEigen)?;
-    let scale = values.iter().map(|s| s.norm()).fold(0.0, f64::max);
+    let mut values = a.eigenvalues().map_err(|_| ModesError::DampedEigen)?;
+    // Each rigid-body mode (ω_i ≈ 0) gives two real eigenvalues: 0 (its z₁ row is zero) and
+    // the decay of its velocity under C (0, or −α under Rayleigh damping). They are the
+    // 2·n_rigid real eigenvalues of smallest |s|, counted apart.
+    let n_rigid = lambda
+        .iter()
+        .filter(|&&l| l < RIGID_TOLERANCE * scale)
+        .count();
+    let norm_max = values.iter().map(|s| s.norm()).fold(0.0, f64::max);
+    let is_real = |s: &c64| s.im.abs() <= 1e-9 * norm_max.max(f64::MIN_POSITIVE);
+    let mut real: Vec<usize> = (0..values.len()).filter(|&i| is_real(&values[i])).collect();
+    real.sort_by(|&a, &b| values[a].norm().total_cmp(&values[b].norm()));
+    let mut drop: Vec<usize> = real.into_iter().take(2 * n_rigid).collect();
+    let rigid = drop.len();
+    drop.sort_unstable();
+    for &i in drop.iter().rev() {
+        values.remove(i);
+    }
     let mut modes: Vec<DampedMode> = values
         .into_iter()
-        .filter(|s| s.im >= -1e-12 * scale)
+        .filter(|s| s.im >= -1e-9 * norm_max)
         .map(|s| {
             let norm = s.norm();
             DampedMode {
@@ -346,7 +397,7 @@ pub fn damped_modes(
         .collect();
     modes.sort_by(|a, b| a.natural_hz.total_cmp(&b.natural_hz));
     modes.truncate(count);
-    Ok(Some(modes))
+    Ok(Some(DampedModes { modes, rigid }))
 }
 
 #[cfg(test)]

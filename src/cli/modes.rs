@@ -226,7 +226,8 @@ fn modes_text(
     if let Some(r) = reduction {
         let j = ReductionJson::new(r);
         let _ = writeln!(s, "reduced      {} DOFs: {}", j.n_reduced, j.makeup_line());
-        let _ = write!(s, "{}", r.model.report);
+        let report = r.model.report.to_string();
+        let _ = writeln!(s, "{}", report.trim_end());
         let fi: Vec<String> = j
             .fixed_interface_hz
             .iter()
@@ -288,8 +289,16 @@ fn modes_text(
         }
         for (model, damped) in [("full", &c.full_damped), ("reduced", &c.reduced_damped)] {
             if let Some(d) = damped {
-                let _ = writeln!(s, "  damped modes, {model} model: natural Hz, damped Hz, ζ");
-                for (i, m) in d.iter().enumerate() {
+                let _ = writeln!(
+                    s,
+                    "  damped modes, {model} model: natural Hz, damped Hz, ζ{}",
+                    if d.rigid > 0 {
+                        format!(" ({} rigid-body eigenvalues s ≈ 0 left out)", d.rigid)
+                    } else {
+                        String::new()
+                    }
+                );
+                for (i, m) in d.modes.iter().enumerate() {
                     let _ = writeln!(
                         s,
                         "  {:>4}  {:>14.6}  {:>14.6}  {:.4e}",
@@ -358,7 +367,7 @@ pub fn reduce(options: &ReduceOptions) -> Result<ReduceReport, CommandError> {
         json.n_reduced,
         json.makeup_line()
     );
-    let _ = write!(text, "{}", reduction.model.report);
+    let _ = writeln!(text, "{}", reduction.model.report.to_string().trim_end());
     let _ = writeln!(text, "written to {}:", dir.display());
     for f in &files {
         let _ = writeln!(text, "  {}", f.display());

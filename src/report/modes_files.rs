@@ -12,7 +12,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::analysis::modes::{case_name, DampedMode, EigenMethod, NaturalModes};
+use crate::analysis::modes::{case_name, DampedModes, EigenMethod, NaturalModes};
 use crate::fe::{write_vtu, PointField, VtuError};
 use crate::model::Problem;
 use crate::report::files::WriteError;
@@ -27,9 +27,9 @@ pub struct CaseModes {
     /// Reduced model.
     pub reduced: Option<NaturalModes>,
     /// Damped modes of the full model (None: undamped or too large).
-    pub full_damped: Option<Vec<DampedMode>>,
+    pub full_damped: Option<DampedModes>,
     /// Damped modes of the reduced model.
-    pub reduced_damped: Option<Vec<DampedMode>>,
+    pub reduced_damped: Option<DampedModes>,
 }
 
 /// Relative error of a reduced frequency, `None` where it has no meaning.
@@ -76,13 +76,13 @@ pub fn modes_csv(cases: &[CaseModes]) -> String {
 }
 
 /// `damped_modes.csv`: `case,model,mode,natural_hz,damped_hz,damping_ratio,re,im` (s = re + i·im
-/// in 1/s).
+/// in 1/s); elastic modes only, rigid-body eigenvalues are counted in `modes.json`.
 pub fn damped_csv(cases: &[CaseModes]) -> String {
     let mut s = String::from("case,model,mode,natural_hz,damped_hz,damping_ratio,re,im\n");
     for c in cases {
         let name = case_name(c.full.case);
         for (model, modes) in [("full", &c.full_damped), ("reduced", &c.reduced_damped)] {
-            for (i, m) in modes.iter().flatten().enumerate() {
+            for (i, m) in modes.iter().flat_map(|d| &d.modes).enumerate() {
                 let _ = writeln!(
                     s,
                     "{name},{model},{},{:.10e},{:.10e},{:.6e},{:.10e},{:.10e}",
@@ -166,13 +166,15 @@ pub struct ModelModesJson {
     pub max_residual: Option<f64>,
     /// Wall-clock time (s).
     pub seconds: f64,
-    /// Damped modes: natural and damped frequency (Hz) and damping ratio.
+    /// Damped elastic modes: natural and damped frequency (Hz) and damping ratio.
     pub damped: Option<Vec<[f64; 3]>>,
+    /// Rigid-body eigenvalues of the damped problem left out of `damped`.
+    pub damped_rigid: Option<usize>,
 }
 
 impl ModelModesJson {
     /// From computed modes.
-    pub fn new(m: &NaturalModes, damped: Option<&Vec<DampedMode>>) -> Self {
+    pub fn new(m: &NaturalModes, damped: Option<&DampedModes>) -> Self {
         let (method, sturm_count, sturm_shift_hz, max_residual) = match &m.method {
             EigenMethod::Dense => ("dense", None, None, None),
             EigenMethod::Lanczos {
@@ -195,8 +197,10 @@ impl ModelModesJson {
             sturm_shift_hz,
             max_residual,
             seconds: m.seconds,
+            damped_rigid: damped.map(|d| d.rigid),
             damped: damped.map(|d| {
-                d.iter()
+                d.modes
+                    .iter()
                     .map(|x| [x.natural_hz, x.damped_hz, x.damping_ratio])
                     .collect()
             }),
