@@ -343,7 +343,12 @@ pub fn damped_modes(
     let m = problem.model.mass.to_dense();
     let (lambda, phi) = fricbound_reduction::dense_generalized_eigenvalues(k.as_ref(), m.as_ref())
         .map_err(|_| ModesError::MassSingular)?;
-    let omega: Vec<f64> = lambda.iter().map(|l| l.max(0.0).sqrt()).collect();
+    // Rigid-body modes at exactly ω = 0, as in the undamped report.
+    let rigid_bound = RIGID_TOLERANCE * scale;
+    let omega: Vec<f64> = lambda
+        .iter()
+        .map(|&l| if l < rigid_bound { 0.0 } else { l.sqrt() })
+        .collect();
     let c = problem.model.damping.to_dense();
     let c_modal = phi.transpose() * &c * &phi;
     let a = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
@@ -368,10 +373,7 @@ pub fn damped_modes(
     // Each rigid-body mode (ω_i ≈ 0) gives two real eigenvalues: 0 (its z₁ row is zero) and
     // the decay of its velocity under C (0, or −α under Rayleigh damping). They are the
     // 2·n_rigid real eigenvalues of smallest |s|, counted apart.
-    let n_rigid = lambda
-        .iter()
-        .filter(|&&l| l < RIGID_TOLERANCE * scale)
-        .count();
+    let n_rigid = lambda.iter().filter(|&&l| l < rigid_bound).count();
     let norm_max = values.iter().map(|s| s.norm()).fold(0.0, f64::max);
     let is_real = |s: &c64| s.im.abs() <= 1e-9 * norm_max.max(f64::MIN_POSITIVE);
     let mut real: Vec<usize> = (0..values.len()).filter(|&i| is_real(&values[i])).collect();
