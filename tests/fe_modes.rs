@@ -416,6 +416,11 @@ freq_end_hz = 20.0
 
 [output]
 dofs = ["{tip}.y"]
+
+[reduction]
+modes = 6
+[reduction.boundary]
+groups = ["tip_edge"]
 "#,
         mesh = data.display()
     );
@@ -455,6 +460,25 @@ dofs = ["{tip}.y"]
             .dir
             .join(format!("modes_full_{}.vtu", modes::case_name(c.full.case)))
             .exists());
+    }
+    // The tip edge kept physical in both directions: its nodes but the tip corner (whose x
+    // and y are kept already, as the contact node) are extra.
+    let tip_nodes = mesh.group_nodes("tip_edge").unwrap().len();
+    let red = report.reduction.as_ref().unwrap();
+    assert_eq!(
+        (
+            red.boundary_contacts,
+            red.boundary_contact_nodes,
+            red.boundary_outputs
+        ),
+        (1, 1, 0)
+    );
+    assert_eq!(red.boundary_extra, 2 * tip_nodes - 2);
+    assert!(report.dir.join("modes_reduced_stuck.vtu").exists());
+    for c in &report.cases {
+        for e in fricbound::report::modes_files::relative_errors(c) {
+            assert!(e.unwrap() > -1e-9);
+        }
     }
     // The stuck spring stiffens: every stuck frequency at or above the open one.
     for (o, s) in report.cases[0]
@@ -581,4 +605,52 @@ fn a_free_body_has_rigid_modes_at_zero_and_its_damped_rigid_eigenvalues_counted_
     let text = &report.text;
     assert!(text.contains("1 rigid-body mode(s) at 0 Hz"), "{text}");
     assert!(text.contains("0 (rigid body)"), "{text}");
+}
+
+#[test]
+fn reduction_boundary_keeps_extra_dofs_and_groups_and_refuses_bad_ones_by_field() {
+    let dir = tempfile::tempdir().unwrap();
+    // Chains: one extra DOF by name.
+    let scene = chain_scene(
+        dir.path(),
+        50,
+        "\n[reduction]\nmodes = 4\n[reduction.boundary]\ndofs = [\"20.x\", \"50.y\"]\n",
+    );
+    let out = dir.path().join("reduced");
+    let r = reduce(&ReduceOptions {
+        scene: scene.clone(),
+        out: Some(out.clone()),
+        overrides: Vec::new(),
+    })
+    .unwrap();
+    // 50.y is already kept (the contact node's other direction): only 20.x is extra.
+    let j = &r.reduction;
+    assert_eq!(
+        (
+            j.n_boundary,
+            j.boundary_contacts,
+            j.boundary_contact_nodes,
+            j.boundary_outputs,
+            j.boundary_extra
+        ),
+        (4, 1, 1, 1, 1)
+    );
+    let dofs = std::fs::read_to_string(out.join("reduced_dofs.csv")).unwrap();
+    assert!(dofs.contains("\n2,20.x,physical,20,x,\n"), "{dofs}");
+    // A name that is not a DOF, and groups without a mesh, are refused naming the field.
+    let bad = fricbound::scene::load(&scene, &["reduction.boundary.dofs=[\"20.q\"]".to_string()])
+        .unwrap()
+        .validate_unreduced(&scene.display().to_string())
+        .unwrap_err()
+        .to_string();
+    assert!(bad.contains("reduction.boundary.dofs[0]"), "{bad}");
+    let bad = fricbound::scene::load(&scene, &["reduction.boundary.groups=[\"tip\"]".to_string()])
+        .unwrap()
+        .validate_unreduced(&scene.display().to_string())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        bad.contains("reduction.boundary.groups[0]") && bad.contains("mesh"),
+        "{bad}"
+    );
 }
