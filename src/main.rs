@@ -54,9 +54,9 @@ enum Command {
     Modes {
         /// Scene file (TOML).
         scene: PathBuf,
-        /// Modes per contact case (every copy of a repeated last frequency is added).
-        #[arg(long, default_value_t = 10)]
-        count: usize,
+        /// Modes per contact case, ≥ 1 (every copy of a repeated last frequency is added).
+        #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u64).range(1..))]
+        count: u64,
         /// Contact cases: open (removed), stuck (kt, kn springs) or both.
         #[arg(long, value_enum, default_value_t = fricbound::cli::modes::ContactCases::Both)]
         contacts: fricbound::cli::modes::ContactCases,
@@ -144,7 +144,7 @@ fn main() -> ExitCode {
             overrides,
         } => fricbound::cli::modes::modes(&fricbound::cli::modes::ModesOptions {
             scene,
-            count,
+            count: usize::try_from(count).unwrap_or(usize::MAX),
             contacts,
             out,
             overrides,

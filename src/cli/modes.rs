@@ -101,7 +101,12 @@ fn reduce_with_outputs(
 /// Runs `fricbound modes` (module docs) and writes its files.
 pub fn modes(options: &ModesOptions) -> Result<ModesReport, CommandError> {
     if options.count == 0 {
-        return Err(SceneError::invalid("--count", "count", "ask for at least one mode").into());
+        return Err(SceneError::invalid(
+            &options.scene.display().to_string(),
+            "--count",
+            "ask for at least one mode",
+        )
+        .into());
     }
     let (label, full, reduction) = full_and_reduced(&options.scene, &options.overrides)?;
     let dir = options
