@@ -49,6 +49,36 @@ enum Command {
         #[arg(long = "set", value_name = "FIELD=VALUE")]
         overrides: Vec<String>,
     },
+    /// Natural frequencies of the full and reduced models, contacts open and stuck, with
+    /// their relative errors; damped modes; mode shapes; the reduction report.
+    Modes {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Modes per contact case, ≥ 1 (every copy of a repeated last frequency is added).
+        #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u64).range(1..))]
+        count: u64,
+        /// Contact cases: open (removed), stuck (kt, kn springs) or both.
+        #[arg(long, value_enum, default_value_t = fricbound::cli::modes::ContactCases::Both)]
+        contacts: fricbound::cli::modes::ContactCases,
+        /// Output folder (default: out/<scene name>/modes).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override a scene field by its dotted path.
+        #[arg(long = "set", value_name = "FIELD=VALUE")]
+        overrides: Vec<String>,
+    },
+    /// Write the Craig-Bampton reduced model (K_r, M_r, C_r as Matrix Market, reduced DOF map,
+    /// recovery rows of the outputs, reduction report).
+    Reduce {
+        /// Scene file (TOML) with a [reduction] table.
+        scene: PathBuf,
+        /// Output folder (default: out/<scene name>/reduced).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override a scene field by its dotted path.
+        #[arg(long = "set", value_name = "FIELD=VALUE")]
+        overrides: Vec<String>,
+    },
     /// Generate or inspect FE meshes.
     Mesh {
         #[command(subcommand)]
@@ -106,6 +136,32 @@ fn main() -> ExitCode {
         Command::Check { scene, overrides } => fricbound::cli::check(scene.as_deref(), &overrides)
             .map(|s| print!("{s}"))
             .map_err(|e| e.to_string()),
+        Command::Modes {
+            scene,
+            count,
+            contacts,
+            out,
+            overrides,
+        } => fricbound::cli::modes::modes(&fricbound::cli::modes::ModesOptions {
+            scene,
+            count: usize::try_from(count).unwrap_or(usize::MAX),
+            contacts,
+            out,
+            overrides,
+        })
+        .map(|r| print!("{}", r.text))
+        .map_err(|e| e.to_string()),
+        Command::Reduce {
+            scene,
+            out,
+            overrides,
+        } => fricbound::cli::modes::reduce(&fricbound::cli::modes::ReduceOptions {
+            scene,
+            out,
+            overrides,
+        })
+        .map(|r| print!("{}", r.text))
+        .map_err(|e| e.to_string()),
         Command::Bench { command } => fricbound::cli::bench::run(&command)
             .map(|text| print!("{text}"))
             .map_err(|e| e.to_string()),

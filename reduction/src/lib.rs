@@ -98,6 +98,32 @@ pub fn lowest_eigenpairs(
     lowest_eigenpairs_with(k, m, n, shift, Ordering::Metis, &LanczosOptions::default())
 }
 
+/// Sturm-sequence count of the full model: how many eigenvalues of `K φ = λ M φ` lie below
+/// `sigma` (rad²/s²), from the negative pivots of an `L D Lᵀ` factorisation of `K − σM`
+/// (Sylvester's law of inertia). It checks that an eigen solve missed no mode below `sigma`.
+/// `None` when a zero pivot occurred (σ on an eigenvalue: move it).
+pub fn count_eigenvalues_below(
+    k: SparseColMatRef<'_, usize, f64>,
+    m: SparseColMatRef<'_, usize, f64>,
+    sigma: f64,
+    ordering: Ordering,
+) -> Result<Option<usize>, ReductionError> {
+    if !sigma.is_finite() {
+        return Err(ReductionError::InvalidArgument(format!(
+            "shift {sigma} is not finite"
+        )));
+    }
+    let size = k.nrows();
+    let kl = csc::lower(&csc::canonical_symmetric(k, "K", size)?);
+    let ml = csc::lower(&csc::canonical_symmetric(m, "M", size)?);
+    let a = csc::add_scaled(&kl, &ml, -sigma);
+    drop((kl, ml));
+    let (_, inv, _) = factor::fill_reducing_order(&a, ordering)?;
+    let count = factor::negative_pivots(&a.permute_sym_lower(&inv));
+    block::release_scratch();
+    count
+}
+
 /// [`lowest_eigenpairs`] with a chosen ordering and Lanczos settings.
 pub fn lowest_eigenpairs_with(
     k: SparseColMatRef<'_, usize, f64>,

@@ -26,6 +26,9 @@
 //! - [`peaks::path_extrema`]: the same for resonances and anti-resonances (local minima) of
 //!   every output of an FRF run, with the path points they were refined from
 //!   ([`peaks::PathExtremum`]); a failed refinement reports the path point, never an error.
+//! - [`modes::natural_modes`], [`modes::damped_modes`]: natural frequencies and shapes of the
+//!   linear structure with contacts open or stuck (dense or Lanczos with a Sturm check), damped
+//!   eigenvalues and modal damping ratios.
 //! - [`limits::analyse`]: the limit analysis (limit, intermediate and scanned curves, grid
 //!   classification, bound check, hysteresis loops) as a [`limits::LimitAnalysis`].
 //! - [`limits::solve_case`]: one case's curve and its refined resonance peak.
@@ -34,4 +37,5 @@
 pub mod frf;
 pub mod limits;
 pub mod linear;
+pub mod modes;
 pub mod peaks;

@@ -16,11 +16,14 @@
 //!   numbers next to the paper's statements;
 //! - [`bench`](mod@bench) (`fricbound bench`): the scaling study of the reduction and the solves;
 //! - [`mesh`] (`fricbound mesh`): generates the blade-pair mesh;
+//! - [`modes`] (`fricbound modes`, `fricbound reduce`): natural frequencies of the full and
+//!   reduced models, the reduced model written out;
 //! - [`CommandError`]: why a command failed, naming what failed.
 
 pub mod bench;
 mod limits_run;
 pub mod mesh;
+pub mod modes;
 pub mod paper;
 mod sweep_run;
 
@@ -58,6 +61,9 @@ pub enum CommandError {
     /// A figure could not be drawn.
     #[error(transparent)]
     Plot(#[from] PlotError),
+    /// Natural frequencies could not be computed.
+    #[error(transparent)]
+    Eigen(#[from] crate::analysis::modes::ModesError),
     /// The output folder could not be created.
     #[error("{path}: cannot create output folder: {source}")]
     OutputDir {
@@ -594,7 +600,7 @@ pub fn memory_refusal(
 const MESH_MODES: usize = 10;
 
 /// Creates the output folder `dir` (and its parents).
-fn create_dir(dir: &Path) -> Result<(), CommandError> {
+pub(crate) fn create_dir(dir: &Path) -> Result<(), CommandError> {
     std::fs::create_dir_all(dir).map_err(|source| CommandError::OutputDir {
         path: dir.display().to_string(),
         source,
@@ -931,6 +937,7 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
         }
         let _ = writeln!(s, "{line}");
     }
+    s.push_str(&modes::boundary_check_lines(&scene, &label)?);
     Ok(s)
 }
 

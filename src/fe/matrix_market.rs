@@ -19,12 +19,18 @@
 //! as f64).
 //!
 //! # DOF map
-//! A CSV file, one DOF per line: `node,direction,row`. `#` starts a comment line; blank lines
-//! are skipped. The first other line is the header and states the row base:
-//! `node,direction,row` or `node,direction,row1` for 1-based rows (the Matrix Market
-//! convention), `node,direction,row0` for 0-based rows. `node` is the exporting code's node id
-//! (unsigned integer), `direction` one of `x y z rx ry rz`. Every matrix row must be named
-//! exactly once.
+//! A CSV file, one DOF per line: node, direction, row. `#` starts a comment line; blank lines
+//! are skipped. The first other line is the header, three column names in this order, as the
+//! exporting codes write them ([`DOF_MAP_HEADERS`]):
+//! - node: `node`, `node_id`, `nodeid` or `nid`: the exporting code's node id (unsigned integer);
+//! - direction: `direction`, `dir` or `dof`: `x y z rx ry rz` or their numbers `1`-`6`
+//!   (the Nastran/Abaqus component numbers: 1-3 translations, 4-6 rotations);
+//! - row: `row1` for 1-based rows (the Matrix Market convention), `row0` or `index` for 0-based
+//!   rows, `row` for the base the scene declares (`model.matrix_market.dof_map_base`), 1-based
+//!   when it declares none.
+//!
+//! A header that is none of these is refused with the list of accepted names. Every matrix row
+//! must be named exactly once.
 
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read};
@@ -212,6 +218,24 @@ pub fn read_fe_matrices(
     dof_map_path: &Path,
     symmetry_tolerance: f64,
 ) -> Result<FeMatrices, FeMatrixError> {
+    read_fe_matrices_with_base(
+        stiffness_path,
+        mass_path,
+        dof_map_path,
+        symmetry_tolerance,
+        None,
+    )
+}
+
+/// [`read_fe_matrices`] with the row base of a DOF map whose header says `row` (0 or 1; see
+/// [`read_dof_map_with_base`]).
+pub fn read_fe_matrices_with_base(
+    stiffness_path: &Path,
+    mass_path: &Path,
+    dof_map_path: &Path,
+    symmetry_tolerance: f64,
+    row_base: Option<usize>,
+) -> Result<FeMatrices, FeMatrixError> {
     let stiffness = read_symmetric_matrix(stiffness_path, symmetry_tolerance)?;
     let mass = read_symmetric_matrix(mass_path, symmetry_tolerance)?;
     if stiffness.nrows() != mass.nrows() {
@@ -222,7 +246,7 @@ pub fn read_fe_matrices(
             mass_size: mass.nrows(),
         });
     }
-    let dofs = read_dof_map(dof_map_path, stiffness.nrows())?;
+    let dofs = read_dof_map_with_base(dof_map_path, stiffness.nrows(), row_base)?;
     Ok(FeMatrices {
         stiffness,
         mass,
@@ -291,6 +315,17 @@ pub fn check_symmetric(
 
 /// Reads a DOF map file (format in the module doc) for matrices with `size` rows.
 pub fn read_dof_map(path: &Path, size: usize) -> Result<DofMap, FeMatrixError> {
+    read_dof_map_with_base(path, size, None)
+}
+
+/// Reads a DOF map whose `row` column counts from `row_base` (0 or 1) when the header says
+/// plain `row`; `None` means 1-based. A header `row0`/`index` or `row1` states its own base and
+/// must agree with a declared one.
+pub fn read_dof_map_with_base(
+    path: &Path,
+    size: usize,
+    row_base: Option<usize>,
+) -> Result<DofMap, FeMatrixError> {
     let file = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|source| FeMatrixError::Io {
         file: file.clone(),
@@ -307,16 +342,8 @@ pub fn read_dof_map(path: &Path, size: usize) -> Result<DofMap, FeMatrixError> {
         }
         let fields: Vec<&str> = content.split(',').map(str::trim).collect();
         let Some(row_base) = base else {
-            base = Some(parse_dof_map_header(&fields).ok_or_else(|| {
-                FeMatrixError::format(
-                    &file,
-                    line,
-                    format!(
-                        "expected the header `node,direction,row` (1-based rows), \
-                         `node,direction,row1` or `node,direction,row0` (0-based rows), \
-                         found `{content}`"
-                    ),
-                )
+            base = Some(parse_dof_map_header(&fields, row_base).map_err(|reason| {
+                FeMatrixError::format(&file, line, format!("{reason}, found `{content}`"))
             })?);
             continue;
         };
@@ -337,12 +364,12 @@ pub fn read_dof_map(path: &Path, size: usize) -> Result<DofMap, FeMatrixError> {
                 format!("node `{}` is not an unsigned integer", fields[0]),
             )
         })?;
-        let direction = Direction::parse(fields[1]).ok_or_else(|| {
+        let direction = parse_direction(fields[1]).ok_or_else(|| {
             FeMatrixError::format(
                 &file,
                 line,
                 format!(
-                    "direction `{}` is not one of x, y, z, rx, ry, rz",
+                    "direction `{}` is not one of x, y, z, rx, ry, rz or 1-6",
                     fields[1]
                 ),
             )
@@ -387,7 +414,7 @@ pub fn read_dof_map(path: &Path, size: usize) -> Result<DofMap, FeMatrixError> {
         return Err(FeMatrixError::format(
             &file,
             text.lines().count().max(1),
-            "no header `node,direction,row` found",
+            format!("no header found; {DOF_MAP_HEADERS}"),
         ));
     }
     let missing: Vec<usize> = (0..size).filter(|&r| slots[r].is_none()).collect();
@@ -410,18 +437,47 @@ pub fn read_dof_map(path: &Path, size: usize) -> Result<DofMap, FeMatrixError> {
     DofMap::new(dofs).map_err(|e| FeMatrixError::format(&file, 0, e.to_string()))
 }
 
-/// Row base stated by the header fields, or `None` if they are not a DOF map header.
-fn parse_dof_map_header(fields: &[&str]) -> Option<usize> {
-    if fields.len() != 3
-        || !fields[0].eq_ignore_ascii_case("node")
-        || !fields[1].eq_ignore_ascii_case("direction")
-    {
-        return None;
+/// The DOF map headers accepted, as an error message lists them.
+pub const DOF_MAP_HEADERS: &str = "expected a header of three columns `node,direction,row`: \
+     node as `node`, `node_id`, `nodeid` or `nid`; direction as `direction`, `dir` or `dof` \
+     (values x, y, z, rx, ry, rz or 1-6); row as `row1` (1-based), `row0` or `index` \
+     (0-based), or `row` (1-based unless the scene sets model.matrix_market.dof_map_base)";
+
+/// Row base stated by the header fields (`declared` is the scene's base for a plain `row`), or
+/// why they are not a DOF map header.
+fn parse_dof_map_header(fields: &[&str], declared: Option<usize>) -> Result<usize, String> {
+    let lower: Vec<String> = fields.iter().map(|f| f.to_ascii_lowercase()).collect();
+    let is_node = |f: &str| matches!(f, "node" | "node_id" | "nodeid" | "nid");
+    let is_direction = |f: &str| matches!(f, "direction" | "dir" | "dof");
+    if lower.len() != 3 || !is_node(&lower[0]) || !is_direction(&lower[1]) {
+        return Err(DOF_MAP_HEADERS.to_string());
     }
-    match fields[2].to_ascii_lowercase().as_str() {
-        "row" | "row1" => Some(1),
-        "row0" => Some(0),
-        _ => None,
+    let stated = match lower[2].as_str() {
+        "row" => return Ok(declared.unwrap_or(1)),
+        "row1" => 1,
+        "row0" | "index" => 0,
+        _ => return Err(DOF_MAP_HEADERS.to_string()),
+    };
+    match declared {
+        Some(b) if b != stated => Err(format!(
+            "the header's `{}` states {stated}-based rows but the scene declares \
+             model.matrix_market.dof_map_base = {b}",
+            fields[2]
+        )),
+        _ => Ok(stated),
+    }
+}
+
+/// A direction as written in DOF maps: a name (`x` .. `rz`) or a component number 1-6.
+fn parse_direction(text: &str) -> Option<Direction> {
+    match text.trim() {
+        "1" => Some(Direction::X),
+        "2" => Some(Direction::Y),
+        "3" => Some(Direction::Z),
+        "4" => Some(Direction::Rx),
+        "5" => Some(Direction::Ry),
+        "6" => Some(Direction::Rz),
+        other => Direction::parse(other),
     }
 }
 

@@ -56,7 +56,9 @@ pub use assembly::{assemble, AssemblyError, FeModel, GroupMaterial};
 pub use contact_patch::{pair_patch, ContactPair, ContactPatch, ContactPatchError, PatchSpec};
 pub use dof::{Direction, Dof, DofMap};
 pub use material::{Material, PlaneAssumption};
-pub use matrix_market::{read_fe_matrices, FeMatrices, FeMatrixError};
+pub use matrix_market::{
+    read_fe_matrices, read_fe_matrices_with_base, FeMatrices, FeMatrixError, DOF_MAP_HEADERS,
+};
 pub use mesh::{ElementKind, Mesh, MeshError, PhysicalGroup};
 pub use msh_read::{read_msh, MshReadError};
 pub use msh_write::{write_msh, MshFormat, MshWriteError};

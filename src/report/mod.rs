@@ -14,11 +14,17 @@
 //! - [`plot`]: the figures as PNG and SVG ([`plot::plot_frf`], [`plot::plot_limits`],
 //!   [`plot::plot_sweep`], [`plot::plot_hysteresis`], [`plot::plot_lines`]);
 //! - [`mesh_results`]: a converged point's response on the FE mesh (VTU);
-//! - [`mesh_modes`]: the stuck-contact modes on the FE mesh (VTU).
+//! - [`mesh_modes`]: the stuck-contact modes on the FE mesh (VTU);
+//! - [`modes_files`]: the files of `fricbound modes` (frequencies of the full and reduced
+//!   models side by side, damped modes, mode shapes, `modes.json`);
+//! - [`reduced_files`]: the files of `fricbound reduce` (K_r, M_r, C_r as Matrix Market, the
+//!   reduced DOF map, the recovery rows) and the reduction report in JSON.
 
 pub mod files;
 pub mod limit_files;
 pub mod mesh_modes;
 pub mod mesh_results;
+pub mod modes_files;
 pub mod owned;
 pub mod plot;
+pub mod reduced_files;

@@ -9,7 +9,7 @@ use crate::analysis::linear::contact_stiffness;
 use crate::model::matrix::StructuralMatrix;
 use crate::model::reduce::{self, ReductionSettings};
 use crate::model::{LinearModel, Problem};
-use crate::scene::checker::Checker;
+use crate::scene::checker::{Checker, DofNames};
 use crate::scene::error::SceneError;
 use crate::scene::fe_input::{self, FeStructure, ReductionSpec};
 use crate::scene::schema::ModelSpec;
@@ -110,30 +110,61 @@ pub(super) fn build_model(
     ))
 }
 
-/// The problem reduced by Craig-Bampton when the scene has a `[reduction]` table (with the
-/// model's Rayleigh damping, α 1/s and β s); unchanged otherwise.
-pub(super) fn reduce_problem(
+/// The reduction settings of a `[reduction]` table (with the model's Rayleigh damping, α 1/s
+/// and β s, and the `[reduction.boundary]` DOFs resolved to full-model rows); `None` without
+/// the table. No recovery rows are asked for here (the `reduce` command adds the outputs').
+pub(super) fn reduction_settings(
     reduction: Option<&ReductionSpec>,
     model: &ModelSpec,
     ck: &Checker,
-    problem: Problem,
-) -> Result<Problem, SceneError> {
+    dofs: &DofNames,
+    fe: Option<&FeStructure>,
+) -> Result<Option<ReductionSettings>, SceneError> {
     let Some(r) = reduction else {
-        return Ok(problem);
+        return Ok(None);
     };
     if r.modes == 0 {
         return Err(ck.err("reduction.modes", "must be ≥ 1"));
     }
     let zeta = ck.non_negative("reduction.modal_damping", r.modal_damping)?;
     let [alpha, beta] = model.rayleigh.unwrap_or([0.0, 0.0]);
-    let settings = ReductionSettings {
+    let mut boundary = r
+        .boundary
+        .dofs
+        .iter()
+        .enumerate()
+        .map(|(i, d)| ck.dof(&format!("reduction.boundary.dofs[{i}]"), d, dofs))
+        .collect::<Result<Vec<_>, _>>()?;
+    for (i, g) in r.boundary.groups.iter().enumerate() {
+        let field = format!("reduction.boundary.groups[{i}]");
+        let Some(fe) = fe else {
+            return Err(ck.err(
+                field,
+                "groups need an FE mesh (`model.mesh`); name DOFs in reduction.boundary.dofs",
+            ));
+        };
+        boundary.extend(fe_input::group_dofs(ck.file, &field, fe, g)?);
+    }
+    Ok(Some(ReductionSettings {
         modes: r.modes,
         modal_damping: zeta,
         rayleigh: (alpha, beta),
         ordering: r.ordering.ordering(),
         recover: Vec::new(),
+        boundary,
+    }))
+}
+
+/// The problem reduced by Craig-Bampton with `settings`; unchanged without them.
+pub(super) fn reduce_problem(
+    settings: Option<&ReductionSettings>,
+    ck: &Checker,
+    problem: Problem,
+) -> Result<Problem, SceneError> {
+    let Some(settings) = settings else {
+        return Ok(problem);
     };
-    Ok(reduce::reduce(&problem, &settings)
+    Ok(reduce::reduce(&problem, settings)
         .map_err(|e| ck.err("reduction", e.to_string()))?
         .problem)
 }

@@ -57,8 +57,12 @@ pub struct MatrixMarketSpec {
     pub stiffness: PathBuf,
     /// Mass matrix file (kg).
     pub mass: PathBuf,
-    /// DOF map (CSV `node,direction,row`).
+    /// DOF map (CSV `node,direction,row`; header variants in [`crate::fe::matrix_market`]).
     pub dof_map: PathBuf,
+    /// Row base (0 or 1) of a DOF map whose header names the row column plain `row`;
+    /// absent: 1-based (headers `row0`/`index` and `row1` state their own base).
+    #[serde(default)]
+    pub dof_map_base: Option<usize>,
     /// Relative tolerance of the symmetry check of `general` files.
     #[serde(default = "default_symmetry_tolerance")]
     pub symmetry_tolerance: f64,
@@ -80,6 +84,22 @@ pub struct ReductionSpec {
     /// Ordering of the interior Cholesky factorisation: `metis` (default) or `amd`.
     #[serde(default)]
     pub ordering: OrderingSpec,
+    /// DOFs kept physical beyond the contact and output DOFs.
+    #[serde(default)]
+    pub boundary: BoundarySpec,
+}
+
+/// `[reduction.boundary]`: extra DOFs kept as physical coordinates of the reduced model (e.g.
+/// where a reduced model is to be coupled to another one, or checked against a test).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoundarySpec {
+    /// DOFs by name (`<node>.<dir>`, e.g. `12.x`).
+    #[serde(default)]
+    pub dofs: Vec<String>,
+    /// Mesh physical groups: every DOF of their nodes.
+    #[serde(default)]
+    pub groups: Vec<String>,
 }
 
 /// Fill-reducing ordering, as written in scenes.
@@ -238,11 +258,19 @@ pub fn build_structure(
             )
         }
         (None, Some(mm)) => {
-            let m = fe::read_fe_matrices(
+            if let Some(b) = mm.dof_map_base.filter(|b| *b > 1) {
+                return Err(SceneError::invalid(
+                    file,
+                    "model.matrix_market.dof_map_base",
+                    format!("{b} is not a row base: give 0 (0-based rows) or 1 (1-based)"),
+                ));
+            }
+            let m = fe::read_fe_matrices_with_base(
                 &resolve(file, &mm.stiffness),
                 &resolve(file, &mm.mass),
                 &resolve(file, &mm.dof_map),
                 mm.symmetry_tolerance,
+                mm.dof_map_base,
             )
             .map_err(|e| SceneError::invalid(file, "model.matrix_market", e.to_string()))?;
             (m.stiffness, m.mass, m.dofs, None, 1.0)
@@ -437,6 +465,49 @@ pub fn group_load(
             (r, w)
         })
         .collect())
+}
+
+/// Every free DOF of a group's nodes (all directions), for DOFs kept physical in a reduction.
+pub fn group_dofs(
+    file: &str,
+    field: &str,
+    structure: &FeStructure,
+    group: &str,
+) -> Result<Vec<usize>, SceneError> {
+    let Some(mesh) = &structure.mesh else {
+        return Err(SceneError::invalid(
+            file,
+            field,
+            "groups need an FE mesh (`model.mesh`)",
+        ));
+    };
+    let nodes = mesh
+        .group_nodes(group)
+        .map_err(|e| SceneError::invalid(file, field, e.to_string()))?;
+    let rows: Vec<usize> = nodes
+        .iter()
+        .flat_map(|&i| {
+            let id = mesh.nodes[i].id;
+            [
+                Direction::X,
+                Direction::Y,
+                Direction::Z,
+                Direction::Rx,
+                Direction::Ry,
+                Direction::Rz,
+            ]
+            .into_iter()
+            .filter_map(move |d| structure.dofs.row(id, d))
+        })
+        .collect();
+    if rows.is_empty() {
+        return Err(SceneError::invalid(
+            file,
+            field,
+            format!("group `{group}` has no free DOF (clamped?)"),
+        ));
+    }
+    Ok(rows)
 }
 
 /// Range of Young's modulus accepted for a solid (Pa): from soft foams and gels (1 kPa) to

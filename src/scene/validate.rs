@@ -11,6 +11,7 @@ use crate::analysis::limits::LimitSettings;
 use crate::contact::aft::MarchSettings;
 use crate::contact::ContactEffects;
 use crate::hbm::formulation::check_relative_coordinates;
+use crate::model::reduce::ReductionSettings;
 use crate::model::{Effects, FeOrigin, Formulation, Problem};
 use crate::scene::check_analysis::{analysis, frequency_bound, outputs};
 use crate::scene::check_bodies::check_held_bodies;
@@ -18,7 +19,7 @@ use crate::scene::check_contacts::{check_gap_scale, contact_set};
 use crate::scene::check_limits::limit_settings;
 use crate::scene::check_loads::{harmonic_loads, harmonic_set, static_load};
 use crate::scene::check_model::{
-    build_model, check_stuck_structure, reduce_problem, stiffness_scale,
+    build_model, check_stuck_structure, reduce_problem, reduction_settings, stiffness_scale,
 };
 use crate::scene::check_sweep::{check_sweep, check_sweep_points};
 use crate::scene::checker::{Checker, DofNames};
@@ -46,26 +47,70 @@ impl Scene {
         Ok(checked)
     }
 
+    /// Checks every value of this scene (not the scene at its sweep points) and builds the
+    /// full problem, before any reduction, with the reduction settings of its `[reduction]`
+    /// table: for the commands that reduce themselves and compare the full model with the
+    /// reduced one (`modes`, `reduce`). The full problem with contacts stuck must be held.
+    pub fn validate_unreduced(
+        &self,
+        file: &str,
+    ) -> Result<(Problem, Option<ReductionSettings>), SceneError> {
+        let ck = Checker { file };
+        let (problem, _, reduction, held) = self.unreduced(&ck)?;
+        check_stuck_structure(&ck, &problem)?;
+        held?;
+        Ok((problem, reduction))
+    }
+
     /// Checks every value of this scene (the `[sweep]` table's own fields, not the scene at
     /// its points) and builds the problem and the limit settings.
     fn validate_scene(&self, file: &str) -> Result<(Problem, Option<LimitSettings>), SceneError> {
         let ck = Checker { file };
-        let (model, fe) = build_model(&self.model, &ck)?;
+        let (problem, limits, reduction, held) = self.unreduced(&ck)?;
+        let problem = reduce_problem(reduction.as_ref(), &ck, problem)?;
+        check_stuck_structure(&ck, &problem)?;
+        held?;
+        if problem.analysis.formulation == Formulation::Schur {
+            check_relative_coordinates(&problem)
+                .map_err(|e| ck.err("analysis.formulation", e.to_string()))?;
+        }
+        Ok((problem, limits))
+    }
+
+    /// The tables checked up to the reduction: the full problem, the limit settings, the
+    /// reduction settings and the outcome of the held-body check (reported after the
+    /// stuck-structure check, which names a body that even stuck contacts cannot hold).
+    #[allow(clippy::type_complexity)]
+    fn unreduced(
+        &self,
+        ck: &Checker,
+    ) -> Result<
+        (
+            Problem,
+            Option<LimitSettings>,
+            Option<ReductionSettings>,
+            Result<(), SceneError>,
+        ),
+        SceneError,
+    > {
+        let (model, fe) = build_model(&self.model, ck)?;
         let k_scale = stiffness_scale(&model);
         let dofs = DofNames::new(&model.dof_names);
         let dofs = &dofs;
         let n = model.n_dofs();
 
-        let (contacts, sides) = contact_set(self, &ck, dofs, fe.as_ref(), k_scale)?;
-        let (static_load, load_dofs) = static_load(&self.static_loads, &ck, dofs, fe.as_ref(), n)?;
-        let harmonics = harmonic_set(&self.harmonics, &ck)?;
+        let (contacts, sides) = contact_set(self, ck, dofs, fe.as_ref(), k_scale)?;
+        let (static_load, load_dofs) = static_load(&self.static_loads, ck, dofs, fe.as_ref(), n)?;
+        let harmonics = harmonic_set(&self.harmonics, ck)?;
         let harmonic_loads =
-            harmonic_loads(&self.harmonic_loads, &ck, dofs, fe.as_ref(), &harmonics)?;
-        frequency_bound(&self.analysis, &harmonics, &model, &contacts, &ck)?;
-        let analysis = analysis(&self.analysis, &ck)?;
-        let outputs = outputs(&self.output, &ck, dofs, fe.as_ref())?;
+            harmonic_loads(&self.harmonic_loads, ck, dofs, fe.as_ref(), &harmonics)?;
+        frequency_bound(&self.analysis, &harmonics, &model, &contacts, ck)?;
+        let analysis = analysis(&self.analysis, ck)?;
+        let outputs = outputs(&self.output, ck, dofs, fe.as_ref())?;
+        let reduction =
+            reduction_settings(self.reduction.as_ref(), &self.model, ck, dofs, fe.as_ref())?;
 
-        let limits = limit_settings(self, &ck)?;
+        let limits = limit_settings(self, ck)?;
         let problem = Problem {
             model,
             contacts,
@@ -98,13 +143,13 @@ impl Scene {
                 })
             }),
         };
-        check_sweep(self, &ck)?;
+        check_sweep(self, ck)?;
         // Inline contacts only (patch gaps come from the mesh's geometry).
         if self.contacts.len() == problem.contacts.len() {
             let fields: Vec<String> = (0..self.contacts.len())
                 .map(|i| format!("contacts[{i}].gap"))
                 .collect();
-            check_gap_scale(&ck, &problem, &fields)?;
+            check_gap_scale(ck, &problem, &fields)?;
         }
         // On the full model, before reduction; reported after the stuck-structure check, which
         // names a body that even stuck contacts cannot hold.
@@ -119,15 +164,8 @@ impl Scene {
                     .collect()
             })
             .collect();
-        let held = check_held_bodies(&ck, &problem, &points, &load_dofs);
-        let problem = reduce_problem(self.reduction.as_ref(), &self.model, &ck, problem)?;
-        check_stuck_structure(&ck, &problem)?;
-        held?;
-        if problem.analysis.formulation == Formulation::Schur {
-            check_relative_coordinates(&problem)
-                .map_err(|e| ck.err("analysis.formulation", e.to_string()))?;
-        }
-        Ok((problem, limits))
+        let held = check_held_bodies(ck, &problem, &points, &load_dofs);
+        Ok((problem, limits, reduction, held))
     }
 }
 

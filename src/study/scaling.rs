@@ -263,6 +263,7 @@ pub fn reduced_problem(size: ModelSize, modes: usize, dir: &Path) -> Result<Prob
         rayleigh: (0.0, 0.0),
         ordering: fricbound_reduction::Ordering::Metis,
         recover: Vec::new(),
+        boundary: Vec::new(),
     };
     Ok(reduce::reduce(&full, &settings).map_err(setup)?.problem)
 }
