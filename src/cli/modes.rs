@@ -267,30 +267,29 @@ fn modes_text(
                 "  {rigid} rigid-body mode(s) at 0 Hz: a body is free with the contacts {name}"
             );
         }
-        let _ = writeln!(
-            s,
-            "  {:>4}  {:>18}  {:>18}  {:>11}",
-            "mode", "full (Hz)", "reduced (Hz)", "rel. error"
-        );
         let errors = modes_files::relative_errors(c);
         let rows = c
             .full
             .modes
             .len()
             .max(c.reduced.as_ref().map_or(0, |r| r.modes.len()));
+        // Without a reduction, the full model's column alone.
+        let line = |a: &str, b: &str, c2: &str, d: &str| match c.reduced {
+            Some(_) => format!("  {a:>4}  {b:>18}  {c2:>18}  {d:>11}\n"),
+            None => format!("  {a:>4}  {b:>18}\n"),
+        };
+        s.push_str(&line("mode", "full (Hz)", "reduced (Hz)", "rel. error"));
         for i in 0..rows {
-            let _ = writeln!(
-                s,
-                "  {:>4}  {:>18}  {:>18}  {:>11}",
-                i + 1,
-                freq_cell(c.full.modes.get(i)),
-                freq_cell(c.reduced.as_ref().and_then(|r| r.modes.get(i))),
-                errors
+            s.push_str(&line(
+                &(i + 1).to_string(),
+                &freq_cell(c.full.modes.get(i)),
+                &freq_cell(c.reduced.as_ref().and_then(|r| r.modes.get(i))),
+                &errors
                     .get(i)
                     .copied()
                     .flatten()
-                    .map_or("-".to_string(), |e| format!("{e:.3e}"))
-            );
+                    .map_or("-".to_string(), |e| format!("{e:.3e}")),
+            ));
         }
         for (model, damped) in [("full", &c.full_damped), ("reduced", &c.reduced_damped)] {
             if let Some(d) = damped {
