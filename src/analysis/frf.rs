@@ -4,6 +4,7 @@
 use std::f64::consts::PI;
 use std::time::Instant;
 
+use crate::analysis::error_estimate::{ErrorEstimator, EstimateProblems, PointAccuracy};
 use crate::analysis::linear;
 use crate::contact::harmonic::{Block, HarmonicSet};
 use crate::contact::ContactState;
@@ -35,6 +36,9 @@ pub struct FrfPoint {
     pub residual: f64,
     /// All Fourier coefficients, harmonic-major (m).
     pub coefficients: Vec<f64>,
+    /// A-posteriori error estimate of the amplitudes (continuation points of a run whose
+    /// scene asks for it; None for points solved on their own, such as refined peaks).
+    pub accuracy: Option<PointAccuracy>,
 }
 
 /// A jump of an FRF run to another branch past a fold the path did not come back from.
@@ -333,11 +337,13 @@ fn output_amplitude_groups(
         .collect()
 }
 
-struct Adapter<'o, O: FrfObserver> {
+struct Adapter<'o, 'e, O: FrfObserver> {
     observer: &'o mut O,
     points: Vec<FrfPoint>,
     /// A converged point whose full coefficients could not be recovered.
     failure: Option<HbmError>,
+    /// The error estimate of every accepted point, when the scene asks for it.
+    estimator: Option<ErrorEstimator<'e>>,
 }
 
 /// The outputs of a converged path point, on full coefficients.
@@ -365,18 +371,22 @@ fn full_point(system: &mut HbmOperator<'_>, p: &PathPoint) -> Result<FrfPoint, H
         newton_iterations: p.iterations,
         residual: p.residual,
         coefficients,
+        accuracy: None,
     })
 }
 
-impl<O: FrfObserver> Observer<HbmOperator<'_>> for Adapter<'_, O> {
+impl<O: FrfObserver> Observer<HbmOperator<'_>> for Adapter<'_, '_, O> {
     fn accepted(&mut self, system: &mut HbmOperator<'_>, p: &PathPoint) {
-        let point = match full_point(system, p) {
+        let mut point = match full_point(system, p) {
             Ok(point) => point,
             Err(e) => {
                 self.failure.get_or_insert(e);
                 return;
             }
         };
+        if let Some(estimator) = &mut self.estimator {
+            point.accuracy = Some(estimator.estimate(&point.coefficients, p.omega));
+        }
         self.observer.point(&point);
         self.points.push(point);
     }
@@ -422,10 +432,16 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
     // How the scale grows and which amplitudes the steps follow: the same on every branch.
     let adaptive = adaptive_scale(problem, &set, &system);
     let amplitude_groups = output_amplitude_groups(problem, &set, &system);
+    let refined = EstimateProblems::new(problem);
+    let estimator = refined
+        .as_ref()
+        .map(|r| ErrorEstimator::new(problem, r))
+        .transpose()?;
     let mut adapter = Adapter {
         observer,
         points: Vec::new(),
         failure: None,
+        estimator,
     };
     let mut run = FrfRun {
         points: Vec::new(),
@@ -495,6 +511,7 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
                     observer: &mut Silent,
                     points: Vec::new(),
                     failure: None,
+                    estimator: None,
                 };
                 let mut filler = Continuation::new(fill, x_scale.clone())
                     .with_adaptive_scale(adaptive.clone())
@@ -520,8 +537,13 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
                 adapter.observer.jump(&jump);
                 run.jumps.push(jump);
                 for p in back.points.iter().skip(1).rev() {
-                    adapter.observer.point(p);
-                    adapter.points.push(p.clone());
+                    let mut p = p.clone();
+                    if let Some(estimator) = &mut adapter.estimator {
+                        let omega = 2.0 * PI * p.freq_hz;
+                        p.accuracy = Some(estimator.estimate(&p.coefficients, omega));
+                    }
+                    adapter.observer.point(&p);
+                    adapter.points.push(p);
                 }
                 start_hz = freq_hz;
                 guess = x;

@@ -111,6 +111,14 @@ pub enum CommandError {
         /// The estimate, the memory available and the fields to lower.
         reason: String,
     },
+    /// A study could not be carried out (its reference did not solve).
+    #[error("{scene}: {reason}")]
+    Study {
+        /// Scene label.
+        scene: String,
+        /// What failed.
+        reason: String,
+    },
     /// A linear reference failed.
     #[error("{scene}: linear reference: {reason}")]
     Linear {
@@ -703,6 +711,11 @@ fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
             .collect::<Vec<_>>()
             .join(", ")
     };
+    // Said quiet or not, like jumps: the results are less accurate than the scene asks for.
+    let accuracy_warnings = crate::analysis::error_estimate::run_warnings(problem, &run.points);
+    for w in &accuracy_warnings {
+        eprintln!("warning: {w}");
+    }
     let count = |kind: ExtremumKind| extrema.iter().filter(|e| e.kind == kind).count();
     let unrefined = extrema.iter().filter(|e| !e.peak.refined).count();
     let unrefined = if unrefined > 0 {
@@ -714,18 +727,43 @@ fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
         dir: dir.clone(),
         summary: format!(
             "{} converged points in {:.3} s ({} step cuts); turning points: {turning}\n\
-             {} resonance peaks and {} anti-resonances refined{unrefined}",
+             {} resonance peaks and {} anti-resonances refined{unrefined}{}",
             run.points.len(),
             run.elapsed_s,
             run.rejected_steps,
             count(ExtremumKind::Resonance),
             count(ExtremumKind::AntiResonance),
+            accuracy_line(problem, &run.points, accuracy_warnings.len()),
         ),
         incomplete,
         outcome: RunOutcome::Frf(Box::new(run)),
         open: ctx.open.clone(),
         stuck: ctx.stuck.clone(),
     })
+}
+
+/// The summary line of the error estimate: the largest estimates over the run's points and how
+/// many warnings were printed (empty when the estimate is off).
+fn accuracy_line(problem: &Problem, points: &[FrfPoint], warnings: usize) -> String {
+    let outputs: Vec<String> = problem
+        .outputs
+        .iter()
+        .map(|&d| problem.model.dof_names[d].clone())
+        .collect();
+    let threshold = problem.analysis.error_estimate.warn_threshold;
+    match files::accuracy_summary(&outputs, threshold, points) {
+        None => String::new(),
+        Some(s) => {
+            let largest = |v: &[f64]| v.iter().copied().fold(0.0_f64, f64::max);
+            format!(
+                "\nerror estimate: largest truncation {:.2e}, sampling {:.2e} (threshold {:.2e}; \
+                 {warnings} warning(s))",
+                largest(&s.max_trunc_err),
+                largest(&s.max_sampling_err),
+                threshold
+            )
+        }
+    }
 }
 
 /// `fricbound check`: validates the scene and returns a printable summary.
