@@ -54,6 +54,11 @@ enum Command {
         #[command(subcommand)]
         command: fricbound::cli::mesh::MeshCommand,
     },
+    /// Studies over solver settings (`study accuracy SCENE`).
+    Study {
+        #[command(subcommand)]
+        command: fricbound::cli::study::StudyCommand,
+    },
     /// Scaling study of FE size, contact points, harmonics and solver strategies.
     Bench {
         #[command(subcommand)]
@@ -105,6 +110,12 @@ fn main() -> ExitCode {
         }
         Command::Check { scene, overrides } => fricbound::cli::check(scene.as_deref(), &overrides)
             .map(|s| print!("{s}"))
+            .map_err(|e| e.to_string()),
+        Command::Study { command } => fricbound::cli::study::run(&command)
+            .map(|r| {
+                print!("{}", r.summary);
+                incomplete = r.incomplete;
+            })
             .map_err(|e| e.to_string()),
         Command::Bench { command } => fricbound::cli::bench::run(&command)
             .map(|text| print!("{text}"))

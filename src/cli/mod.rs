@@ -16,12 +16,14 @@
 //!   numbers next to the paper's statements;
 //! - [`bench`](mod@bench) (`fricbound bench`): the scaling study of the reduction and the solves;
 //! - [`mesh`] (`fricbound mesh`): generates the blade-pair mesh;
+//! - [`study`] (`fricbound study accuracy`): what each solver setting costs and gives in accuracy;
 //! - [`CommandError`]: why a command failed, naming what failed.
 
 pub mod bench;
 mod limits_run;
 pub mod mesh;
 pub mod paper;
+pub mod study;
 mod sweep_run;
 
 use std::path::{Path, PathBuf};
