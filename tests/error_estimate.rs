@@ -105,7 +105,7 @@ fn truncation_estimate_tracks_the_true_error_on_the_paper_case() {
                 }
             }
         }
-        let warnings = run_warnings(&problem, &run.points);
+        let warnings = run_warnings(&problem, &frf::accuracy_of(&run.points));
         println!(
             "H = {h}: {} points, warnings: {warnings:#?}",
             run.points.len()

@@ -370,17 +370,14 @@ pub fn largest(points: &[&PointAccuracy], outputs: usize) -> (Vec<f64>, Vec<f64>
     (trunc, samp)
 }
 
-/// The end-of-run warning lines of a run's points (path order): one per band where an
-/// estimate exceeds the scene's threshold ([`warnings`], [`warning_text`]); empty when the
-/// estimate is off or everything is below the threshold.
-pub fn run_warnings(problem: &Problem, points: &[crate::analysis::frf::FrfPoint]) -> Vec<String> {
-    let with: Vec<(f64, &PointAccuracy)> = points
-        .iter()
-        .filter_map(|p| p.accuracy.as_ref().map(|a| (p.freq_hz, a)))
-        .collect();
+/// The end-of-run warning lines of a run's estimates (frequency in Hz and estimate of each
+/// point that has one, in path order; see `crate::analysis::frf::accuracy_of`): one per band
+/// where an estimate exceeds the scene's threshold ([`warnings`], [`warning_text`]); empty when
+/// the estimate is off or everything is below the threshold.
+pub fn run_warnings(problem: &Problem, with: &[(f64, &PointAccuracy)]) -> Vec<String> {
     let h_max = problem.harmonics.iter().copied().max().unwrap_or(1);
     warnings(
-        &with,
+        with,
         problem.outputs.len(),
         problem.analysis.error_estimate.warn_threshold,
     )

@@ -41,6 +41,15 @@ pub struct FrfPoint {
     pub accuracy: Option<PointAccuracy>,
 }
 
+/// The frequency (Hz) and error estimate of every point of `points` that has one, in order
+/// (for [`crate::analysis::error_estimate::run_warnings`]).
+pub fn accuracy_of(points: &[FrfPoint]) -> Vec<(f64, &PointAccuracy)> {
+    points
+        .iter()
+        .filter_map(|p| p.accuracy.as_ref().map(|a| (p.freq_hz, a)))
+        .collect()
+}
+
 /// A jump of an FRF run to another branch past a fold the path did not come back from.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Jump {

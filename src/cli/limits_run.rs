@@ -102,7 +102,10 @@ pub fn run_limits(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
     let elapsed = started.elapsed().as_secs_f64();
     // The error estimate's warnings per limit and intermediate curve, quiet or not.
     for c in analysis.limits.iter().chain(&analysis.intermediate) {
-        for w in crate::analysis::error_estimate::run_warnings(problem, &c.points) {
+        for w in crate::analysis::error_estimate::run_warnings(
+            problem,
+            &crate::analysis::frf::accuracy_of(&c.points),
+        ) {
             eprintln!("warning: curve {}: {w}", c.case.name);
         }
     }

@@ -714,7 +714,8 @@ fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
             .join(", ")
     };
     // Said quiet or not, like jumps: the results are less accurate than the scene asks for.
-    let accuracy_warnings = crate::analysis::error_estimate::run_warnings(problem, &run.points);
+    let accuracy_warnings =
+        crate::analysis::error_estimate::run_warnings(problem, &frf::accuracy_of(&run.points));
     for w in &accuracy_warnings {
         eprintln!("warning: {w}");
     }
@@ -851,6 +852,24 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
         s,
         "effects      normal load {:?}, lift-off {}, statics {:?}",
         e.contact.normal_load, e.contact.liftoff, e.coupling
+    );
+    let estimate = &problem.analysis.error_estimate;
+    let _ = writeln!(
+        s,
+        "accuracy     {}",
+        if estimate.enabled {
+            format!(
+                "error estimate on every point (truncation to H = {}, sampling at {} \
+                 samples), warning above {} %",
+                crate::analysis::error_estimate::extended_harmonic(
+                    problem.harmonics.iter().copied().max().unwrap_or(1)
+                ),
+                2 * problem.samples,
+                100.0 * estimate.warn_threshold
+            )
+        } else {
+            "error estimate off ([accuracy] estimate = false)".to_string()
+        }
     );
     let _ = writeln!(
         s,
