@@ -58,10 +58,19 @@ fn run_writes_all_results() {
     }
     let json = json(&out.join("solution.json"));
     assert_eq!(json["status"], "complete");
-    // H = 1 is about 10 % off near this resonance (tests/error_estimate.rs): the run says so.
+    // H = 1 is about 10 % off near this resonance (tests/error_estimate.rs): solution.json
+    // has it, and a run that is not quiet says so on stderr (a quiet one writes nothing there).
     let largest = json["accuracy"]["max_trunc_err"][0].as_f64().unwrap();
     assert!(largest > 0.05, "{largest}");
-    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.stderr.is_empty(), "{}", text(&o.stderr));
+    let loud = support::fricbound(&[
+        "run",
+        &scene("zoom-2nd.toml"),
+        "--out",
+        dir.path().join("loud").to_str().unwrap(),
+    ]);
+    assert!(loud.status.success());
+    let stderr = text(&loud.stderr);
     assert!(
         stderr.contains("warning: accuracy: the harmonic truncation error of y2")
             && stderr.contains("harmonics.max > 1 needed"),

@@ -100,13 +100,14 @@ pub fn run_limits(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
         source,
     })?;
     let elapsed = started.elapsed().as_secs_f64();
-    // The error estimate's warnings per limit and intermediate curve, quiet or not.
-    for c in analysis.limits.iter().chain(&analysis.intermediate) {
-        for w in crate::analysis::error_estimate::run_warnings(
-            problem,
-            &crate::analysis::frf::accuracy_of(&c.points),
-        ) {
-            eprintln!("warning: curve {}: {w}", c.case.name);
+    // The error estimate's warnings per limit and intermediate curve, unless quiet (the
+    // largest estimates are in limits.json either way).
+    if !ctx.options.quiet {
+        for c in analysis.limits.iter().chain(&analysis.intermediate) {
+            let points = crate::analysis::frf::accuracy_of(&c.points);
+            for w in crate::analysis::error_estimate::run_warnings(problem, &points) {
+                eprintln!("warning: curve {}: {w}", c.case.name);
+            }
         }
     }
     let incomplete = analysis_incomplete(&analysis);

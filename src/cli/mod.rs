@@ -713,11 +713,14 @@ fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
             .collect::<Vec<_>>()
             .join(", ")
     };
-    // Said quiet or not, like jumps: the results are less accurate than the scene asks for.
+    // On stderr unless quiet (a quiet complete run writes nothing there); the largest
+    // estimates are in solution.json either way.
     let accuracy_warnings =
         crate::analysis::error_estimate::run_warnings(problem, &frf::accuracy_of(&run.points));
-    for w in &accuracy_warnings {
-        eprintln!("warning: {w}");
+    if !ctx.options.quiet {
+        for w in &accuracy_warnings {
+            eprintln!("warning: {w}");
+        }
     }
     let count = |kind: ExtremumKind| extrema.iter().filter(|e| e.kind == kind).count();
     let unrefined = extrema.iter().filter(|e| !e.peak.refined).count();
