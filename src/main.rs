@@ -84,6 +84,11 @@ enum Command {
         #[command(subcommand)]
         command: fricbound::cli::mesh::MeshCommand,
     },
+    /// Studies over solver settings (`study accuracy SCENE`).
+    Study {
+        #[command(subcommand)]
+        command: fricbound::cli::study::StudyCommand,
+    },
     /// Scaling study of FE size, contact points, harmonics and solver strategies.
     Bench {
         #[command(subcommand)]
@@ -162,6 +167,12 @@ fn main() -> ExitCode {
         })
         .map(|r| print!("{}", r.text))
         .map_err(|e| e.to_string()),
+        Command::Study { command } => fricbound::cli::study::run(&command)
+            .map(|r| {
+                print!("{}", r.summary);
+                incomplete = r.incomplete;
+            })
+            .map_err(|e| e.to_string()),
         Command::Bench { command } => fricbound::cli::bench::run(&command)
             .map(|text| print!("{text}"))
             .map_err(|e| e.to_string()),

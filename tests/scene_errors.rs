@@ -1438,3 +1438,20 @@ fn sweep_value_given_twice() {
         &["duplicate value 60 (also sweep.values[0])"],
     );
 }
+
+#[test]
+fn accuracy_threshold_must_be_a_relative_error() {
+    for (value, part) in [
+        ("0", "must be > 0"),
+        ("1.5", "must be ≤ 1"),
+        ("nan", "must be a finite number"),
+    ] {
+        let o = format!("accuracy.threshold={value}");
+        rejects_with(
+            paper_wedge_scene(),
+            &[o.as_str()],
+            "accuracy.threshold",
+            &[part],
+        );
+    }
+}

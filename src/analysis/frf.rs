@@ -4,6 +4,7 @@
 use std::f64::consts::PI;
 use std::time::Instant;
 
+use crate::analysis::error_estimate::{ErrorEstimator, EstimateProblems, PointAccuracy};
 use crate::analysis::linear;
 use crate::contact::harmonic::{Block, HarmonicSet};
 use crate::contact::ContactState;
@@ -36,6 +37,18 @@ pub struct FrfPoint {
     pub residual: f64,
     /// All Fourier coefficients, harmonic-major (m).
     pub coefficients: Vec<f64>,
+    /// A-posteriori error estimate of the amplitudes (continuation points of a run whose
+    /// scene asks for it; None for points solved on their own, such as refined peaks).
+    pub accuracy: Option<PointAccuracy>,
+}
+
+/// The frequency (Hz) and error estimate of every point of `points` that has one, in order
+/// (for [`crate::analysis::error_estimate::run_warnings`]).
+pub fn accuracy_of(points: &[FrfPoint]) -> Vec<(f64, &PointAccuracy)> {
+    points
+        .iter()
+        .filter_map(|p| p.accuracy.as_ref().map(|a| (p.freq_hz, a)))
+        .collect()
 }
 
 /// A jump of an FRF run from one branch to another: where the path turned back at a fold and
@@ -358,11 +371,13 @@ fn output_amplitude_groups(
         .collect()
 }
 
-struct Adapter<'o, O: FrfObserver> {
+struct Adapter<'o, 'e, O: FrfObserver> {
     observer: &'o mut O,
     points: Vec<FrfPoint>,
     /// A converged point whose full coefficients could not be recovered.
     failure: Option<HbmError>,
+    /// The error estimate of every accepted point, when the scene asks for it.
+    estimator: Option<ErrorEstimator<'e>>,
 }
 
 /// The outputs of a converged path point, on full coefficients.
@@ -390,18 +405,22 @@ fn full_point(system: &mut HbmOperator<'_>, p: &PathPoint) -> Result<FrfPoint, H
         newton_iterations: p.iterations,
         residual: p.residual,
         coefficients,
+        accuracy: None,
     })
 }
 
-impl<O: FrfObserver> Observer<HbmOperator<'_>> for Adapter<'_, O> {
+impl<O: FrfObserver> Observer<HbmOperator<'_>> for Adapter<'_, '_, O> {
     fn accepted(&mut self, system: &mut HbmOperator<'_>, p: &PathPoint) {
-        let point = match full_point(system, p) {
+        let mut point = match full_point(system, p) {
             Ok(point) => point,
             Err(e) => {
                 self.failure.get_or_insert(e);
                 return;
             }
         };
+        if let Some(estimator) = &mut self.estimator {
+            point.accuracy = Some(estimator.estimate(&point.coefficients, p.omega));
+        }
         self.observer.point(&point);
         self.points.push(point);
     }
@@ -447,10 +466,16 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
     // How the scale grows and which amplitudes the steps follow: the same on every branch.
     let adaptive = adaptive_scale(problem, &set, &system);
     let amplitude_groups = output_amplitude_groups(problem, &set, &system);
+    let refined = EstimateProblems::new(problem);
+    let estimator = refined
+        .as_ref()
+        .map(|r| ErrorEstimator::new(problem, r))
+        .transpose()?;
     let mut adapter = Adapter {
         observer,
         points: Vec::new(),
         failure: None,
+        estimator,
     };
     let mut run = FrfRun {
         points: Vec::new(),
@@ -575,8 +600,12 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
             };
             adapter.observer.jump(&jump);
             run.jumps.push(jump);
-            for p in branch {
+            for mut p in branch {
                 reached = reached.max(p.freq_hz);
+                if let Some(estimator) = &mut adapter.estimator {
+                    let omega = 2.0 * PI * p.freq_hz;
+                    p.accuracy = Some(estimator.estimate(&p.coefficients, omega));
+                }
                 adapter.observer.point(&p);
                 adapter.points.push(p);
             }
@@ -633,6 +662,7 @@ impl Branching<'_> {
             observer: &mut Silent,
             points: Vec::new(),
             failure: None,
+            estimator: None,
         };
         let mut continuation = Continuation::new(settings, self.x_scale.to_vec())
             .with_adaptive_scale(self.adaptive.clone())

@@ -33,7 +33,10 @@
 //!   classification, bound check, hysteresis loops) as a [`limits::LimitAnalysis`].
 //! - [`limits::solve_case`]: one case's curve and its refined resonance peak.
 //! - [`limits::LimitAnalysis::variability`]: the size of the variability between the limits.
+//! - [`error_estimate::ErrorEstimator`]: the a-posteriori truncation and sampling error
+//!   estimate of every converged continuation point ([`error_estimate::PointAccuracy`]).
 
+pub mod error_estimate;
 pub mod frf;
 pub mod limits;
 pub mod linear;

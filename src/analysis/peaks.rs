@@ -374,6 +374,7 @@ mod tests {
             newton_iterations: 1,
             residual: 0.0,
             coefficients: Vec::new(),
+            accuracy: None,
         }
     }
 

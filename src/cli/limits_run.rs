@@ -100,6 +100,16 @@ pub fn run_limits(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
         source,
     })?;
     let elapsed = started.elapsed().as_secs_f64();
+    // The error estimate's warnings per limit and intermediate curve, unless quiet (the
+    // largest estimates are in limits.json either way).
+    if !ctx.options.quiet {
+        for c in analysis.limits.iter().chain(&analysis.intermediate) {
+            let points = crate::analysis::frf::accuracy_of(&c.points);
+            for w in crate::analysis::error_estimate::run_warnings(problem, &points) {
+                eprintln!("warning: curve {}: {w}", c.case.name);
+            }
+        }
+    }
     let incomplete = analysis_incomplete(&analysis);
     write_analysis(
         ctx,
@@ -193,18 +203,27 @@ struct CurveJson<'a> {
     status: &'a limits::CurveStatus,
     peak: Option<&'a limits::Peak>,
     continuation_retries: usize,
+    /// Largest error estimates over the curve's points (when the scene asks for them).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    accuracy: Option<files::AccuracySummary>,
     /// The whole path, or the finished points of an unfinished case.
     points: &'a [FrfPoint],
     turning_points_hz: &'a [f64],
 }
 
 /// One curve as written in `limits.json`.
-fn curve_json(c: &CaseCurve) -> serde_json::Value {
+fn curve_json(ctx: &RunContext<'_>, c: &CaseCurve) -> serde_json::Value {
+    let info = ctx.info();
     serde_json::to_value(CurveJson {
         case: &c.case,
         status: &c.status,
         peak: c.peak.as_ref(),
         continuation_retries: c.retries,
+        accuracy: files::accuracy_summary(
+            &info.outputs,
+            ctx.problem.analysis.error_estimate.warn_threshold,
+            &c.points,
+        ),
         points: &c.points,
         turning_points_hz: &c.turning_points,
     })
@@ -259,8 +278,8 @@ fn write_json(
         "status": status,
         "elapsed_s": elapsed,
         "curves": curve_statuses(a),
-        "limits": a.limits.iter().map(curve_json).collect::<Vec<_>>(),
-        "intermediate": a.intermediate.iter().map(curve_json).collect::<Vec<_>>(),
+        "limits": a.limits.iter().map(|c| curve_json(ctx, c)).collect::<Vec<_>>(),
+        "intermediate": a.intermediate.iter().map(|c| curve_json(ctx, c)).collect::<Vec<_>>(),
         "band": {
             "grid_points": a.grid.len(),
             "defined_points": a.band_points(),

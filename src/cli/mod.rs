@@ -18,6 +18,7 @@
 //! - [`mesh`] (`fricbound mesh`): generates the blade-pair mesh;
 //! - [`modes`] (`fricbound modes`, `fricbound reduce`): natural frequencies of the full and
 //!   reduced models, the reduced model written out;
+//! - [`study`] (`fricbound study accuracy`): what each solver setting costs and gives in accuracy;
 //! - [`CommandError`]: why a command failed, naming what failed.
 
 pub mod bench;
@@ -25,6 +26,7 @@ mod limits_run;
 pub mod mesh;
 pub mod modes;
 pub mod paper;
+pub mod study;
 mod sweep_run;
 
 use std::path::{Path, PathBuf};
@@ -115,6 +117,14 @@ pub enum CommandError {
         /// Scene label.
         scene: String,
         /// The estimate, the memory available and the fields to lower.
+        reason: String,
+    },
+    /// A study could not be carried out (its reference did not solve).
+    #[error("{scene}: {reason}")]
+    Study {
+        /// Scene label.
+        scene: String,
+        /// What failed.
         reason: String,
     },
     /// A linear reference failed.
@@ -724,6 +734,15 @@ fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
             .collect::<Vec<_>>()
             .join(", ")
     };
+    // On stderr unless quiet (a quiet complete run writes nothing there); the largest
+    // estimates are in solution.json either way.
+    let accuracy_warnings =
+        crate::analysis::error_estimate::run_warnings(problem, &frf::accuracy_of(&run.points));
+    if !ctx.options.quiet {
+        for w in &accuracy_warnings {
+            eprintln!("warning: {w}");
+        }
+    }
     let count = |kind: ExtremumKind| extrema.iter().filter(|e| e.kind == kind).count();
     let unrefined = extrema.iter().filter(|e| !e.peak.refined).count();
     let unrefined = if unrefined > 0 {
@@ -735,18 +754,43 @@ fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
         dir: dir.clone(),
         summary: format!(
             "{} converged points in {:.3} s ({} step cuts); turning points: {turning}\n\
-             {} resonance peaks and {} anti-resonances refined{unrefined}",
+             {} resonance peaks and {} anti-resonances refined{unrefined}{}",
             run.points.len(),
             run.elapsed_s,
             run.rejected_steps,
             count(ExtremumKind::Resonance),
             count(ExtremumKind::AntiResonance),
+            accuracy_line(problem, &run.points, accuracy_warnings.len()),
         ),
         incomplete,
         outcome: RunOutcome::Frf(Box::new(run)),
         open: ctx.open.clone(),
         stuck: ctx.stuck.clone(),
     })
+}
+
+/// The summary line of the error estimate: the largest estimates over the run's points and how
+/// many warnings were printed (empty when the estimate is off).
+fn accuracy_line(problem: &Problem, points: &[FrfPoint], warnings: usize) -> String {
+    let outputs: Vec<String> = problem
+        .outputs
+        .iter()
+        .map(|&d| problem.model.dof_names[d].clone())
+        .collect();
+    let threshold = problem.analysis.error_estimate.warn_threshold;
+    match files::accuracy_summary(&outputs, threshold, points) {
+        None => String::new(),
+        Some(s) => {
+            let largest = |v: &[f64]| v.iter().copied().fold(0.0_f64, f64::max);
+            format!(
+                "\nerror estimate: largest truncation {:.2e}, sampling {:.2e} (threshold {:.2e}; \
+                 {warnings} warning(s))",
+                largest(&s.max_trunc_err),
+                largest(&s.max_sampling_err),
+                threshold
+            )
+        }
+    }
 }
 
 /// `fricbound check`: validates the scene and returns a printable summary.
@@ -832,6 +876,24 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
         s,
         "effects      normal load {:?}, lift-off {}, statics {:?}",
         e.contact.normal_load, e.contact.liftoff, e.coupling
+    );
+    let estimate = &problem.analysis.error_estimate;
+    let _ = writeln!(
+        s,
+        "accuracy     {}",
+        if estimate.enabled {
+            format!(
+                "error estimate on every point (truncation to H = {}, sampling at {} \
+                 samples), warning above {} %",
+                crate::analysis::error_estimate::extended_harmonic(
+                    problem.harmonics.iter().copied().max().unwrap_or(1)
+                ),
+                2 * problem.samples,
+                100.0 * estimate.warn_threshold
+            )
+        } else {
+            "error estimate off ([accuracy] estimate = false)".to_string()
+        }
     );
     let _ = writeln!(
         s,

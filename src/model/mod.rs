@@ -15,6 +15,6 @@ pub mod problem;
 pub mod reduce;
 
 pub use problem::{
-    Analysis, Coupling, DofSplit, Effects, FeOrigin, Formulation, HarmonicLoad, JacobianStrategy,
-    LinearModel, Problem, CHORD_MIN_UNKNOWNS,
+    Analysis, Coupling, DofSplit, Effects, ErrorEstimateSettings, FeOrigin, Formulation,
+    HarmonicLoad, JacobianStrategy, LinearModel, Problem, CHORD_MIN_UNKNOWNS,
 };

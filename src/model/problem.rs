@@ -116,6 +116,28 @@ pub struct Analysis {
     pub formulation: Formulation,
     /// Points of the uniform frequency grid of the linear references.
     pub linear_points: usize,
+    /// The a-posteriori error estimate on every converged point (scene table `[accuracy]`).
+    pub error_estimate: ErrorEstimateSettings,
+}
+
+/// Settings of the a-posteriori error estimate computed on every converged continuation point
+/// (`crate::analysis::error_estimate`): whether it runs, and the relative amplitude error above
+/// which a run warns.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ErrorEstimateSettings {
+    /// Whether the estimate is computed (off: no extra work and no extra columns).
+    pub enabled: bool,
+    /// Relative first-harmonic amplitude error above which the run warns (default 0.01).
+    pub warn_threshold: f64,
+}
+
+impl Default for ErrorEstimateSettings {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            warn_threshold: 0.01,
+        }
+    }
 }
 
 /// Default of [`ContinuationSettings::chord_min_unknowns`].

@@ -45,7 +45,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), WriteError> {
 }
 
 /// Header of `frf.csv`: `freq_hz`, `<dof>_amp`, `<dof>_peak` per output, `<contact>_state` per
-/// contact, `newton_iters`.
+/// contact, `newton_iters`, then the error-estimate columns ([`accuracy_header`]).
 pub fn frf_header(problem: &Problem) -> String {
     let mut h = String::from("freq_hz");
     for &d in &problem.outputs {
@@ -55,7 +55,9 @@ pub fn frf_header(problem: &Problem) -> String {
     for c in &problem.contacts {
         let _ = write!(h, ",{}_state", c.name);
     }
-    h.push_str(",newton_iters\n");
+    h.push_str(",newton_iters");
+    accuracy_header(problem, &mut h);
+    h.push('\n');
     h
 }
 
@@ -68,9 +70,100 @@ pub fn frf_row(point: &FrfPoint) -> String {
     for s in &point.states {
         let _ = write!(r, ",{}", s.label());
     }
-    let _ = writeln!(r, ",{}", point.newton_iterations);
+    let _ = write!(r, ",{}", point.newton_iterations);
+    accuracy_cells(point, &mut r);
+    r.push('\n');
     r
 }
+
+// ---- Error-estimate columns (issue 11): kept together here so that other column additions
+// merge beside them.
+
+/// The error-estimate columns of `frf.csv` and `curve_*.csv`, when the scene asks for the
+/// estimate (`[accuracy].estimate`): `<dof>_trunc_err` and `<dof>_sampling_err` per output,
+/// the estimated relative error of the first-harmonic amplitude due to harmonic truncation and
+/// AFT sampling ([`crate::analysis::error_estimate`]).
+pub fn accuracy_header(problem: &Problem, h: &mut String) {
+    if problem.analysis.error_estimate.enabled {
+        for &d in &problem.outputs {
+            let name = &problem.model.dof_names[d];
+            let _ = write!(h, ",{name}_trunc_err,{name}_sampling_err");
+        }
+    }
+}
+
+/// The cells of [`accuracy_header`] for one point (nothing when the point has no estimate;
+/// every continuation point of a run with the estimate on has one). NaN: not formed.
+pub fn accuracy_cells(point: &FrfPoint, r: &mut String) {
+    if let Some(acc) = &point.accuracy {
+        for (t, s) in acc.truncation.iter().zip(&acc.sampling) {
+            let _ = write!(r, ",{t:.3e},{s:.3e}");
+        }
+    }
+}
+
+/// The largest error estimates of a run's points, for `solution.json` and `limits.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct AccuracySummary {
+    /// Output DOF names.
+    pub outputs: Vec<String>,
+    /// Largest harmonic-truncation estimate per output (relative).
+    pub max_trunc_err: Vec<f64>,
+    /// Largest AFT-sampling estimate per output (relative).
+    pub max_sampling_err: Vec<f64>,
+    /// Frequency of the point with the largest truncation estimate per output (Hz).
+    pub max_trunc_err_hz: Vec<f64>,
+    /// Frequency of the point with the largest sampling estimate per output (Hz).
+    pub max_sampling_err_hz: Vec<f64>,
+    /// Points whose estimate could not be formed (NaN cells).
+    pub unformed_points: usize,
+    /// The warning threshold of the scene (relative).
+    pub threshold: f64,
+}
+
+/// The [`AccuracySummary`] of `points` (None when no point carries an estimate).
+pub fn accuracy_summary(
+    outputs: &[String],
+    threshold: f64,
+    points: &[FrfPoint],
+) -> Option<AccuracySummary> {
+    let with: Vec<(f64, &crate::analysis::error_estimate::PointAccuracy)> = points
+        .iter()
+        .filter_map(|p| p.accuracy.as_ref().map(|a| (p.freq_hz, a)))
+        .collect();
+    if with.is_empty() {
+        return None;
+    }
+    let k = outputs.len();
+    let mut s = AccuracySummary {
+        outputs: outputs.to_vec(),
+        max_trunc_err: vec![0.0; k],
+        max_sampling_err: vec![0.0; k],
+        max_trunc_err_hz: vec![f64::NAN; k],
+        max_sampling_err_hz: vec![f64::NAN; k],
+        unformed_points: 0,
+        threshold,
+    };
+    for (f, a) in with {
+        let values = a.truncation.iter().chain(&a.sampling);
+        if values.clone().any(|v| v.is_nan()) {
+            s.unformed_points += 1;
+        }
+        for o in 0..k.min(a.truncation.len()) {
+            if a.truncation[o] > s.max_trunc_err[o] {
+                s.max_trunc_err[o] = a.truncation[o];
+                s.max_trunc_err_hz[o] = f;
+            }
+            if a.sampling[o] > s.max_sampling_err[o] {
+                s.max_sampling_err[o] = a.sampling[o];
+                s.max_sampling_err_hz[o] = f;
+            }
+        }
+    }
+    Some(s)
+}
+
+// ---- end of the error-estimate columns.
 
 /// CSV of a linear reference: `freq_hz`, `<dof>_amp` per output.
 pub fn linear_csv(problem: &Problem, curve: &LinearCurve) -> String {
@@ -167,6 +260,9 @@ struct SolutionFile<'a> {
     /// Refined resonances and anti-resonances, once computed (after the continuation).
     #[serde(skip_serializing_if = "Option::is_none")]
     peaks: Option<&'a [PeakRecord]>,
+    /// Largest error estimates over the points (when the scene asks for the estimate).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    accuracy: Option<AccuracySummary>,
     points: Vec<PointRecord<'a>>,
 }
 
@@ -272,6 +368,8 @@ pub struct FrfWriter {
     json_writes: usize,
     /// First write error met (writing stops being attempted after it).
     pub error: Option<WriteError>,
+    /// Warning threshold of the error estimate (relative), for `solution.json`.
+    threshold: f64,
 }
 
 /// Opens `path` for writing, truncated.
@@ -315,6 +413,7 @@ impl FrfWriter {
             last_json_s: 0.0,
             json_writes: 0,
             error: None,
+            threshold: problem.analysis.error_estimate.warn_threshold,
         }
     }
 
@@ -363,6 +462,7 @@ impl FrfWriter {
                          holding every DOF of info.dofs)",
             }),
             peaks: self.peaks.as_deref(),
+            accuracy: accuracy_summary(&self.info.outputs, self.threshold, &self.points),
             points: self
                 .points
                 .iter()
@@ -533,6 +633,7 @@ mod tests {
             newton_iterations: 1 + k % 4,
             residual: 1e-12,
             coefficients: vec![k as f64; 18],
+            accuracy: None,
         }
     }
 

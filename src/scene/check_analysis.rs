@@ -4,13 +4,13 @@
 //! and the `[output]` table into the response DOFs.
 
 use crate::contact::ContactPoint;
-use crate::model::{Analysis, LinearModel, CHORD_MIN_UNKNOWNS};
+use crate::model::{Analysis, ErrorEstimateSettings, LinearModel, CHORD_MIN_UNKNOWNS};
 use crate::numerics::ContinuationSettings;
 use crate::scene::check_model::diagonal;
 use crate::scene::checker::{Checker, DofNames};
 use crate::scene::error::SceneError;
 use crate::scene::fe_input::FeStructure;
-use crate::scene::schema::{AnalysisSpec, OutputSpec};
+use crate::scene::schema::{AccuracySpec, AnalysisSpec, OutputSpec};
 
 /// Most continuation points or linear-reference points a scene may ask for.
 pub const MAX_POINTS: usize = 10_000_000;
@@ -139,6 +139,25 @@ pub(super) fn analysis(a: &AnalysisSpec, ck: &Checker) -> Result<Analysis, Scene
         jacobian: a.jacobian,
         formulation: a.formulation,
         linear_points: a.linear_points,
+        error_estimate: ErrorEstimateSettings::default(),
+    })
+}
+
+/// The `[accuracy]` table into the error-estimate settings: the threshold must lie in (0, 1].
+pub(super) fn error_estimate(
+    spec: &AccuracySpec,
+    ck: &Checker,
+) -> Result<ErrorEstimateSettings, SceneError> {
+    let threshold = ck.positive("accuracy.threshold", spec.threshold)?;
+    if threshold > 1.0 {
+        return Err(ck.err(
+            "accuracy.threshold",
+            format!("is a relative error and must be ≤ 1, got {threshold}"),
+        ));
+    }
+    Ok(ErrorEstimateSettings {
+        enabled: spec.estimate,
+        warn_threshold: threshold,
     })
 }
 

@@ -57,7 +57,7 @@ pub use limits_schema::{
 pub use overrides::{apply_override, load, parse};
 pub use paper::{default_scene_label, paper_wedge_scene, PAPER_DEFAULT_SCENE};
 pub use schema::{
-    AnalysisSpec, ContactSpec, EffectsSpec, GroupDirectionSpec, HarmonicLoadSpec, HarmonicsSpec,
-    ModelSpec, OutputSpec, Scene, StaticLoadSpec,
+    AccuracySpec, AnalysisSpec, ContactSpec, EffectsSpec, GroupDirectionSpec, HarmonicLoadSpec,
+    HarmonicsSpec, ModelSpec, OutputSpec, Scene, StaticLoadSpec,
 };
 pub use validate::load_problem;

@@ -53,6 +53,9 @@ pub struct Scene {
     /// Parameter sweep of the limit analysis (optimal curves); absent: no sweep.
     #[serde(default)]
     pub sweep: Option<SweepSpec>,
+    /// The a-posteriori error estimate on every converged point; absent: on, 1 % threshold.
+    #[serde(default, skip_serializing_if = "AccuracySpec::is_default")]
+    pub accuracy: AccuracySpec,
 }
 
 /// Inline dense matrices with DOF names.
@@ -334,4 +337,39 @@ pub struct GroupDirectionSpec {
     pub group: String,
     /// `x`, `y` or `z`.
     pub direction: String,
+}
+
+/// The `[accuracy]` table: the a-posteriori error estimate of every converged point
+/// (truncation of the harmonic set and AFT sampling, see `crate::analysis::error_estimate`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AccuracySpec {
+    /// Whether the estimate is computed (default true).
+    #[serde(default = "yes")]
+    pub estimate: bool,
+    /// Relative error of a first-harmonic amplitude above which a run warns (default 0.01).
+    #[serde(default = "default_warn_threshold")]
+    pub threshold: f64,
+}
+
+impl Default for AccuracySpec {
+    fn default() -> Self {
+        Self {
+            estimate: true,
+            threshold: default_warn_threshold(),
+        }
+    }
+}
+
+impl AccuracySpec {
+    /// Whether the table holds its defaults (then it is left out of the canonical scene, so
+    /// the scene hash of a scene without it does not change).
+    pub fn is_default(&self) -> bool {
+        *self == Self::default()
+    }
+}
+
+/// Default of `[accuracy].threshold`: 1 %.
+fn default_warn_threshold() -> f64 {
+    0.01
 }

@@ -13,7 +13,7 @@ use crate::contact::ContactEffects;
 use crate::hbm::formulation::check_relative_coordinates;
 use crate::model::reduce::ReductionSettings;
 use crate::model::{Effects, FeOrigin, Formulation, Problem};
-use crate::scene::check_analysis::{analysis, frequency_bound, outputs};
+use crate::scene::check_analysis::{analysis, error_estimate, frequency_bound, outputs};
 use crate::scene::check_bodies::check_held_bodies;
 use crate::scene::check_contacts::{check_gap_scale, contact_set};
 use crate::scene::check_limits::limit_settings;
@@ -105,7 +105,8 @@ impl Scene {
         let harmonic_loads =
             harmonic_loads(&self.harmonic_loads, ck, dofs, fe.as_ref(), &harmonics)?;
         frequency_bound(&self.analysis, &harmonics, &model, &contacts, ck)?;
-        let analysis = analysis(&self.analysis, ck)?;
+        let mut analysis = analysis(&self.analysis, ck)?;
+        analysis.error_estimate = error_estimate(&self.accuracy, ck)?;
         let outputs = outputs(&self.output, ck, dofs, fe.as_ref())?;
         let reduction =
             reduction_settings(self.reduction.as_ref(), &self.model, ck, dofs, fe.as_ref())?;

@@ -8,7 +8,9 @@
 //! | module | main types | job |
 //! |---|---|---|
 //! | [`sweep`] | `SweepPoint`, `run`, `problem_at` | sweeps of any numeric scene field: optimal curves, resonance-frequency limits, limit analyses per value (paper Figs. 15-19) |
+//! | [`accuracy`] | `Setting`, `SettingResult`, `run_settings`, `pareto_front` | what each solver setting (harmonics, samples, tolerance, interior modes, effect switches) costs in time and gives in accuracy against a converged reference |
 //! | [`scaling`] | `ModelSize`, `SolverConfig`, `NewtonIteration` | what FE size, contact count, harmonics and solver strategy cost |
 
+pub mod accuracy;
 pub mod scaling;
 pub mod sweep;

@@ -187,6 +187,7 @@ mod tests {
             newton_iterations: 3,
             residual: 1e-10,
             coefficients: Vec::new(),
+            accuracy: None,
         }
     }
 

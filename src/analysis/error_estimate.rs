@@ -1,0 +1,442 @@
+//! A-posteriori error estimate of a converged harmonic-balance point: how much each output's
+//! first-harmonic amplitude would change if the harmonic set were larger (truncation) or the
+//! AFT sampled the period more finely (sampling).
+//!
+//! # Truncation
+//!
+//! A converged point x (harmonics 0..H, or the scene's set) is padded with zero coefficients
+//! for the harmonics H+1 … 2H+1 ([`extended_harmonic`]) and put into the harmonic balance on the
+//! extended set (paper Eq. 7 with more harmonics), at the same frequency and the same number of
+//! samples per period (doubled only where the scene's count does not resolve 2H+1). With the
+//! same samples the displacement samples, the march and the kept force harmonics are those of
+//! the converged point, so the residual is zero on the kept harmonics and holds on the new ones
+//! exactly what the truncation threw away: the contact forces' harmonics H+1 … 2H+1. One Newton step of the extended system, δ = −J⁻¹R, pushes these forces
+//! through the dynamic stiffness of the new harmonics (with the contacts' linearisation) and
+//! carries their effect back onto the kept harmonics through the contact Jacobian. The
+//! estimate of an output is |A(x + δ) − A(x)| / A(x), A the first-harmonic amplitude
+//! √(c₁² + s₁²).
+//!
+//! # Sampling
+//!
+//! The same point put into the harmonic balance of the same harmonic set at twice the samples
+//! per period: the residual is what the coarser sampling of the march misses (stick-slip and
+//! lift-off transitions located to a sample), and one Newton step gives the estimate as above.
+//!
+//! Both are first-order estimates at a fixed frequency: near a fold of the path the Jacobian
+//! at fixed frequency is nearly singular and the amplitude at that frequency is sensitive to
+//! any change, so the estimates grow there, as the fixed-frequency error does. An estimate
+//! that cannot be formed (an AFT march that does not settle, a singular Jacobian) is NaN.
+//!
+//! Cost per point: one residual, Jacobian and factorisation of the system on 2H+1 harmonics, and
+//! one of the system at twice the samples (about two Newton iterations; a point takes 2-4).
+
+use crate::contact::harmonic::HarmonicSet;
+use crate::hbm::operator::HbmOperator;
+use crate::hbm::HbmError;
+use crate::model::Problem;
+use crate::numerics::jacobian::AssembledJacobian;
+use crate::numerics::ParametricResidual;
+
+/// The error estimate of one converged point, per output DOF (relative to its first-harmonic
+/// amplitude; NaN where the estimate could not be formed).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct PointAccuracy {
+    /// Harmonic-truncation estimate per output DOF (relative).
+    pub truncation: Vec<f64>,
+    /// AFT-sampling estimate per output DOF (relative).
+    pub sampling: Vec<f64>,
+}
+
+/// The two refined problems the estimate puts a point into: the harmonic set extended to 2H,
+/// and the same set at twice the samples. Built once per run (see [`ErrorEstimator`]).
+#[derive(Debug, Clone)]
+pub struct EstimateProblems {
+    /// The problem on the extended harmonic set.
+    pub truncation: Problem,
+    /// The problem at twice the samples per period.
+    pub sampling: Problem,
+}
+
+impl EstimateProblems {
+    /// The refined problems of `problem`, or None when its scene switched the estimate off.
+    pub fn new(problem: &Problem) -> Option<Self> {
+        if !problem.analysis.error_estimate.enabled {
+            return None;
+        }
+        let h = problem.harmonics.iter().copied().max().unwrap_or(1);
+        let top = extended_harmonic(h);
+        let mut truncation = problem.clone();
+        truncation.harmonics = problem
+            .harmonics
+            .iter()
+            .copied()
+            .chain(h + 1..=top)
+            .collect();
+        truncation.harmonics.sort_unstable();
+        truncation.harmonics.dedup();
+        while truncation.samples <= 2 * top {
+            truncation.samples *= 2;
+        }
+        let mut sampling = problem.clone();
+        sampling.samples = 2 * problem.samples;
+        Some(Self {
+            truncation,
+            sampling,
+        })
+    }
+}
+
+/// The highest harmonic of the truncation estimate's extended set for a scene whose highest
+/// harmonic is `h`: 2H + 1. A first-harmonic motion through a Jenkins element gives odd
+/// harmonics first (the slip reversals are symmetric over the period), so at H = 1 the set must
+/// reach the 3rd harmonic for the estimate to see what matters.
+pub fn extended_harmonic(h: usize) -> usize {
+    2 * h + 1
+}
+
+/// One refined operator and a Jacobian in its storage (pattern built once).
+struct Refined<'p> {
+    operator: HbmOperator<'p>,
+    jacobian: AssembledJacobian,
+    /// For each block of the base unknowns, its index among the refined operator's blocks.
+    block_of: Vec<usize>,
+}
+
+impl<'p> Refined<'p> {
+    fn new(problem: &'p Problem, base: &HarmonicSet) -> Result<Self, HbmError> {
+        let mut operator = HbmOperator::new(problem)?;
+        let jacobian = operator.new_jacobian();
+        let refined = operator.unknowns().clone();
+        let block_of = base
+            .blocks()
+            .iter()
+            .map(|b| {
+                refined
+                    .blocks()
+                    .iter()
+                    .position(|c| c == b)
+                    .expect("the refined set holds the base set")
+            })
+            .collect();
+        Ok(Self {
+            operator,
+            jacobian,
+            block_of,
+        })
+    }
+
+    /// Full coefficients of the refined problem after one Newton step from the base point
+    /// `x` (full coefficients on the base set) padded with zeros; None when the step cannot be
+    /// formed.
+    fn newton_step(&mut self, n: usize, x: &[f64], omega: f64) -> Option<Vec<f64>> {
+        let set = self.operator.unknowns();
+        let mut padded = vec![0.0; n * set.n_blocks()];
+        for (j, &jr) in self.block_of.iter().enumerate() {
+            padded[jr * n..(jr + 1) * n].copy_from_slice(&x[j * n..(j + 1) * n]);
+        }
+        let xr = self.operator.restrict(&padded);
+        let dim = xr.len();
+        let mut r = vec![0.0; dim];
+        let mut dr = vec![0.0; dim];
+        self.operator
+            .residual_and_jacobian(&xr, omega, &mut r, &mut self.jacobian, &mut dr)
+            .ok()?;
+        let delta = self.jacobian.solve(&r).ok()?;
+        let stepped: Vec<f64> = xr.iter().zip(&delta).map(|(a, d)| a - d).collect();
+        let full = self.operator.expand(&stepped, omega).ok()?;
+        full.iter().all(|v| v.is_finite()).then_some(full)
+    }
+}
+
+/// First-harmonic amplitude √(c₁² + s₁²) of each output DOF from full coefficients on `set`.
+fn amplitudes(problem: &Problem, set: &HarmonicSet, x: &[f64]) -> Vec<f64> {
+    let n = problem.model.n_dofs();
+    let (c1, s1) = (set.cos_block(1), set.sin_block(1));
+    problem
+        .outputs
+        .iter()
+        .map(|&d| {
+            let c = c1.map_or(0.0, |j| x[j * n + d]);
+            let s = s1.map_or(0.0, |j| x[j * n + d]);
+            c.hypot(s)
+        })
+        .collect()
+}
+
+/// |a − b| / b per output (0 where both are 0, infinite where only b is).
+fn relative_changes(refined: &[f64], base: &[f64]) -> Vec<f64> {
+    refined
+        .iter()
+        .zip(base)
+        .map(|(&a, &b)| {
+            let change = (a - b).abs();
+            if change == 0.0 {
+                0.0
+            } else {
+                change / b.abs()
+            }
+        })
+        .collect()
+}
+
+/// Estimates the truncation and sampling errors of converged points of one problem, reusing
+/// the refined operators (and their Jacobian patterns) from point to point.
+pub struct ErrorEstimator<'p> {
+    problem: &'p Problem,
+    set: HarmonicSet,
+    truncation: Refined<'p>,
+    sampling: Refined<'p>,
+}
+
+impl<'p> ErrorEstimator<'p> {
+    /// An estimator for converged points of `problem` (full coefficients on its unknown
+    /// harmonics), on the refined problems `refined` built from it.
+    pub fn new(problem: &'p Problem, refined: &'p EstimateProblems) -> Result<Self, HbmError> {
+        let set = problem.unknown_harmonics();
+        Ok(Self {
+            problem,
+            truncation: Refined::new(&refined.truncation, &set)?,
+            sampling: Refined::new(&refined.sampling, &set)?,
+            set,
+        })
+    }
+
+    /// The estimate at the converged point `x` (full coefficients, harmonic-major) solved at
+    /// ω = `omega` (rad/s).
+    pub fn estimate(&mut self, x: &[f64], omega: f64) -> PointAccuracy {
+        let n = self.problem.model.n_dofs();
+        let base = amplitudes(self.problem, &self.set, x);
+        let nan = || vec![f64::NAN; base.len()];
+        let truncation = match self.truncation.newton_step(n, x, omega) {
+            Some(full) => {
+                let set = self.truncation.operator.unknowns().clone();
+                relative_changes(&amplitudes(self.problem, &set, &full), &base)
+            }
+            None => nan(),
+        };
+        let sampling = match self.sampling.newton_step(n, x, omega) {
+            Some(full) => relative_changes(&amplitudes(self.problem, &self.set, &full), &base),
+            None => nan(),
+        };
+        PointAccuracy {
+            truncation,
+            sampling,
+        }
+    }
+}
+
+/// A frequency band where an estimate exceeds the scene's threshold, for the end-of-run warning.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AccuracyWarning {
+    /// `truncation` or `sampling`.
+    pub kind: EstimateKind,
+    /// Output DOF index (into the problem's outputs).
+    pub output: usize,
+    /// Lowest and highest frequency of the points above the threshold (Hz).
+    pub from_hz: f64,
+    /// See `from_hz`.
+    pub to_hz: f64,
+    /// Largest estimate in the band (relative).
+    pub largest: f64,
+}
+
+/// Which estimate a warning is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EstimateKind {
+    /// Harmonic truncation.
+    Truncation,
+    /// AFT sampling.
+    Sampling,
+}
+
+/// Bands of consecutive points (in path order) where an estimate exceeds `threshold`, per
+/// output and kind; NaN estimates (not formed) count as above. Bands less than
+/// [`MERGE_FRACTION`] of the points' frequency span apart are reported as one.
+pub fn warnings(
+    points: &[(f64, &PointAccuracy)],
+    outputs: usize,
+    threshold: f64,
+) -> Vec<AccuracyWarning> {
+    let (lo, hi) = points
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+            (a.min(p.0), b.max(p.0))
+        });
+    let gap = MERGE_FRACTION * (hi - lo).max(0.0);
+    let mut merged: Vec<AccuracyWarning> = Vec::new();
+    for w in bands(points, outputs, threshold) {
+        match merged.last_mut() {
+            Some(last)
+                if last.kind == w.kind
+                    && last.output == w.output
+                    && w.from_hz - last.to_hz <= gap
+                    && last.from_hz - w.to_hz <= gap =>
+            {
+                last.from_hz = last.from_hz.min(w.from_hz);
+                last.to_hz = last.to_hz.max(w.to_hz);
+                if w.largest > last.largest || w.largest.is_nan() {
+                    last.largest = w.largest;
+                }
+            }
+            _ => merged.push(w),
+        }
+    }
+    merged
+}
+
+/// Fraction of the frequency span under which two warning bands are merged.
+pub const MERGE_FRACTION: f64 = 0.02;
+
+/// The bands of [`warnings`] before merging.
+fn bands(points: &[(f64, &PointAccuracy)], outputs: usize, threshold: f64) -> Vec<AccuracyWarning> {
+    let mut found = Vec::new();
+    for kind in [EstimateKind::Truncation, EstimateKind::Sampling] {
+        for output in 0..outputs {
+            let mut band: Option<AccuracyWarning> = None;
+            for &(freq_hz, acc) in points {
+                let values = match kind {
+                    EstimateKind::Truncation => &acc.truncation,
+                    EstimateKind::Sampling => &acc.sampling,
+                };
+                let e = values.get(output).copied().unwrap_or(f64::NAN);
+                if e > threshold || e.is_nan() {
+                    let b = band.get_or_insert(AccuracyWarning {
+                        kind,
+                        output,
+                        from_hz: freq_hz,
+                        to_hz: freq_hz,
+                        largest: e,
+                    });
+                    b.from_hz = b.from_hz.min(freq_hz);
+                    b.to_hz = b.to_hz.max(freq_hz);
+                    if e > b.largest || e.is_nan() {
+                        b.largest = e;
+                    }
+                } else if let Some(b) = band.take() {
+                    found.push(b);
+                }
+            }
+            found.extend(band);
+        }
+    }
+    found
+}
+
+/// The warning line of a band: where, how large, and which field to raise. `h_max` is the
+/// highest balanced harmonic, `samples` the samples per period, `output` the DOF's name.
+pub fn warning_text(w: &AccuracyWarning, output: &str, h_max: usize, samples: usize) -> String {
+    let size = if w.largest.is_nan() {
+        "could not be estimated".to_string()
+    } else {
+        format!("is estimated at up to {:.2} %", 100.0 * w.largest)
+    };
+    let (what, advice) = match w.kind {
+        EstimateKind::Truncation => (
+            "harmonic truncation",
+            format!(
+                "harmonics.max > {h_max} needed (the estimate compares with H = {})",
+                extended_harmonic(h_max)
+            ),
+        ),
+        EstimateKind::Sampling => (
+            "AFT sampling",
+            format!("harmonics.samples > {samples} needed (try {})", 2 * samples),
+        ),
+    };
+    format!(
+        "accuracy: the {what} error of {output}'s amplitude {size} between {:.4} and {:.4} Hz: \
+         {advice}",
+        w.from_hz, w.to_hz
+    )
+}
+
+/// The largest estimate per output over `points` (NaN ignored; 0 for no points), truncation
+/// then sampling.
+pub fn largest(points: &[&PointAccuracy], outputs: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut trunc = vec![0.0_f64; outputs];
+    let mut samp = vec![0.0_f64; outputs];
+    for p in points {
+        for (m, v) in trunc.iter_mut().zip(&p.truncation) {
+            if v.is_finite() {
+                *m = m.max(*v);
+            }
+        }
+        for (m, v) in samp.iter_mut().zip(&p.sampling) {
+            if v.is_finite() {
+                *m = m.max(*v);
+            }
+        }
+    }
+    (trunc, samp)
+}
+
+/// The end-of-run warning lines of a run's estimates (frequency in Hz and estimate of each
+/// point that has one, in path order; see `crate::analysis::frf::accuracy_of`): one per band
+/// where an estimate exceeds the scene's threshold ([`warnings`], [`warning_text`]); empty when
+/// the estimate is off or everything is below the threshold.
+pub fn run_warnings(problem: &Problem, with: &[(f64, &PointAccuracy)]) -> Vec<String> {
+    let h_max = problem.harmonics.iter().copied().max().unwrap_or(1);
+    warnings(
+        with,
+        problem.outputs.len(),
+        problem.analysis.error_estimate.warn_threshold,
+    )
+    .iter()
+    .map(|w| {
+        let name = &problem.model.dof_names[problem.outputs[w.output]];
+        warning_text(w, name, h_max, problem.samples)
+    })
+    .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn acc(t: f64, s: f64) -> PointAccuracy {
+        PointAccuracy {
+            truncation: vec![t],
+            sampling: vec![s],
+        }
+    }
+
+    #[test]
+    fn warning_bands_join_consecutive_points() {
+        let a = [
+            acc(0.001, 0.0),
+            acc(0.05, 0.0),
+            acc(0.02, 0.0),
+            acc(0.001, 0.2),
+            acc(0.03, 0.0),
+            acc(0.001, 0.0),
+            acc(0.001, 0.0),
+            acc(0.04, 0.0),
+        ];
+        let points: Vec<(f64, &PointAccuracy)> =
+            [100.0, 101.0, 102.0, 103.0, 104.0, 120.0, 150.0, 200.0]
+                .into_iter()
+                .zip(&a)
+                .collect();
+        let w = warnings(&points, 1, 0.01);
+        assert_eq!(w.len(), 3, "{w:?}");
+        // 101-102 and 104 are 2 Hz apart, under 2 % of the 100 Hz span: one band.
+        assert_eq!(w[0].kind, EstimateKind::Truncation);
+        assert_eq!(
+            (w[0].from_hz, w[0].to_hz, w[0].largest),
+            (101.0, 104.0, 0.05)
+        );
+        assert_eq!((w[1].from_hz, w[1].to_hz), (200.0, 200.0));
+        assert_eq!(w[2].kind, EstimateKind::Sampling);
+        assert_eq!((w[2].from_hz, w[2].to_hz), (103.0, 103.0));
+        let text = warning_text(&w[0], "y2", 1, 256);
+        assert!(text.contains("harmonics.max > 1"), "{text}");
+        assert!(text.contains("101.0000 and 104.0000 Hz"), "{text}");
+    }
+
+    #[test]
+    fn largest_ignores_unformed_estimates() {
+        let a = [acc(0.01, f64::NAN), acc(0.03, 0.002)];
+        let refs: Vec<&PointAccuracy> = a.iter().collect();
+        assert_eq!(largest(&refs, 1), (vec![0.03], vec![0.002]));
+    }
+}

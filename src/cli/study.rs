@@ -1,0 +1,326 @@
+//! `fricbound study accuracy`: the accuracy study of a scene ([`crate::study::accuracy`]) with
+//! its files: `study.csv` (one row per setting, appended as each finishes), `study.md` and the
+//! error-against-time figure `accuracy_pareto.png`/`.svg` with the Pareto front.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+use clap::Subcommand;
+use indicatif::{ProgressBar, ProgressStyle};
+use plotters::style::RGBColor;
+
+use super::CommandError;
+use crate::report::files::write_atomic;
+use crate::report::plot::{self, figure_files, Curve};
+use crate::scene::SceneError;
+use crate::study::accuracy::{self, SettingErrors, SettingResult};
+
+/// Studies over solver settings.
+#[derive(Debug, Clone, Subcommand)]
+pub enum StudyCommand {
+    /// What accuracy costs in time: each setting (harmonics, samples, tolerance, interior modes,
+    /// effect switches) against a converged reference.
+    Accuracy {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Short setting lists (seconds on the paper case).
+        #[arg(long)]
+        quick: bool,
+        /// Output folder (default: out/<scene name>-accuracy).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override a scene field by its dotted path (applied to every setting).
+        #[arg(long = "set", value_name = "FIELD=VALUE")]
+        overrides: Vec<String>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+}
+
+/// What a study produced: the summary text and, when some setting failed or did not cover the
+/// range, why (exit code 3).
+#[derive(Debug, Clone)]
+pub struct StudyReport {
+    /// Printable summary.
+    pub summary: String,
+    /// Failed or incomplete settings, None when all are complete.
+    pub incomplete: Option<String>,
+}
+
+/// Header of `study.csv` for a reference with `peaks` resonance peaks.
+fn csv_header(peaks: usize) -> String {
+    let mut h = String::from(
+        "group,setting,status,unknowns,points,newton_iterations,time_s,curve_l2_err,\
+         peak_amp_err,peak_freq_err",
+    );
+    for k in 1..=peaks {
+        let _ = write!(h, ",peak{k}_amp_err,peak{k}_freq_err");
+    }
+    h.push('\n');
+    h
+}
+
+/// One `study.csv` row.
+fn csv_row(r: &SettingResult, e: &SettingErrors) -> String {
+    // Commas in a label or a status become semicolons: one cell each, no quoting.
+    let status = r.status.replace(',', ";");
+    let mut s = format!(
+        "{},{},{status},{},{},{},{:.4e},{:.3e},{:.3e},{:.3e}",
+        r.setting.group,
+        r.setting.label.replace(',', ";"),
+        r.unknowns,
+        r.points,
+        r.newton_iterations,
+        r.time_s,
+        e.curve_l2,
+        e.max_peak_amplitude(),
+        e.max_peak_frequency()
+    );
+    for (a, f) in &e.peaks {
+        let _ = write!(s, ",{a:.3e},{f:.3e}");
+    }
+    s.push('\n');
+    s
+}
+
+/// Runs a study command.
+pub fn run(command: &StudyCommand) -> Result<StudyReport, CommandError> {
+    match command {
+        StudyCommand::Accuracy {
+            scene,
+            quick,
+            out,
+            overrides,
+            quiet,
+        } => accuracy_study(scene, *quick, out.clone(), overrides, *quiet),
+    }
+}
+
+fn io_error(path: &std::path::Path, source: std::io::Error) -> CommandError {
+    CommandError::Write(crate::report::files::WriteError {
+        path: path.display().to_string(),
+        source,
+    })
+}
+
+fn accuracy_study(
+    scene_path: &std::path::Path,
+    quick: bool,
+    out: Option<PathBuf>,
+    user: &[String],
+    quiet: bool,
+) -> Result<StudyReport, CommandError> {
+    let label = scene_path.display().to_string();
+    let text = std::fs::read_to_string(scene_path).map_err(|source| SceneError::Io {
+        file: label.clone(),
+        source,
+    })?;
+    let (scene, problem, base) = accuracy::load(&text, &label, user)?;
+    let (reference, check, settings) = accuracy::settings(&scene, &problem, quick);
+    let stem = scene_path
+        .file_stem()
+        .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{stem}-accuracy")));
+    std::fs::create_dir_all(&dir).map_err(|source| CommandError::OutputDir {
+        path: dir.display().to_string(),
+        source,
+    })?;
+    let bar = (!quiet).then(|| {
+        let bar = ProgressBar::new(2 + settings.len() as u64);
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} {msg}",
+            )
+            .expect("static template"),
+        );
+        bar.set_message("reference");
+        bar
+    });
+    // The reference and its check first (every error needs the reference), side by side.
+    let (ref_result, check_result) = rayon::join(
+        || accuracy::run_setting(&text, &label, &base, &reference),
+        || accuracy::run_setting(&text, &label, &base, &check),
+    );
+    if let Some(bar) = &bar {
+        bar.inc(2);
+    }
+    if ref_result.status != "complete" {
+        return Err(CommandError::Study {
+            scene: label,
+            reason: format!(
+                "the accuracy study's reference ({}) did not solve: {}",
+                reference.label, ref_result.status
+            ),
+        });
+    }
+    let check_errors = accuracy::errors(&check_result, &ref_result);
+    // study.csv, its rows appended as settings finish.
+    let csv_path = dir.join("study.csv");
+    let mut file = std::fs::File::create(&csv_path).map_err(|e| io_error(&csv_path, e))?;
+    let header = csv_header(ref_result.peaks.len());
+    file.write_all(header.as_bytes())
+        .and_then(|()| file.write_all(csv_row(&check_result, &check_errors).as_bytes()))
+        .map_err(|e| io_error(&csv_path, e))?;
+    let file = Mutex::new((file, None::<std::io::Error>));
+    let results = accuracy::run_settings(&text, &label, &base, &settings, |r| {
+        let row = csv_row(r, &accuracy::errors(r, &ref_result));
+        let mut guard = file.lock().expect("no panics while holding the lock");
+        if guard.1.is_none() {
+            if let Err(e) = guard
+                .0
+                .write_all(row.as_bytes())
+                .and_then(|()| guard.0.flush())
+            {
+                guard.1 = Some(e);
+            }
+        }
+        if let Some(bar) = &bar {
+            bar.inc(1);
+            bar.set_message(r.setting.label.clone());
+        }
+    });
+    if let Some(bar) = &bar {
+        bar.finish_and_clear();
+    }
+    if let Some(e) = file.into_inner().expect("lock not poisoned").1 {
+        return Err(io_error(&csv_path, e));
+    }
+    let errors: Vec<SettingErrors> = results
+        .iter()
+        .map(|r| accuracy::errors(r, &ref_result))
+        .collect();
+    // The figure: peak amplitude error against time, the Pareto front marked and labelled.
+    let pairs: Vec<(f64, f64)> = results
+        .iter()
+        .zip(&errors)
+        .map(|(r, e)| (r.time_s, e.max_peak_amplitude()))
+        .collect();
+    let front = accuracy::pareto_front(&pairs);
+    let front_x: Vec<f64> = front.iter().map(|&i| pairs[i].0).collect();
+    let front_y: Vec<f64> = front.iter().map(|&i| pairs[i].1).collect();
+    // The other settings as one series of lone points (NaN between them breaks the line).
+    let others: Vec<(f64, f64)> = (0..pairs.len())
+        .filter(|i| !front.contains(i))
+        .flat_map(|i| [pairs[i], (f64::NAN, f64::NAN)])
+        .collect();
+    let others_x: Vec<f64> = others.iter().map(|p| p.0).collect();
+    let others_y: Vec<f64> = others.iter().map(|p| p.1).collect();
+    let labels: Vec<String> = results.iter().map(|r| r.setting.label.clone()).collect();
+    let fronts: Vec<([f64; 1], [f64; 1])> = front
+        .iter()
+        .map(|&i| ([pairs[i].0], [pairs[i].1]))
+        .collect();
+    let mut series: Vec<Curve> = vec![
+        Curve {
+            label: "Pareto front",
+            x: &front_x,
+            y: &front_y,
+            color: RGBColor(200, 30, 30),
+            dashed: true,
+            markers: true,
+        },
+        Curve {
+            label: "other settings",
+            x: &others_x,
+            y: &others_y,
+            color: RGBColor(150, 150, 150),
+            dashed: false,
+            markers: true,
+        },
+    ];
+    for (k, (&i, (x, y))) in front.iter().zip(&fronts).enumerate() {
+        series.push(Curve {
+            label: labels[i].as_str(),
+            x: &x[..],
+            y: &y[..],
+            color: plot::palette(k + 1),
+            dashed: false,
+            markers: true,
+        });
+    }
+    let (png, svg) = figure_files(&dir, "accuracy_pareto");
+    plot::plot_lines(
+        &format!("What accuracy costs: {}", scene.title),
+        "wall time of the FRF (s)",
+        "largest relative peak amplitude error",
+        true,
+        &series,
+        &png,
+        &svg,
+    )?;
+    // study.md
+    let mut md = format!(
+        "# Accuracy study: {}\n\nScene `{label}`{}. Reference: {} ({} points, {:.2} s). \
+         Reference converged to: curve L2 {:.2e}, peak amplitude {:.2e}, peak frequency {:.2e} \
+         (against {}).\n\nSettings are varied one at a time from the scene as given; errors \
+         are relative to the reference, for the first output ({}). Times are wall times of \
+         the continuation with the settings running in parallel (one per core).\n\n\
+         | group | setting | status | unknowns | points | Newton its | time (s) | curve L2 err | \
+         peak amp err | peak freq err | Pareto |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        scene.title,
+        if user.is_empty() {
+            String::new()
+        } else {
+            format!(" with {}", user.join(" "))
+        },
+        reference.label,
+        ref_result.points,
+        ref_result.time_s,
+        check_errors.curve_l2,
+        check_errors.max_peak_amplitude(),
+        check_errors.max_peak_frequency(),
+        check.label,
+        problem.model.dof_names[problem.outputs[0]],
+    );
+    for (i, (r, e)) in results.iter().zip(&errors).enumerate() {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {} | {:.3} | {:.2e} | {:.2e} | {:.2e} | {} |",
+            r.setting.group,
+            r.setting.label,
+            r.status,
+            r.unknowns,
+            r.points,
+            r.newton_iterations,
+            r.time_s,
+            e.curve_l2,
+            e.max_peak_amplitude(),
+            e.max_peak_frequency(),
+            if front.contains(&i) { "yes" } else { "" }
+        );
+    }
+    let _ = writeln!(
+        md,
+        "\nReference peaks (Hz, m): {:?}\n\n![error against time](accuracy_pareto.png)",
+        ref_result.peaks
+    );
+    write_atomic(&dir.join("study.md"), md.as_bytes())?;
+    let unfinished: Vec<String> = results
+        .iter()
+        .chain([&check_result])
+        .filter(|r| r.status != "complete")
+        .map(|r| format!("{} ({})", r.setting.label, r.status))
+        .collect();
+    let summary = format!(
+        "accuracy study of {label}: {} settings; reference {} converged to {:.2e} (peak \
+         amplitude against {}); Pareto front: {}\nresults in {}\n",
+        results.len(),
+        reference.label,
+        check_errors.max_peak_amplitude(),
+        check.label,
+        front
+            .iter()
+            .map(|&i| results[i].setting.label.as_str())
+            .collect::<Vec<_>>()
+            .join(", "),
+        dir.display()
+    );
+    Ok(StudyReport {
+        summary,
+        incomplete: (!unfinished.is_empty())
+            .then(|| format!("settings not complete: {}", unfinished.join("; "))),
+    })
+}

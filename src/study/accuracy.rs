@@ -1,0 +1,418 @@
+//! The accuracy study: what each solver setting costs in time and gives in accuracy.
+//!
+//! One setting at a time is changed from the scene as given: the harmonic set (H), the AFT
+//! samples per period, the Newton residual tolerance, the Craig-Bampton interior modes (scenes
+//! with `[reduction]`), and each effect switch (constant normal load, no lift-off, uncoupled
+//! statics). Every setting's FRF is compared with a reference: the most refined setting (the
+//! largest H with the most samples and the tightest tolerance), whose convergence is checked
+//! against the next refinement down (H one step lower): the difference is reported.
+//!
+//! Per setting: the error of each resonance peak of the first output (refined amplitude and
+//! frequency, relative, against the nearest reference peak), the relative L2 error of the
+//! first output's amplitude over the range both paths cover ([`curve_l2_error`]), the wall time
+//! of the continuation (peak refinement excluded), Newton iterations and unknowns.
+//!
+//! Limit scenes are studied on the FRF of the scene's own initial states (the `[limits]` and
+//! `[sweep]` tables are removed), not per limit curve.
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use crate::analysis::frf::{self, FrfPoint, Silent};
+use crate::analysis::peaks;
+use crate::model::Problem;
+use crate::scene::{self, Scene, SceneError};
+
+/// One setting of the study: a group (`reference`, `harmonics`, `samples`, `tolerance`,
+/// `modes`, `effect`), a label and the scene overrides that make it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Setting {
+    /// What is varied.
+    pub group: &'static str,
+    /// Short label (`H = 3`, `samples = 64`, `no lift-off`, …).
+    pub label: String,
+    /// Scene overrides (`FIELD=VALUE`) on top of the scene as given.
+    pub overrides: Vec<String>,
+}
+
+/// The settings of a study of `scene`: the reference, the convergence check of the reference,
+/// then the settings varied one at a time. `quick` uses short lists (seconds on the paper case).
+pub fn settings(scene: &Scene, problem: &Problem, quick: bool) -> (Setting, Setting, Vec<Setting>) {
+    let h0 = problem.harmonics.iter().copied().max().unwrap_or(1);
+    let s0 = problem.samples;
+    let (h_list, s_list, tol_list): (Vec<usize>, Vec<usize>, Vec<f64>) = if quick {
+        (vec![1, 3, 5], vec![64, 128, 256], vec![1e-4, 1e-8])
+    } else {
+        (
+            vec![1, 2, 3, 5, 7, 9, 11, 15],
+            vec![32, 64, 128, 256, 512, 1024, 2048],
+            vec![1e-4, 1e-6, 1e-8, 1e-10],
+        )
+    };
+    let h_ref = if quick { 7 } else { 21 };
+    let h_check = if quick { 5 } else { 15 };
+    let s_ref = if quick { 512 } else { 4096 };
+    let tol_ref = 1e-12;
+    let h_of = |h: usize| format!("harmonics.max={h}");
+    let s_of = |s: usize| format!("harmonics.samples={s}");
+    // A scene with an explicit harmonic list gets H = 1..h instead (the list removed).
+    let drop_list: Vec<String> = if scene.harmonics.list.is_some() {
+        vec!["harmonics.list=".to_string()]
+    } else {
+        Vec::new()
+    };
+    let set_h = |h: usize, s: usize| {
+        let mut o = drop_list.clone();
+        o.extend([h_of(h), s_of(s.max(4 * h + 2))]);
+        o
+    };
+    let fixed = |h: usize, s: usize, tol: f64| {
+        let mut o = set_h(h, s);
+        o.push(format!("analysis.residual_tolerance={tol:e}"));
+        o
+    };
+    let reference = Setting {
+        group: "reference",
+        label: format!("H = {h_ref}; samples = {s_ref}; tol = {tol_ref:e}"),
+        overrides: fixed(h_ref, s_ref, tol_ref),
+    };
+    let check = Setting {
+        group: "reference",
+        label: format!("H = {h_check}; samples = {s_ref}; tol = {tol_ref:e}"),
+        overrides: fixed(h_check, s_ref, tol_ref),
+    };
+    let mut list = Vec::new();
+    for &h in &h_list {
+        list.push(Setting {
+            group: "harmonics",
+            label: format!("H = {h}"),
+            overrides: set_h(h, s0),
+        });
+    }
+    for &s in s_list.iter().filter(|&&s| s > 2 * h0) {
+        list.push(Setting {
+            group: "samples",
+            label: format!("samples = {s}"),
+            overrides: vec![s_of(s)],
+        });
+    }
+    for &t in &tol_list {
+        list.push(Setting {
+            group: "tolerance",
+            label: format!("tol = {t:e}"),
+            overrides: vec![format!("analysis.residual_tolerance={t:e}")],
+        });
+    }
+    if let Some(r) = &scene.reduction {
+        let modes: Vec<usize> = if quick {
+            vec![r.modes / 2, r.modes]
+        } else {
+            vec![r.modes / 4, r.modes / 2, r.modes, 2 * r.modes]
+        };
+        for m in modes.into_iter().filter(|&m| m >= 1) {
+            list.push(Setting {
+                group: "modes",
+                label: format!("modes = {m}"),
+                overrides: vec![format!("reduction.modes={m}")],
+            });
+        }
+    }
+    for (label, o) in [
+        ("constant normal load", "effects.normal_load=\"constant\""),
+        ("no lift-off", "effects.liftoff=false"),
+        ("uncoupled statics", "effects.coupling=\"uncoupled\""),
+    ] {
+        list.push(Setting {
+            group: "effect",
+            label: label.to_string(),
+            overrides: vec![o.to_string()],
+        });
+    }
+    (reference, check, list)
+}
+
+/// What one setting gave.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SettingResult {
+    /// The setting.
+    pub setting: Setting,
+    /// `complete`, `incomplete: …` or `failed: …`.
+    pub status: String,
+    /// Newton unknowns (DOFs × coefficient blocks of the problem).
+    pub unknowns: usize,
+    /// Converged path points.
+    pub points: usize,
+    /// Newton iterations over the path.
+    pub newton_iterations: usize,
+    /// Wall time of the continuation (s).
+    pub time_s: f64,
+    /// The path (empty when the setting failed).
+    pub path: Vec<FrfPoint>,
+    /// Refined resonance peaks of the first output: (frequency Hz, amplitude m).
+    pub peaks: Vec<(f64, f64)>,
+}
+
+/// Errors of a setting against the reference.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SettingErrors {
+    /// Relative L2 error of the first output's amplitude over the common range.
+    pub curve_l2: f64,
+    /// Per reference peak: relative amplitude and frequency errors of the nearest peak (NaN
+    /// when the setting has no peak).
+    pub peaks: Vec<(f64, f64)>,
+}
+
+impl SettingErrors {
+    /// The largest peak amplitude error (NaN when some peak is missing).
+    pub fn max_peak_amplitude(&self) -> f64 {
+        self.peaks
+            .iter()
+            .map(|p| p.0)
+            .fold(0.0, |a: f64, b| if b.is_nan() { b } else { a.max(b) })
+    }
+    /// The largest peak frequency error (NaN when some peak is missing).
+    pub fn max_peak_frequency(&self) -> f64 {
+        self.peaks
+            .iter()
+            .map(|p| p.1)
+            .fold(0.0, |a: f64, b| if b.is_nan() { b } else { a.max(b) })
+    }
+}
+
+/// Solves one setting of `scene_text` (named `label`, with the base overrides `base`) and
+/// refines its peaks; a setting that does not validate or solve is reported `failed: …`.
+pub fn run_setting(
+    scene_text: &str,
+    label: &str,
+    base: &[String],
+    setting: &Setting,
+) -> SettingResult {
+    let mut overrides = base.to_vec();
+    overrides.extend(setting.overrides.iter().cloned());
+    overrides.push("accuracy.estimate=false".into());
+    let failed = |status: String| SettingResult {
+        setting: setting.clone(),
+        status,
+        unknowns: 0,
+        points: 0,
+        newton_iterations: 0,
+        time_s: f64::NAN,
+        path: Vec::new(),
+        peaks: Vec::new(),
+    };
+    let problem = match scene::parse(scene_text, label, &overrides).and_then(|s| s.validate(label))
+    {
+        Ok(p) => p,
+        Err(e) => return failed(format!("failed: {e}")),
+    };
+    let unknowns = problem.model.n_dofs() * problem.unknown_harmonics().n_blocks();
+    let started = Instant::now();
+    let run = frf::solve(&problem, &mut Silent);
+    let time_s = started.elapsed().as_secs_f64();
+    let run = match run {
+        Ok(r) => r,
+        Err(e) => {
+            let mut r = failed(format!("failed: {e}"));
+            r.unknowns = unknowns;
+            r.time_s = time_s;
+            return r;
+        }
+    };
+    let status = match run.incomplete_reason() {
+        None => "complete".to_string(),
+        Some(reason) => format!("incomplete: {reason}"),
+    };
+    let peaks = peaks::path_peaks(&problem, &run.points)
+        .ok()
+        .and_then(|mut p| (!p.is_empty()).then(|| p.swap_remove(0)))
+        .unwrap_or_default()
+        .iter()
+        .map(|p| (p.freq_hz, p.amplitude))
+        .collect();
+    SettingResult {
+        setting: setting.clone(),
+        status,
+        unknowns,
+        points: run.points.len(),
+        newton_iterations: run.points.iter().map(|p| p.newton_iterations).sum(),
+        time_s,
+        path: run.points,
+        peaks,
+    }
+}
+
+/// First output's amplitude on `path` at `freq_hz` (linear on the first segment holding it).
+fn amplitude_at(path: &[FrfPoint], freq_hz: f64) -> Option<f64> {
+    path.windows(2).find_map(|w| {
+        let (lo, hi) = if w[0].freq_hz <= w[1].freq_hz {
+            (&w[0], &w[1])
+        } else {
+            (&w[1], &w[0])
+        };
+        if freq_hz < lo.freq_hz || freq_hz > hi.freq_hz {
+            return None;
+        }
+        let span = hi.freq_hz - lo.freq_hz;
+        let t = if span > 0.0 {
+            (freq_hz - lo.freq_hz) / span
+        } else {
+            0.0
+        };
+        Some(lo.amplitudes[0] + t * (hi.amplitudes[0] - lo.amplitudes[0]))
+    })
+}
+
+/// Relative L2 error ‖a − r‖ / ‖r‖ of the first output's amplitude of `path` against
+/// `reference`, on 400 uniform frequencies of the range both cover (NaN when they share none).
+pub fn curve_l2_error(path: &[FrfPoint], reference: &[FrfPoint]) -> f64 {
+    let range = |p: &[FrfPoint]| {
+        p.iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
+                (a.min(q.freq_hz), b.max(q.freq_hz))
+            })
+    };
+    let (a0, a1) = range(path);
+    let (r0, r1) = range(reference);
+    let (lo, hi) = (a0.max(r0), a1.min(r1));
+    if hi <= lo || !hi.is_finite() {
+        return f64::NAN;
+    }
+    let (mut num, mut den) = (0.0, 0.0);
+    for k in 0..=400 {
+        let f = lo + (hi - lo) * k as f64 / 400.0;
+        if let (Some(a), Some(r)) = (amplitude_at(path, f), amplitude_at(reference, f)) {
+            num += (a - r) * (a - r);
+            den += r * r;
+        }
+    }
+    if den > 0.0 {
+        (num / den).sqrt()
+    } else {
+        f64::NAN
+    }
+}
+
+/// The errors of `result` against `reference`.
+pub fn errors(result: &SettingResult, reference: &SettingResult) -> SettingErrors {
+    SettingErrors {
+        curve_l2: curve_l2_error(&result.path, &reference.path),
+        peaks: reference
+            .peaks
+            .iter()
+            .map(|&(fr, ar)| {
+                result
+                    .peaks
+                    .iter()
+                    .min_by(|a, b| (a.0 - fr).abs().total_cmp(&(b.0 - fr).abs()))
+                    .map_or((f64::NAN, f64::NAN), |&(f, a)| {
+                        ((a - ar).abs() / ar, (f - fr).abs() / fr)
+                    })
+            })
+            .collect(),
+    }
+}
+
+/// Indices of the Pareto-optimal points of (time, error): no other point is at most as slow and
+/// at most as wrong while better in one. Points with a NaN are never on the front.
+pub fn pareto_front(points: &[(f64, f64)]) -> Vec<usize> {
+    let mut front: Vec<usize> = (0..points.len())
+        .filter(|&i| {
+            let (ti, ei) = points[i];
+            ti.is_finite()
+                && ei.is_finite()
+                && !points
+                    .iter()
+                    .enumerate()
+                    .any(|(j, &(tj, ej))| j != i && tj <= ti && ej <= ei && (tj < ti || ej < ei))
+        })
+        .collect();
+    front.sort_by(|&a, &b| points[a].0.total_cmp(&points[b].0));
+    front
+}
+
+/// Runs `settings` in parallel (rayon), calling `done` with each result as it finishes (from
+/// the worker threads).
+pub fn run_settings<F>(
+    scene_text: &str,
+    label: &str,
+    base: &[String],
+    settings: &[Setting],
+    done: F,
+) -> Vec<SettingResult>
+where
+    F: Fn(&SettingResult) + Sync,
+{
+    settings
+        .par_iter()
+        .map(|s| {
+            let r = run_setting(scene_text, label, base, s);
+            done(&r);
+            r
+        })
+        .collect()
+}
+
+/// The base overrides of a study: the user's, plus the removal of `[limits]` and `[sweep]`
+/// when the scene has them (the study runs the plain FRF).
+pub fn base_overrides(scene: &Scene, user: &[String]) -> Vec<String> {
+    let mut o = user.to_vec();
+    if scene.limits.is_some() {
+        o.push("limits=".into());
+    }
+    if scene.sweep.is_some() {
+        o.push("sweep=".into());
+    }
+    o
+}
+
+/// Parses the scene for [`settings`]: the scene and its checked problem with the base
+/// overrides.
+pub fn load(
+    scene_text: &str,
+    label: &str,
+    user: &[String],
+) -> Result<(Scene, Problem, Vec<String>), SceneError> {
+    let scene = scene::parse(scene_text, label, user)?;
+    let base = base_overrides(&scene, user);
+    let scene = scene::parse(scene_text, label, &base)?;
+    let problem = scene.validate(label)?;
+    Ok((scene, problem, base))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pareto_front_keeps_the_undominated() {
+        let p = [
+            (1.0, 0.1),
+            (2.0, 0.01),
+            (3.0, 0.05),
+            (0.5, 0.5),
+            (4.0, 0.001),
+            (5.0, f64::NAN),
+        ];
+        assert_eq!(pareto_front(&p), vec![3, 0, 1, 4]);
+    }
+
+    #[test]
+    fn l2_error_of_a_scaled_curve() {
+        let point = |f: f64, a: f64| FrfPoint {
+            freq_hz: f,
+            amplitudes: vec![a],
+            peaks: vec![a],
+            states: Vec::new(),
+            newton_iterations: 1,
+            residual: 0.0,
+            coefficients: Vec::new(),
+            accuracy: None,
+        };
+        let r: Vec<FrfPoint> = (0..=10).map(|k| point(k as f64, 1.0 + k as f64)).collect();
+        let a: Vec<FrfPoint> = (0..=10)
+            .map(|k| point(k as f64, 1.01 * (1.0 + k as f64)))
+            .collect();
+        assert!((curve_l2_error(&a, &r) - 0.01).abs() < 1e-12);
+    }
+}
