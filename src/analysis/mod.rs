@@ -30,8 +30,12 @@
 //!   classification, bound check, hysteresis loops) as a [`limits::LimitAnalysis`].
 //! - [`limits::solve_case`]: one case's curve and its refined resonance peak.
 //! - [`limits::LimitAnalysis::variability`]: the size of the variability between the limits.
+//! - [`stability::point_stability`]: Hill stability of a converged point (Floquet exponents
+//!   from the quadratic Hill eigenvalue problem, [`stability::PointStability`]); computed on
+//!   every FRF point when the scene sets `analysis.stability`.
 
 pub mod frf;
 pub mod limits;
 pub mod linear;
 pub mod peaks;
+pub mod stability;

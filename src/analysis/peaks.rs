@@ -395,6 +395,7 @@ mod tests {
             newton_iterations: 1,
             residual: 0.0,
             coefficients: Vec::new(),
+            stability: None,
         }
     }
 

@@ -20,6 +20,7 @@ use crate::analysis::peaks::{ExtremumKind, PathExtremum};
 use crate::contact::ContactState;
 use crate::model::Problem;
 use crate::numerics::NewtonFailure;
+use crate::report::stability_columns;
 
 /// Writing a result file failed.
 #[derive(Debug, thiserror::Error)]
@@ -45,7 +46,8 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), WriteError> {
 }
 
 /// Header of `frf.csv`: `freq_hz`, `<dof>_amp`, `<dof>_peak` per output, `<contact>_state` per
-/// contact, `newton_iters`.
+/// contact, `newton_iters`, then with `analysis.stability` the columns of
+/// [`stability_columns`].
 pub fn frf_header(problem: &Problem) -> String {
     let mut h = String::from("freq_hz");
     for &d in &problem.outputs {
@@ -55,7 +57,9 @@ pub fn frf_header(problem: &Problem) -> String {
     for c in &problem.contacts {
         let _ = write!(h, ",{}_state", c.name);
     }
-    h.push_str(",newton_iters\n");
+    h.push_str(",newton_iters");
+    h.push_str(stability_columns::header(problem));
+    h.push('\n');
     h
 }
 
@@ -68,7 +72,9 @@ pub fn frf_row(point: &FrfPoint) -> String {
     for s in &point.states {
         let _ = write!(r, ",{}", s.label());
     }
-    let _ = writeln!(r, ",{}", point.newton_iterations);
+    let _ = write!(r, ",{}", point.newton_iterations);
+    r.push_str(&stability_columns::cells(point.stability.as_ref()));
+    r.push('\n');
     r
 }
 
@@ -215,6 +221,9 @@ struct PointRecord<'a> {
     residual: f64,
     #[serde(skip_serializing_if = "Option::is_none")]
     coefficients: Option<&'a [f64]>,
+    /// `stable`, `floquet_re`, `floquet_freq_hz` when the scene sets `analysis.stability`.
+    #[serde(flatten)]
+    stability: Option<&'a crate::analysis::stability::PointStability>,
 }
 
 /// A cut continuation step, kept for the record.
@@ -374,6 +383,7 @@ impl FrfWriter {
                     newton_iterations: p.newton_iterations,
                     residual: p.residual,
                     coefficients: inline.then_some(p.coefficients.as_slice()),
+                    stability: p.stability.as_ref(),
                 })
                 .collect(),
         };
@@ -533,6 +543,7 @@ mod tests {
             newton_iterations: 1 + k % 4,
             residual: 1e-12,
             coefficients: vec![k as f64; 18],
+            stability: None,
         }
     }
 

@@ -14,7 +14,8 @@
 //! - [`plot`]: the figures as PNG and SVG ([`plot::plot_frf`], [`plot::plot_limits`],
 //!   [`plot::plot_sweep`], [`plot::plot_hysteresis`], [`plot::plot_lines`]);
 //! - [`mesh_results`]: a converged point's response on the FE mesh (VTU);
-//! - [`mesh_modes`]: the stuck-contact modes on the FE mesh (VTU).
+//! - [`mesh_modes`]: the stuck-contact modes on the FE mesh (VTU);
+//! - [`stability_columns`]: the Hill-stability columns of `frf.csv` and `curve_*.csv`.
 
 pub mod files;
 pub mod limit_files;
@@ -22,3 +23,4 @@ pub mod mesh_modes;
 pub mod mesh_results;
 pub mod owned;
 pub mod plot;
+pub mod stability_columns;
