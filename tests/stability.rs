@@ -151,3 +151,62 @@ fn scenes_hill_does_not_suit_are_refused_naming_the_field() {
         );
     }
 }
+
+#[test]
+fn a_limit_analysis_reports_where_each_limit_curve_is_unstable() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = run_scene(
+        &scene("fig13-3rd.toml"),
+        dir.path(),
+        &["analysis.stability=true"],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let limits = json(&dir.path().join("limits.json"));
+    let curves = limits["stability"]["limit_curves"].as_array().unwrap();
+    assert_eq!(curves.len(), 2);
+    for c in curves {
+        let name = c["case"].as_str().unwrap();
+        let (header, rows) = csv(&dir.path().join(format!("curve_{name}.csv")));
+        assert!(
+            header.ends_with(",stable,floquet_re,floquet_freq_hz"),
+            "{header}"
+        );
+        let (f, s) = (column(&header, "freq_hz"), column(&header, "stable"));
+        let unstable: Vec<f64> = rows
+            .iter()
+            .filter(|r| r[s] == "false")
+            .map(|r| r[f].parse().unwrap())
+            .collect();
+        assert_eq!(c["points"].as_u64().unwrap() as usize, rows.len());
+        assert_eq!(
+            c["unstable_points"].as_u64().unwrap() as usize,
+            unstable.len()
+        );
+        // Every unstable point lies in one of the reported stretches, and each stretch's
+        // ends are unstable points.
+        let stretches: Vec<(f64, f64)> = c["unstable_hz"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| (s[0].as_f64().unwrap(), s[1].as_f64().unwrap()))
+            .collect();
+        // (The CSV holds 11 significant digits.)
+        let tol = |f: f64| 1e-9 * f;
+        for &u in &unstable {
+            assert!(
+                stretches
+                    .iter()
+                    .any(|&(a, b)| a - tol(a) <= u && u <= b + tol(b)),
+                "{name}: {u}"
+            );
+        }
+        for (a, b) in &stretches {
+            for end in [a, b] {
+                assert!(
+                    unstable.iter().any(|u| (u - end).abs() <= 1e-9 * end),
+                    "{name}: {end}"
+                );
+            }
+        }
+    }
+}

@@ -29,8 +29,9 @@
 //! ⎣ −(ω²Δ₂)⁻¹J   −(ω²Δ₂)⁻¹ωΔ₁  ⎦ ⎣sp⎦ = s ⎣sp⎦
 //! ```
 //!
-//! goes to faer's dense nonsymmetric eigen solver ([`faer::Mat::eigen`]; the QZ of the pencil
-//! was tried first and is tens of times slower on these matrices). A singular mass matrix is
+//! goes to faer's dense nonsymmetric eigen solver (`faer::linalg::evd::evd_real`, on the calling
+//! thread; the QZ of the pencil
+//! was tried first: on the paper system at H = 3 it took seconds per point against milliseconds). A singular mass matrix is
 //! refused. The cost grows as (2·unknowns)³: models with more than [`MAX_HILL_UNKNOWNS`]
 //! unknowns are refused at the scene check (field `analysis.stability`).
 //!
@@ -85,7 +86,9 @@ pub struct PointStability {
     /// Real part of the leading Floquet exponent (1/s): > 0 grows, < 0 decays.
     pub floquet_re: f64,
     /// |Im λ|/2π of the leading exponent (Hz): the frequency of the mode that destabilises
-    /// the point (0 for a real exponent, e.g. between two folds).
+    /// the point (0 for a real exponent, e.g. past a fold). A perturbation holds every
+    /// λ + ikω, so this frequency is defined modulo the excitation frequency; the kept copy is
+    /// the one whose content is most centred.
     pub floquet_freq_hz: f64,
 }
 
@@ -183,17 +186,16 @@ pub fn floquet_exponents(
             }
         }
     }
-    let eigen = a.eigen().map_err(|_| StabilityError::EigenSolve { size })?;
-    let (values, vectors) = (eigen.S(), eigen.U());
+    let (values, vectors) =
+        sequential_eigen(a.as_ref()).map_err(|_| StabilityError::EigenSolve { size })?;
     // Eigenvalues λ = ω s with the centroid k̄ of their eigenvector's content.
     let mut finite: Vec<(c64, f64)> = Vec::new();
-    for k in 0..size {
-        let s = values[k];
+    for (k, s) in values.iter().enumerate() {
         if !(s.re.is_finite() && s.im.is_finite()) {
             continue;
         }
         let centroid = content_centroid(set, n, vectors.col(k).subrows(0, dim));
-        finite.push((s * omega, centroid));
+        finite.push((*s * omega, centroid));
     }
     if finite.is_empty() {
         return Err(StabilityError::NoFiniteExponent);
@@ -203,6 +205,61 @@ pub fn floquet_exponents(
     let keep = ((finite.len() as f64 / nb as f64).round() as usize).max(1);
     finite.sort_by(|a, b| a.1.abs().total_cmp(&b.1.abs()));
     Ok(finite.into_iter().take(keep).map(|(l, _)| l).collect())
+}
+
+/// Eigenvalues and right eigenvectors of a real square matrix, solved on the calling thread
+/// (faer's default parallelism spreads these small solves over rayon's threads, which on a
+/// loaded machine cost more in waiting than the solve itself, and the limit analysis already
+/// runs its curves in parallel). Complex pairs come as (λ, v), (λ̄, v̄).
+fn sequential_eigen(
+    a: MatRef<'_, f64>,
+) -> Result<(Vec<c64>, Mat<c64>), faer::linalg::evd::EvdError> {
+    use faer::diag::Diag;
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::linalg::evd::{evd_real, evd_scratch, ComputeEigenvectors};
+    use faer::Par;
+    let n = a.nrows();
+    let mut s_re = Diag::<f64>::zeros(n);
+    let mut s_im = Diag::<f64>::zeros(n);
+    let mut u = Mat::<f64>::zeros(n, n);
+    let mut buffer = MemBuffer::new(evd_scratch::<f64>(
+        n,
+        ComputeEigenvectors::No,
+        ComputeEigenvectors::Yes,
+        Par::Seq,
+        Default::default(),
+    ));
+    evd_real(
+        a,
+        s_re.as_mut(),
+        s_im.as_mut(),
+        None,
+        Some(u.as_mut()),
+        Par::Seq,
+        MemStack::new(&mut buffer),
+        Default::default(),
+    )?;
+    let mut values = vec![c64::new(0.0, 0.0); n];
+    let mut vectors = Mat::<c64>::zeros(n, n);
+    let mut j = 0;
+    while j < n {
+        if s_im[j] == 0.0 || j + 1 == n {
+            values[j] = c64::new(s_re[j], s_im[j]);
+            for i in 0..n {
+                vectors[(i, j)] = c64::new(u[(i, j)], 0.0);
+            }
+            j += 1;
+        } else {
+            values[j] = c64::new(s_re[j], s_im[j]);
+            values[j + 1] = c64::new(s_re[j], -s_im[j]);
+            for i in 0..n {
+                vectors[(i, j)] = c64::new(u[(i, j)], u[(i, j + 1)]);
+                vectors[(i, j + 1)] = c64::new(u[(i, j)], -u[(i, j + 1)]);
+            }
+            j += 2;
+        }
+    }
+    Ok((values, vectors))
 }
 
 /// The centroid k̄ = Σ k‖cₖ‖² / Σ ‖cₖ‖² of the complex-exponential content cₖ (k = −H..H) of
@@ -287,16 +344,19 @@ pub fn point_stability(
 }
 
 /// The stretches of a path (frequencies in Hz, `[from, to]` with from ≤ to) over which
-/// consecutive points are unstable, in path order; a single unstable point gives a stretch of
-/// zero width. Points without stability (not computed) count as stable.
-pub fn unstable_stretches(points: &[crate::analysis::frf::FrfPoint]) -> Vec<[f64; 2]> {
+/// consecutive points are unstable, in path order, from each point's frequency and stability;
+/// a single unstable point gives a stretch of zero width. Points without stability (not
+/// computed) count as stable.
+pub fn unstable_stretches(
+    points: impl IntoIterator<Item = (f64, Option<PointStability>)>,
+) -> Vec<[f64; 2]> {
     let mut stretches = Vec::new();
     let mut current: Option<[f64; 2]> = None;
-    for p in points {
-        if p.stability.is_some_and(|s| !s.stable) {
-            let span = current.get_or_insert([p.freq_hz, p.freq_hz]);
-            span[0] = span[0].min(p.freq_hz);
-            span[1] = span[1].max(p.freq_hz);
+    for (freq_hz, stability) in points {
+        if stability.is_some_and(|s| !s.stable) {
+            let span = current.get_or_insert([freq_hz, freq_hz]);
+            span[0] = span[0].min(freq_hz);
+            span[1] = span[1].max(freq_hz);
         } else if let Some(span) = current.take() {
             stretches.push(span);
         }

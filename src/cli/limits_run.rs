@@ -212,7 +212,8 @@ fn curve_json(c: &CaseCurve, stability: bool) -> serde_json::Value {
         continuation_retries: c.retries,
         points: &c.points,
         turning_points_hz: &c.turning_points,
-        unstable_hz: stability.then(|| unstable_stretches(&c.points)),
+        unstable_hz: stability
+            .then(|| unstable_stretches(c.points.iter().map(|p| (p.freq_hz, p.stability)))),
     })
     .expect("result types serialise")
 }
@@ -296,7 +297,7 @@ fn band_stability_json(a: &LimitAnalysis) -> serde_json::Value {
         .limits
         .iter()
         .map(|c| {
-            let stretches = unstable_stretches(&c.points);
+            let stretches = unstable_stretches(c.points.iter().map(|p| (p.freq_hz, p.stability)));
             serde_json::json!({
                 "case": c.case.name,
                 "unstable_hz": stretches,
@@ -463,7 +464,7 @@ pub(super) fn summary(a: &LimitAnalysis, elapsed: f64) -> String {
                 s,
                 "  {:<24} Hill stability: {}",
                 c.case.name,
-                match unstable_stretches(&c.points) {
+                match unstable_stretches(c.points.iter().map(|p| (p.freq_hz, p.stability))) {
                     v if v.is_empty() => "stable throughout".to_string(),
                     v => format!("UNSTABLE over {}", stretches_text(&v)),
                 }
