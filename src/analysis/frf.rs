@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use crate::analysis::error_estimate::{ErrorEstimator, EstimateProblems, PointAccuracy};
 use crate::analysis::linear;
+use crate::analysis::stability::{point_stability, PointStability, StabilityError};
 use crate::contact::harmonic::{Block, HarmonicSet};
 use crate::contact::ContactState;
 use crate::hbm::operator::HbmOperator;
@@ -40,6 +41,9 @@ pub struct FrfPoint {
     /// A-posteriori error estimate of the amplitudes (continuation points of a run whose
     /// scene asks for it; None for points solved on their own, such as refined peaks).
     pub accuracy: Option<PointAccuracy>,
+    /// Hill stability of the point, when the scene asks for it (`analysis.stability`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stability: Option<PointStability>,
 }
 
 /// The frequency (Hz) and error estimate of every point of `points` that has one, in order
@@ -397,27 +401,50 @@ fn full_point(system: &mut HbmOperator<'_>, p: &PathPoint) -> Result<FrfPoint, H
         .into_iter()
         .find(|f| (p.freq_hz() - f).abs() <= 8.0 * f64::EPSILON * f)
         .unwrap_or_else(|| p.freq_hz());
+    let states = system.states().to_vec();
     Ok(FrfPoint {
         freq_hz,
         amplitudes,
         peaks,
-        states: system.states().to_vec(),
+        states,
         newton_iterations: p.iterations,
         residual: p.residual,
         coefficients,
         accuracy: None,
+        stability: None,
     })
+}
+
+/// The point with its Hill stability at ω (rad/s) when the problem asks for it
+/// (`analysis.stability`): computed for the points of a continuation path (FRF runs and every
+/// limit, intermediate and scanned curve), not for the extra solves of peak refinements and
+/// common grids.
+fn with_stability(
+    system: &mut HbmOperator<'_>,
+    mut point: FrfPoint,
+    omega: f64,
+) -> Result<FrfPoint, HbmError> {
+    if system.full_ref().problem().analysis.stability {
+        point.stability = Some(
+            point_stability(system.full(), &point.coefficients, omega).map_err(|e| match e {
+                StabilityError::Hbm(e) => e,
+                other => HbmError::Stability(other.to_string()),
+            })?,
+        );
+    }
+    Ok(point)
 }
 
 impl<O: FrfObserver> Observer<HbmOperator<'_>> for Adapter<'_, '_, O> {
     fn accepted(&mut self, system: &mut HbmOperator<'_>, p: &PathPoint) {
-        let mut point = match full_point(system, p) {
-            Ok(point) => point,
-            Err(e) => {
-                self.failure.get_or_insert(e);
-                return;
-            }
-        };
+        let mut point =
+            match full_point(system, p).and_then(|point| with_stability(system, point, p.omega)) {
+                Ok(point) => point,
+                Err(e) => {
+                    self.failure.get_or_insert(e);
+                    return;
+                }
+            };
         if let Some(estimator) = &mut self.estimator {
             point.accuracy = Some(estimator.estimate(&point.coefficients, p.omega));
         }

@@ -3,9 +3,10 @@
 //!
 //! Today these are the nonlinear frequency response by continuation of the harmonic balance,
 //! the linear references (contacts open, contacts stuck), and the paper's limit analysis of the
-//! response among multiple steady states (two-point method, Ferhatoglu & Zucca 2021, §3). Next
-//! to come here: the accuracy study (harmonics and time samples), Hill stability of the
-//! periodic solutions, time integration as an independent check, and the response envelope.
+//! response among multiple steady states (two-point method, Ferhatoglu & Zucca 2021, §3), and
+//! the Hill stability of the periodic solutions. Next to come here: the accuracy study
+//! (harmonics and time samples), time integration as an independent check, and the response
+//! envelope.
 //!
 //! Layer: above `hbm`, below `scene`. It uses `hbm` (the harmonic-balance system and
 //! operator), `model` (the problem), `contact` (contact states, harmonic sets) and `numerics`
@@ -35,6 +36,9 @@
 //! - [`limits::LimitAnalysis::variability`]: the size of the variability between the limits.
 //! - [`error_estimate::ErrorEstimator`]: the a-posteriori truncation and sampling error
 //!   estimate of every converged continuation point ([`error_estimate::PointAccuracy`]).
+//! - [`stability::point_stability`]: Hill stability of a converged point (Floquet exponents
+//!   from the quadratic Hill eigenvalue problem, [`stability::PointStability`]); computed on
+//!   every FRF point when the scene sets `analysis.stability`.
 
 pub mod error_estimate;
 pub mod frf;
@@ -42,3 +46,4 @@ pub mod limits;
 pub mod linear;
 pub mod modes;
 pub mod peaks;
+pub mod stability;

@@ -375,6 +375,7 @@ mod tests {
             residual: 0.0,
             coefficients: Vec::new(),
             accuracy: None,
+            stability: None,
         }
     }
 

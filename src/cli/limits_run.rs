@@ -6,10 +6,12 @@ use std::sync::Mutex;
 use super::{CommandError, RunContext, RunOutcome, RunReport};
 use crate::analysis::frf::FrfPoint;
 use crate::analysis::limits::{self, CaseCurve, LimitAnalysis, Regime};
+use crate::analysis::stability::{stretches_text, unstable_stretches};
 use crate::report::files::{self, frf_header, frf_row};
 use crate::report::limit_files;
 use crate::report::plot::{
-    figure_files, palette, plot_hysteresis, plot_limits, Curve, LimitFigure, Loop,
+    figure_files, palette, plot_hysteresis, plot_limits, Curve, LimitFigure, Loop, UNSTABLE_COLOR,
+    UNSTABLE_LABEL,
 };
 
 /// Writes one curve's path as `curve_<name>.csv` (same columns as `frf.csv`): the whole path of
@@ -209,10 +211,13 @@ struct CurveJson<'a> {
     /// The whole path, or the finished points of an unfinished case.
     points: &'a [FrfPoint],
     turning_points_hz: &'a [f64],
+    /// With `analysis.stability`: the stretches `[from_hz, to_hz]` of unstable points.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    unstable_hz: Option<Vec<[f64; 2]>>,
 }
 
-/// One curve as written in `limits.json`.
-fn curve_json(ctx: &RunContext<'_>, c: &CaseCurve) -> serde_json::Value {
+/// One curve as written in `limits.json` (with `unstable_hz` when `stability` is on).
+fn curve_json(ctx: &RunContext<'_>, c: &CaseCurve, stability: bool) -> serde_json::Value {
     let info = ctx.info();
     serde_json::to_value(CurveJson {
         case: &c.case,
@@ -226,6 +231,8 @@ fn curve_json(ctx: &RunContext<'_>, c: &CaseCurve) -> serde_json::Value {
         ),
         points: &c.points,
         turning_points_hz: &c.turning_points,
+        unstable_hz: stability
+            .then(|| unstable_stretches(c.points.iter().map(|p| (p.freq_hz, p.stability)))),
     })
     .expect("result types serialise")
 }
@@ -273,13 +280,18 @@ fn write_json(
     elapsed: f64,
     status: &str,
 ) -> Result<(), CommandError> {
-    let json = serde_json::json!({
+    let stability = ctx.problem.analysis.stability;
+    let mut json = serde_json::json!({
         "info": ctx.info(),
         "status": status,
         "elapsed_s": elapsed,
         "curves": curve_statuses(a),
-        "limits": a.limits.iter().map(|c| curve_json(ctx, c)).collect::<Vec<_>>(),
-        "intermediate": a.intermediate.iter().map(|c| curve_json(ctx, c)).collect::<Vec<_>>(),
+        "limits": a.limits.iter().map(|c| curve_json(ctx, c, stability)).collect::<Vec<_>>(),
+        "intermediate": a
+            .intermediate
+            .iter()
+            .map(|c| curve_json(ctx, c, stability))
+            .collect::<Vec<_>>(),
         "band": {
             "grid_points": a.grid.len(),
             "defined_points": a.band_points(),
@@ -292,9 +304,37 @@ fn write_json(
         "hysteresis": a.loops,
         "hysteresis_missing": a.loops_missing,
     });
+    if stability {
+        json["stability"] = band_stability_json(a);
+    }
     let bytes = serde_json::to_vec_pretty(&json).expect("JSON values serialise");
     files::write_atomic(&ctx.dir.join("limits.json"), &bytes)?;
     Ok(())
+}
+
+/// `limits.json` → `stability`: for each limit curve (the two that form the band), the
+/// stretches where Hill's method finds it unstable, and the grid frequencies where the band
+/// exists but is bounded by an unstable limit point (a state the structure does not keep).
+fn band_stability_json(a: &LimitAnalysis) -> serde_json::Value {
+    let curves: Vec<serde_json::Value> = a
+        .limits
+        .iter()
+        .map(|c| {
+            let stretches = unstable_stretches(c.points.iter().map(|p| (p.freq_hz, p.stability)));
+            serde_json::json!({
+                "case": c.case.name,
+                "unstable_hz": stretches,
+                "unstable_points": c.points.iter().filter(|p| p.stability.is_some_and(|s| !s.stable)).count(),
+                "points": c.points.len(),
+                "text": stretches_text(&stretches),
+            })
+        })
+        .collect();
+    serde_json::json!({
+        "method": "Hill (Floquet exponents of the harmonic-balance Jacobian); a limit curve is \
+                   not a reachable bound where it is unstable",
+        "limit_curves": curves,
+    })
 }
 
 /// Draws `limits_<dof>` per output DOF (band, curves, multiple-solution and state rows) and
@@ -338,7 +378,23 @@ fn plot(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandError> {
         let intermediate: Vec<&CaseCurve> = a.intermediate.iter().collect();
         let series = curve_series(&limit_curves, &intermediate, k);
         let (open_y, stuck_y) = reference_ys(ctx, k);
-        let curves = curves_with_references(ctx, &series, &open_y, &stuck_y);
+        let overlays: Vec<(Vec<f64>, Vec<f64>)> = limit_curves
+            .iter()
+            .chain(&intermediate)
+            .map(|c| unstable_overlay(&c.points, k))
+            .filter(|(x, _)| !x.is_empty())
+            .collect();
+        let mut curves = curves_with_references(ctx, &series, &open_y, &stuck_y);
+        for (i, (x, y)) in overlays.iter().enumerate() {
+            curves.push(Curve {
+                label: if i == 0 { UNSTABLE_LABEL } else { "" },
+                x,
+                y,
+                color: UNSTABLE_COLOR,
+                dashed: true,
+                markers: true,
+            });
+        }
         let fig = LimitFigure {
             title: &title,
             output_name: name,
@@ -425,6 +481,19 @@ pub(super) fn summary(a: &LimitAnalysis, elapsed: f64) -> String {
             }
         );
     }
+    for c in &a.limits {
+        if c.points.iter().any(|p| p.stability.is_some()) {
+            let _ = writeln!(
+                s,
+                "  {:<24} Hill stability: {}",
+                c.case.name,
+                match unstable_stretches(c.points.iter().map(|p| (p.freq_hz, p.stability))) {
+                    v if v.is_empty() => "stable throughout".to_string(),
+                    v => format!("UNSTABLE over {}", stretches_text(&v)),
+                }
+            );
+        }
+    }
     let multiple = a
         .grid
         .iter()
@@ -485,6 +554,27 @@ fn reference_ys(ctx: &RunContext<'_>, k: usize) -> (Vec<f64>, Vec<f64>) {
         ctx.open.amplitudes.iter().map(|r| r[k]).collect(),
         ctx.stuck.amplitudes.iter().map(|r| r[k]).collect(),
     )
+}
+
+/// The unstable points of a curve's path for output `k` as (frequencies, amplitudes), NaN at
+/// stable points so that the drawn runs break there; empty when no point is unstable.
+fn unstable_overlay(points: &[FrfPoint], k: usize) -> (Vec<f64>, Vec<f64>) {
+    if !points
+        .iter()
+        .any(|p| p.stability.is_some_and(|s| !s.stable))
+    {
+        return (Vec::new(), Vec::new());
+    }
+    points
+        .iter()
+        .map(|p| {
+            if p.stability.is_some_and(|s| !s.stable) {
+                (p.freq_hz, p.amplitudes.get(k).copied().unwrap_or(f64::NAN))
+            } else {
+                (f64::NAN, f64::NAN)
+            }
+        })
+        .unzip()
 }
 
 /// The series as coloured curves, followed by the two linear references (dashed grey: open;

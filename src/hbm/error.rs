@@ -22,6 +22,9 @@ pub enum HbmError {
     /// The problem does not admit the formulation asked for.
     #[error("formulation: {0}")]
     Formulation(#[from] RelativeCoordinatesError),
+    /// The Hill stability of a converged point could not be computed (the eigen solve).
+    #[error("Hill stability: {0}")]
+    Stability(String),
     /// The static pre-solve of the uncoupled mode did not converge.
     #[error("static pre-solve did not converge in {iterations} iterations (relative residual {residual:.3e})")]
     StaticNotConverged {

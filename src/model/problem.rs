@@ -116,6 +116,9 @@ pub struct Analysis {
     pub formulation: Formulation,
     /// Points of the uniform frequency grid of the linear references.
     pub linear_points: usize,
+    /// Hill stability of every converged point ([`crate::analysis::stability`]); off costs
+    /// nothing.
+    pub stability: bool,
     /// The a-posteriori error estimate on every converged point (scene table `[accuracy]`).
     pub error_estimate: ErrorEstimateSettings,
 }

@@ -20,6 +20,7 @@ use crate::analysis::peaks::{ExtremumKind, PathExtremum};
 use crate::contact::ContactState;
 use crate::model::Problem;
 use crate::numerics::NewtonFailure;
+use crate::report::stability_columns;
 
 /// Writing a result file failed.
 #[derive(Debug, thiserror::Error)]
@@ -45,7 +46,8 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), WriteError> {
 }
 
 /// Header of `frf.csv`: `freq_hz`, `<dof>_amp`, `<dof>_peak` per output, `<contact>_state` per
-/// contact, `newton_iters`, then the error-estimate columns ([`accuracy_header`]).
+/// contact, `newton_iters`, then the error-estimate columns ([`accuracy_header`]), then with
+/// `analysis.stability` the columns of [`stability_columns`].
 pub fn frf_header(problem: &Problem) -> String {
     let mut h = String::from("freq_hz");
     for &d in &problem.outputs {
@@ -57,6 +59,7 @@ pub fn frf_header(problem: &Problem) -> String {
     }
     h.push_str(",newton_iters");
     accuracy_header(problem, &mut h);
+    h.push_str(stability_columns::header(problem));
     h.push('\n');
     h
 }
@@ -72,11 +75,12 @@ pub fn frf_row(point: &FrfPoint) -> String {
     }
     let _ = write!(r, ",{}", point.newton_iterations);
     accuracy_cells(point, &mut r);
+    r.push_str(&stability_columns::cells(point.stability.as_ref()));
     r.push('\n');
     r
 }
 
-// ---- Error-estimate columns (issue 11): kept together here so that other column additions
+// ---- Error-estimate columns: kept together here so that other column additions
 // merge beside them.
 
 /// The error-estimate columns of `frf.csv` and `curve_*.csv`, when the scene asks for the
@@ -311,6 +315,9 @@ struct PointRecord<'a> {
     residual: f64,
     #[serde(skip_serializing_if = "Option::is_none")]
     coefficients: Option<&'a [f64]>,
+    /// `stable`, `floquet_re`, `floquet_freq_hz` when the scene sets `analysis.stability`.
+    #[serde(flatten)]
+    stability: Option<&'a crate::analysis::stability::PointStability>,
 }
 
 /// A cut continuation step, kept for the record.
@@ -474,6 +481,7 @@ impl FrfWriter {
                     newton_iterations: p.newton_iterations,
                     residual: p.residual,
                     coefficients: inline.then_some(p.coefficients.as_slice()),
+                    stability: p.stability.as_ref(),
                 })
                 .collect(),
         };
@@ -634,6 +642,7 @@ mod tests {
             residual: 1e-12,
             coefficients: vec![k as f64; 18],
             accuracy: None,
+            stability: None,
         }
     }
 

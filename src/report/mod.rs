@@ -19,6 +19,7 @@
 //!   models side by side, damped modes, mode shapes, `modes.json`);
 //! - [`reduced_files`]: the files of `fricbound reduce` (K_r, M_r, C_r as Matrix Market, the
 //!   reduced DOF map, the recovery rows) and the reduction report in JSON.
+//! - [`stability_columns`]: the Hill-stability columns of `frf.csv` and `curve_*.csv`.
 
 pub mod files;
 pub mod limit_files;
@@ -28,3 +29,4 @@ pub mod modes_files;
 pub mod owned;
 pub mod plot;
 pub mod reduced_files;
+pub mod stability_columns;

@@ -3,8 +3,11 @@
 //! problem's [`Analysis`] settings, the frequency range bounded by what the model resolves,
 //! and the `[output]` table into the response DOFs.
 
+use crate::analysis::stability::{harmonics_supported, MAX_HILL_UNKNOWNS};
 use crate::contact::ContactPoint;
-use crate::model::{Analysis, ErrorEstimateSettings, LinearModel, CHORD_MIN_UNKNOWNS};
+use crate::model::{
+    Analysis, Coupling, ErrorEstimateSettings, LinearModel, Problem, CHORD_MIN_UNKNOWNS,
+};
 use crate::numerics::ContinuationSettings;
 use crate::scene::check_model::diagonal;
 use crate::scene::checker::{Checker, DofNames};
@@ -139,6 +142,7 @@ pub(super) fn analysis(a: &AnalysisSpec, ck: &Checker) -> Result<Analysis, Scene
         jacobian: a.jacobian,
         formulation: a.formulation,
         linear_points: a.linear_points,
+        stability: a.stability,
         error_estimate: ErrorEstimateSettings::default(),
     })
 }
@@ -159,6 +163,44 @@ pub(super) fn error_estimate(
         enabled: spec.estimate,
         warn_threshold: threshold,
     })
+}
+
+/// With `analysis.stability` on: Hill's method needs the 0th harmonic among the unknowns
+/// (a coupled scene) and the harmonics 0..H without gaps, and its dense eigen solve at most
+/// [`MAX_HILL_UNKNOWNS`] unknowns (DOFs × coefficient blocks, after any reduction).
+pub(super) fn check_stability(ck: &Checker, problem: &Problem) -> Result<(), SceneError> {
+    if !problem.analysis.stability {
+        return Ok(());
+    }
+    let field = "analysis.stability";
+    if problem.effects.coupling != Coupling::Coupled {
+        return Err(ck.err(
+            field,
+            "Hill stability needs the 0th harmonic among the unknowns: set effects.coupling = \"coupled\"",
+        ));
+    }
+    let set = problem.unknown_harmonics();
+    if !harmonics_supported(&set) {
+        return Err(ck.err(
+            field,
+            format!(
+                "Hill stability needs the harmonics 0, 1, …, H without gaps (harmonics.max), got {:?}",
+                set.harmonics()
+            ),
+        ));
+    }
+    let unknowns = problem.model.n_dofs() * set.n_blocks();
+    if unknowns > MAX_HILL_UNKNOWNS {
+        return Err(ck.err(
+            field,
+            format!(
+                "{unknowns} harmonic-balance unknowns ({} DOFs × {} blocks) exceed the {MAX_HILL_UNKNOWNS} of the dense Hill eigen solve: lower harmonics.max, reduce the model, or turn stability off",
+                problem.model.n_dofs(),
+                set.n_blocks()
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// The response DOFs of the `[output]` table: the named DOFs, then every node of each group

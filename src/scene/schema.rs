@@ -289,6 +289,9 @@ pub struct AnalysisSpec {
     /// Points of the uniform grid for the linear references.
     #[serde(default = "default_linear_points")]
     pub linear_points: usize,
+    /// Hill stability (Floquet exponents) of every converged point; default off.
+    #[serde(default)]
+    pub stability: bool,
 }
 
 /// Default most continuation points.

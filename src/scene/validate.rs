@@ -13,7 +13,9 @@ use crate::contact::ContactEffects;
 use crate::hbm::formulation::check_relative_coordinates;
 use crate::model::reduce::ReductionSettings;
 use crate::model::{Effects, FeOrigin, Formulation, Problem};
-use crate::scene::check_analysis::{analysis, error_estimate, frequency_bound, outputs};
+use crate::scene::check_analysis::{
+    analysis, check_stability, error_estimate, frequency_bound, outputs,
+};
 use crate::scene::check_bodies::check_held_bodies;
 use crate::scene::check_contacts::{check_gap_scale, contact_set};
 use crate::scene::check_limits::limit_settings;
@@ -74,6 +76,7 @@ impl Scene {
             check_relative_coordinates(&problem)
                 .map_err(|e| ck.err("analysis.formulation", e.to_string()))?;
         }
+        check_stability(&ck, &problem)?;
         Ok((problem, limits))
     }
 

@@ -408,6 +408,7 @@ mod tests {
             residual: 0.0,
             coefficients: Vec::new(),
             accuracy: None,
+            stability: None,
         };
         let r: Vec<FrfPoint> = (0..=10).map(|k| point(k as f64, 1.0 + k as f64)).collect();
         let a: Vec<FrfPoint> = (0..=10)

@@ -1,7 +1,8 @@
 //! The FRF figure: the nonlinear frequency response of one output DOF (first-harmonic
 //! amplitude, in path order, with markers) over the linear open- and stuck-contact references
 //! (dashed) on a log amplitude axis, with one strip per contact below it showing the contact
-//! state at each point.
+//! state at each point; points found unstable by Hill's method are overdrawn black, dashed
+//! and marked.
 
 use std::path::Path;
 
@@ -12,7 +13,9 @@ use super::backend::{write_figure, PlotError};
 use super::chart::ChartSpec;
 use super::series::{points, valid_runs, Line};
 use super::strips::{Strip, StripChart};
-use super::style::{state_color, NONLINEAR_COLOR, OPEN_COLOR, STUCK_COLOR};
+use super::style::{
+    state_color, NONLINEAR_COLOR, OPEN_COLOR, STUCK_COLOR, UNSTABLE_COLOR, UNSTABLE_LABEL,
+};
 use crate::analysis::frf::FrfPoint;
 use crate::analysis::linear::LinearCurve;
 
@@ -82,6 +85,34 @@ fn spliced_line<'a>(fig: &'a FrfFigure, out: usize) -> impl Iterator<Item = (f64
     })
 }
 
+/// The points Hill's method found unstable ([`FrfPoint::stability`]), as a black dashed line
+/// with markers over the nonlinear line: runs of consecutive unstable path points, broken at
+/// stable points, branch starts and points outside the frequency range. Empty when no point is
+/// unstable (or stability was not computed), so the legend has no entry then.
+fn unstable_line(fig: &FrfFigure, out: usize, in_range: &dyn Fn(f64) -> bool) -> Line {
+    let gap = (f64::NAN, f64::NAN);
+    let points = fig.points.iter().enumerate().flat_map(|(i, p)| {
+        let start = fig.branch_starts.contains(&i).then_some(gap);
+        let unstable = p.stability.is_some_and(|s| !s.stable) && in_range(p.freq_hz);
+        let here = if unstable {
+            (
+                p.freq_hz,
+                p.amplitudes.get(out).copied().unwrap_or(f64::NAN),
+            )
+        } else {
+            gap
+        };
+        start.into_iter().chain(std::iter::once(here))
+    });
+    Line {
+        label: UNSTABLE_LABEL.to_string(),
+        runs: valid_runs(points, true),
+        color: UNSTABLE_COLOR,
+        dashed: true,
+        markers: true,
+    }
+}
+
 /// Draws the nonlinear FRF (first-harmonic amplitude, path order, as a line with markers) over the
 /// linear open and stuck references (dashed lines), on a log amplitude axis, and below the main
 /// chart one horizontal strip per contact showing its state at each point (colour legend: stuck,
@@ -131,11 +162,15 @@ pub fn plot_frf(fig: &FrfFigure, png: &Path, svg: &Path) -> Result<(), PlotError
         dashed: true,
         markers: false,
     };
-    let curves = vec![
+    let mut curves = vec![
         reference(fig.open, "linear, contacts open", OPEN_COLOR),
         reference(fig.stuck, "linear, contacts stuck", STUCK_COLOR),
         nonlinear,
     ];
+    let unstable = unstable_line(fig, out, &in_range);
+    if !unstable.is_empty() {
+        curves.push(unstable);
+    }
 
     let freqs: Vec<f64> = points(&curves).map(|p| p.0).collect();
     let x = linear_range(freqs.iter().copied(), 0.0);
@@ -188,6 +223,7 @@ mod tests {
             residual: 1e-10,
             coefficients: Vec::new(),
             accuracy: None,
+            stability: None,
         }
     }
 

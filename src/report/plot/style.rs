@@ -37,6 +37,11 @@ pub(super) const OPEN_COLOR: RGBColor = RGBColor(110, 110, 110);
 /// Colour of the linear reference with the contacts stuck (and of the stuck state).
 pub(super) const STUCK_COLOR: RGBColor = RGBColor(31, 100, 180);
 
+/// Colour of the overlay on points found unstable by Hill's method (dashed, marked).
+pub const UNSTABLE_COLOR: RGBColor = RGBColor(0, 0, 0);
+/// Legend label of that overlay.
+pub const UNSTABLE_LABEL: &str = "unstable (Hill): dashed, marked";
+
 /// Label of the shaded band in the legends.
 pub(super) const BAND_LABEL: &str = "variability band";
 /// Fill colour of the band (drawn translucent).
