@@ -9,7 +9,7 @@
 //! H = 1 curve where it crosses the reference (the test pins that down).
 
 use fricbound::analysis::error_estimate::run_warnings;
-use fricbound::analysis::frf::{self, FrfPoint, Silent};
+use fricbound::analysis::frf::{self, Silent};
 use fricbound::model::Problem;
 use fricbound::scene;
 
@@ -20,29 +20,6 @@ fn zoom_2nd(overrides: &[String]) -> Problem {
         .expect("scene loads")
         .validate("zoom-2nd")
         .expect("scene is valid")
-}
-
-/// First-harmonic amplitude of y2 on the path `points` at `freq_hz` (linear between the
-/// bracketing points of the first segment holding it).
-fn amplitude_at(points: &[FrfPoint], freq_hz: f64) -> Option<f64> {
-    points.windows(2).find_map(|w| {
-        let (a, b) = (&w[0], &w[1]);
-        let (lo, hi) = if a.freq_hz <= b.freq_hz {
-            (a, b)
-        } else {
-            (b, a)
-        };
-        if freq_hz < lo.freq_hz || freq_hz > hi.freq_hz {
-            return None;
-        }
-        let span = hi.freq_hz - lo.freq_hz;
-        let t = if span > 0.0 {
-            (freq_hz - lo.freq_hz) / span
-        } else {
-            0.0
-        };
-        Some(lo.amplitudes[0] + t * (hi.amplitudes[0] - lo.amplitudes[0]))
-    })
 }
 
 #[test]
@@ -70,7 +47,7 @@ fn truncation_estimate_tracks_the_true_error_on_the_paper_case() {
                 .accuracy
                 .as_ref()
                 .expect("every path point has an estimate");
-            let Some(truth_amp) = amplitude_at(&reference.points, p.freq_hz) else {
+            let Some(truth_amp) = frf::amplitude_on_path(&reference.points, p.freq_hz) else {
                 continue;
             };
             let truth = (p.amplitudes[0] - truth_amp).abs() / truth_amp;

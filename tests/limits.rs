@@ -469,10 +469,14 @@ fn sweep_series_of_whole_limit_analyses_and_failed_points() {
     );
 
     // A case that cannot be solved is recorded, the point's other cases are still attempted,
-    // and the sweep goes on.
+    // and the sweep goes on. Unsolvable here: a thousand times the paper's excitation with one
+    // Newton iteration (three at fixed frequency) leaves a residual of about 0.3 at the start.
+    // (An unreachable tolerance no longer fails: Newton accepts a residual at its round-off
+    // level.)
     let mut failing = o.clone();
     failing.push("analysis.max_iterations=1".into());
-    failing.push("analysis.residual_tolerance=1e-300".into());
+    failing.push("harmonic_loads.0.sin=-2e4".into());
+    failing.push("harmonic_loads.1.sin=5e3".into());
     let points = sweep::run(&text, "paper", &failing, &spec, |_| {}).unwrap();
     assert_eq!(points.len(), 4);
     for p in &points {

@@ -1026,14 +1026,14 @@ impl<'p> PointSolver<'p> {
     }
 }
 
-/// The first path segment bracketing `freq_hz` and the linearly interpolated coefficients on it.
-pub fn interpolate_on_path(points: &[FrfPoint], freq_hz: f64) -> Option<Vec<f64>> {
+/// The first path segment bracketing `freq_hz`: its lower and upper end (by frequency) and
+/// the fraction t ∈ [0, 1] of the way from the lower one (0 on a segment of zero width).
+pub fn bracket_on_path(points: &[FrfPoint], freq_hz: f64) -> Option<(&FrfPoint, &FrfPoint, f64)> {
     points.windows(2).find_map(|w| {
-        let (a, b) = (&w[0], &w[1]);
-        let (lo, hi) = if a.freq_hz <= b.freq_hz {
-            (a, b)
+        let (lo, hi) = if w[0].freq_hz <= w[1].freq_hz {
+            (&w[0], &w[1])
         } else {
-            (b, a)
+            (&w[1], &w[0])
         };
         if freq_hz < lo.freq_hz || freq_hz > hi.freq_hz {
             return None;
@@ -1044,14 +1044,27 @@ pub fn interpolate_on_path(points: &[FrfPoint], freq_hz: f64) -> Option<Vec<f64>
         } else {
             0.0
         };
-        Some(
-            lo.coefficients
-                .iter()
-                .zip(&hi.coefficients)
-                .map(|(p, q)| p + t * (q - p))
-                .collect(),
-        )
+        Some((lo, hi, t))
     })
+}
+
+/// The linearly interpolated coefficients on the first path segment bracketing `freq_hz`.
+pub fn interpolate_on_path(points: &[FrfPoint], freq_hz: f64) -> Option<Vec<f64>> {
+    let (lo, hi, t) = bracket_on_path(points, freq_hz)?;
+    Some(
+        lo.coefficients
+            .iter()
+            .zip(&hi.coefficients)
+            .map(|(p, q)| p + t * (q - p))
+            .collect(),
+    )
+}
+
+/// The first output's first-harmonic amplitude (m), linear on the first path segment
+/// bracketing `freq_hz`.
+pub fn amplitude_on_path(points: &[FrfPoint], freq_hz: f64) -> Option<f64> {
+    let (lo, hi, t) = bracket_on_path(points, freq_hz)?;
+    Some(lo.amplitudes[0] + t * (hi.amplitudes[0] - lo.amplitudes[0]))
 }
 
 #[cfg(test)]

@@ -753,11 +753,17 @@ fn run_frf(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
     Ok(RunReport {
         dir: dir.clone(),
         summary: format!(
-            "{} converged points in {:.3} s ({} step cuts); turning points: {turning}\n\
-             {} resonance peaks and {} anti-resonances refined{unrefined}{}",
+            "{} converged points in {:.3} s ({} step cuts, {} formulation{}); turning points: \
+             {turning}\n{} resonance peaks and {} anti-resonances refined{unrefined}{}",
             run.points.len(),
             run.elapsed_s,
             run.rejected_steps,
+            crate::hbm::cost::formulation_name(problem.formulation()),
+            if problem.analysis.formulation == crate::model::Formulation::Auto {
+                format!(", chosen by auto: {}", problem.auto_formulation().1)
+            } else {
+                String::new()
+            },
             count(ExtremumKind::Resonance),
             count(ExtremumKind::AntiResonance),
             accuracy_line(problem, &run.points, accuracy_warnings.len()),
@@ -842,6 +848,9 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
         cost.unknowns,
         cost.factored
     );
+    if problem.analysis.formulation == crate::model::Formulation::Auto {
+        let _ = writeln!(s, "  auto       {}", problem.auto_formulation().1);
+    }
     let _ = writeln!(s, "cost         {}", cost.summary());
     let parallel = parallel_solves(&scene, &problem, limits.as_ref());
     match available_memory() {

@@ -97,8 +97,13 @@ pub const MARCH_PERIODS: f64 = 2.0;
 /// Unknowns of Newton's iteration on `p`: all DOFs per coefficient block, or the contact DOFs
 /// per block for the condensed formulation.
 pub fn unknowns(p: &Problem) -> usize {
+    unknowns_for(p, p.formulation())
+}
+
+/// [`unknowns`] of `p` solved in `formulation`.
+pub fn unknowns_for(p: &Problem, formulation: Formulation) -> usize {
     let blocks = p.unknown_harmonics().n_blocks();
-    match p.formulation() {
+    match formulation {
         Formulation::Condensed => p.contact_dofs().len() * blocks,
         _ => p.model.n_dofs() * blocks,
     }
@@ -107,9 +112,14 @@ pub fn unknowns(p: &Problem) -> usize {
 /// Rows of the matrix factorised per Newton iteration on `p`: the unknowns, except for the
 /// schur formulation (2 relative coordinates per contact point and coefficient block).
 pub fn factored_size(p: &Problem) -> usize {
-    match p.formulation() {
+    factored_size_for(p, p.formulation())
+}
+
+/// [`factored_size`] of `p` solved in `formulation`.
+pub fn factored_size_for(p: &Problem, formulation: Formulation) -> usize {
+    match formulation {
         Formulation::Schur => 2 * p.contacts.len() * p.unknown_harmonics().n_blocks(),
-        _ => unknowns(p),
+        _ => unknowns_for(p, formulation),
     }
 }
 
@@ -224,7 +234,12 @@ impl CostEstimate {
 /// Estimates the size and cost of `p`'s harmonic balance without allocating in proportion to
 /// it (see the module docs for the model).
 pub fn estimate(p: &Problem) -> CostEstimate {
-    let formulation = p.formulation();
+    estimate_for(p, p.formulation())
+}
+
+/// [`estimate`] of `p` solved in `formulation` (what `auto` compares, see
+/// `Problem::formulation`).
+pub fn estimate_for(p: &Problem, formulation: Formulation) -> CostEstimate {
     let n = p.model.n_dofs() as f64;
     let set = p.unknown_harmonics();
     let b = set.n_blocks() as f64;
@@ -235,8 +250,8 @@ pub fn estimate(p: &Problem) -> CostEstimate {
     // Dynamic harmonics (h ≥ 1) of the unknowns, and whether the 0th is among them.
     let dynamic = set.harmonics().iter().filter(|&&h| h > 0).count() as f64;
     let has_static = set.constant_block().is_some();
-    let unknowns = unknowns(p);
-    let factored = factored_size(p);
+    let unknowns = unknowns_for(p, formulation);
+    let factored = factored_size_for(p, formulation);
     let m = unknowns as f64;
 
     // AFT: basis and projection, derivative matrices, sample buffers.

@@ -242,27 +242,6 @@ pub fn run_setting(
     }
 }
 
-/// First output's amplitude on `path` at `freq_hz` (linear on the first segment holding it).
-fn amplitude_at(path: &[FrfPoint], freq_hz: f64) -> Option<f64> {
-    path.windows(2).find_map(|w| {
-        let (lo, hi) = if w[0].freq_hz <= w[1].freq_hz {
-            (&w[0], &w[1])
-        } else {
-            (&w[1], &w[0])
-        };
-        if freq_hz < lo.freq_hz || freq_hz > hi.freq_hz {
-            return None;
-        }
-        let span = hi.freq_hz - lo.freq_hz;
-        let t = if span > 0.0 {
-            (freq_hz - lo.freq_hz) / span
-        } else {
-            0.0
-        };
-        Some(lo.amplitudes[0] + t * (hi.amplitudes[0] - lo.amplitudes[0]))
-    })
-}
-
 /// Relative L2 error ‖a − r‖ / ‖r‖ of the first output's amplitude of `path` against
 /// `reference`, on 400 uniform frequencies of the range both cover (NaN when they share none).
 pub fn curve_l2_error(path: &[FrfPoint], reference: &[FrfPoint]) -> f64 {
@@ -281,7 +260,10 @@ pub fn curve_l2_error(path: &[FrfPoint], reference: &[FrfPoint]) -> f64 {
     let (mut num, mut den) = (0.0, 0.0);
     for k in 0..=400 {
         let f = lo + (hi - lo) * k as f64 / 400.0;
-        if let (Some(a), Some(r)) = (amplitude_at(path, f), amplitude_at(reference, f)) {
+        if let (Some(a), Some(r)) = (
+            frf::amplitude_on_path(path, f),
+            frf::amplitude_on_path(reference, f),
+        ) {
             num += (a - r) * (a - r);
             den += r * r;
         }
