@@ -79,6 +79,32 @@ enum Command {
         #[arg(long = "set", value_name = "FIELD=VALUE")]
         overrides: Vec<String>,
     },
+    /// Check HBM points by time integration (Newmark, same contact law): steady-state
+    /// amplitude against the HBM, dt convergence, periodicity, and Hill's verdict. Writes
+    /// verify.csv, verify.json and a time-history figure per frequency; exit 3 if a case failed
+    /// or did not settle.
+    Verify {
+        /// Scene file (TOML; the built-in paper scene when omitted).
+        scene: Option<PathBuf>,
+        /// Excitation frequencies (Hz), comma separated.
+        #[arg(long, value_delimiter = ',', required = true)]
+        freqs: Vec<f64>,
+        /// Newmark steps per period (default 256·H; the dt check also runs twice as many).
+        #[arg(long)]
+        steps_per_period: Option<usize>,
+        /// Most periods integrated per run (default 300).
+        #[arg(long)]
+        max_periods: Option<usize>,
+        /// Output folder (default: out/<scene name>/verify).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override a scene field by its dotted path.
+        #[arg(long = "set", value_name = "FIELD=VALUE")]
+        overrides: Vec<String>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Generate or inspect FE meshes.
     Mesh {
         #[command(subcommand)]
@@ -176,6 +202,28 @@ fn main() -> ExitCode {
         Command::Bench { command } => fricbound::cli::bench::run(&command)
             .map(|text| print!("{text}"))
             .map_err(|e| e.to_string()),
+        Command::Verify {
+            scene,
+            freqs,
+            steps_per_period,
+            max_periods,
+            out,
+            overrides,
+            quiet,
+        } => fricbound::cli::verify_run::run(&fricbound::cli::verify_run::VerifyOptions {
+            scene,
+            freqs,
+            out,
+            overrides,
+            steps_per_period,
+            max_periods,
+            quiet,
+        })
+        .map(|r| {
+            print!("{}", r.text);
+            incomplete = r.incomplete;
+        })
+        .map_err(|e| e.to_string()),
         Command::Mesh { command } => fricbound::cli::mesh::run(&command)
             .map(|text| print!("{text}"))
             .map_err(|e| e.to_string()),
