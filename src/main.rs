@@ -104,6 +104,13 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        /// Start on the HBM solution (default) or at rest at the static deflection.
+        #[arg(long, value_enum, default_value_t = fricbound::cli::verify_run::StartFrom::Hbm)]
+        from: fricbound::cli::verify_run::StartFrom,
+        /// Initial tangential states m in [-1, 1], comma separated, each applied to every
+        /// contact (one case per frequency and state; default: the scene's).
+        #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_parser = parse_initial_state)]
+        initial_states: Vec<f64>,
     },
     /// Generate or inspect FE meshes.
     Mesh {
@@ -120,6 +127,16 @@ enum Command {
         #[command(subcommand)]
         command: fricbound::cli::bench::BenchCommand,
     },
+}
+
+/// An initial tangential state m: a number in [−1, 1].
+fn parse_initial_state(s: &str) -> Result<f64, String> {
+    let m: f64 = s.trim().parse().map_err(|e| format!("{s}: {e}"))?;
+    if (-1.0..=1.0).contains(&m) {
+        Ok(m)
+    } else {
+        Err(format!("{m} is outside [-1, 1]"))
+    }
 }
 
 /// Parses the arguments, runs the command and maps its result to the exit code: 0 complete
@@ -210,6 +227,8 @@ fn main() -> ExitCode {
             out,
             overrides,
             quiet,
+            from,
+            initial_states,
         } => fricbound::cli::verify_run::run(&fricbound::cli::verify_run::VerifyOptions {
             scene,
             freqs,
@@ -218,6 +237,8 @@ fn main() -> ExitCode {
             steps_per_period,
             max_periods,
             quiet,
+            from,
+            initial_states,
         })
         .map(|r| {
             print!("{}", r.text);

@@ -201,6 +201,46 @@ fn verify_command_writes_csv_json_and_figure_for_one_frequency() {
             .unwrap();
     assert_eq!(json.as_array().unwrap().len(), 1);
     assert!(dir.path().join("verify_160Hz.png").exists());
+    // From rest at the static deflection, one case per initial state: two rows, no error.
+    let dir2 = tempfile::tempdir().unwrap();
+    let st = std::process::Command::new(env!("CARGO_BIN_EXE_fricbound"))
+        .args([
+            "verify",
+            "--freqs",
+            "160",
+            "--from",
+            "static",
+            "--initial-states",
+            "-1,1",
+            "--steps-per-period",
+            "64",
+            "--max-periods",
+            "40",
+            "--quiet",
+            "--out",
+        ])
+        .arg(dir2.path())
+        .output()
+        .unwrap();
+    assert!(matches!(st.status.code(), Some(0) | Some(3)));
+    let csv2 = std::fs::read_to_string(dir2.path().join("verify.csv")).unwrap();
+    let rows: Vec<&str> = csv2.lines().skip(1).collect();
+    assert_eq!(rows.len(), 2, "{csv2}");
+    assert!(rows[0].starts_with("160,-1,static,") && rows[1].starts_with("160,1,static,"));
+    assert!(rows.iter().all(|r| r.ends_with(',')), "{csv2}");
+    // An initial state outside [-1, 1] is a usage error.
+    let bad_m = std::process::Command::new(env!("CARGO_BIN_EXE_fricbound"))
+        .args([
+            "verify",
+            "--freqs",
+            "160",
+            "--initial-states",
+            "2",
+            "--quiet",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(bad_m.status.code(), Some(2));
     // Bad input: no frequencies is a usage error.
     let bad = std::process::Command::new(env!("CARGO_BIN_EXE_fricbound"))
         .args(["verify", "--quiet"])

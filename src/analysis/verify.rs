@@ -97,6 +97,9 @@ pub enum VerifyError {
         /// Last relative residual.
         residual: f64,
     },
+    /// The static deflection could not be solved.
+    #[error("static deflection: {0}")]
+    Static(String),
     /// The initial coefficients do not match the problem's layout.
     #[error("initial coefficients have length {found}, expected {expected}")]
     WrongLength {
@@ -571,6 +574,71 @@ pub fn hbm_state(
     })
 }
 
+/// A start at rest (q̇ = 0) at the static deflection with every contact stuck by its kₜ, kₙ
+/// springs about the rest position ([`crate::analysis::linear::stuck_guess`] at h = 0), and each
+/// contact's slider placed so that its tangential force is T = m μ N there (N = kₙ v, zero when
+/// open), m = `initial_state` ∈ [−1, 1]. Unless m makes T equal the stuck spring force this is
+/// not an equilibrium: the integration starts with the transient the changed slider causes.
+pub fn static_state(problem: &Problem, initial_state: f64) -> Result<TimeState, VerifyError> {
+    let set = HarmonicSet::new(vec![0]);
+    let q = crate::analysis::linear::stuck_guess(problem, &set, 0.0)
+        .map_err(|e| VerifyError::Static(e.to_string()))?;
+    let liftoff = problem.effects.contact.liftoff;
+    let sliders = problem
+        .contacts
+        .iter()
+        .map(|p| {
+            let u = p.tangential_of(&q);
+            let v = p.normal_of(&q) - p.gap;
+            let n = if liftoff {
+                (p.law.kn * v).max(0.0)
+            } else {
+                p.law.kn * v
+            };
+            if n > 0.0 {
+                u - initial_state * p.law.mu * n / p.law.kt
+            } else {
+                u
+            }
+        })
+        .collect();
+    Ok(TimeState {
+        qdot: vec![0.0; q.len()],
+        q,
+        sliders,
+    })
+}
+
+/// Integrates from `start` at dt and dt/2 (see [`verify_point`]) and compares with the HBM
+/// amplitudes `hbm_amplitudes` of the outputs.
+pub fn verify_from(
+    problem: &Problem,
+    start: &TimeState,
+    h_max: usize,
+    hbm_amplitudes: &[f64],
+    freq_hz: f64,
+    settings: &VerifySettings,
+) -> Result<PointVerification, VerifyError> {
+    let coarse = integrate(problem, freq_hz, start, h_max, settings)?;
+    let fine_settings = VerifySettings {
+        steps_per_period: 2 * settings.steps_per_period,
+        ..*settings
+    };
+    let fine = integrate(problem, freq_hz, start, h_max, &fine_settings)?;
+    let rel = |a: &[f64], b: &[f64]| {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs() / y.abs().max(1e-300))
+            .fold(0.0_f64, f64::max)
+    };
+    Ok(PointVerification {
+        dt_change: rel(&coarse.amplitudes, &fine.amplitudes),
+        hbm_difference: rel(&fine.amplitudes, hbm_amplitudes),
+        coarse,
+        fine,
+    })
+}
+
 /// Verifies a harmonic-balance point (full coefficients `x` on `set` at `freq_hz`, with
 /// first-harmonic output amplitudes `hbm_amplitudes`): integrates from its state at τ = 0 with
 /// `settings.steps_per_period` and with twice as many steps, and reports the dt change and the
@@ -585,22 +653,5 @@ pub fn verify_point(
 ) -> Result<PointVerification, VerifyError> {
     let h_max = set.max_harmonic();
     let start = hbm_state(problem, set, x, freq_hz, settings.steps_per_period)?;
-    let coarse = integrate(problem, freq_hz, &start, h_max, settings)?;
-    let fine_settings = VerifySettings {
-        steps_per_period: 2 * settings.steps_per_period,
-        ..*settings
-    };
-    let fine = integrate(problem, freq_hz, &start, h_max, &fine_settings)?;
-    let rel = |a: &[f64], b: &[f64]| {
-        a.iter()
-            .zip(b)
-            .map(|(x, y)| (x - y).abs() / y.abs().max(1e-300))
-            .fold(0.0_f64, f64::max)
-    };
-    Ok(PointVerification {
-        dt_change: rel(&coarse.amplitudes, &fine.amplitudes),
-        hbm_difference: rel(&fine.amplitudes, hbm_amplitudes),
-        coarse,
-        fine,
-    })
+    verify_from(problem, &start, h_max, hbm_amplitudes, freq_hz, settings)
 }
