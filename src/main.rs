@@ -79,6 +79,39 @@ enum Command {
         #[arg(long = "set", value_name = "FIELD=VALUE")]
         overrides: Vec<String>,
     },
+    /// Check HBM points by time integration (Newmark, same contact law): steady-state
+    /// amplitude against the HBM, dt convergence, periodicity, and Hill's verdict. Writes
+    /// verify.csv, verify.json and a time-history figure per frequency; exit 3 if a case failed
+    /// or did not settle.
+    Verify {
+        /// Scene file (TOML; the built-in paper scene when omitted).
+        scene: Option<PathBuf>,
+        /// Excitation frequencies (Hz), comma separated.
+        #[arg(long, value_delimiter = ',', required = true)]
+        freqs: Vec<f64>,
+        /// Newmark steps per period (default 256·H; the dt check also runs twice as many).
+        #[arg(long)]
+        steps_per_period: Option<usize>,
+        /// Most periods integrated per run (default 300).
+        #[arg(long)]
+        max_periods: Option<usize>,
+        /// Output folder (default: out/<scene name>/verify).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override a scene field by its dotted path.
+        #[arg(long = "set", value_name = "FIELD=VALUE")]
+        overrides: Vec<String>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+        /// Start on the HBM solution (default) or at rest at the static deflection.
+        #[arg(long, value_enum, default_value_t = fricbound::cli::verify_run::StartFrom::Hbm)]
+        from: fricbound::cli::verify_run::StartFrom,
+        /// Initial tangential states m in [-1, 1], comma separated, each applied to every
+        /// contact (one case per frequency and state; default: the scene's).
+        #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_parser = parse_initial_state)]
+        initial_states: Vec<f64>,
+    },
     /// Generate or inspect FE meshes.
     Mesh {
         #[command(subcommand)]
@@ -94,6 +127,16 @@ enum Command {
         #[command(subcommand)]
         command: fricbound::cli::bench::BenchCommand,
     },
+}
+
+/// An initial tangential state m: a number in [−1, 1].
+fn parse_initial_state(s: &str) -> Result<f64, String> {
+    let m: f64 = s.trim().parse().map_err(|e| format!("{s}: {e}"))?;
+    if (-1.0..=1.0).contains(&m) {
+        Ok(m)
+    } else {
+        Err(format!("{m} is outside [-1, 1]"))
+    }
 }
 
 /// Parses the arguments, runs the command and maps its result to the exit code: 0 complete
@@ -176,6 +219,32 @@ fn main() -> ExitCode {
         Command::Bench { command } => fricbound::cli::bench::run(&command)
             .map(|text| print!("{text}"))
             .map_err(|e| e.to_string()),
+        Command::Verify {
+            scene,
+            freqs,
+            steps_per_period,
+            max_periods,
+            out,
+            overrides,
+            quiet,
+            from,
+            initial_states,
+        } => fricbound::cli::verify_run::run(&fricbound::cli::verify_run::VerifyOptions {
+            scene,
+            freqs,
+            out,
+            overrides,
+            steps_per_period,
+            max_periods,
+            quiet,
+            from,
+            initial_states,
+        })
+        .map(|r| {
+            print!("{}", r.text);
+            incomplete = r.incomplete;
+        })
+        .map_err(|e| e.to_string()),
         Command::Mesh { command } => fricbound::cli::mesh::run(&command)
             .map(|text| print!("{text}"))
             .map_err(|e| e.to_string()),

@@ -39,6 +39,8 @@
 //! - [`stability::point_stability`]: Hill stability of a converged point (Floquet exponents
 //!   from the quadratic Hill eigenvalue problem, [`stability::PointStability`]); computed on
 //!   every FRF point when the scene sets `analysis.stability`.
+//! - [`verify::verify_point`]: time integration (Newmark, implicit contact return mapping) from
+//!   a harmonic-balance point to its steady state, with a dt check ([`verify::PointVerification`]).
 
 pub mod error_estimate;
 pub mod frf;
@@ -47,3 +49,4 @@ pub mod linear;
 pub mod modes;
 pub mod peaks;
 pub mod stability;
+pub mod verify;

@@ -19,6 +19,7 @@
 //! - [`modes`] (`fricbound modes`, `fricbound reduce`): natural frequencies of the full and
 //!   reduced models, the reduced model written out;
 //! - [`study`] (`fricbound study accuracy`): what each solver setting costs and gives in accuracy;
+//! - [`verify_run`] (`fricbound verify`): time integration of HBM points, against the HBM and Hill;
 //! - [`CommandError`]: why a command failed, naming what failed.
 
 pub mod bench;
@@ -28,6 +29,7 @@ pub mod modes;
 pub mod paper;
 pub mod study;
 mod sweep_run;
+pub mod verify_run;
 
 use std::path::{Path, PathBuf};
 

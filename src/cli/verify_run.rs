@@ -1,0 +1,390 @@
+//! `fricbound verify`: the time-integration check of harmonic-balance points.
+//!
+//! For each frequency: the HBM point is solved by Newton from the stuck linear guess (the
+//! open-contact guess if that fails), its Hill stability computed, and the equations of motion
+//! integrated from it ([`crate::analysis::verify::verify_point`], at dt and dt/2). Cases run in
+//! parallel (rayon) with a progress bar. Writes `verify.csv`, `verify.json` and one time-history
+//! figure per frequency (`verify_<freq>Hz.png/.svg`: the output DOFs over the last integrated
+//! period against the HBM's periodic motion).
+
+use std::f64::consts::PI;
+use std::path::PathBuf;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+
+use crate::analysis::frf::PointSolver;
+use crate::analysis::linear;
+use crate::analysis::stability;
+use crate::analysis::verify::{self, PointVerification, VerifySettings};
+use crate::report::files::write_atomic;
+use crate::report::plot::{self, figure_files, palette, Curve};
+
+use super::{create_dir, default_out_dir, load_scene, CommandError};
+
+/// Relative first-harmonic difference from the HBM point (last integrated period, dt/2) below
+/// which a motion started on the HBM point counts as having stayed on it, settled or not (a
+/// stable point with a slowly decaying mode, e.g. −0.17 1/s, need not settle within the budget).
+pub const STAY_TOLERANCE: f64 = 1e-3;
+
+/// Where each time integration starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum StartFrom {
+    /// On the harmonic-balance solution at τ = 0 (sliders from the AFT's march).
+    #[default]
+    Hbm,
+    /// At rest at the stuck static deflection, sliders set to T = m μ N
+    /// ([`crate::analysis::verify::static_state`]).
+    Static,
+}
+
+/// Options of `fricbound verify`.
+#[derive(Debug, Clone, Default)]
+pub struct VerifyOptions {
+    /// Scene file (the built-in paper scene when None).
+    pub scene: Option<PathBuf>,
+    /// Excitation frequencies (Hz).
+    pub freqs: Vec<f64>,
+    /// Output folder (default: out/<scene>/verify).
+    pub out: Option<PathBuf>,
+    /// Scene overrides.
+    pub overrides: Vec<String>,
+    /// Steps per period (default 256·H).
+    pub steps_per_period: Option<usize>,
+    /// Period budget (default 300).
+    pub max_periods: Option<usize>,
+    /// No progress bar.
+    pub quiet: bool,
+    /// Where the integrations start.
+    pub from: StartFrom,
+    /// Initial tangential states m ∈ [−1, 1], each applied to every contact (one case per
+    /// frequency and state); empty: the scene's own `initial_state` per contact.
+    pub initial_states: Vec<f64>,
+}
+
+/// One verified frequency.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct VerifyCase {
+    /// Frequency (Hz).
+    pub freq_hz: f64,
+    /// Initial tangential state m of every contact (None: the scene's).
+    pub initial_state: Option<f64>,
+    /// Where the integration started.
+    pub from: StartFrom,
+    /// HBM first-harmonic amplitude of each output (m).
+    pub hbm_amplitudes: Vec<f64>,
+    /// Hill's verdict at the HBM point (None if it could not be computed).
+    pub hill_stable: Option<bool>,
+    /// Leading Floquet exponent's real part (1/s).
+    pub floquet_re: Option<f64>,
+    /// The time integration (None when the case failed; see `error`).
+    pub verification: Option<PointVerification>,
+    /// Whether the motion stayed within [`STAY_TOLERANCE`] of the HBM point.
+    pub stays: Option<bool>,
+    /// Whether Hill's verdict agrees (stable ⇔ stays).
+    pub hill_agrees: Option<bool>,
+    /// Why the case failed, if it did.
+    pub error: Option<String>,
+}
+
+/// What `fricbound verify` did.
+#[derive(Debug, Clone)]
+pub struct VerifyReport {
+    /// Printed table.
+    pub text: String,
+    /// Why the run is incomplete (a case failed or did not settle).
+    pub incomplete: Option<String>,
+    /// The cases in frequency order.
+    pub cases: Vec<VerifyCase>,
+}
+
+fn one_case(
+    scene_problem: &crate::model::Problem,
+    freq: f64,
+    initial_state: Option<f64>,
+    from: StartFrom,
+    settings: &VerifySettings,
+    fig_dir: &std::path::Path,
+) -> VerifyCase {
+    let mut problem_m = scene_problem.clone();
+    if let Some(m) = initial_state {
+        for c in &mut problem_m.contacts {
+            c.law.initial_state = m;
+        }
+    }
+    let problem = &problem_m;
+    let mut case = VerifyCase {
+        freq_hz: freq,
+        initial_state,
+        from,
+        hbm_amplitudes: Vec::new(),
+        hill_stable: None,
+        floquet_re: None,
+        verification: None,
+        stays: None,
+        hill_agrees: None,
+        error: None,
+    };
+    let omega = 2.0 * PI * freq;
+    let mut solver = match PointSolver::new(problem) {
+        Ok(s) => s,
+        Err(e) => {
+            case.error = Some(e.to_string());
+            return case;
+        }
+    };
+    let set = solver.system().unknowns().clone();
+    let point = [linear::stuck_guess, linear::open_guess]
+        .iter()
+        .filter_map(|g| g(problem, &set, omega).ok())
+        .find_map(|guess| solver.solve(&guess, freq).ok());
+    let Some(point) = point else {
+        case.error = Some(format!("harmonic balance did not converge at {freq} Hz"));
+        return case;
+    };
+    case.hbm_amplitudes = point.amplitudes.clone();
+    if let Ok(s) = stability::point_stability(solver.system(), &point.coefficients, omega) {
+        case.hill_stable = Some(s.stable);
+        case.floquet_re = Some(s.floquet_re);
+    }
+    let start = match from {
+        StartFrom::Hbm => verify::hbm_state(
+            problem,
+            &set,
+            &point.coefficients,
+            freq,
+            settings.steps_per_period,
+        ),
+        StartFrom::Static => verify::static_state(problem, initial_state.unwrap_or(0.0)),
+    };
+    let outcome = start.and_then(|start| {
+        verify::verify_from(
+            problem,
+            &start,
+            set.max_harmonic(),
+            &point.amplitudes,
+            freq,
+            settings,
+        )
+    });
+    match outcome {
+        Ok(v) => {
+            let stays = v.hbm_difference < STAY_TOLERANCE;
+            case.stays = Some(stays);
+            case.hill_agrees = case.hill_stable.map(|h| h == stays);
+            let stem = match initial_state {
+                Some(m) => format!("verify_{freq}Hz_m{m}"),
+                None => format!("verify_{freq}Hz"),
+            };
+            let _ = time_history_figure(problem, &set, &point.coefficients, &v, fig_dir, &stem);
+            case.verification = Some(v);
+        }
+        Err(e) => case.error = Some(e.to_string()),
+    }
+    case
+}
+
+/// The output DOFs over the last integrated period (fine dt) against the HBM motion.
+fn time_history_figure(
+    problem: &crate::model::Problem,
+    set: &crate::contact::harmonic::HarmonicSet,
+    x: &[f64],
+    v: &PointVerification,
+    dir: &std::path::Path,
+    stem: &str,
+) -> Result<(), plot::PlotError> {
+    let n = problem.model.n_dofs();
+    let steps = v.fine.steps_per_period;
+    let tau: Vec<f64> = (0..steps)
+        .map(|k| 2.0 * PI * k as f64 / steps as f64)
+        .collect();
+    let mut owned: Vec<(String, Vec<f64>, bool)> = Vec::new();
+    for (o, &d) in problem.outputs.iter().enumerate() {
+        let name = &problem.model.dof_names[d];
+        let coef: Vec<f64> = (0..set.n_blocks()).map(|j| x[j * n + d]).collect();
+        let hbm: Vec<f64> = tau.iter().map(|&t| set.evaluate(&coef, t)).collect();
+        owned.push((
+            format!("{name} time integration"),
+            v.fine.last_period[o].clone(),
+            false,
+        ));
+        owned.push((format!("{name} HBM"), hbm, true));
+    }
+    let curves: Vec<Curve> = owned
+        .iter()
+        .enumerate()
+        .map(|(i, (label, y, dashed))| Curve {
+            label,
+            x: &tau,
+            y,
+            color: palette(i / 2),
+            dashed: *dashed,
+            markers: false,
+        })
+        .collect();
+    let (png, svg) = figure_files(dir, stem);
+    plot::plot_lines(
+        &format!(
+            "Time integration vs HBM at {} Hz (last of {} periods)",
+            v.fine.freq_hz, v.fine.periods
+        ),
+        "τ = ωt (rad)",
+        "displacement (m)",
+        false,
+        &curves,
+        &png,
+        &svg,
+    )
+}
+
+fn opt<T: std::fmt::Display>(v: Option<T>) -> String {
+    v.map(|x| x.to_string()).unwrap_or_default()
+}
+
+/// Runs `fricbound verify`.
+pub fn run(options: &VerifyOptions) -> Result<VerifyReport, CommandError> {
+    let (label, _scene, problem, _limits) =
+        load_scene(options.scene.as_deref(), &options.overrides)?;
+    let dir = options.out.clone().unwrap_or_else(|| {
+        default_out_dir(options.scene.as_deref(), &options.overrides).join("verify")
+    });
+    create_dir(&dir)?;
+    let h_max = problem.harmonics.iter().copied().max().unwrap_or(1);
+    let mut settings = VerifySettings::for_harmonics(h_max);
+    if let Some(s) = options.steps_per_period {
+        settings.steps_per_period = s;
+    }
+    if let Some(p) = options.max_periods {
+        settings.max_periods = p;
+    }
+    let states: Vec<Option<f64>> = if options.initial_states.is_empty() {
+        vec![None]
+    } else {
+        options.initial_states.iter().map(|&m| Some(m)).collect()
+    };
+    let jobs: Vec<(f64, Option<f64>)> = options
+        .freqs
+        .iter()
+        .flat_map(|&f| states.iter().map(move |&m| (f, m)))
+        .collect();
+    let bar = (!options.quiet).then(|| {
+        let b = ProgressBar::new(jobs.len() as u64);
+        b.set_style(
+            ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} verify",
+            )
+            .expect("static template"),
+        );
+        b
+    });
+    let cases: Vec<VerifyCase> = jobs
+        .par_iter()
+        .map(|&(f, m)| {
+            let c = one_case(&problem, f, m, options.from, &settings, &dir);
+            if let Some(b) = &bar {
+                b.inc(1);
+            }
+            c
+        })
+        .collect();
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let outputs: Vec<String> = problem
+        .outputs
+        .iter()
+        .map(|&d| problem.model.dof_names[d].clone())
+        .collect();
+    let mut csv = String::from("freq_hz,initial_state,from");
+    for o in &outputs {
+        csv.push_str(&format!(",{o}_hbm_amp,{o}_time_amp"));
+    }
+    csv.push_str(",rel_diff,dt_change,periods,settled,nonharmonic_energy,hill_stable,floquet_re,stays,hill_agrees,error\n");
+    let mut text = format!(
+        "{label}: time integration (Newmark average acceleration, {} steps/period and twice that)\n",
+        settings.steps_per_period
+    );
+    text.push_str(
+        "freq_hz  m     rel_diff   dt_change  periods settled hill_stable stays agrees\n",
+    );
+    let mut problems = Vec::new();
+    for c in &cases {
+        csv.push_str(&format!(
+            "{},{},{}",
+            c.freq_hz,
+            opt(c.initial_state),
+            match c.from {
+                StartFrom::Hbm => "hbm",
+                StartFrom::Static => "static",
+            }
+        ));
+        for (o, _) in outputs.iter().enumerate() {
+            let t = c
+                .verification
+                .as_ref()
+                .map(|v| v.fine.amplitudes[o].to_string())
+                .unwrap_or_default();
+            csv.push_str(&format!(
+                ",{},{}",
+                c.hbm_amplitudes
+                    .get(o)
+                    .map(|a| a.to_string())
+                    .unwrap_or_default(),
+                t
+            ));
+        }
+        let v = c.verification.as_ref();
+        csv.push_str(&format!(
+            ",{},{},{},{},{},{},{},{},{},{}\n",
+            opt(v.map(|v| v.hbm_difference)),
+            opt(v.map(|v| v.dt_change)),
+            opt(v.map(|v| v.fine.periods)),
+            opt(v.map(|v| v.fine.settled)),
+            opt(v.map(|v| v.fine.nonharmonic_energy)),
+            opt(c.hill_stable),
+            opt(c.floquet_re),
+            opt(c.stays),
+            opt(c.hill_agrees),
+            c.error.clone().unwrap_or_default().replace(',', ";"),
+        ));
+        match v {
+            Some(v) => text.push_str(&format!(
+                "{:<8} {:<5} {:<10.3e} {:<10.3e} {:<7} {:<7} {:<11} {:<5} {}\n",
+                c.freq_hz,
+                opt(c.initial_state),
+                v.hbm_difference,
+                v.dt_change,
+                v.fine.periods,
+                v.fine.settled,
+                opt(c.hill_stable),
+                opt(c.stays),
+                opt(c.hill_agrees)
+            )),
+            None => text.push_str(&format!(
+                "{:<8} {:<5} failed: {}\n",
+                c.freq_hz,
+                opt(c.initial_state),
+                c.error.clone().unwrap_or_default()
+            )),
+        }
+        let case_name = match c.initial_state {
+            Some(m) => format!("{} Hz (m = {m})", c.freq_hz),
+            None => format!("{} Hz", c.freq_hz),
+        };
+        if c.error.is_some() {
+            problems.push(format!("{case_name} failed"));
+        } else if v.is_some_and(|v| !v.fine.settled) {
+            problems.push(format!("{case_name} did not settle"));
+        }
+    }
+    write_atomic(&dir.join("verify.csv"), csv.as_bytes())?;
+    let json = serde_json::to_string_pretty(&cases).unwrap_or_default();
+    write_atomic(&dir.join("verify.json"), json.as_bytes())?;
+    text.push_str(&format!("written to {}\n", dir.display()));
+    Ok(VerifyReport {
+        text,
+        incomplete: (!problems.is_empty()).then(|| problems.join(", ")),
+        cases,
+    })
+}

@@ -1,0 +1,250 @@
+//! Time integration (`analysis::verify`) against closed-form linear responses and against the
+//! harmonic balance on the paper case.
+
+use fricbound::analysis::frf::PointSolver;
+use fricbound::analysis::linear::{self, LinearCase};
+use fricbound::analysis::verify::{self, VerifySettings};
+use fricbound::contact::harmonic::HarmonicSet;
+use fricbound::model::matrix::StructuralMatrix;
+use fricbound::model::Problem;
+use fricbound::scene;
+use fricbound::scene::paper_wedge_scene;
+
+fn paper(h_max: usize) -> Problem {
+    paper_with(h_max, &[])
+}
+
+fn paper_with(h_max: usize, extra: &[&str]) -> Problem {
+    let mut o: Vec<String> = vec![
+        "analysis.freq_start_hz=150.0".into(),
+        "analysis.freq_end_hz=230.0".into(),
+        format!("harmonics.max={h_max}"),
+    ];
+    o.extend(extra.iter().map(|s| s.to_string()));
+    scene::parse(paper_wedge_scene(), "paper", &o)
+        .unwrap()
+        .validate("paper")
+        .unwrap()
+}
+
+/// The HBM point at `freq_hz` from the stuck linear guess: (harmonic set, coefficients,
+/// output amplitudes).
+fn hbm_point(problem: &Problem, freq_hz: f64) -> (HarmonicSet, Vec<f64>, Vec<f64>) {
+    let mut solver = PointSolver::new(problem).unwrap();
+    let set = solver.system().unknowns().clone();
+    let guess = linear::stuck_guess(problem, &set, 2.0 * std::f64::consts::PI * freq_hz).unwrap();
+    let point = solver.solve(&guess, freq_hz).unwrap();
+    (set, point.coefficients, point.amplitudes)
+}
+
+#[test]
+fn stuck_linear_system_reaches_the_closed_form_response_with_second_order_dt_error() {
+    // Friction so high that no contact slips and a pre-load that keeps them closed: the system
+    // is linear (the stuck reference). Damper damping added so that transients die out.
+    let mut problem = paper(1);
+    for c in &mut problem.contacts {
+        c.law.mu = 1e3;
+    }
+    let n = problem.model.n_dofs();
+    problem.model.damping =
+        StructuralMatrix::Dense(faer::Mat::from_fn(
+            n,
+            n,
+            |i, j| {
+                if i == j {
+                    20.0
+                } else {
+                    0.0
+                }
+            },
+        ));
+    let freq = 120.0;
+    let exact = linear::frf(&problem, LinearCase::Stuck, &[freq]).unwrap()[0].clone();
+    let exact_out: Vec<f64> = problem.outputs.iter().map(|&d| exact[d]).collect();
+    let (set, x, hbm_amp) = hbm_point(&problem, freq);
+    assert!((hbm_amp[0] - exact_out[0]).abs() < 1e-9 * exact_out[0]);
+    let settings = VerifySettings {
+        steps_per_period: 128,
+        ..VerifySettings::for_harmonics(1)
+    };
+    let check = verify::verify_point(&problem, &set, &x, &hbm_amp, freq, &settings).unwrap();
+    assert!(check.coarse.settled && check.fine.settled, "{check:?}");
+    let err_coarse = (check.coarse.amplitudes[0] - exact_out[0]).abs() / exact_out[0];
+    let err_fine = (check.fine.amplitudes[0] - exact_out[0]).abs() / exact_out[0];
+    println!("linear: error {err_coarse:.3e} (128 steps) {err_fine:.3e} (256 steps)");
+    assert!(err_fine < 1e-3, "{err_fine}");
+    // Trapezoidal rule: second order, the error drops about four times when dt halves.
+    assert!(err_fine < 0.35 * err_coarse, "{err_coarse} {err_fine}");
+    assert!(
+        check.fine.nonharmonic_energy < 1e-6,
+        "{}",
+        check.fine.nonharmonic_energy
+    );
+}
+
+/// Damper damping of 5 N s/m on xD, yD: without it the damper mode (about 553 Hz stuck) is
+/// undamped and Hill finds the paper's 160 Hz point unstable (see the next test).
+const DAMPER_DAMPING: [&str; 2] = ["model.damping.4.4=5", "model.damping.5.5=5"];
+
+#[test]
+fn paper_case_at_a_unique_solution_matches_the_hbm_better_with_more_harmonics() {
+    let freq = 160.0;
+    let mut differences = Vec::new();
+    for h in [1, 5] {
+        let problem = paper_with(h, &DAMPER_DAMPING);
+        let (set, x, hbm_amp) = hbm_point(&problem, freq);
+        let settings = VerifySettings {
+            steps_per_period: 1024,
+            ..VerifySettings::for_harmonics(h)
+        };
+        let check = verify::verify_point(&problem, &set, &x, &hbm_amp, freq, &settings).unwrap();
+        println!(
+            "H = {h}: HBM {:.6e} time {:.6e} diff {:.3e} dt change {:.3e} periods {} settled {} nonharmonic {:.3e}",
+            hbm_amp[0],
+            check.fine.amplitudes[0],
+            check.hbm_difference,
+            check.dt_change,
+            check.fine.periods,
+            check.fine.settled,
+            check.fine.nonharmonic_energy
+        );
+        assert!(check.fine.settled, "H = {h}: {:?}", check.fine.last_change);
+        assert!(check.dt_change < 1e-3, "H = {h}: {}", check.dt_change);
+        differences.push(check.hbm_difference);
+    }
+    assert!(differences[1] < 1e-2, "{differences:?}");
+    assert!(differences[1] < differences[0], "{differences:?}");
+}
+
+#[test]
+fn paper_case_point_that_hill_calls_unstable_leaves_the_hbm_solution() {
+    // C_D = 0 as printed in the paper: Hill flags the 160 Hz point (H = 5) unstable, and the
+    // time integration started on it does not come back to a periodic state near it.
+    let freq = 160.0;
+    let problem = paper(5);
+    let mut solver = PointSolver::new(&problem).unwrap();
+    let set = solver.system().unknowns().clone();
+    let omega = 2.0 * std::f64::consts::PI * freq;
+    let guess = linear::stuck_guess(&problem, &set, omega).unwrap();
+    let point = solver.solve(&guess, freq).unwrap();
+    let hill = fricbound::analysis::stability::point_stability(
+        solver.system(),
+        &point.coefficients,
+        omega,
+    )
+    .unwrap();
+    let settings = VerifySettings {
+        steps_per_period: 256,
+        max_periods: 300,
+        ..VerifySettings::for_harmonics(5)
+    };
+    let check = verify::verify_point(
+        &problem,
+        &set,
+        &point.coefficients,
+        &point.amplitudes,
+        freq,
+        &settings,
+    )
+    .unwrap();
+    println!(
+        "undamped damper, 160 Hz: Hill stable {} floquet_re {:.3} 1/s; time: settled {} diff {:.3e} last change {:.3e}",
+        hill.stable, hill.floquet_re, check.fine.settled, check.hbm_difference, check.fine.last_change
+    );
+    assert!(!hill.stable);
+    assert!(!check.fine.settled && !check.coarse.settled);
+}
+
+#[test]
+fn verify_command_writes_csv_json_and_figure_for_one_frequency() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_fricbound"))
+        .args([
+            "verify",
+            "--freqs",
+            "160",
+            "--steps-per-period",
+            "128",
+            "--quiet",
+            "--set",
+            "analysis.freq_start_hz=150.0",
+            "--set",
+            "analysis.freq_end_hz=230.0",
+            "--set",
+            DAMPER_DAMPING[0],
+            "--set",
+            DAMPER_DAMPING[1],
+            "--out",
+        ])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{stdout} {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.path().join("verify.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let row: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(header.len(), row.len());
+    let col = |name: &str| row[header.iter().position(|h| *h == name).unwrap()];
+    assert_eq!(col("freq_hz"), "160");
+    assert_eq!(col("settled"), "true");
+    let diff: f64 = col("rel_diff").parse().unwrap();
+    assert!(diff < 0.05, "{diff}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("verify.json")).unwrap())
+            .unwrap();
+    assert_eq!(json.as_array().unwrap().len(), 1);
+    assert!(dir.path().join("verify_160Hz.png").exists());
+    // From rest at the static deflection, one case per initial state: two rows, no error.
+    let dir2 = tempfile::tempdir().unwrap();
+    let st = std::process::Command::new(env!("CARGO_BIN_EXE_fricbound"))
+        .args([
+            "verify",
+            "--freqs",
+            "160",
+            "--from",
+            "static",
+            "--initial-states",
+            "-1,1",
+            "--steps-per-period",
+            "64",
+            "--max-periods",
+            "40",
+            "--quiet",
+            "--out",
+        ])
+        .arg(dir2.path())
+        .output()
+        .unwrap();
+    assert!(matches!(st.status.code(), Some(0) | Some(3)));
+    let csv2 = std::fs::read_to_string(dir2.path().join("verify.csv")).unwrap();
+    let rows: Vec<&str> = csv2.lines().skip(1).collect();
+    assert_eq!(rows.len(), 2, "{csv2}");
+    assert!(rows[0].starts_with("160,-1,static,") && rows[1].starts_with("160,1,static,"));
+    assert!(rows.iter().all(|r| r.ends_with(',')), "{csv2}");
+    // An initial state outside [-1, 1] is a usage error.
+    let bad_m = std::process::Command::new(env!("CARGO_BIN_EXE_fricbound"))
+        .args([
+            "verify",
+            "--freqs",
+            "160",
+            "--initial-states",
+            "2",
+            "--quiet",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(bad_m.status.code(), Some(2));
+    // Bad input: no frequencies is a usage error.
+    let bad = std::process::Command::new(env!("CARGO_BIN_EXE_fricbound"))
+        .args(["verify", "--quiet"])
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+}
