@@ -1301,7 +1301,7 @@ fn sweep_parameter_unusable_in_file_names() {
     );
 }
 
-// Refusals that say why (issue 10, item 6): pre-loads and interferences that leave the damper
+// Refusals that say why: pre-loads and interferences that leave the damper
 // held by nothing, values out of proportion to the model, FE materials out of physical bounds,
 // and a sweep value given twice. Each is refused by `check` and `run` naming the field.
 

@@ -6,8 +6,9 @@
 //! A contact's rows may use fewer directions than its node has (a grounded contact with a
 //! zero normal component, a 3D patch whose frame has no z component); the node is kept
 //! physical in every direction all the same, so the reduced model does not depend on which
-//! components of a contact frame happen to be zero (issue 14 reports a model where such
-//! nodes left partly interior gave 58 boundary DOFs instead of 102 and a 10th mode 4 % off). Everything else is condensed into constraint modes and the
+//! components of a contact frame happen to be zero (a model reported with such nodes left
+//! partly interior had 58 boundary DOFs instead of 102 and its 10th mode 4 % off). Everything
+//! else is condensed into constraint modes and the
 //! lowest fixed-interface modes by the `fricbound-reduction` crate, so the reduced coordinates
 //! are q = [u_B; η]: the boundary displacements (named as in the full model) then the modal
 //! amplitudes (`mode1`, `mode2`, ...). Contacts and outputs keep their meaning on u_B exactly,
