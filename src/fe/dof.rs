@@ -31,6 +31,16 @@ impl Direction {
     /// The translations in axis order, as used by solid elements.
     pub const TRANSLATIONS: [Direction; 3] = [Direction::X, Direction::Y, Direction::Z];
 
+    /// Every direction, translations then rotations.
+    pub const ALL: [Direction; 6] = [
+        Direction::X,
+        Direction::Y,
+        Direction::Z,
+        Direction::Rx,
+        Direction::Ry,
+        Direction::Rz,
+    ];
+
     /// Parses `x`, `y`, `z`, `rx`, `ry`, `rz` (case-insensitive).
     pub fn parse(text: &str) -> Option<Direction> {
         match text.trim().to_ascii_lowercase().as_str() {
@@ -226,14 +236,7 @@ mod tests {
 
     #[test]
     fn direction_names_parse_back() {
-        for d in [
-            Direction::X,
-            Direction::Y,
-            Direction::Z,
-            Direction::Rx,
-            Direction::Ry,
-            Direction::Rz,
-        ] {
+        for d in Direction::ALL {
             assert_eq!(Direction::parse(&d.name().to_uppercase()), Some(d));
         }
         assert_eq!(Direction::parse("w"), None);

@@ -488,16 +488,9 @@ pub fn group_dofs(
         .iter()
         .flat_map(|&i| {
             let id = mesh.nodes[i].id;
-            [
-                Direction::X,
-                Direction::Y,
-                Direction::Z,
-                Direction::Rx,
-                Direction::Ry,
-                Direction::Rz,
-            ]
-            .into_iter()
-            .filter_map(move |d| structure.dofs.row(id, d))
+            Direction::ALL
+                .into_iter()
+                .filter_map(move |d| structure.dofs.row(id, d))
         })
         .collect();
     if rows.is_empty() {
