@@ -9,9 +9,11 @@
 //! | [`point`] | [`ContactPoint`], [`DamperSide`], [`JenkinsLaw`], [`ContactState`] | contact points (relative displacement rows, frame, gap), damper sides, the Jenkins law's parameters, contact states |
 //! | [`harmonic`] | `HarmonicSet`, `Block`, `SampleBasis` | real Fourier basis, unknown ordering (harmonic-major), time sampling |
 //! | [`aft`] | `AftWorkspace`, `MarchSettings`, `AftError` | the alternating frequency/time march of the Jenkins law (paper Eqs. 4-6) and its analytic Jacobian |
+//! | [`aft2d`] | `Aft2dWorkspace`, `Jenkins2dLaw` | the march of the isotropic 2D Jenkins element in a contact's tangent plane (radial return onto the friction circle) and its analytic Jacobian through the periodic steady state |
 //! | [`describing_function`] | [`jenkins_describing_function`] | the exact first harmonic under constant normal load (paper Eqs. 17-18), the AFT's reference |
 
 pub mod aft;
+pub mod aft2d;
 pub mod describing_function;
 pub mod harmonic;
 pub mod point;

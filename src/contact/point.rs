@@ -38,6 +38,20 @@ pub struct ContactEffects {
     pub liftoff: bool,
 }
 
+impl ContactEffects {
+    /// Normal force N (N) of a spring kₙ (N/m) compressed by v (m), and whether the spring is
+    /// active (its force follows v): with lift-off N = max(kₙ v, 0), active only while closed;
+    /// without, N = kₙ v always.
+    pub fn normal_force(&self, kn: f64, v: f64) -> (f64, bool) {
+        let force = kn * v;
+        if !self.liftoff || force > 0.0 {
+            (force, true)
+        } else {
+            (0.0, false)
+        }
+    }
+}
+
 impl Default for ContactEffects {
     fn default() -> Self {
         Self {

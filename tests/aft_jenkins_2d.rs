@@ -1,0 +1,191 @@
+//! Property tests of the 2D Jenkins element's analytic Jacobian (`contact::aft2d`) against
+//! finite differences of its periodic steady state, in every contact regime.
+
+use fricbound::contact::aft2d::{Aft2dWorkspace, Jenkins2dLaw};
+use fricbound::contact::harmonic::HarmonicSet;
+use fricbound::contact::{ContactEffects, ContactState, NormalLoad};
+use proptest::prelude::*;
+
+const SAMPLES: usize = 128;
+
+fn law(mu: f64, m: [f64; 2]) -> Jenkins2dLaw {
+    Jenkins2dLaw {
+        kt: 1e5,
+        kn: 1e5,
+        mu,
+        initial_state: m,
+    }
+}
+
+/// Largest error of the analytic ∂(T̂₁, T̂₂, N̂)/∂(û₁, û₂, v̂) against central differences,
+/// relative to the largest entry, and the contact state. Where the two one-sided differences
+/// disagree (a sample sits on a stick/slip or open/closed kink within the step), the better
+/// one-sided difference is the check, as for the 1D element.
+fn jacobian_error(l: Jenkins2dLaw, effects: ContactEffects, x: [&[f64]; 3]) -> (f64, ContactState) {
+    let set = HarmonicSet::up_to(3);
+    let nb = set.n_blocks();
+    let mut aft = Aft2dWorkspace::new(&set, SAMPLES);
+    let state = aft
+        .evaluate(&l, effects, [x[0], x[1]], x[2], true)
+        .expect("march settles")
+        .state;
+    let forces = |aft: &Aft2dWorkspace| -> Vec<f64> {
+        aft.t_hat[0]
+            .iter()
+            .chain(&aft.t_hat[1])
+            .chain(&aft.n_hat)
+            .copied()
+            .collect()
+    };
+    let f0 = forces(&aft);
+    let analytic = |r: usize, c: usize| -> f64 {
+        if r < 2 * nb {
+            aft.dt_dx[r * 3 * nb + c]
+        } else if c >= 2 * nb {
+            aft.dn_dv[(r - 2 * nb) * nb + (c - 2 * nb)]
+        } else {
+            0.0
+        }
+    };
+    let jac: Vec<Vec<f64>> = (0..3 * nb)
+        .map(|r| (0..3 * nb).map(|c| analytic(r, c)).collect())
+        .collect();
+    let max_entry = jac
+        .iter()
+        .flatten()
+        .fold(f64::MIN_POSITIVE, |a, x| a.max(x.abs()));
+    let mut worst = 0.0_f64;
+    #[allow(clippy::needless_range_loop)] // c indexes the columns of jac and of x alike
+    for c in 0..3 * nb {
+        let (which, i) = (c / nb, c % nb);
+        // One step for every coefficient, set by the largest displacement coefficient (a step
+        // relative to a tiny coefficient drowns in the rounding of the large forces).
+        let scale = x
+            .iter()
+            .flat_map(|c| c.iter())
+            .fold(f64::MIN_POSITIVE, |a, v| a.max(v.abs()));
+        let h = 1e-7 * scale;
+        let mut shifted = |sign: f64| {
+            let mut p = [x[0].to_vec(), x[1].to_vec(), x[2].to_vec()];
+            p[which][i] += sign * h;
+            aft.evaluate(&l, effects, [&p[0], &p[1]], &p[2], false)
+                .expect("march settles");
+            forces(&aft)
+        };
+        let (fp, fm) = (shifted(1.0), shifted(-1.0));
+        let (mut central, mut forward, mut backward, mut spread) =
+            (0.0_f64, 0.0_f64, 0.0_f64, 0.0_f64);
+        for r in 0..3 * nb {
+            let a = jac[r][c];
+            let fwd = (fp[r] - f0[r]) / h;
+            let bwd = (f0[r] - fm[r]) / h;
+            central = central.max((0.5 * (fwd + bwd) - a).abs());
+            forward = forward.max((fwd - a).abs());
+            backward = backward.max((bwd - a).abs());
+            spread = spread.max((fwd - bwd).abs());
+        }
+        worst = worst.max(if spread < 1e-6 * max_entry {
+            central
+        } else {
+            forward.min(backward)
+        });
+    }
+    (worst / max_entry, state)
+}
+
+/// Random coefficients for harmonics 0..3 of u₁, u₂ (amplitude `ua`) and v (mean `v0`,
+/// oscillation `va`), decaying with the harmonic.
+fn coefficients(seed: &[f64], ua: f64, v0: f64, va: f64) -> [Vec<f64>; 3] {
+    let mut x = [vec![0.0; 7], vec![0.0; 7], vec![0.0; 7]];
+    x[2][0] = v0;
+    for j in 0..7_usize {
+        let decay = 1.0 / (1 + j.saturating_sub(1) / 2) as f64;
+        x[0][j] = ua * seed[j] * decay;
+        x[1][j] = ua * seed[7 + j] * decay;
+        if j > 0 {
+            x[2][j] = va * seed[14 + j] * decay;
+        }
+    }
+    x
+}
+
+fn regime() -> impl Strategy<Value = (Vec<f64>, [f64; 2], f64)> {
+    (
+        prop::collection::vec(-1.0..1.0f64, 21),
+        (0.0..1.0f64, 0.0..std::f64::consts::TAU),
+        0.1..1.0f64,
+    )
+        .prop_map(|(s, (r, angle), mu)| (s, [r * angle.cos(), r * angle.sin()], mu))
+}
+
+fn effects(constant: bool) -> ContactEffects {
+    ContactEffects {
+        normal_load: if constant {
+            NormalLoad::Constant
+        } else {
+            NormalLoad::Variable
+        },
+        liftoff: true,
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    #[test]
+    fn jacobian_stuck((s, m, mu) in regime(), constant in any::<bool>()) {
+        // Large normal load, small tangential motion: never slips.
+        let x = coefficients(&s, 1e-6, 1e-3, 1e-5);
+        let (err, state) = jacobian_error(law(mu, [0.5 * m[0], 0.5 * m[1]]), effects(constant), [&x[0], &x[1], &x[2]]);
+        prop_assert_eq!(state, ContactState::Stuck);
+        prop_assert!(err < 1e-6, "relative error {}", err);
+    }
+
+    #[test]
+    fn jacobian_stick_slip_with_rotating_direction((s, m, mu) in regime(), constant in any::<bool>()) {
+        let mut x = coefficients(&s, 1e-4, 1e-4, 3e-5);
+        // An ellipse of 5e-4 by 3e-4 m: kₜ times its extent exceeds the friction circle's
+        // diameter 2μN ≤ 42 N, so the contact slips, along a direction that turns.
+        x[0][1] += 5e-4;
+        x[1][2] += 3e-4;
+        let (err, state) = jacobian_error(law(mu, m), effects(constant), [&x[0], &x[1], &x[2]]);
+        prop_assert_eq!(state, ContactState::StickSlip);
+        prop_assert!(err < 1e-6, "relative error {}", err);
+    }
+
+    #[test]
+    fn jacobian_nearly_straight_slip((s, m, mu) in regime(), constant in any::<bool>()) {
+        // Slip mostly along t₁ with a small transverse wobble: the slider's transverse
+        // offset contracts slowly, the case the fixed-point derivative is for.
+        let mut x = coefficients(&s, 1e-6, 1e-4, 1e-5);
+        x[0][1] += 5e-4;
+        let (err, state) = jacobian_error(law(mu, m), effects(constant), [&x[0], &x[1], &x[2]]);
+        prop_assert_eq!(state, ContactState::StickSlip);
+        prop_assert!(err < 1e-5, "relative error {}", err);
+    }
+
+    #[test]
+    fn jacobian_stick_slip_liftoff((s, m, mu) in regime()) {
+        let mut x = coefficients(&s, 1e-4, 2e-5, 2e-5);
+        x[0][1] += 2e-4;
+        x[1][2] += 1e-4;
+        // A normal oscillation larger than the mean and the other harmonics: it separates.
+        x[2][2] += 1e-4;
+        let (err, state) = jacobian_error(law(mu, m), effects(false), [&x[0], &x[1], &x[2]]);
+        prop_assert_eq!(state, ContactState::StickSlipLiftoff);
+        prop_assert!(err < 1e-6, "relative error {}", err);
+    }
+
+    #[test]
+    fn jacobian_grazing((s, m, mu) in regime(), reach in 0.9..1.1f64) {
+        // A circle whose radius is about the stick limit μN/kₜ under a constant N: the
+        // contact just slips or just sticks.
+        let v0 = 1e-4;
+        let radius = reach * mu * v0;
+        let mut x = coefficients(&s, 1e-7, v0, 0.0);
+        x[0][1] += radius;
+        x[1][2] += radius;
+        let (err, _) = jacobian_error(law(mu, [0.0 * m[0], 0.0]), effects(true), [&x[0], &x[1], &x[2]]);
+        prop_assert!(err < 1e-5, "relative error {}", err);
+    }
+}
