@@ -13,7 +13,7 @@ pub const MAX_DOFS: usize = 10_000;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RelativeCoordinatesError {
     /// No contact point.
-    #[error("the schur formulation needs at least one contact point")]
+    #[error("the schur formulation needs at least one contact point with a non-zero tangential or normal direction")]
     NoContacts,
     /// The model is too large to hold dense.
     #[error("the schur formulation holds the structural matrices dense; {n} DOFs is above its limit of {MAX_DOFS} (reduce the model, or use the sparse formulation)")]
@@ -31,9 +31,32 @@ pub enum RelativeCoordinatesError {
     },
 }
 
+/// The relative coordinates of each contact point: for its tangential and its normal row,
+/// `true` when the row is not zero. A row whose coefficients are all zero (a contact to
+/// ground with a zero normal direction, whose normal load is constant: N = kn·gap) moves with
+/// no DOF, so it carries no coordinate; such a contact has the tangential coordinate u alone.
+pub fn active_contact_rows(problem: &Problem) -> Vec<[bool; 2]> {
+    let nonzero = |row: &[(usize, f64)]| row.iter().any(|&(_, a)| a != 0.0);
+    problem
+        .contacts
+        .iter()
+        .map(|c| [nonzero(&c.tangential), nonzero(&c.normal)])
+        .collect()
+}
+
+/// Number of relative contact coordinates of the schur formulation: the non-zero tangential
+/// and normal rows of the contact points ([`active_contact_rows`]), 2 per contact point
+/// unless a row is zero.
+pub fn relative_coordinate_count(problem: &Problem) -> usize {
+    active_contact_rows(problem)
+        .iter()
+        .map(|r| r.iter().filter(|&&a| a).count())
+        .sum()
+}
+
 /// Checks that the problem has independent relative contact coordinates: the pivots of the
-/// Cholesky factor of B Bᵀ (one row per contact direction) stay above 1e-6 of the largest,
-/// i.e. cond(B) below about 10⁶. Cheap (n_q² entries at most).
+/// Cholesky factor of B Bᵀ (one row per non-zero contact direction, see
+/// [`active_contact_rows`]) stay above 1e-12 of the largest. Cheap (n_q² entries at most).
 pub fn check_relative_coordinates(problem: &Problem) -> Result<(), RelativeCoordinatesError> {
     let n = problem.model.n_dofs();
     if problem.contacts.is_empty() {
@@ -42,11 +65,23 @@ pub fn check_relative_coordinates(problem: &Problem) -> Result<(), RelativeCoord
     if n > MAX_DOFS {
         return Err(RelativeCoordinatesError::TooLarge { n });
     }
-    let rows: Vec<&[(usize, f64)]> = problem
+    // The non-zero rows, each with the contact it belongs to.
+    let active = active_contact_rows(problem);
+    let (rows, row_contact): (Vec<&[(usize, f64)]>, Vec<usize>) = problem
         .contacts
         .iter()
-        .flat_map(|c| [c.tangential.as_slice(), c.normal.as_slice()])
-        .collect();
+        .zip(&active)
+        .enumerate()
+        .flat_map(|(p, (c, a))| {
+            [(c.tangential.as_slice(), a[0]), (c.normal.as_slice(), a[1])]
+                .into_iter()
+                .filter(|(_, on)| *on)
+                .map(move |(row, _)| (row, p))
+        })
+        .unzip();
+    if rows.is_empty() {
+        return Err(RelativeCoordinatesError::NoContacts);
+    }
     let n_q = rows.len();
     // Per DOF, the rows touching it with their coefficient (duplicates summed): the Gram
     // products come from these sparse columns.
@@ -74,7 +109,7 @@ pub fn check_relative_coordinates(problem: &Problem) -> Result<(), RelativeCoord
         let ratio = pivot / max_diag.max(f64::MIN_POSITIVE);
         if ratio.is_nan() || ratio <= 1e-12 {
             return Err(RelativeCoordinatesError::Dependent {
-                contact: problem.contacts[k / 2].name.clone(),
+                contact: problem.contacts[row_contact[k]].name.clone(),
                 ratio,
             });
         }
