@@ -119,9 +119,7 @@ pub fn factored_size(p: &Problem) -> usize {
 /// [`factored_size`] of `p` solved in `formulation`.
 pub fn factored_size_for(p: &Problem, formulation: Formulation) -> usize {
     match formulation {
-        Formulation::Schur => {
-            crate::hbm::formulation::relative_coordinate_count(p) * p.unknown_harmonics().n_blocks()
-        }
+        Formulation::Schur => p.relative_coordinate_count() * p.unknown_harmonics().n_blocks(),
         _ => unknowns_for(p, formulation),
     }
 }
@@ -323,7 +321,7 @@ pub fn estimate_for(p: &Problem, formulation: Formulation) -> CostEstimate {
             (bytes, flops, 4.0 * m * m)
         }
         Formulation::Schur => {
-            let n_q = crate::hbm::formulation::relative_coordinate_count(p) as f64;
+            let n_q = p.relative_coordinate_count() as f64;
             let n_z = (n - n_q).max(0.0);
             let q = factored as f64;
             let per_harmonic = dynamic * C64 * n * n + if has_static { F64 * n * n } else { 0.0 };

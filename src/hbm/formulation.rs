@@ -31,32 +31,12 @@ pub enum RelativeCoordinatesError {
     },
 }
 
-/// The relative coordinates of each contact point: for its tangential and its normal row,
-/// `true` when the row is not zero. A row whose coefficients are all zero (a contact to
-/// ground with a zero normal direction, whose normal load is constant: N = kn·gap) moves with
-/// no DOF, so it carries no coordinate; such a contact has the tangential coordinate u alone.
-pub fn active_contact_rows(problem: &Problem) -> Vec<[bool; 2]> {
-    let nonzero = |row: &[(usize, f64)]| row.iter().any(|&(_, a)| a != 0.0);
-    problem
-        .contacts
-        .iter()
-        .map(|c| [nonzero(&c.tangential), nonzero(&c.normal)])
-        .collect()
-}
-
-/// Number of relative contact coordinates of the schur formulation: the non-zero tangential
-/// and normal rows of the contact points ([`active_contact_rows`]), 2 per contact point
-/// unless a row is zero.
-pub fn relative_coordinate_count(problem: &Problem) -> usize {
-    active_contact_rows(problem)
-        .iter()
-        .map(|r| r.iter().filter(|&&a| a).count())
-        .sum()
-}
+/// One contact row over the DOFs: (DOF, coefficient) entries.
+type ContactRow<'a> = &'a [(usize, f64)];
 
 /// Checks that the problem has independent relative contact coordinates: the pivots of the
 /// Cholesky factor of B Bᵀ (one row per non-zero contact direction, see
-/// [`active_contact_rows`]) stay above 1e-12 of the largest. Cheap (n_q² entries at most).
+/// `Problem::nonzero_contact_rows`) stay above 1e-12 of the largest. Cheap (n_q² entries at most).
 pub fn check_relative_coordinates(problem: &Problem) -> Result<(), RelativeCoordinatesError> {
     let n = problem.model.n_dofs();
     if problem.contacts.is_empty() {
@@ -66,8 +46,8 @@ pub fn check_relative_coordinates(problem: &Problem) -> Result<(), RelativeCoord
         return Err(RelativeCoordinatesError::TooLarge { n });
     }
     // The non-zero rows, each with the contact it belongs to.
-    let active = active_contact_rows(problem);
-    let (rows, row_contact): (Vec<&[(usize, f64)]>, Vec<usize>) = problem
+    let active = problem.nonzero_contact_rows();
+    let (rows, row_contact): (Vec<ContactRow>, Vec<usize>) = problem
         .contacts
         .iter()
         .zip(&active)

@@ -40,9 +40,7 @@ use faer::prelude::Solve;
 use faer::{c64, Mat};
 
 use crate::contact::harmonic::{Block, HarmonicSet};
-use crate::hbm::formulation::{
-    active_contact_rows, check_relative_coordinates, RelativeCoordinatesError,
-};
+use crate::hbm::formulation::{check_relative_coordinates, RelativeCoordinatesError};
 use crate::model::{DofSplit, Problem};
 use crate::numerics::jacobian::{ImplicitFactor, ImplicitJacobian};
 use crate::numerics::linalg::{
@@ -210,7 +208,8 @@ impl RelativeCoordinates {
             .map(|c| (c.tangential.clone(), c.normal.clone()))
             .collect();
         let mut n_q = 0;
-        let coordinate: Vec<[Option<usize>; 2]> = active_contact_rows(problem)
+        let coordinate: Vec<[Option<usize>; 2]> = problem
+            .nonzero_contact_rows()
             .iter()
             .map(|on| {
                 on.map(|on| {
