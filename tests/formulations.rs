@@ -431,3 +431,26 @@ fn auto_picks_the_formulation_estimated_fastest() {
     }
     assert_eq!(paper(&[]).formulation(), Formulation::Dense);
 }
+
+/// A Jenkins element to ground with a zero normal direction (constant normal load from its
+/// interference) has one relative coordinate: the schur formulation gives it the tangential
+/// one alone, and then matches the dense formulation: the same Jacobian entries and solves at
+/// converged points, and the same solutions along the path.
+#[test]
+fn schur_handles_contacts_with_a_zero_normal_direction() {
+    let text = chain_scene(12, 3);
+    let chain = fricbound::scene::parse(&text, "chain", &[])
+        .and_then(|s| s.validate("chain"))
+        .expect("valid chain scene");
+    let dense = with_formulation(chain.clone(), Formulation::Dense);
+    let schur = with_formulation(chain, Formulation::Schur);
+    // One coordinate per contact and coefficient block (H = 5: 11 blocks).
+    assert_eq!(fricbound::hbm::cost::factored_size(&schur), 3 * 11);
+    let run = frf::solve(&dense, &mut Silent).unwrap();
+    for k in [run.points.len() / 3, 2 * run.points.len() / 3] {
+        let point = &run.points[k];
+        let omega = 2.0 * std::f64::consts::PI * point.freq_hz;
+        schur_solves_match_dense(&dense, &schur, &point.coefficients, omega);
+    }
+    assert_variants_agree(&dense, &[("schur", schur)]);
+}

@@ -32,9 +32,9 @@ fn quick_accuracy_study_runs_end_to_end() {
         ),
         "{header}"
     );
-    // The reference check, 3 harmonic sets, 3 sample counts, 2 tolerances, 3 effect switches
-    // (labels and statuses hold no commas: one cell each).
-    assert_eq!(rows.len(), 12, "{rows:?}");
+    // The reference check, 3 harmonic sets and one odd-only set, 3 sample counts, 2
+    // tolerances, 3 effect switches (labels and statuses hold no commas: one cell each).
+    assert_eq!(rows.len(), 13, "{rows:?}");
     let row = |label: &str| {
         rows.iter()
             .find(|r| r[1].trim_matches('"') == label)

@@ -20,15 +20,19 @@
 //!
 //! The same point put into the harmonic balance of the same harmonic set at twice the samples
 //! per period: the residual is what the coarser sampling of the march misses (stick-slip and
-//! lift-off transitions located to a sample), and one Newton step gives the estimate as above.
+//! lift-off transitions located to a sample). It is pushed through the Jacobian already
+//! factorised for the truncation step (the extended system's; the residual on the kept
+//! harmonics, zero on the new ones): one Newton step as above, at the cost of one residual
+//! at twice the samples and one more solve with the same factors.
 //!
 //! Both are first-order estimates at a fixed frequency: near a fold of the path the Jacobian
 //! at fixed frequency is nearly singular and the amplitude at that frequency is sensitive to
 //! any change, so the estimates grow there, as the fixed-frequency error does. An estimate
 //! that cannot be formed (an AFT march that does not settle, a singular Jacobian) is NaN.
 //!
-//! Cost per point: one residual, Jacobian and factorisation of the system on 2H+1 harmonics, and
-//! one of the system at twice the samples (about two Newton iterations; a point takes 2-4).
+//! Cost per point: one residual, Jacobian and factorisation of the system on 2H+1 harmonics,
+//! one residual at twice the samples, and two solves with the same factors (before the
+//! sampling step reused the factors, it took a Jacobian and a factorisation of its own).
 
 use crate::contact::harmonic::HarmonicSet;
 use crate::hbm::operator::HbmOperator;
@@ -125,24 +129,37 @@ impl<'p> Refined<'p> {
         })
     }
 
-    /// Full coefficients of the refined problem after one Newton step from the base point
-    /// `x` (full coefficients on the base set) padded with zeros; None when the step cannot be
-    /// formed.
-    fn newton_step(&mut self, n: usize, x: &[f64], omega: f64) -> Option<Vec<f64>> {
+    /// The base point `x` (full coefficients on the base set, `n` DOFs) padded with zeros on
+    /// the refined set, in the refined operator's unknowns.
+    fn padded(&self, n: usize, x: &[f64]) -> Vec<f64> {
         let set = self.operator.unknowns();
         let mut padded = vec![0.0; n * set.n_blocks()];
         for (j, &jr) in self.block_of.iter().enumerate() {
             padded[jr * n..(jr + 1) * n].copy_from_slice(&x[j * n..(j + 1) * n]);
         }
-        let xr = self.operator.restrict(&padded);
-        let dim = xr.len();
-        let mut r = vec![0.0; dim];
-        let mut dr = vec![0.0; dim];
-        self.operator
-            .residual_and_jacobian(&xr, omega, &mut r, &mut self.jacobian, &mut dr)
-            .ok()?;
-        let delta = self.jacobian.solve(&r).ok()?;
-        let stepped: Vec<f64> = xr.iter().zip(&delta).map(|(a, d)| a - d).collect();
+        self.operator.restrict(&padded)
+    }
+
+    /// `r` (a residual in the unknowns of an operator on the base set, `base_blocks` blocks)
+    /// placed on the kept blocks of this operator's unknowns, zero on the others; None when
+    /// the block sizes differ.
+    fn on_kept_blocks(&self, r: &[f64], base_blocks: usize) -> Option<Vec<f64>> {
+        let blocks = self.operator.unknowns().n_blocks();
+        let dim = self.operator.dim();
+        let size = dim / blocks.max(1);
+        if r.len() != size * base_blocks || self.block_of.len() != base_blocks {
+            return None;
+        }
+        let mut out = vec![0.0; dim];
+        for (j, &jr) in self.block_of.iter().enumerate() {
+            out[jr * size..(jr + 1) * size].copy_from_slice(&r[j * size..(j + 1) * size]);
+        }
+        Some(out)
+    }
+
+    /// Full coefficients of `xr − δ` (refined unknowns); None when not finite.
+    fn stepped(&mut self, xr: &[f64], delta: &[f64], omega: f64) -> Option<Vec<f64>> {
+        let stepped: Vec<f64> = xr.iter().zip(delta).map(|(a, d)| a - d).collect();
         let full = self.operator.expand(&stepped, omega).ok()?;
         full.iter().all(|v| v.is_finite()).then_some(full)
     }
@@ -185,7 +202,8 @@ pub struct ErrorEstimator<'p> {
     problem: &'p Problem,
     set: HarmonicSet,
     truncation: Refined<'p>,
-    sampling: Refined<'p>,
+    /// The operator at twice the samples (residuals only).
+    sampling: HbmOperator<'p>,
 }
 
 impl<'p> ErrorEstimator<'p> {
@@ -196,26 +214,60 @@ impl<'p> ErrorEstimator<'p> {
         Ok(Self {
             problem,
             truncation: Refined::new(&refined.truncation, &set)?,
-            sampling: Refined::new(&refined.sampling, &set)?,
+            sampling: HbmOperator::new(&refined.sampling)?,
             set,
         })
     }
 
     /// The estimate at the converged point `x` (full coefficients, harmonic-major) solved at
-    /// ω = `omega` (rad/s).
+    /// ω = `omega` (rad/s): one residual and Jacobian of the extended system, factorised once
+    /// for both Newton steps (truncation: its own residual; sampling: the residual at twice
+    /// the samples on the kept harmonics).
     pub fn estimate(&mut self, x: &[f64], omega: f64) -> PointAccuracy {
         let n = self.problem.model.n_dofs();
         let base = amplitudes(self.problem, &self.set, x);
         let nan = || vec![f64::NAN; base.len()];
-        let truncation = match self.truncation.newton_step(n, x, omega) {
-            Some(full) => {
-                let set = self.truncation.operator.unknowns().clone();
-                relative_changes(&amplitudes(self.problem, &set, &full), &base)
-            }
+        let xr = self.truncation.padded(n, x);
+        let dim = xr.len();
+        let mut r = vec![0.0; dim];
+        let mut dr = vec![0.0; dim];
+        if self
+            .truncation
+            .operator
+            .residual_and_jacobian(&xr, omega, &mut r, &mut self.truncation.jacobian, &mut dr)
+            .is_err()
+        {
+            return PointAccuracy {
+                truncation: nan(),
+                sampling: nan(),
+            };
+        }
+        // The sampling residual on the base set, moved onto the extended unknowns.
+        let xs = self.sampling.restrict(x);
+        let mut rs = vec![0.0; xs.len()];
+        let sampling_rhs = self
+            .sampling
+            .residual(&xs, omega, &mut rs)
+            .ok()
+            .and_then(|()| self.truncation.on_kept_blocks(&rs, self.set.n_blocks()));
+        let mut rhs: Vec<&[f64]> = vec![&r];
+        if let Some(s) = &sampling_rhs {
+            rhs.push(s);
+        }
+        let Ok(deltas) = self.truncation.jacobian.solve_many(&rhs) else {
+            return PointAccuracy {
+                truncation: nan(),
+                sampling: nan(),
+            };
+        };
+        let ext = self.truncation.operator.unknowns().clone();
+        let mut change = |delta: &[f64]| match self.truncation.stepped(&xr, delta, omega) {
+            Some(full) => relative_changes(&amplitudes(self.problem, &ext, &full), &base),
             None => nan(),
         };
-        let sampling = match self.sampling.newton_step(n, x, omega) {
-            Some(full) => relative_changes(&amplitudes(self.problem, &self.set, &full), &base),
+        let truncation = change(&deltas[0]);
+        let sampling = match deltas.get(1) {
+            Some(d) => change(d),
             None => nan(),
         };
         PointAccuracy {

@@ -31,7 +31,7 @@
 //!   h ≥ 1, a quarter for h = 0) plus one such block in construction, and the dense Jacobian
 //!   on the m = n_c·b contact unknowns (4·m²);
 //! - `schur`: dense K, M, C and their congruences (6·n²), per dynamic harmonic the complex
-//!   elimination of everything but the n_q = 2c relative coordinates (n² complex values:
+//!   elimination of everything but the n_q ≤ 2c relative coordinates (one per non-zero contact row; n² complex values:
 //!   LU, coupling blocks and the Schur complement; n² real for h = 0), and the reduced matrix
 //!   of (n_q·b)² values with its single-precision copy; twice all of the factor part, since
 //!   the continuation keeps the previous factorisation while it builds the next one.
@@ -110,7 +110,8 @@ pub fn unknowns_for(p: &Problem, formulation: Formulation) -> usize {
 }
 
 /// Rows of the matrix factorised per Newton iteration on `p`: the unknowns, except for the
-/// schur formulation (2 relative coordinates per contact point and coefficient block).
+/// schur formulation (2 relative coordinates per contact point, 1 where its normal or
+/// tangential direction is zero, and coefficient block).
 pub fn factored_size(p: &Problem) -> usize {
     factored_size_for(p, p.formulation())
 }
@@ -118,7 +119,7 @@ pub fn factored_size(p: &Problem) -> usize {
 /// [`factored_size`] of `p` solved in `formulation`.
 pub fn factored_size_for(p: &Problem, formulation: Formulation) -> usize {
     match formulation {
-        Formulation::Schur => 2 * p.contacts.len() * p.unknown_harmonics().n_blocks(),
+        Formulation::Schur => p.relative_coordinate_count() * p.unknown_harmonics().n_blocks(),
         _ => unknowns_for(p, formulation),
     }
 }
@@ -320,7 +321,7 @@ pub fn estimate_for(p: &Problem, formulation: Formulation) -> CostEstimate {
             (bytes, flops, 4.0 * m * m)
         }
         Formulation::Schur => {
-            let n_q = 2.0 * c;
+            let n_q = p.relative_coordinate_count() as f64;
             let n_z = (n - n_q).max(0.0);
             let q = factored as f64;
             let per_harmonic = dynamic * C64 * n * n + if has_static { F64 * n * n } else { 0.0 };

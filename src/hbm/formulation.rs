@@ -13,7 +13,7 @@ pub const MAX_DOFS: usize = 10_000;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RelativeCoordinatesError {
     /// No contact point.
-    #[error("the schur formulation needs at least one contact point")]
+    #[error("the schur formulation needs at least one contact point with a non-zero tangential or normal direction")]
     NoContacts,
     /// The model is too large to hold dense.
     #[error("the schur formulation holds the structural matrices dense; {n} DOFs is above its limit of {MAX_DOFS} (reduce the model, or use the sparse formulation)")]
@@ -31,9 +31,12 @@ pub enum RelativeCoordinatesError {
     },
 }
 
+/// One contact row over the DOFs: (DOF, coefficient) entries.
+type ContactRow<'a> = &'a [(usize, f64)];
+
 /// Checks that the problem has independent relative contact coordinates: the pivots of the
-/// Cholesky factor of B Bᵀ (one row per contact direction) stay above 1e-6 of the largest,
-/// i.e. cond(B) below about 10⁶. Cheap (n_q² entries at most).
+/// Cholesky factor of B Bᵀ (one row per non-zero contact direction, see
+/// `Problem::nonzero_contact_rows`) stay above 1e-12 of the largest. Cheap (n_q² entries at most).
 pub fn check_relative_coordinates(problem: &Problem) -> Result<(), RelativeCoordinatesError> {
     let n = problem.model.n_dofs();
     if problem.contacts.is_empty() {
@@ -42,11 +45,23 @@ pub fn check_relative_coordinates(problem: &Problem) -> Result<(), RelativeCoord
     if n > MAX_DOFS {
         return Err(RelativeCoordinatesError::TooLarge { n });
     }
-    let rows: Vec<&[(usize, f64)]> = problem
+    // The non-zero rows, each with the contact it belongs to.
+    let active = problem.nonzero_contact_rows();
+    let (rows, row_contact): (Vec<ContactRow>, Vec<usize>) = problem
         .contacts
         .iter()
-        .flat_map(|c| [c.tangential.as_slice(), c.normal.as_slice()])
-        .collect();
+        .zip(&active)
+        .enumerate()
+        .flat_map(|(p, (c, a))| {
+            [(c.tangential.as_slice(), a[0]), (c.normal.as_slice(), a[1])]
+                .into_iter()
+                .filter(|(_, on)| *on)
+                .map(move |(row, _)| (row, p))
+        })
+        .unzip();
+    if rows.is_empty() {
+        return Err(RelativeCoordinatesError::NoContacts);
+    }
     let n_q = rows.len();
     // Per DOF, the rows touching it with their coefficient (duplicates summed): the Gram
     // products come from these sparse columns.
@@ -74,7 +89,7 @@ pub fn check_relative_coordinates(problem: &Problem) -> Result<(), RelativeCoord
         let ratio = pivot / max_diag.max(f64::MIN_POSITIVE);
         if ratio.is_nan() || ratio <= 1e-12 {
             return Err(RelativeCoordinatesError::Dependent {
-                contact: problem.contacts[k / 2].name.clone(),
+                contact: problem.contacts[row_contact[k]].name.clone(),
                 ratio,
             });
         }

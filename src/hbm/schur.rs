@@ -19,8 +19,10 @@
 //! S_h = Ã_qq − Ã_qz Ã_zz⁻¹ Ã_zq       (dynamic Schur complement on the relative coordinates)
 //! ```
 //!
-//! and Newton's linear system becomes (blockdiag_h S_h + N_c) y_q = r_q on 2 · contacts ·
-//! blocks unknowns: with node-to-node pairs that is half the contact DOFs (4 per pair in 2D),
+//! and Newton's linear system becomes (blockdiag_h S_h + N_c) y_q = r_q on n_q · blocks
+//! unknowns (n_q = 2 per contact point; 1 for a contact whose normal row is zero, a
+//! Jenkins element to ground with a constant normal load, whose v moves with no DOF and whose
+//! normal rows of N_c therefore act on nothing): with node-to-node pairs that is half the contact DOFs (4 per pair in 2D),
 //! an eighth of the dense LU work of the condensed formulation. Ã_zz is the structure with
 //! every contact glued (q = 0), which is regular even when a body (the damper) is held only by
 //! its contacts; the 0th harmonic therefore needs no regularisation.
@@ -75,6 +77,9 @@ pub struct RelativeCoordinates {
     c: Mat<f64>,
     /// Per contact, its tangential and normal rows.
     rows: Vec<ContactRows>,
+    /// Per contact, the relative coordinate of its tangential and normal rows (None for a
+    /// zero row, which carries no coordinate).
+    coordinate: Vec<[Option<usize>; 2]>,
     /// Per DOF, the contacts whose rows touch it.
     dof_contacts: Vec<Vec<usize>>,
     /// Per unknown block: its harmonic and damping partner (block, sign).
@@ -91,20 +96,23 @@ struct ContactComponent {
     /// The group's DOFs (problem indices, sorted).
     dofs: Vec<usize>,
     /// For each column of `block`, its y coordinate: the group's relative coordinates
-    /// (2p, 2p + 1 for contact p) first, then its share of the null-space coordinates w.
+    /// (those of its contacts' non-zero rows) first, then its share of the null-space
+    /// coordinates w.
     y_rows: Vec<usize>,
     /// [P N] on the group's DOFs: P = Bᵀ(BBᵀ)⁻¹, N an orthonormal basis of ker B.
     block: Mat<f64>,
 }
 
-/// Groups the contacts by shared DOFs (union-find) and builds each group's block.
+/// Groups the contacts by shared DOFs (union-find) and builds each group's block; `coordinate`
+/// gives each contact row's relative coordinate (None for a zero row), numbered 0..n_q.
 fn contact_components(
     problem: &Problem,
     rows: &[ContactRows],
+    coordinate: &[[Option<usize>; 2]],
     split: &DofSplit,
 ) -> Result<Vec<ContactComponent>, RelativeCoordinatesError> {
     let n_contacts = rows.len();
-    let n_q = 2 * n_contacts;
+    let n_q = coordinate.iter().flatten().flatten().count();
     let mut parent: Vec<usize> = (0..n_contacts).collect();
     fn find(parent: &mut [usize], mut i: usize) -> usize {
         while parent[i] != i {
@@ -148,7 +156,12 @@ fn contact_components(
             .collect();
         dofs.sort_unstable();
         dofs.dedup();
-        let (m, d) = (2 * contacts.len(), dofs.len());
+        // The group's non-zero rows: (contact, 0 tangential / 1 normal, coordinate).
+        let active: Vec<(usize, usize, usize)> = contacts
+            .iter()
+            .flat_map(|&p| (0..2).filter_map(move |a| coordinate[p][a].map(|q| (p, a, q))))
+            .collect();
+        let (m, d) = (active.len(), dofs.len());
         if m > d {
             return Err(RelativeCoordinatesError::Dependent {
                 contact: problem.contacts[contacts[0]].name.clone(),
@@ -156,12 +169,11 @@ fn contact_components(
             });
         }
         let mut b = Mat::<f64>::zeros(m, d);
-        for (k, &p) in contacts.iter().enumerate() {
-            for (row, entries) in [(2 * k, &rows[p].0), (2 * k + 1, &rows[p].1)] {
-                for &(dof, a) in entries.iter() {
-                    let col = dofs.binary_search(&dof).expect("listed above");
-                    b[(row, col)] += a;
-                }
+        for (row, &(p, a, _)) in active.iter().enumerate() {
+            let entries = if a == 0 { &rows[p].0 } else { &rows[p].1 };
+            for &(dof, v) in entries.iter() {
+                let col = dofs.binary_search(&dof).expect("listed above");
+                b[(row, col)] += v;
             }
         }
         let gram = &b * b.transpose();
@@ -172,7 +184,7 @@ fn contact_components(
         let p = gram_lu.solve(&b).transpose().to_owned();
         let q_full = b.transpose().to_owned().qr().compute_Q();
         let block = Mat::from_fn(d, d, |i, j| if j < m { p[(i, j)] } else { q_full[(i, j)] });
-        let mut y_rows: Vec<usize> = contacts.iter().flat_map(|&p| [2 * p, 2 * p + 1]).collect();
+        let mut y_rows: Vec<usize> = active.iter().map(|&(_, _, q)| q).collect();
         y_rows.extend(w_next..w_next + (d - m));
         w_next += d - m;
         components.push(ContactComponent {
@@ -195,8 +207,20 @@ impl RelativeCoordinates {
             .iter()
             .map(|c| (c.tangential.clone(), c.normal.clone()))
             .collect();
-        let n_q = 2 * rows.len();
-        let components = contact_components(problem, &rows, &split)?;
+        let mut n_q = 0;
+        let coordinate: Vec<[Option<usize>; 2]> = problem
+            .nonzero_contact_rows()
+            .iter()
+            .map(|on| {
+                on.map(|on| {
+                    on.then(|| {
+                        n_q += 1;
+                        n_q - 1
+                    })
+                })
+            })
+            .collect();
+        let components = contact_components(problem, &rows, &coordinate, &split)?;
         let dense = |m: &crate::model::matrix::StructuralMatrix| m.to_dense();
         let (k, m, c) = (
             dense(&problem.model.stiffness),
@@ -259,6 +283,7 @@ impl RelativeCoordinates {
             m,
             c,
             rows,
+            coordinate,
             dof_contacts,
             blocks,
             harmonics,
@@ -274,9 +299,14 @@ impl RelativeCoordinates {
         self.n
     }
 
-    /// Number of relative coordinates n_q (2 per contact point).
+    /// Number of relative coordinates n_q (2 per contact point, 1 where a row is zero).
     pub fn n_relative(&self) -> usize {
         self.n_q
+    }
+
+    /// Number of contact points.
+    pub fn n_contacts(&self) -> usize {
+        self.rows.len()
     }
 
     /// Number of unknown blocks.
@@ -451,12 +481,16 @@ impl RelativeCoordinates {
         let per_contact = 4 * nb * nb;
         for p in 0..self.rows.len() {
             let values = &contact_values[p * per_contact..(p + 1) * per_contact];
+            // Entries on a zero row or column act on nothing (that row of B is zero).
+            let coordinate = self.coordinate[p];
             for j in 0..nb {
                 for i in 0..nb {
                     for a in 0..2 {
+                        let Some(qa) = coordinate[a] else { continue };
                         for b in 0..2 {
+                            let Some(qb) = coordinate[b] else { continue };
                             let v = values[((j * nb + i) * 2 + a) * 2 + b];
-                            s[(j * n_q + 2 * p + a, i * n_q + 2 * p + b)] += v;
+                            s[(j * n_q + qa, i * n_q + qb)] += v;
                         }
                     }
                 }
@@ -632,7 +666,7 @@ impl ImplicitJacobian for SchurJacobian {
     }
     fn values_len(&self) -> usize {
         let nb = self.0.n_blocks();
-        self.0.n_relative() / 2 * 4 * nb * nb
+        self.0.n_contacts() * 4 * nb * nb
     }
     fn entry(&self, omega: f64, values: &[f64], i: usize, j: usize) -> f64 {
         self.0.entry(omega, values, i, j)

@@ -224,6 +224,27 @@ impl Problem {
         HarmonicSet::new(h)
     }
 
+    /// For each contact point, whether its tangential and its normal row are non-zero. A row
+    /// whose coefficients are all zero (a contact to ground with a zero normal direction, whose
+    /// normal load is constant: N = kn·gap) moves with no DOF; the schur formulation gives such
+    /// a contact its non-zero coordinate only.
+    pub fn nonzero_contact_rows(&self) -> Vec<[bool; 2]> {
+        let nonzero = |row: &[(usize, f64)]| row.iter().any(|&(_, a)| a != 0.0);
+        self.contacts
+            .iter()
+            .map(|c| [nonzero(&c.tangential), nonzero(&c.normal)])
+            .collect()
+    }
+
+    /// Number of relative contact coordinates: the non-zero tangential and normal rows of the
+    /// contact points ([`Self::nonzero_contact_rows`]), 2 per contact point unless a row is zero.
+    pub fn relative_coordinate_count(&self) -> usize {
+        self.nonzero_contact_rows()
+            .iter()
+            .map(|r| r.iter().filter(|&&a| a).count())
+            .sum()
+    }
+
     /// DOFs touched by some contact (sorted, unique): the nonlinear DOFs.
     pub fn contact_dofs(&self) -> Vec<usize> {
         let mut dofs: Vec<usize> = self

@@ -387,6 +387,37 @@ impl AssembledJacobian {
         }
     }
 
+    /// Solves J x = b for every b of `rhs` with one factorisation (each solution as
+    /// [`Self::solve`] gives it): several right-hand sides at the cost of one factorisation.
+    pub fn solve_many(&mut self, rhs: &[&[f64]]) -> Result<Vec<Vec<f64>>, LinearSolveError> {
+        match self.storage {
+            Storage::Dense => {
+                let n = self.n;
+                if rhs.iter().any(|b| b.iter().any(|v| !v.is_finite())) {
+                    return Err(LinearSolveError::NonFinite);
+                }
+                let a = Mat::from_fn(n, n, |i, j| self.values[i + j * n]);
+                let lu = checked_lu(&a)?;
+                let b = Mat::from_fn(n, rhs.len(), |i, k| rhs[k][i]);
+                let x = lu.solve(&b);
+                let out: Vec<Vec<f64>> = (0..rhs.len())
+                    .map(|k| (0..n).map(|i| x[(i, k)]).collect())
+                    .collect();
+                if out.iter().flatten().any(|v| !v.is_finite()) {
+                    return Err(LinearSolveError::NonFinite);
+                }
+                Ok(out)
+            }
+            Storage::Sparse | Storage::Schur => {
+                let ones = vec![1.0; self.n];
+                let lu = self.inner_factor(&ones)?;
+                rhs.iter()
+                    .map(|b| self.checked_solve(&lu, &ones, b))
+                    .collect()
+            }
+        }
+    }
+
     /// Solves the bordered system [[s·J, col], [row]] y = rhs, with `col` of length n and
     /// `row`, `rhs` of length n + 1.
     pub fn solve_bordered(
@@ -632,6 +663,37 @@ mod tests {
         );
         s.solve(&b).unwrap();
         assert_eq!(s.factorisations, 3);
+    }
+
+    #[test]
+    fn solve_many_factorises_once_and_matches_single_solves() {
+        let a = [[4.0, 1.0, 0.0], [-1.0, 3.0, 2.0], [0.0, -2.0, 5.0]];
+        let pattern: Vec<(usize, usize)> = (0..3)
+            .flat_map(|r| (0..3).map(move |c| (r, c)))
+            .filter(|&(r, c)| a[r][c] != 0.0)
+            .collect();
+        let (b1, b2) = ([1.0, 2.0, 3.0], [-0.5, 0.0, 4.0]);
+        for mut j in [
+            AssembledJacobian::dense(3),
+            AssembledJacobian::sparse(3, pattern),
+        ] {
+            fill(&mut j, &a);
+            let many = j.solve_many(&[&b1, &b2]).unwrap();
+            let before = j.factorisations;
+            let one = [j.solve(&b1).unwrap(), j.solve(&b2).unwrap()];
+            for k in 0..2 {
+                for i in 0..3 {
+                    assert!(
+                        (many[k][i] - one[k][i]).abs() < 1e-14,
+                        "{many:?} vs {one:?}"
+                    );
+                }
+            }
+            if j.storage() == Storage::Sparse {
+                // One factorisation for both right-hand sides, one per single solve.
+                assert_eq!((before, j.factorisations), (1, 3));
+            }
+        }
     }
 
     #[test]
