@@ -401,7 +401,7 @@ fn plot(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandError> {
                     y,
                     color: plotters::style::RGBColor(0, 0, 0),
                     dashed: false,
-                    markers: true,
+                    markers: false,
                 });
             }
         }
