@@ -4,9 +4,8 @@
 //! Today these are the nonlinear frequency response by continuation of the harmonic balance,
 //! the linear references (contacts open, contacts stuck), and the paper's limit analysis of the
 //! response among multiple steady states (two-point method, Ferhatoglu & Zucca 2021, §3), and
-//! the Hill stability of the periodic solutions. Next to come here: the accuracy study
-//! (harmonics and time samples), time integration as an independent check, and the response
-//! envelope.
+//! the Hill stability of the periodic solutions, and the response envelope over all initial
+//! tangential states (`limits::envelope`).
 //!
 //! Layer: above `hbm`, below `scene`. It uses `hbm` (the harmonic-balance system and
 //! operator), `model` (the problem), `contact` (contact states, harmonic sets) and `numerics`
@@ -33,6 +32,9 @@
 //! - [`limits::analyse`]: the limit analysis (limit, intermediate and scanned curves, grid
 //!   classification, bound check, hysteresis loops) as a [`limits::LimitAnalysis`].
 //! - [`limits::solve_case`]: one case's curve and its refined resonance peak.
+//! - [`limits::envelope()`], [`limits::envelope_at`]: the largest and smallest amplitude over
+//!   m ∈ [−1, 1]^k per side or point, by bounded optimisation with dA/dm from
+//!   [`limits::amplitude_sensitivity`] (implicit-function theorem).
 //! - [`limits::LimitAnalysis::variability`]: the size of the variability between the limits.
 //! - [`error_estimate::ErrorEstimator`]: the a-posteriori truncation and sampling error
 //!   estimate of every converged continuation point ([`error_estimate::PointAccuracy`]).

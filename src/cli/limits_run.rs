@@ -162,7 +162,7 @@ fn write_tables(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandEr
     let cases: Vec<_> = a.limits.iter().map(|c| c.case.clone()).collect();
     files::write_atomic(
         &ctx.dir.join("limits.csv"),
-        limit_files::limits_csv(&ctx.problem, &cases, &a.grid).as_bytes(),
+        limit_files::limits_csv(&ctx.problem, &cases, &a.grid, a.envelope.as_ref()).as_bytes(),
     )?;
     let mut rows: Vec<limit_files::PeakRow> = Vec::new();
     for c in &a.limits {
@@ -304,6 +304,9 @@ fn write_json(
         "hysteresis": a.loops,
         "hysteresis_missing": a.loops_missing,
     });
+    if let Some(e) = &a.envelope {
+        json["envelope"] = serde_json::to_value(e).expect("result types serialise");
+    }
     if stability {
         json["stability"] = band_stability_json(a);
     }
@@ -385,6 +388,23 @@ fn plot(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandError> {
             .filter(|(x, _)| !x.is_empty())
             .collect();
         let mut curves = curves_with_references(ctx, &series, &open_y, &stuck_y);
+        let (env_min, env_max) = envelope_series(a, k);
+        if !env_max.is_empty() {
+            for (i, y) in [&env_max, &env_min].into_iter().enumerate() {
+                curves.push(Curve {
+                    label: if i == 0 {
+                        "envelope over all m (max, min)"
+                    } else {
+                        ""
+                    },
+                    x: &grid_x,
+                    y,
+                    color: plotters::style::RGBColor(0, 0, 0),
+                    dashed: false,
+                    markers: false,
+                });
+            }
+        }
         for (i, (x, y)) in overlays.iter().enumerate() {
             curves.push(Curve {
                 label: if i == 0 { UNSTABLE_LABEL } else { "" },
@@ -514,10 +534,76 @@ pub(super) fn summary(a: &LimitAnalysis, elapsed: f64) -> String {
             b.below_at.as_ref().map(|(f, c)| format!("({c} at {f:.3} Hz)")).unwrap_or_default(),
         );
     }
+    if let Some(e) = &a.envelope {
+        let _ = writeln!(s, "{}", envelope_summary(e));
+    }
     for m in &a.loops_missing {
         let _ = writeln!(s, "  hysteresis not computed: {m}");
     }
     s.trim_end().to_string()
+}
+
+/// The envelope's lines of the summary: cost, and where and by how much the two limit curves
+/// fail to bound it (first output DOF).
+fn envelope_summary(e: &limits::Envelope) -> String {
+    let m_text = |m: &[f64]| {
+        e.groups
+            .iter()
+            .zip(m)
+            .map(|(g, m)| format!("{g} {m:+.3}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let c = &e.check;
+    let mut s = format!(
+        "  envelope ({} m per {}): {} solves in {:.2} s",
+        e.groups.len(),
+        match e.mode {
+            limits::EnvelopeMode::Sides => "side",
+            limits::EnvelopeMode::Points => "contact point",
+        },
+        e.solves,
+        e.elapsed_s
+    );
+    if e.unsolved > 0 {
+        s.push_str(&format!(
+            "; NO state solved at {} grid frequencies",
+            e.unsolved
+        ));
+    }
+    s.push_str(&format!(
+        "\n  envelope above the upper limit at {} of {} grid frequencies, by at most {:.3} %{}",
+        c.points_above,
+        c.compared,
+        100.0 * c.max_excess_above,
+        c.above_at
+            .as_ref()
+            .map(|(f, m)| format!(" ({f:.3} Hz, m: {})", m_text(m)))
+            .unwrap_or_default()
+    ));
+    s.push_str(&format!(
+        "\n  envelope below the lower limit at {} of {} grid frequencies, by at most {:.3} %{}",
+        c.points_below,
+        c.compared,
+        100.0 * c.max_excess_below,
+        c.below_at
+            .as_ref()
+            .map(|(f, m)| format!(" ({f:.3} Hz, m: {})", m_text(m)))
+            .unwrap_or_default()
+    ));
+    for p in &e.peaks {
+        if let Some(Some(hi)) = p.point.max.first() {
+            s.push_str(&format!(
+                "\n  envelope at the peak of {} ({:.4} Hz): max {:.5e} m (m: {}), limit {:.5e} m",
+                p.case,
+                p.point.freq_hz,
+                hi.amplitude,
+                m_text(&hi.m),
+                p.limit_amplitude
+            ));
+        }
+    }
+    s
 }
 
 /// One drawn curve of a limit figure: label, frequencies (Hz), amplitudes (m), dashed.
@@ -546,6 +632,21 @@ fn curve_series(
             )
         })
         .collect()
+}
+
+/// The envelope's smallest and largest amplitude of output `k` on the grid (NaN where no state
+/// was solved); empty without an envelope.
+fn envelope_series(a: &LimitAnalysis, k: usize) -> (Vec<f64>, Vec<f64>) {
+    let Some(e) = &a.envelope else {
+        return (Vec::new(), Vec::new());
+    };
+    let amp = |b: Option<&Option<limits::EnvelopeBound>>| {
+        b.and_then(|b| b.as_ref()).map_or(f64::NAN, |b| b.amplitude)
+    };
+    e.points
+        .iter()
+        .map(|p| (amp(p.min.get(k)), amp(p.max.get(k))))
+        .unzip()
 }
 
 /// Amplitudes of output `k` of the linear references (contacts open, contacts stuck).

@@ -108,6 +108,9 @@ pub struct AftWorkspace {
     gram_weights: [Vec<f64>; 3],
     gram_spectra: [Vec<Complex<f64>>; 3],
     anchor_sum: Vec<f64>,
+    /// Whether the slider of the last march was never moved from its initial position by a
+    /// slip (beyond rounding) or a separation: the forces then depend on m.
+    initial_anchor: bool,
     /// Tangential relative displacement samples u(τ_k) (m).
     pub u: Vec<f64>,
     /// Normal relative displacement samples v(τ_k) (m).
@@ -165,6 +168,7 @@ impl AftWorkspace {
             ],
             gram_spectra,
             anchor_sum: vec![0.0; nb],
+            initial_anchor: false,
             u: vec![0.0; n_samples],
             v: vec![0.0; n_samples],
             t: vec![0.0; n_samples],
@@ -320,6 +324,7 @@ impl AftWorkspace {
         };
         let mut anchor = 0usize;
         let mut anchor_sign = if limit0 > 0.0 { law.initial_state } else { 0.0 };
+        self.initial_anchor = limit0 > 0.0;
         let mut w_start = w;
         let mut drift = f64::INFINITY;
         let mut open_samples;
@@ -356,6 +361,7 @@ impl AftWorkspace {
                     anchor = k;
                     anchor_sign = 0.0;
                     open_samples += 1;
+                    self.initial_anchor = false;
                     continue;
                 }
                 let predictor = law.kt * (self.u[k] - w);
@@ -377,6 +383,7 @@ impl AftWorkspace {
                     // not a state change.
                     if predictor.abs() - limit > 1e-9 * (limit + law.kt * scale) {
                         stick_margin_slips += 1;
+                        self.initial_anchor = false;
                     }
                 }
             }
@@ -406,6 +413,39 @@ impl AftWorkspace {
             periods: self.settings.max_periods.max(2),
             drift,
         })
+    }
+
+    /// ∂T̂₀/∂m of the last evaluation (N per unit m): the derivative of the constant block of
+    /// the tangential force with respect to the initial tangential state m (T(0) = m μ N(0),
+    /// paper Eqs. 14-15). The other blocks of ∂T̂/∂m are zero.
+    ///
+    /// m enters the march only through the initial slider position w₀ = u₀ − m μ N₀ / kₜ. A
+    /// slip or a separation anywhere in the march (in the final period or in the transient
+    /// periods before it) resets the slider to a position that does not depend on m, and the
+    /// derivative is 0. When neither happened, the contact is stuck over the whole period with
+    /// every sample anchored at the initial condition: T_k = kₜ (u_k − u₀) + m μ N₀, so
+    /// ∂T_k/∂m = μ N₀ at every sample and only the mean T̂₀ moves. A contact that slipped in
+    /// the transient and then stuck (reported `Stuck`, touching μN once per period) forgets
+    /// m. Slips by rounding only (m = ±1, where the contact touches μN at τ = 0) do not count:
+    /// the value is then the one-sided derivative into [−1, 1].
+    pub fn initial_state_derivative(&self, law: &JenkinsLaw) -> f64 {
+        if self.initial_anchor {
+            law.mu * self.n[0].max(0.0)
+        } else {
+            0.0
+        }
+    }
+
+    /// The initial state m at which a march would start directly in the steady state of the
+    /// last evaluation, T(0) / (μ N(0)) ∈ [−1, 1], when that state is stuck over the whole
+    /// period (`state` as reported); `None` otherwise (slipping or open somewhere, or open at
+    /// τ = 0). A contact that slipped in the transient and then stuck has the same forces as
+    /// the march started at this m, which stays stuck from its start: the response depends on
+    /// m only through it (m is clamped to the range of initial states that stay stuck).
+    pub fn effective_initial_state(&self, law: &JenkinsLaw, state: ContactState) -> Option<f64> {
+        let limit0 = law.mu * self.n[0];
+        (state == ContactState::Stuck && limit0 > 0.0)
+            .then(|| (self.t[0] / limit0).clamp(-1.0, 1.0))
     }
 
     /// Assembles ∂T̂/∂û, ∂T̂/∂v̂, ∂N̂/∂v̂ from the recorded sample kinds.

@@ -12,9 +12,11 @@
 //! | [`derivatives`] | `finite_difference_jacobian`, `check_operator_jacobian` | finite-difference Jacobians and derivative checks |
 //! | [`continuation`] | [`Continuation`], [`ContinuationSettings`] | Newton at fixed λ, predictor-corrector continuation in λ |
 //! | [`golden`] | [`golden::maximise`] | golden-section search for a maximum where evaluations may fail |
+//! | [`box_minimize`] | [`box_minimize::minimise_in_box`] | projected quasi-Newton minimisation over a box, evaluations may fail |
 //! | [`broyden`] | `BroydenUpdates` | secant updates of a factorised Newton matrix (chord steps) |
 //! | [`path`] | [`PathPoint`], [`PathSummary`], [`Observer`], [`NewtonFailure`] | what continuation produces and reports |
 
+pub mod box_minimize;
 pub mod broyden;
 pub mod continuation;
 pub mod derivatives;

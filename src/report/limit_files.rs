@@ -3,7 +3,9 @@
 //! * `limits.csv`: the common grid: `freq_hz`, per limit case `<case>_amp`, `lower_amp`,
 //!   `upper_amp`, `regime` (`unique`, `multiple`, `unknown`), `stuck_sides`, `slipping_sides`,
 //!   per limit case `<case>_N0_slipping` (N) and `<case>_label`, per limit case and contact
-//!   `<case>_<contact>_state`. A limit curve that did not cover the range has NaN amplitudes
+//!   `<case>_<contact>_state`, then with `[limits] envelope` per output DOF
+//!   `<dof>_envelope_min_amp` and `<dof>_envelope_max_amp` (m; NaN where no state was solved).
+//!   A limit curve that did not cover the range has NaN amplitudes
 //!   (and empty states) where it has no solution; the band (`lower_amp`, `upper_amp`) is NaN
 //!   and the regime `unknown` wherever either limit curve is missing.
 //! * `peaks.csv`: one row per case: `curve`, `kind` (limit, intermediate, scan), `m_<contact>`
@@ -21,7 +23,9 @@
 
 use std::fmt::Write as _;
 
-use crate::analysis::limits::{CurveStatus, GridPoint, HysteresisLoop, LimitCase, Peak, Regime};
+use crate::analysis::limits::{
+    CurveStatus, Envelope, GridPoint, HysteresisLoop, LimitCase, Peak, Regime,
+};
 use crate::model::Problem;
 use crate::study::sweep::SweepPoint;
 
@@ -33,8 +37,13 @@ fn side_list(problem: &Problem, sides: &[usize]) -> String {
         .join(";")
 }
 
-/// `limits.csv` text.
-pub fn limits_csv(problem: &Problem, cases: &[LimitCase], grid: &[GridPoint]) -> String {
+/// `limits.csv` text (with the envelope's columns when one is given).
+pub fn limits_csv(
+    problem: &Problem,
+    cases: &[LimitCase],
+    grid: &[GridPoint],
+    envelope: Option<&Envelope>,
+) -> String {
     let mut s = String::from("freq_hz");
     for c in cases {
         let _ = write!(s, ",{}_amp", c.name);
@@ -48,8 +57,14 @@ pub fn limits_csv(problem: &Problem, cases: &[LimitCase], grid: &[GridPoint]) ->
             let _ = write!(s, ",{}_{}_state", c.name, contact.name);
         }
     }
+    if envelope.is_some() {
+        for &d in &problem.outputs {
+            let dof = &problem.model.dof_names[d];
+            let _ = write!(s, ",{dof}_envelope_min_amp,{dof}_envelope_max_amp");
+        }
+    }
     s.push('\n');
-    for g in grid {
+    for (i, g) in grid.iter().enumerate() {
         let _ = write!(s, "{:.10e}", g.freq_hz);
         for a in &g.amplitudes {
             let _ = write!(s, ",{a:.10e}");
@@ -92,6 +107,20 @@ pub fn limits_csv(problem: &Problem, cases: &[LimitCase], grid: &[GridPoint]) ->
                 for st in states {
                     let _ = write!(s, ",{}", st.label());
                 }
+            }
+        }
+        if let Some(e) = envelope {
+            let p = e.points.get(i);
+            for o in 0..problem.outputs.len() {
+                let amp = |b: Option<&Option<crate::analysis::limits::EnvelopeBound>>| {
+                    b.and_then(|b| b.as_ref()).map_or(f64::NAN, |b| b.amplitude)
+                };
+                let _ = write!(
+                    s,
+                    ",{:.10e},{:.10e}",
+                    amp(p.and_then(|p| p.min.get(o))),
+                    amp(p.and_then(|p| p.max.get(o)))
+                );
             }
         }
         s.push('\n');

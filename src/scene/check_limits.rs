@@ -7,6 +7,9 @@ use crate::scene::checker::Checker;
 use crate::scene::error::SceneError;
 use crate::scene::schema::Scene;
 
+/// Most initial states (damper sides or contact points) the envelope optimises over.
+pub const MAX_ENVELOPE_GROUPS: usize = 64;
+
 /// The limit-analysis settings of the scene's `[limits]` table; `None` without one. The
 /// frequency range of `[analysis]` bounds the peak window and the loop frequencies.
 pub(super) fn limit_settings(
@@ -60,6 +63,25 @@ pub(super) fn limit_settings(
                 l.bound_scan.len()
             ),
         ));
+    }
+
+    // The envelope's search holds a dense k × k curvature estimate and solves k sensitivities
+    // per state: k = sides or contact points is kept to what that serves.
+    if let Some(mode) = l.envelope {
+        let k = match mode {
+            crate::analysis::limits::EnvelopeMode::Sides => sides,
+            crate::analysis::limits::EnvelopeMode::Points => scene.contacts.len(),
+        };
+        if k > MAX_ENVELOPE_GROUPS {
+            return Err(ck.err(
+                "limits.envelope",
+                format!(
+                    "{k} initial states to optimise (one per {}); at most \
+                     {MAX_ENVELOPE_GROUPS}: use `sides`",
+                    if sides == k { "side" } else { "contact point" }
+                ),
+            ));
+        }
     }
 
     // Intermediate cases per side or point; names must not clash with the uniform ones.
@@ -191,5 +213,6 @@ pub(super) fn limit_settings(
         bound_scan: l.bound_scan.clone(),
         peak_window_hz,
         hysteresis,
+        envelope: l.envelope,
     }))
 }

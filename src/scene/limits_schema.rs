@@ -31,6 +31,10 @@ pub struct LimitsSpec {
     /// Hysteresis loops to write; absent: at every curve's peak.
     #[serde(default)]
     pub hysteresis: Option<HysteresisSpec>,
+    /// The response envelope over all initial tangential states: `"sides"` (one m per damper
+    /// side) or `"points"` (one m per contact point); absent: not computed.
+    #[serde(default)]
+    pub envelope: Option<crate::analysis::limits::EnvelopeMode>,
 }
 
 /// Default of `[limits].grid_points`: points of the common frequency grid.

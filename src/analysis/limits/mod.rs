@@ -19,7 +19,9 @@
 //! the optimum pre-load the two cross (paper Fig. 15b).
 //!
 //! Whether the limits really bound the other solutions is checked, not assumed: a scan over
-//! intermediate states per side reports the largest excursion outside the band.
+//! intermediate states per side reports the largest excursion outside the band, and the
+//! response envelope (`[limits] envelope`) finds the largest and smallest amplitude over all
+//! initial states per side or per point by bounded optimisation.
 //!
 //! Every case is attempted whatever the others do: a curve that fails or stops before the end
 //! frequency keeps its finished points and says how it ended ([`CurveStatus`]); the band and
@@ -36,6 +38,8 @@
 //! | `side` | damper sides: [`SideStatics`], [`SideState`], [`LimitLabel`], [`Regime`] |
 //! | `grid` | the common grid: [`GridPoint`], [`on_grid`], [`classify`] |
 //! | `bounds` | the bound check: [`BoundCheck`], [`check_bounds`] |
+//! | `sensitivity` | dA/dm by the implicit-function theorem: [`AmplitudeSensitivity`], [`amplitude_sensitivity`] |
+//! | `envelope` | the response envelope over m ∈ [−1, 1]^k: [`Envelope`], [`envelope()`], [`envelope_at`] |
 //! | `loops` | contact loops: [`HysteresisLoop`], [`hysteresis`], [`LoopSet`] |
 //! | `run` | the analysis: [`LimitSettings`], [`analyse`], [`LimitAnalysis`], [`ScannedCase`], [`Variability`] |
 //!
@@ -44,19 +48,29 @@
 pub mod bounds;
 pub mod case;
 pub mod curve;
+pub mod envelope;
 pub mod error;
 pub mod grid;
 pub mod loops;
 pub mod peak;
 pub mod run;
+pub mod sensitivity;
 pub mod side;
 
 pub use bounds::{check_bounds, BoundCheck, ExcessStates};
 pub use case::{scan_cases, signed, two_point_cases, CaseSpec, LimitCase};
 pub use curve::{attempt_case, solve_case, CaseCurve, CurveStatus};
+pub use envelope::{
+    envelope, envelope_at, group_states, Envelope, EnvelopeAtPeak, EnvelopeBound, EnvelopeCheck,
+    EnvelopeInputs, EnvelopeMode, EnvelopePoint, EnvelopeSeeds,
+};
 pub use error::LimitError;
 pub use grid::{classify, on_grid, GridPoint, GridSolution};
 pub use loops::{hysteresis, HysteresisLoop, HysteresisRequest, LoopSet};
 pub use peak::{linear_resonance, refine_peak, Peak};
 pub use run::{analyse, LimitAnalysis, LimitSettings, ScannedCase, Variability};
+pub use sensitivity::{
+    amplitude_sensitivity, residual_derivative, AmplitudeSensitivity, ResidualDerivative,
+    SensitivityError,
+};
 pub use side::{side_states, side_statics, LimitLabel, Regime, SideState, SideStatics};

@@ -11,6 +11,7 @@ use crate::hbm::HbmSystem;
 use super::bounds::{check_bounds, BoundCheck};
 use super::case::{scan_cases, two_point_cases, CaseSpec, LimitCase};
 use super::curve::{attempt_case, CaseCurve, CurveStatus};
+use super::envelope::{envelope, search_settings, Envelope, EnvelopeInputs, EnvelopeMode};
 use super::error::LimitError;
 use super::grid::{classify, on_grid, GridPoint, GridSolution};
 use super::loops::{curve_loops, HysteresisRequest, LoopSet};
@@ -32,6 +33,9 @@ pub struct LimitSettings {
     pub peak_window_hz: Option<(f64, f64)>,
     /// Hysteresis loops to compute.
     pub hysteresis: HysteresisRequest,
+    /// The response envelope over the initial states, one m per side or per point; `None`:
+    /// not computed.
+    pub envelope: Option<EnvelopeMode>,
 }
 
 impl Default for LimitSettings {
@@ -43,6 +47,7 @@ impl Default for LimitSettings {
             bound_scan: Vec::new(),
             peak_window_hz: None,
             hysteresis: HysteresisRequest::default(),
+            envelope: None,
         }
     }
 }
@@ -92,6 +97,8 @@ pub struct LimitAnalysis {
     pub loops: Vec<LoopSet>,
     /// Requested loops that could not be computed (no solution of the curve there), as text.
     pub loops_missing: Vec<String>,
+    /// The response envelope, when asked for.
+    pub envelope: Option<Envelope>,
 }
 
 /// Size of the variability of one limit analysis (first output DOF). Values that need a limit
@@ -173,6 +180,7 @@ impl LimitAnalysis {
             .chain(&self.intermediate)
             .all(|c| c.status.is_complete())
             && self.scanned.iter().all(|c| c.status.is_complete())
+            && self.envelope.as_ref().is_none_or(|e| e.unsolved == 0)
     }
 
     /// "curve `<name>` incomplete: …" / "curve `<name>` failed: …" of every case that did not
@@ -189,12 +197,19 @@ impl LimitAnalysis {
                     .filter(|c| !c.status.is_complete())
                     .map(|c| format!("curve `{}` {}", c.case.name, c.status.text())),
             )
+            .chain(self.envelope.as_ref().filter(|e| e.unsolved > 0).map(|e| {
+                format!(
+                    "envelope: no state solved at {} of {} grid frequencies",
+                    e.unsolved,
+                    e.points.len()
+                )
+            }))
             .collect()
     }
 }
 
-/// Runs the two-point limit analysis, intermediate curves, the bound scan and the requested
-/// hysteresis loops. Curves are solved in parallel (rayon); results do not depend on the
+/// Runs the two-point limit analysis, intermediate curves, the bound scan, the response
+/// envelope (when [`LimitSettings::envelope`] asks for it) and the requested hysteresis loops. Curves are solved in parallel (rayon); results do not depend on the
 /// thread count.
 ///
 /// Every case is attempted ([`attempt_case`]), whatever the others do: a case that fails or
@@ -254,8 +269,8 @@ where
         .collect();
     let grid_points = classify(problem, &grid, &limits_on_grid);
 
-    let (bounds, scanned) = if scanned_cases.is_empty() {
-        (None, Vec::new())
+    let (bounds, scanned, scanned_on_grid) = if scanned_cases.is_empty() {
+        (None, Vec::new(), Vec::new())
     } else {
         let results: Vec<(ScannedCase, Vec<GridSolution>)> = scanned_cases
             .par_iter()
@@ -288,8 +303,29 @@ where
             .map(|(s, sols)| (s.case.clone(), sols.clone(), s.peak.clone()))
             .collect();
         let check = check_bounds(&grid_points, &limit_peaks, &compared);
-        (Some(check), results.into_iter().map(|(s, _)| s).collect())
+        let (scanned, sols): (Vec<ScannedCase>, Vec<Vec<GridSolution>>) =
+            results.into_iter().unzip();
+        (Some(check), scanned, sols)
     };
+    let envelope = settings.envelope.map(|mode| {
+        let inputs = EnvelopeInputs {
+            limits: limits
+                .iter()
+                .zip(&limits_on_grid)
+                .map(|(c, s)| (&c.case, s.as_slice()))
+                .collect(),
+            scanned: scanned
+                .iter()
+                .zip(&scanned_on_grid)
+                .map(|(c, s)| (&c.case, s.as_slice()))
+                .collect(),
+            peaks: limits
+                .iter()
+                .filter_map(|c| c.peak.as_ref().map(|p| (&c.case, p)))
+                .collect(),
+        };
+        envelope(problem, mode, &grid_points, &inputs, &search_settings())
+    });
     let per_curve: Vec<(Vec<LoopSet>, Vec<String>)> = limits
         .par_iter()
         .chain(intermediate.par_iter())
@@ -308,5 +344,6 @@ where
         scanned,
         loops,
         loops_missing,
+        envelope,
     })
 }
