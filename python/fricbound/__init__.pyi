@@ -129,6 +129,12 @@ class SweepResult:
     def limit_peaks(self) -> Tuple[_F, _F]: ...
     def to_pandas(self) -> Any: ...
 
+class VerifyResult:
+    STAY_TOLERANCE: float
+    cases: List[Dict[str, Any]]
+    outputs: List[str]
+    def to_pandas(self) -> Any: ...
+
 class ModesResult:
     case: str
     frequency_hz: _F
@@ -161,6 +167,12 @@ def sweep(
     unit: str = ...,
     progress: Progress = ...,
 ) -> SweepResult: ...
+def verify(
+    scene: Union[Scene, str],
+    freqs_hz: Sequence[float],
+    steps_per_period: Optional[int] = ...,
+    max_periods: Optional[int] = ...,
+) -> VerifyResult: ...
 def modes(scene: Union[Scene, str], count: int = ..., case: str = ...) -> ModesResult: ...
 def reduce(
     K: Any, M: Any, boundary: Sequence[int], modes: int, recover: Optional[Sequence[int]] = ...

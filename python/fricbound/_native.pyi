@@ -32,3 +32,11 @@ def reduce(
     modes: int,
     recover: List[int],
 ) -> Dict[str, Any]: ...
+def verify(
+    text: str,
+    label: str,
+    overrides: List[str],
+    freqs_hz: List[float],
+    steps_per_period: Optional[int] = None,
+    max_periods: Optional[int] = None,
+) -> List[Dict[str, Any]]: ...

@@ -239,6 +239,44 @@ class SweepResult(_Result):
         return f"SweepResult({self.parameter}: {len(self.value)} values, {self.status})"
 
 
+class VerifyResult(_Result):
+    """Time integration of harmonic-balance points (:func:`fricbound.verify`), one entry of
+    ``cases`` per frequency: ``freq_hz``, ``hbm_amplitudes`` and ``amplitudes`` (first-harmonic
+    amplitude of each output from the HBM and from the time integration at dt/2, m),
+    ``coarse_amplitudes`` (at dt), ``hbm_difference`` (largest relative difference),
+    ``dt_change``, ``periods``, ``settled``, ``nonharmonic_energy``, ``hill_stable`` and
+    ``floquet_re`` (None where Hill's method does not apply), ``stays`` (the motion stays within
+    ``STAY_TOLERANCE`` = 1e-3 of the HBM amplitude, as ``fricbound verify`` reports), and
+    ``last_period`` (outputs × steps, m)."""
+
+    STAY_TOLERANCE = 1e-3
+
+    def __init__(self, cases: List[Dict[str, Any]], outputs: List[str]):
+        for c in cases:
+            c["stays"] = bool(c["hbm_difference"] < self.STAY_TOLERANCE)
+            c["last_period"] = np.array(c["last_period"])
+        super().__init__({"cases": cases, "outputs": outputs, "status": "complete"})
+
+    def to_pandas(self):
+        """One row per frequency: ``freq_hz``, ``<dof>_hbm_amp`` and ``<dof>_time_amp`` per
+        output, ``hbm_difference``, ``dt_change``, ``periods``, ``settled``, ``stays``,
+        ``hill_stable``, ``floquet_re``."""
+        pd = _pandas()
+        rows = []
+        for c in self.cases:
+            row: Dict[str, Any] = {"freq_hz": c["freq_hz"]}
+            for k, name in enumerate(self.outputs):
+                row[f"{name}_hbm_amp"] = c["hbm_amplitudes"][k]
+                row[f"{name}_time_amp"] = c["amplitudes"][k]
+            for key in ("hbm_difference", "dt_change", "periods", "settled", "stays", "hill_stable", "floquet_re"):
+                row[key] = c[key]
+            rows.append(row)
+        return pd.DataFrame(rows)
+
+    def __repr__(self) -> str:
+        return f"VerifyResult({[c['freq_hz'] for c in self.cases]} Hz)"
+
+
 class ModesResult(_Result):
     """Natural modes (:func:`fricbound.modes`): ``frequency_hz``, ``eigenvalue`` (rad²/s²),
     ``rigid``, ``shapes`` (DOFs × modes, mass-normalised), ``case`` (``open``/``stuck``),

@@ -449,3 +449,88 @@ pub fn reduce<'py>(
     .map_err(|e| PyValueError::new_err(format!("reduce: {e}")))?;
     convert::reduced_dict(py, &reduced)
 }
+
+/// Time integration of harmonic-balance points (`fricbound verify`, started from the HBM
+/// state): at each frequency the point is solved from the stuck (else the open) linear guess,
+/// its Hill stability computed when the harmonic set allows it, and the equations integrated
+/// in time at dt and dt/2 ([`fricbound::analysis::verify::verify_point`]).
+#[pyfunction]
+#[pyo3(signature = (text, label, overrides, freqs_hz, steps_per_period=None, max_periods=None))]
+pub fn verify<'py>(
+    py: Python<'py>,
+    text: &str,
+    label: &str,
+    overrides: Vec<String>,
+    freqs_hz: Vec<f64>,
+    steps_per_period: Option<usize>,
+    max_periods: Option<usize>,
+) -> PyResult<Bound<'py, pyo3::types::PyList>> {
+    use fricbound::analysis::frf::PointSolver;
+    use fricbound::analysis::{linear, stability, verify};
+    if let Some(f) = freqs_hz.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
+        return Err(PyValueError::new_err(format!(
+            "verify: freqs_hz: {f} is not a positive frequency (Hz)"
+        )));
+    }
+    if steps_per_period.is_some_and(|s| s < 8) || max_periods == Some(0) {
+        return Err(PyValueError::new_err(
+            "verify: steps_per_period must be at least 8 and max_periods at least 1",
+        ));
+    }
+    let (_, problem, _) = load(text, label, &overrides)?;
+    let cases = in_background(py, None, |_| {
+        freqs_hz
+            .iter()
+            .map(|&freq| {
+                let omega = 2.0 * std::f64::consts::PI * freq;
+                let mut solver = PointSolver::new(&problem).map_err(|e| e.to_string())?;
+                let set = solver.system().unknowns().clone();
+                let mut settings = verify::VerifySettings::for_harmonics(set.max_harmonic());
+                if let Some(s) = steps_per_period {
+                    settings.steps_per_period = s;
+                }
+                if let Some(p) = max_periods {
+                    settings.max_periods = p;
+                }
+                let point = [linear::stuck_guess, linear::open_guess]
+                    .iter()
+                    .filter_map(|g| g(&problem, &set, omega).ok())
+                    .find_map(|guess| solver.solve(&guess, freq).ok())
+                    .ok_or_else(|| format!("harmonic balance did not converge at {freq} Hz"))?;
+                let hill =
+                    stability::point_stability(solver.system(), &point.coefficients, omega).ok();
+                let checked = verify::verify_point(
+                    &problem,
+                    &set,
+                    &point.coefficients,
+                    &point.amplitudes,
+                    freq,
+                    &settings,
+                )
+                .map_err(|e| e.to_string())?;
+                Ok((freq, point.amplitudes, hill, checked))
+            })
+            .collect::<Vec<Result<_, String>>>()
+    })?;
+    let out = pyo3::types::PyList::empty(py);
+    for case in cases {
+        let (freq, hbm, hill, v) =
+            case.map_err(|e| SolveError::new_err(format!("{label}: verify: {e}")))?;
+        let d = PyDict::new(py);
+        d.set_item("freq_hz", freq)?;
+        d.set_item("hbm_amplitudes", hbm)?;
+        d.set_item("hill_stable", hill.map(|h| h.stable))?;
+        d.set_item("floquet_re", hill.map(|h| h.floquet_re))?;
+        d.set_item("amplitudes", v.fine.amplitudes.clone())?;
+        d.set_item("coarse_amplitudes", v.coarse.amplitudes.clone())?;
+        d.set_item("hbm_difference", v.hbm_difference)?;
+        d.set_item("dt_change", v.dt_change)?;
+        d.set_item("periods", v.fine.periods)?;
+        d.set_item("settled", v.fine.settled)?;
+        d.set_item("steps_per_period", v.fine.steps_per_period)?;
+        d.set_item("nonharmonic_energy", v.fine.nonharmonic_energy)?;
+        d.set_item("last_period", v.fine.last_period.clone())?;
+        out.append(d)?;
+    }
+    Ok(out)
+}

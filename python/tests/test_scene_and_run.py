@@ -218,3 +218,16 @@ def test_modes_of_the_paper_structure():
     assert m.rigid[0] and m.frequency_hz[0] == 0.0 and expected[0] < 1e-4
     np.testing.assert_allclose(np.sort(m.frequency_hz)[1:], np.sort(expected)[1:], rtol=1e-8)
     assert m.to_pandas().shape == (6, 4)
+
+
+def test_verify_by_time_integration():
+    """At 120 Hz the paper case's HBM point is stable (Hill) and the time integration started
+    from it stays at its amplitude (an independent method: Newmark on the same equations)."""
+    v = fricbound.verify(Scene.paper(), [120.0])
+    c = v.cases[0]
+    assert c["hill_stable"] is True and c["stays"], c
+    assert c["hbm_difference"] < 1e-3 and c["dt_change"] < 1e-3
+    assert c["last_period"].shape == (1, c["steps_per_period"])
+    assert list(v.to_pandas().columns[:3]) == ["freq_hz", "y2_hbm_amp", "y2_time_amp"]
+    with pytest.raises(ValueError, match="freqs_hz"):
+        fricbound.verify(Scene.paper(), [-5.0])
