@@ -59,16 +59,16 @@ def main() -> int:
     k = int(np.nanargmax(ratio))
     ax.annotate(
         f"{ratio[k]:.2f}x at F0 = {result.value[k]:g} N",
-        (result.value[k], upper[k] * 1e3),
+        (result.value[k], lower[k] * 1e3),
         textcoords="offset points",
-        xytext=(-10, 8),
+        xytext=(-5, -16),
         ha="right",
     )
     ax.set_xlabel(f"pre-load {result.parameter} ({result.unit})")
     ax.set_ylabel("y2 resonance-peak amplitude (mm)")
     ax.set_title("Fig. 16a: optimal-curve limits, beta = 120 deg")
     ax.grid(True, alpha=0.3)
-    ax.legend()
+    ax.legend(loc="upper center")
     fig.tight_layout()
     fig.savefig(args.out, dpi=150)
     print(f"figure written to {args.out}")
