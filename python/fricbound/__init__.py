@@ -31,6 +31,7 @@ from ._results import (
     Curve,
     FrfResult,
     LimitsResult,
+    LinearResult,
     ModesResult,
     ReducedModel,
     SweepResult,
@@ -52,6 +53,8 @@ __all__ = [
     "Curve",
     "FrfResult",
     "LimitsResult",
+    "LinearResult",
+    "linear",
     "ModesResult",
     "ReducedModel",
     "SweepResult",
@@ -149,6 +152,15 @@ def verify(
     s = _scene(scene)
     cases = _native.verify(*s._args(), [float(f) for f in freqs_hz], steps_per_period, max_periods)
     return VerifyResult(cases, s.check()["outputs"])
+
+
+def linear(scene: "Scene | str", case: str = "open", points: Optional[int] = None) -> LinearResult:
+    """The linear reference of the scene with its contacts ``"open"`` (removed) or ``"stuck"``
+    (replaced by their kt, kn springs): first-harmonic amplitude of each output on ``points``
+    uniformly spaced frequencies of the analysis range (default ``analysis.linear_points``),
+    as the CLI's ``linear_open.csv`` and ``linear_stuck.csv``."""
+    s = _scene(scene)
+    return LinearResult(_native.linear(*s._args(), str(case), points))
 
 
 def modes(scene: "Scene | str", count: int = 10, case: str = "stuck") -> ModesResult:

@@ -40,3 +40,6 @@ def verify(
     steps_per_period: Optional[int] = None,
     max_periods: Optional[int] = None,
 ) -> List[Dict[str, Any]]: ...
+def linear(
+    text: str, label: str, overrides: List[str], case: str, points: Optional[int] = None
+) -> Dict[str, Any]: ...

@@ -277,6 +277,28 @@ class VerifyResult(_Result):
         return f"VerifyResult({[c['freq_hz'] for c in self.cases]} Hz)"
 
 
+class LinearResult(_Result):
+    """A linear reference (:func:`fricbound.linear`): ``freq_hz`` (points,) and
+    ``amplitudes`` (points, outputs) in m, ``case`` (``open`` or ``stuck``), ``outputs``."""
+
+    status = "complete"
+
+    def amplitude(self, dof: str) -> np.ndarray:
+        """First-harmonic amplitude (m) of output DOF ``dof``."""
+        return self.amplitudes[:, self.outputs.index(dof)]
+
+    def to_pandas(self):
+        """``freq_hz`` and ``<dof>_amp`` per output, as the CLI's ``linear_<case>.csv``."""
+        pd = _pandas()
+        cols: Dict[str, Any] = {"freq_hz": self.freq_hz}
+        for k, name in enumerate(self.outputs):
+            cols[f"{name}_amp"] = self.amplitudes[:, k]
+        return pd.DataFrame(cols)
+
+    def __repr__(self) -> str:
+        return f"LinearResult({self.case}, {len(self.freq_hz)} points)"
+
+
 class ModesResult(_Result):
     """Natural modes (:func:`fricbound.modes`): ``frequency_hz``, ``eigenvalue`` (rad²/s²),
     ``rigid``, ``shapes`` (DOFs × modes, mass-normalised), ``case`` (``open``/``stuck``),

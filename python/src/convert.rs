@@ -17,7 +17,7 @@ use fricbound::scene::SweepSpec;
 use fricbound::study::sweep::SweepPoint;
 
 /// A row-major `rows × cols` numpy array from flat values.
-fn array2<'py>(
+pub fn array2<'py>(
     py: Python<'py>,
     rows: usize,
     cols: usize,

@@ -43,5 +43,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve::modes, m)?)?;
     m.add_function(wrap_pyfunction!(solve::reduce, m)?)?;
     m.add_function(wrap_pyfunction!(solve::verify, m)?)?;
+    m.add_function(wrap_pyfunction!(solve::linear, m)?)?;
     Ok(())
 }

@@ -534,3 +534,50 @@ pub fn verify<'py>(
     }
     Ok(out)
 }
+
+/// The linear reference of the scene with its contacts `"open"` (removed) or `"stuck"`
+/// (replaced by their kt, kn springs) on `points` frequencies of the analysis range (default
+/// `analysis.linear_points`), as the CLI's `linear_open.csv` / `linear_stuck.csv`.
+#[pyfunction]
+#[pyo3(signature = (text, label, overrides, case, points=None))]
+pub fn linear<'py>(
+    py: Python<'py>,
+    text: &str,
+    label: &str,
+    overrides: Vec<String>,
+    case: &str,
+    points: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let case = match case {
+        "open" => LinearCase::Open,
+        "stuck" => LinearCase::Stuck,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "linear: case must be \"open\" or \"stuck\", not {other:?}"
+            )))
+        }
+    };
+    if points.is_some_and(|p| p < 2) {
+        return Err(PyValueError::new_err("linear: points must be at least 2"));
+    }
+    let (_, problem, _) = load(text, label, &overrides)?;
+    let points = points.unwrap_or(problem.analysis.linear_points);
+    let curve = in_background(py, None, |_| {
+        fricbound::analysis::linear::reference_curve(&problem, case, points)
+    })?
+    .map_err(|e| SolveError::new_err(format!("{label}: linear reference: {e}")))?;
+    let d = PyDict::new(py);
+    convert::problem_names(&d, &problem)?;
+    d.set_item("case", fricbound::analysis::modes::case_name(case))?;
+    d.set_item(
+        "freq_hz",
+        numpy::PyArray1::from_vec(py, curve.freqs_hz.clone()),
+    )?;
+    let outputs = problem.outputs.len();
+    let flat: Vec<f64> = curve.amplitudes.iter().flatten().copied().collect();
+    d.set_item(
+        "amplitudes",
+        convert::array2(py, curve.freqs_hz.len(), outputs, flat)?,
+    )?;
+    Ok(d)
+}

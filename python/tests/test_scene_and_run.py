@@ -231,3 +231,27 @@ def test_verify_by_time_integration():
     assert list(v.to_pandas().columns[:3]) == ["freq_hz", "y2_hbm_amp", "y2_time_amp"]
     with pytest.raises(ValueError, match="freqs_hz"):
         fricbound.verify(Scene.paper(), [-5.0])
+
+
+def test_linear_references_equal_the_cli_files(cli_binary, tmp_path):
+    """The open and stuck linear references equal the CLI's linear_open.csv and
+    linear_stuck.csv."""
+    scene = Scene.from_toml(PAPER / "zoom-2nd.toml")
+    out = tmp_path / "cli"
+    subprocess.run([str(cli_binary), "run", str(PAPER / "zoom-2nd.toml"), "--quiet", "--out", str(out)], check=True)
+    for case in ("open", "stuck"):
+        lin = fricbound.linear(scene, case)
+        rows = np.genfromtxt(out / f"linear_{case}.csv", delimiter=",", names=True)
+        np.testing.assert_allclose(lin.freq_hz, rows["freq_hz"], rtol=1e-9)
+        np.testing.assert_allclose(lin.amplitude("y2"), rows["y2_amp"], rtol=1e-9)
+    assert len(fricbound.linear(scene, "stuck", points=11).freq_hz) == 11
+
+
+def test_incomplete_and_too_large_runs_say_so():
+    """A run that uses up its point budget is returned as incomplete (the CLI's exit code 3);
+    a scene estimated not to fit in memory is refused before anything is solved."""
+    r = fricbound.run(Scene.paper().set("analysis.max_points", 20))
+    assert not r.complete and r.status.startswith("incomplete: the point budget")
+    assert len(r) == 20
+    with pytest.raises(MemoryError, match="harmonics.max"):
+        fricbound.run(Scene.paper().set("harmonics.max", 10000).set("harmonics.samples", 32768))
