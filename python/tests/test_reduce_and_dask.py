@@ -167,3 +167,20 @@ def test_limit_analysis_from_python():
     assert {"freq_hz", "lower", "upper", "regime"} <= set(df.columns)
     v = r.variability
     assert v["peak_ratio"] > 1.0
+
+
+def test_limits_sweep_of_whole_analyses_matches_limits():
+    """`limits_sweep(output="limits")` summarises the whole limit analysis at each value: at
+    the scene's own value it gives the numbers of `fricbound.limits` on the scene."""
+    scene = Scene.from_toml(PAPER / "fig13-3rd.toml")
+    df = fricbound.dask.limits_sweep(scene, "contacts.0.mu", [0.5], client="serial", output="limits")
+    r = fricbound.limits(scene)
+    row = df.iloc[0]
+    assert row["status"] == r.status
+    for key in ("upper_peak", "lower_peak", "peak_ratio", "widest_band", "multiple_points"):
+        assert row[key] == r.variability[key], key
+    assert row["m+1_amp"] == r.limits[0].peak["amplitude"]
+    with pytest.raises(ValueError, match="output"):
+        fricbound.dask.limits_sweep(scene, "contacts.0.mu", [0.5], client="serial", output="bands")
+    with pytest.raises(ValueError, match="contacts.0.friction"):
+        fricbound.dask.sweep(scene, "contacts.0.friction", [0.5], client="serial")
