@@ -158,8 +158,12 @@ def test_limit_analysis_from_python():
     """The 3rd-resonance limit analysis: two limit curves whose band holds multiple solutions,
     the upper limit above the lower, and a grid DataFrame."""
     scene = Scene.from_toml(PAPER / "fig13-3rd.toml")
-    r = fricbound.limits(scene)
+    events = []
+    r = fricbound.limits(scene, progress=events.append)
     assert [c.name for c in r.limits] == ["m+1", "m-1"]
+    # One event per limit, intermediate and scanned curve (3 intermediate, 3 x 3 scanned).
+    assert len(events) == 2 + 3 + 9 and {"m+1", "m-1"} <= {e["name"] for e in events}
+    assert all(e["kind"] == "curve" and e["status"] == "complete" for e in events)
     assert r.complete, r.status
     assert np.all(r.grid_upper >= r.grid_lower - 1e-15)
     assert "multiple" in set(r.grid_regime)
