@@ -889,6 +889,12 @@ impl Continuation {
         let dir = self.direction();
         let mut furthest = (dir * a.freq_start_hz, 1usize);
         while summary.points.len() < a.max_points {
+            if crate::numerics::interrupt::requested() {
+                let last = summary.points.last().expect("at least the first point");
+                return Err(ContinuationError::Interrupted {
+                    freq_hz: last.freq_hz(),
+                });
+            }
             if summary.points.len() - furthest.1 > self.stagnation_points() {
                 summary.end = PathEnd::NoProgress;
                 return Ok(summary);

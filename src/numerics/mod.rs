@@ -15,12 +15,14 @@
 //! | [`box_minimize`] | [`box_minimize::minimise_in_box`] | projected quasi-Newton minimisation over a box, evaluations may fail |
 //! | [`broyden`] | `BroydenUpdates` | secant updates of a factorised Newton matrix (chord steps) |
 //! | [`path`] | [`PathPoint`], [`PathSummary`], [`Observer`], [`NewtonFailure`] | what continuation produces and reports |
+//! | [`interrupt`] | `request`, `clear`, `requested` | a process-wide request to stop the runs in progress (Ctrl-C of an embedding caller) |
 
 pub mod box_minimize;
 pub mod broyden;
 pub mod continuation;
 pub mod derivatives;
 pub mod golden;
+pub mod interrupt;
 pub mod jacobian;
 pub mod linalg;
 pub mod path;

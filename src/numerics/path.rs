@@ -72,6 +72,13 @@ pub enum ContinuationError {
         /// Last failure.
         reason: NewtonFailure,
     },
+    /// The run was stopped on request ([`crate::numerics::interrupt`]) before it reached its
+    /// end.
+    #[error("interrupted after {freq_hz:.4} Hz")]
+    Interrupted {
+        /// Frequency of the last converged point (Hz).
+        freq_hz: f64,
+    },
 }
 
 /// A converged point of the path.

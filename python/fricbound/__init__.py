@@ -1,0 +1,228 @@
+"""fricbound from Python: the harmonic-balance solver for structures with dry-friction
+contacts (turbine-blade wedge dampers, friction joints) and the limits of their response
+among the multiple steady states friction allows (Ferhatoglu & Zucca, JSV 494, 2021).
+
+The Rust library is the single implementation: this package converts numpy/scipy data, calls
+the same library functions as the ``fricbound`` CLI and returns numpy arrays.
+
+Main entry points (units SI, frequencies in Hz):
+
+- :class:`Scene` (``from_toml``, ``from_matrices``, ``paper``, ``set``, ``check``);
+- :func:`run` (one FRF), :func:`limits` (two-point limit analysis), :func:`sweep` (peaks of
+  the limit cases over a scene field), :func:`modes`, :func:`reduce` (Craig-Bampton);
+- :mod:`fricbound.dask`: independent solves mapped over a Dask cluster.
+
+Errors: bad input raises ``ValueError`` naming the file, the field (dotted path) and the
+reason; a failed solve raises :class:`SolveError`; a problem too large for the machine
+``MemoryError``. Solves release the GIL; Ctrl-C stops them (``KeyboardInterrupt``) within
+about one continuation step.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Optional, Sequence
+
+import numpy as np
+
+from . import _native
+from ._native import SolveError
+from ._results import (
+    ContinuationPath,
+    Curve,
+    FrfResult,
+    LimitsResult,
+    LinearResult,
+    ModesResult,
+    ReducedModel,
+    SweepResult,
+    VerifyResult,
+)
+from ._scene import MAX_INLINE_DOFS, Scene
+
+__version__ = _native.__version__
+
+__all__ = [
+    "Scene",
+    "run",
+    "limits",
+    "sweep",
+    "modes",
+    "reduce",
+    "SolveError",
+    "ContinuationPath",
+    "Curve",
+    "FrfResult",
+    "LimitsResult",
+    "LinearResult",
+    "linear",
+    "ModesResult",
+    "ReducedModel",
+    "SweepResult",
+    "VerifyResult",
+    "verify",
+    "MAX_INLINE_DOFS",
+    "dask",
+]
+
+Progress = Optional[Callable[[dict], Any]]
+
+
+def _scene(scene: "Scene | str") -> Scene:
+    if isinstance(scene, Scene):
+        return scene
+    return Scene.from_toml(scene)
+
+
+def run(scene: "Scene | str", progress: Progress = None) -> FrfResult:
+    """Solves the scene's nonlinear frequency response (what ``fricbound run`` solves for a
+    scene without ``[limits]`` or ``[sweep]``; those tables are not run here: see
+    :func:`limits` and :func:`sweep`).
+
+    ``progress``, when given, is called with a dict per converged point: ``{"kind":
+    "point", "freq_hz": ..., "amplitudes": [...], "points": count}``; an exception it raises
+    stops the solve and is raised here.
+
+    Returns an :class:`FrfResult`; a run that did not reach the end frequency is returned with
+    ``status = "incomplete: <reason>"`` (``complete`` is False). Raises ``ValueError`` on a bad
+    scene, :class:`SolveError` when the solve fails.
+    """
+    return FrfResult(_native.run(*_scene(scene)._args(), progress))
+
+
+def limits(scene: "Scene | str", progress: Progress = None) -> LimitsResult:
+    """The paper's two-point limit analysis (§3.3) with the scene's ``[limits]`` settings (the
+    defaults when it has none): the limit curves (m = ±1 on every contact point), the
+    intermediate curves, the band on a common grid, the bound scan, the variability.
+
+    Curves are solved in parallel (rayon). ``progress`` is called with ``{"kind": "curve",
+    "name": ..., "status": ...}`` as each curve ends.
+    """
+    return LimitsResult(_native.limits(*_scene(scene)._args(), progress))
+
+
+def sweep(
+    scene: "Scene | str",
+    field: Optional[str] = None,
+    values: Optional[Sequence[float]] = None,
+    *,
+    scale: float = 1.0,
+    offset: float = 0.0,
+    parameter: Optional[str] = None,
+    unit: str = "",
+    progress: Progress = None,
+) -> SweepResult:
+    """Resonance peaks of the limit (and intermediate) cases at each value of a scene field:
+    the paper's optimal curves (Figs. 15-19), ``fricbound run`` of a scene with ``[sweep]``.
+
+    With ``field`` and ``values``, the field (dotted path, as :meth:`Scene.set`) is set to
+    ``offset + scale * value`` for each value (e.g. ``sweep(scene, "static_loads.0.value",
+    f0, scale=-1.0, parameter="F0", unit="N")``); without them the scene's own ``[sweep]``
+    table is run. Values are solved in parallel (rayon). ``progress`` is called with
+    ``{"kind": "sweep", "value": ..., "failures": count}`` as each value finishes.
+    """
+    s = _scene(scene)
+    if field is not None or values is not None:
+        if field is None or values is None:
+            raise ValueError("sweep: give both field and values (or neither, to run the scene's [sweep])")
+        s = s.copy().set(
+            "sweep",
+            {
+                "parameter": parameter or field,
+                "unit": unit,
+                "values": [float(v) for v in values],
+                "targets": [{"field": field, "scale": float(scale), "offset": float(offset)}],
+            },
+        )
+    return SweepResult(_native.sweep(*s._args(), progress))
+
+
+def verify(
+    scene: "Scene | str",
+    freqs_hz: Sequence[float],
+    steps_per_period: Optional[int] = None,
+    max_periods: Optional[int] = None,
+) -> VerifyResult:
+    """Checks harmonic-balance points by time integration (``fricbound verify``, started from
+    the HBM state): at each frequency (Hz) the point is solved from the stuck (else open)
+    linear guess, its Hill stability computed, and the equations of motion integrated
+    (Newmark, ``steps_per_period`` default 256·H, at most ``max_periods`` default 300) at dt and
+    dt/2 until periodic. A stable point's motion stays at the HBM amplitude
+    (``hbm_difference`` < 1e-3); an unstable one drifts away. Dense models up to 2000 DOFs.
+    """
+    s = _scene(scene)
+    cases = _native.verify(*s._args(), [float(f) for f in freqs_hz], steps_per_period, max_periods)
+    return VerifyResult(cases, s.check()["outputs"])
+
+
+def linear(scene: "Scene | str", case: str = "open", points: Optional[int] = None) -> LinearResult:
+    """The linear reference of the scene with its contacts ``"open"`` (removed) or ``"stuck"``
+    (replaced by their kt, kn springs): first-harmonic amplitude of each output on ``points``
+    uniformly spaced frequencies of the analysis range (default ``analysis.linear_points``),
+    as the CLI's ``linear_open.csv`` and ``linear_stuck.csv``."""
+    s = _scene(scene)
+    return LinearResult(_native.linear(*s._args(), str(case), points))
+
+
+def modes(scene: "Scene | str", count: int = 10, case: str = "stuck") -> ModesResult:
+    """The lowest ``count`` natural frequencies and mass-normalised shapes of the scene's
+    structure with its contacts ``"open"`` (removed) or ``"stuck"`` (replaced by their kt, kn
+    springs), as ``fricbound modes`` (dense below a few thousand DOFs, shift-invert Lanczos
+    above)."""
+    return ModesResult(_native.modes(*_scene(scene)._args(), int(count), str(case)))
+
+
+def reduce(
+    K: Any,
+    M: Any,
+    boundary: Sequence[int],
+    modes: int,
+    recover: Optional[Sequence[int]] = None,
+) -> ReducedModel:
+    """Craig-Bampton reduction of a sparse symmetric model (the library's reduction crate, as
+    a scene's ``[reduction]`` table uses).
+
+    Parameters
+    ----------
+    K, M : scipy.sparse matrix or array_like, (n, n)
+        Stiffness (N/m) and mass (kg), symmetric with both triangles stored. ``K`` with the
+        boundary DOFs held must be positive definite.
+    boundary : sequence of int
+        DOF indices kept physical (contacts, loads, outputs), in the order of the reduced
+        coordinates.
+    modes : int
+        Fixed-interface modes kept (a repeated last eigenvalue is kept whole).
+    recover : sequence of int, optional
+        DOFs whose recovery rows are returned (default: none).
+    """
+    n = K.shape[0]
+    return ReducedModel(
+        _native.reduce(
+            n,
+            *_csc_arrays("K", K, n),
+            *_csc_arrays("M", M, n),
+            [int(b) for b in boundary],
+            int(modes),
+            [int(r) for r in (recover or [])],
+        )
+    )
+
+
+def _csc_arrays(name: str, a: Any, n: int):
+    """``indptr``, ``indices``, ``data`` of a matrix in compressed sparse columns."""
+    try:
+        import scipy.sparse as sp
+    except ImportError as e:  # pragma: no cover - depends on the environment
+        raise ImportError("reduce() needs scipy: pip install scipy") from e
+    m = sp.csc_matrix(a)
+    if m.shape != (n, n):
+        raise ValueError(f"reduce: {name}: shape {m.shape}, expected ({n}, {n})")
+    m.sum_duplicates()
+    return (
+        np.ascontiguousarray(m.indptr, dtype=np.int64),
+        np.ascontiguousarray(m.indices, dtype=np.int64),
+        np.ascontiguousarray(m.data, dtype=np.float64),
+    )
+
+
+# Last: the module uses the functions above (it imports dask.distributed only when called).
+from . import dask  # noqa: E402

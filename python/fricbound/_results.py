@@ -1,0 +1,334 @@
+"""Result classes: numpy arrays with names, a ``to_pandas()`` when pandas is installed, and
+plain pickling (they hold only numpy arrays, lists and scalars)."""
+
+from __future__ import annotations
+
+from typing import Any, Dict, List, Optional
+
+import numpy as np
+
+
+def _pandas():
+    try:
+        import pandas as pd
+    except ImportError as e:  # pragma: no cover - depends on the environment
+        raise ImportError("to_pandas() needs pandas: pip install pandas") from e
+    return pd
+
+
+class _Result:
+    """Common part: the fields of the library's result as attributes."""
+
+    def __init__(self, fields: Dict[str, Any]):
+        self.__dict__.update(fields)
+
+    def __getstate__(self) -> dict:
+        return dict(self.__dict__)
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+
+    @property
+    def complete(self) -> bool:
+        """Whether the run covered what was asked for (``status == "complete"``); otherwise
+        ``status`` is ``incomplete: <reason>``, as in the CLI's JSON files (exit code 3)."""
+        return self.status == "complete"
+
+
+class ContinuationPath(_Result):
+    """The converged points of one continuation path.
+
+    Attributes (n points, ``outputs`` response DOFs, ``contacts`` contact points):
+
+    - ``freq_hz`` (n,): excitation frequency (Hz);
+    - ``amplitudes`` (n, outputs): first-harmonic amplitude √(c₁² + s₁²) (m);
+    - ``peaks`` (n, outputs): time-domain peak |q(τ)| over the period, static part included (m);
+    - ``states`` (n, contacts) str: ``stuck``, ``stick-slip``, ``stick-slip-liftoff``, ``open``;
+    - ``coefficients`` (n, DOFs × blocks): Fourier coefficients (m), harmonic-major: the value
+      of DOF ``d`` in block ``b`` (``blocks``: ``0``, ``c1``, ``s1``, ...) is column
+      ``b * len(dofs) + d`` (see :meth:`coefficient`);
+    - ``newton_iterations`` (n,), ``residual`` (n,): Newton iterations and final residual
+      relative to the load norm;
+    - ``trunc_err``, ``sampling_err`` (n, outputs) or None: estimated relative error of the
+      amplitudes from harmonic truncation and AFT sampling (``[accuracy]``, on by default);
+    - ``stable`` (n,) bool, ``floquet_re`` (n,) 1/s, ``floquet_freq_hz`` (n,) or None: Hill
+      stability, when the scene sets ``analysis.stability = true``.
+    """
+
+    trunc_err: Optional[np.ndarray] = None
+    sampling_err: Optional[np.ndarray] = None
+    stable: Optional[np.ndarray] = None
+    floquet_re: Optional[np.ndarray] = None
+    floquet_freq_hz: Optional[np.ndarray] = None
+
+    def __init__(self, fields: Dict[str, Any], names: Dict[str, Any]):
+        fields = dict(fields)
+        states = fields.get("states", [])
+        n_contacts = len(names.get("contacts", []))
+        fields["states"] = (
+            np.array(states, dtype=str) if len(states) else np.empty((0, n_contacts), dtype=str)
+        )
+        for key in ("dofs", "outputs", "contacts", "blocks"):
+            fields.setdefault(key, names.get(key, []))
+        super().__init__(fields)
+
+    def __len__(self) -> int:
+        return len(self.freq_hz)
+
+    def amplitude(self, dof: str) -> np.ndarray:
+        """First-harmonic amplitude (m) of output DOF ``dof`` at every point."""
+        return self.amplitudes[:, self.outputs.index(dof)]
+
+    def coefficient(self, dof: str, block: str) -> np.ndarray:
+        """Fourier coefficient (m) of DOF ``dof`` in block ``block`` (``"0"``, ``"c1"``,
+        ``"s1"``, ...) at every point."""
+        b = self.blocks.index(block)
+        d = self.dofs.index(dof)
+        return self.coefficients[:, b * len(self.dofs) + d]
+
+    def to_pandas(self):
+        """A DataFrame with the columns of the CLI's ``frf.csv``: ``freq_hz``,
+        ``<dof>_amp``, ``<dof>_peak`` per output, ``<contact>_state`` per contact,
+        ``newton_iters``, then ``<dof>_trunc_err``, ``<dof>_sampling_err`` and ``stable``,
+        ``floquet_re``, ``floquet_freq_hz`` when present."""
+        pd = _pandas()
+        cols: Dict[str, Any] = {"freq_hz": self.freq_hz}
+        for k, name in enumerate(self.outputs):
+            cols[f"{name}_amp"] = self.amplitudes[:, k]
+            cols[f"{name}_peak"] = self.peaks[:, k]
+        for k, name in enumerate(self.contacts):
+            cols[f"{name}_state"] = self.states[:, k] if len(self) else []
+        cols["newton_iters"] = self.newton_iterations
+        if self.trunc_err is not None:
+            for k, name in enumerate(self.outputs):
+                cols[f"{name}_trunc_err"] = self.trunc_err[:, k]
+                cols[f"{name}_sampling_err"] = self.sampling_err[:, k]
+        if self.stable is not None:
+            cols["stable"] = self.stable
+            cols["floquet_re"] = self.floquet_re
+            cols["floquet_freq_hz"] = self.floquet_freq_hz
+        return pd.DataFrame(cols)
+
+
+_PATH_KEYS = (
+    "freq_hz",
+    "amplitudes",
+    "peaks",
+    "coefficients",
+    "states",
+    "newton_iterations",
+    "residual",
+    "trunc_err",
+    "sampling_err",
+    "stable",
+    "floquet_re",
+    "floquet_freq_hz",
+)
+
+
+class FrfResult(ContinuationPath):
+    """One nonlinear frequency response (:func:`fricbound.run`): the points of
+    :class:`ContinuationPath`, plus
+
+    - ``status``: ``complete`` or ``incomplete: <reason>`` (as ``solution.json``);
+    - ``turning_points_hz``, ``leaps_hz``, ``jumps``, ``rejected_steps``, ``elapsed_s``;
+    - ``csv``: the run's ``frf.csv`` exactly as the CLI writes it (:meth:`write_csv`).
+    """
+
+    def __init__(self, d: Dict[str, Any]):
+        super().__init__(d, d)
+
+    def write_csv(self, path: str) -> None:
+        """Writes ``frf.csv`` (the CLI's columns and number format) to ``path``."""
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(self.csv)
+
+    def __repr__(self) -> str:
+        return f"FrfResult({len(self)} points, {self.status})"
+
+
+class Curve(ContinuationPath):
+    """A limit or intermediate curve of a limit analysis: the points of :class:`ContinuationPath`, plus
+    ``name`` (``m+1``, ``m-1``, ...), ``contact_states`` (m per contact), ``status``,
+    ``retries``, ``turning_points_hz`` and ``peak`` (dict ``freq_hz``, ``amplitude`` (m),
+    ``refined``, ``states``; None when no point lies in the peak window)."""
+
+    def __init__(self, d: Dict[str, Any], names: Dict[str, Any]):
+        points = d["points"]
+        fields = {k: v for k, v in d.items() if k != "points"}
+        fields.update({k: points[k] for k in _PATH_KEYS if k in points})
+        super().__init__(fields, names)
+
+    def __repr__(self) -> str:
+        return f"Curve({self.name!r}, {len(self)} points, {self.status})"
+
+
+class LimitsResult(_Result):
+    """A limit analysis (:func:`fricbound.limits`, the paper's two-point method):
+
+    - ``limits``: the two limit curves (:class:`Curve`, m = +1 and m = −1 on every point);
+      ``intermediate``: the intermediate curves;
+    - ``grid_freq_hz`` (g,), ``grid_lower``, ``grid_upper`` (g,): the band between the limit
+      curves on the common grid (m); ``grid_amplitudes`` (g, limit curves);
+      ``grid_regime`` (g,) str: ``unique``, ``multiple`` or ``unknown``;
+    - ``bounds``: the bound check of a ``bound_scan`` (largest excess above / below, m) or None;
+      ``scanned``: the scanned cases' peaks;
+    - ``variability``: upper and lower peak (m), their ratio, peak-frequency change (%),
+      widest band; ``status``, ``unfinished``.
+    """
+
+    def __init__(self, d: Dict[str, Any]):
+        fields = dict(d)
+        fields["limits"] = [Curve(c, d) for c in d["limits"]]
+        fields["intermediate"] = [Curve(c, d) for c in d["intermediate"]]
+        fields["grid_regime"] = np.array(d["grid_regime"], dtype=str)
+        super().__init__(fields)
+
+    @property
+    def curves(self) -> "List[Curve]":
+        """Limit curves, then intermediate ones."""
+        return list(self.limits) + list(self.intermediate)
+
+    def to_pandas(self):
+        """The common grid as a DataFrame: ``freq_hz``, ``lower``, ``upper``,
+        ``<case>_amp`` per limit curve, ``regime``."""
+        pd = _pandas()
+        cols: Dict[str, Any] = {
+            "freq_hz": self.grid_freq_hz,
+            "lower": self.grid_lower,
+            "upper": self.grid_upper,
+        }
+        for k, c in enumerate(self.limits):
+            cols[f"{c.name}_amp"] = self.grid_amplitudes[:, k]
+        cols["regime"] = self.grid_regime
+        return pd.DataFrame(cols)
+
+    def __repr__(self) -> str:
+        return f"LimitsResult({len(self.curves)} curves, {self.status})"
+
+
+class SweepResult(_Result):
+    """A sweep of the limit analysis (:func:`fricbound.sweep`): per value (``value``,
+    ``series``) and case (``cases``: the two limit cases, then the intermediate ones)
+    ``peak_amplitude`` (m) and ``peak_freq_hz`` of the resonance peak (NaN where the case
+    failed or did not cover the range), ``peak_refined``; ``failures`` per value, ``status``.
+    """
+
+    def limit_peaks(self) -> "tuple[np.ndarray, np.ndarray]":
+        """Upper and lower limit-curve peak amplitude (m) per value (the larger and smaller
+        of the two limit cases), as the paper's optimal curves (Fig. 16a)."""
+        two = self.peak_amplitude[:, :2]
+        return np.max(two, axis=1), np.min(two, axis=1)
+
+    def to_pandas(self):
+        """One row per value: ``<parameter>`` (and the series parameter), then
+        ``<case>_amp``, ``<case>_freq_hz``, ``<case>_refined`` per case, ``failures``."""
+        pd = _pandas()
+        cols: Dict[str, Any] = {}
+        if self.series_parameter is not None:
+            cols[self.series_parameter] = self.series
+        cols[self.parameter] = self.value
+        for k, c in enumerate(self.cases):
+            cols[f"{c}_amp"] = self.peak_amplitude[:, k]
+            cols[f"{c}_freq_hz"] = self.peak_freq_hz[:, k]
+            cols[f"{c}_refined"] = self.peak_refined[:, k].astype(bool)
+        cols["failures"] = ["; ".join(f) for f in self.failures]
+        return pd.DataFrame(cols)
+
+    def __repr__(self) -> str:
+        return f"SweepResult({self.parameter}: {len(self.value)} values, {self.status})"
+
+
+class VerifyResult(_Result):
+    """Time integration of harmonic-balance points (:func:`fricbound.verify`), one entry of
+    ``cases`` per frequency: ``freq_hz``, ``hbm_amplitudes`` and ``amplitudes`` (first-harmonic
+    amplitude of each output from the HBM and from the time integration at dt/2, m),
+    ``coarse_amplitudes`` (at dt), ``hbm_difference`` (largest relative difference),
+    ``dt_change``, ``periods``, ``settled``, ``nonharmonic_energy``, ``hill_stable`` and
+    ``floquet_re`` (None where Hill's method does not apply), ``stays`` (the motion stays within
+    ``STAY_TOLERANCE`` = 1e-3 of the HBM amplitude, as ``fricbound verify`` reports), and
+    ``last_period`` (outputs × steps, m)."""
+
+    STAY_TOLERANCE = 1e-3
+
+    def __init__(self, cases: List[Dict[str, Any]], outputs: List[str]):
+        for c in cases:
+            c["stays"] = bool(c["hbm_difference"] < self.STAY_TOLERANCE)
+            c["last_period"] = np.array(c["last_period"])
+        super().__init__({"cases": cases, "outputs": outputs, "status": "complete"})
+
+    def to_pandas(self):
+        """One row per frequency: ``freq_hz``, ``<dof>_hbm_amp`` and ``<dof>_time_amp`` per
+        output, ``hbm_difference``, ``dt_change``, ``periods``, ``settled``, ``stays``,
+        ``hill_stable``, ``floquet_re``."""
+        pd = _pandas()
+        rows = []
+        for c in self.cases:
+            row: Dict[str, Any] = {"freq_hz": c["freq_hz"]}
+            for k, name in enumerate(self.outputs):
+                row[f"{name}_hbm_amp"] = c["hbm_amplitudes"][k]
+                row[f"{name}_time_amp"] = c["amplitudes"][k]
+            for key in ("hbm_difference", "dt_change", "periods", "settled", "stays", "hill_stable", "floquet_re"):
+                row[key] = c[key]
+            rows.append(row)
+        return pd.DataFrame(rows)
+
+    def __repr__(self) -> str:
+        return f"VerifyResult({[c['freq_hz'] for c in self.cases]} Hz)"
+
+
+class LinearResult(_Result):
+    """A linear reference (:func:`fricbound.linear`): ``freq_hz`` (points,) and
+    ``amplitudes`` (points, outputs) in m, ``case`` (``open`` or ``stuck``), ``outputs``."""
+
+    status = "complete"
+
+    def amplitude(self, dof: str) -> np.ndarray:
+        """First-harmonic amplitude (m) of output DOF ``dof``."""
+        return self.amplitudes[:, self.outputs.index(dof)]
+
+    def to_pandas(self):
+        """``freq_hz`` and ``<dof>_amp`` per output, as the CLI's ``linear_<case>.csv``."""
+        pd = _pandas()
+        cols: Dict[str, Any] = {"freq_hz": self.freq_hz}
+        for k, name in enumerate(self.outputs):
+            cols[f"{name}_amp"] = self.amplitudes[:, k]
+        return pd.DataFrame(cols)
+
+    def __repr__(self) -> str:
+        return f"LinearResult({self.case}, {len(self.freq_hz)} points)"
+
+
+class ModesResult(_Result):
+    """Natural modes (:func:`fricbound.modes`): ``frequency_hz``, ``eigenvalue`` (rad²/s²),
+    ``rigid``, ``shapes`` (DOFs × modes, mass-normalised), ``case`` (``open``/``stuck``),
+    ``method`` (``dense`` or ``lanczos``), ``dofs``."""
+
+    status = "complete"
+
+    def to_pandas(self):
+        """One row per mode: ``mode``, ``frequency_hz``, ``eigenvalue``, ``rigid``."""
+        pd = _pandas()
+        return pd.DataFrame(
+            {
+                "mode": np.arange(1, len(self.frequency_hz) + 1),
+                "frequency_hz": self.frequency_hz,
+                "eigenvalue": self.eigenvalue,
+                "rigid": self.rigid,
+            }
+        )
+
+    def __repr__(self) -> str:
+        return f"ModesResult({self.case}: {np.round(self.frequency_hz, 3).tolist()} Hz)"
+
+
+class ReducedModel(_Result):
+    """A Craig-Bampton reduced model (:func:`fricbound.reduce`): ``stiffness`` and ``mass``
+    (r × r, r = boundary DOFs + modes), ``boundary`` (full indices of the first coordinates),
+    ``n_modes``, ``modal_frequencies_hz`` of the fixed-interface modes, and ``recovery``
+    (rows × r: the full DOF ``recover[i]`` is ``recovery[i] @ q``)."""
+
+    status = "complete"
+
+    def __repr__(self) -> str:
+        return f"ReducedModel({len(self.boundary)} boundary DOFs + {self.n_modes} modes)"
