@@ -321,8 +321,32 @@ impl Aft2dWorkspace {
             ];
             drift = mismatch[0].hypot(mismatch[1]);
             if drift <= tol {
-                let fixed_point = (outcome.any_slip || outcome.open_samples > 0)
+                let mut outcome = outcome;
+                let mut fixed_point = (outcome.any_slip || outcome.open_samples > 0)
                     && well_conditioned(outcome.period_map_derivative);
+                if fixed_point {
+                    // One more Newton step polishes the fixed point to round-off, so that the
+                    // forces are a smooth function of the coefficients to well below the
+                    // periodicity tolerance (their derivative assumes an exact fixed point).
+                    if let Some(polished) =
+                        newton_update(start, mismatch, outcome.period_map_derivative)
+                    {
+                        let again = self.march_period(law, polished, false, scale);
+                        let change = [
+                            again.slider_end[0] - polished[0],
+                            again.slider_end[1] - polished[1],
+                        ];
+                        if change[0].hypot(change[1]) <= drift
+                            && well_conditioned(again.period_map_derivative)
+                        {
+                            start = polished;
+                            outcome = again;
+                        } else {
+                            outcome = self.march_period(law, start, false, scale);
+                        }
+                    }
+                    fixed_point = outcome.any_slip || outcome.open_samples > 0;
+                }
                 let origin = if fixed_point {
                     StartOrigin::FixedPoint
                 } else if used_newton {
