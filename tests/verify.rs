@@ -248,3 +248,46 @@ fn verify_command_writes_csv_json_and_figure_for_one_frequency() {
         .unwrap();
     assert_eq!(bad.status.code(), Some(2));
 }
+
+#[test]
+fn static_start_is_a_nonlinear_equilibrium_with_the_chosen_tangential_forces() {
+    // Without the harmonic load, the start of `--from static` is an equilibrium: integrated
+    // over a few periods it stays at rest, and every contact carries T = m mu N there.
+    for m in [-1.0, 0.3, 1.0] {
+        let mut problem = paper(1);
+        problem.harmonic_loads.clear();
+        for c in &mut problem.contacts {
+            c.law.initial_state = m;
+        }
+        let start = verify::static_state(&problem).unwrap();
+        for (c, p) in problem.contacts.iter().enumerate() {
+            let u = p.tangential_of(&start.q);
+            let n = p.law.kn * (p.normal_of(&start.q) - p.gap);
+            assert!(n > 0.0, "contact {c} closed");
+            let t = p.law.kt * (u - start.sliders[c]);
+            assert!(
+                (t - m * p.law.mu * n).abs() <= 1e-9 * p.law.mu * n,
+                "m = {m}: T = {t}, N = {n}"
+            );
+        }
+        let settings = VerifySettings {
+            steps_per_period: 64,
+            max_periods: 3,
+            min_periods: 3,
+            ..VerifySettings::for_harmonics(1)
+        };
+        let run = verify::integrate(&problem, 160.0, &start, 1, &settings).unwrap();
+        let scale = start.q.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+        let drift = run.output_coefficients[0][0] - start.q[problem.outputs[0]];
+        println!(
+            "m = {m}: static output {:.6e} m, drift after 3 periods {drift:.3e} m",
+            start.q[problem.outputs[0]]
+        );
+        assert!(drift.abs() < 1e-9 * scale, "m = {m}: drift {drift}");
+        assert!(
+            run.amplitudes[0] < 1e-9 * scale,
+            "m = {m}: {}",
+            run.amplitudes[0]
+        );
+    }
+}
