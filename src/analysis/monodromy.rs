@@ -53,6 +53,16 @@
 //!    from a switch ((μN − |T|)/(μ N_max), N/N_max closed, −kₙv/N_max open), reported as
 //!    [`MonodromyStability::section_phase`] and its margin.
 //!
+//! 5. Grazing: a contact stuck all period that touches |T| = μN at one instant (every stuck
+//!    contact of a limit state m = ±1 does, at τ_ini) makes P non-differentiable at the orbit
+//!    whatever the section: a perturbation one way keeps it stuck, the other way makes it slip
+//!    by an amount of the perturbation's order. Central differences then mix the two pieces;
+//!    measured on the paper's fully stuck 210 Hz point (H = 5): leading exponents +1.3 and
+//!    +0.39 1/s for m = −1, +1, where the stuck linear system has −0.165 (Hill) and the
+//!    monodromy with μ = 1 000 (no grazing) gives −0.15. The slider of such a contact is moved
+//!    inwards by [`GRAZING_NUDGE`] of μN at that instant, onto the neighbouring stuck states
+//!    whose closure the limit state is, before shooting ([`MonodromyStability::grazing_nudged`]).
+//!
 //! The verdict uses Hill's rule: stable when the leading exponent's real part is at most
 //! [`crate::analysis::stability::STABILITY_TOLERANCE`]·ω.
 
@@ -65,6 +75,10 @@ use crate::analysis::stability::STABILITY_TOLERANCE;
 use crate::analysis::verify::{Newmark, TimeState, VerifyError, VerifySettings};
 use crate::model::Problem;
 use crate::numerics::linalg::solve_dense;
+
+/// Fraction of μN by which the slider of a contact that grazes the slip limit while stuck all
+/// period is moved inwards (see [`monodromy_stability`]).
+pub const GRAZING_NUDGE: f64 = 1e-3;
 
 /// Settings of the monodromy computation.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -116,6 +130,9 @@ pub struct MonodromyStability {
     /// That distance, relative to the normal load (see the module docs); near 0 the period
     /// map has a kink at the orbit and the multipliers are not reliable.
     pub section_margin: f64,
+    /// Contacts stuck all period that graze the slip limit, whose slider was moved inwards by
+    /// [`GRAZING_NUDGE`] of μN (the limit states m = ±1 of a stuck contact).
+    pub grazing_nudged: Vec<usize>,
 }
 
 /// The scaled state y = z / scale of a [`TimeState`].
@@ -203,6 +220,22 @@ pub fn monodromy_stability(
     let omega = stepper.omega;
     // Scale: the half range of the motion over one period from the start (at least a
     // millionth of the largest displacement, for a structure nearly at rest).
+    // A contact stuck all period that reaches |T| = μN at one instant (a limit state m = ±1
+    // does, at τ_ini) grazes the slip limit: P is not differentiable there (a perturbation one
+    // way keeps it stuck, the other makes it slip by as much). Its slider is moved inwards by
+    // GRAZING_NUDGE of μN at that instant, onto the stuck states next to the limit, whose
+    // period map is smooth (the limit state is their closure).
+    let probe = stepper.period_map(start, 0)?;
+    let mut nudged_start = start.clone();
+    let mut nudged = Vec::new();
+    for (c, p) in problem.contacts.iter().enumerate() {
+        let (use_ratio, t, nf) = probe.peak_friction_use[c];
+        if probe.stuck_all_period[c] && use_ratio > 1.0 - GRAZING_NUDGE {
+            nudged_start.sliders[c] += t.signum() * GRAZING_NUDGE * p.law.mu * nf / p.law.kt;
+            nudged.push(c);
+        }
+    }
+    let start = &nudged_start;
     let first = stepper.period_map(start, 0)?;
     let q_max = start.q.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     let amplitude = first.half_range.max(1e-6 * q_max).max(1e-300);
@@ -306,5 +339,6 @@ pub fn monodromy_stability(
         orbit_converged: converged,
         section_phase: k0 as f64 * 2.0 * PI / stepper.steps as f64,
         section_margin,
+        grazing_nudged: nudged,
     })
 }

@@ -345,6 +345,9 @@ pub(crate) struct PeriodEnd {
     /// and N/N_max; open: −kₙ v / N_max; a contact that never closes counts 1). 0 where some
     /// contact slips or sits at a switch.
     pub(crate) switch_margin: Vec<f64>,
+    /// Per contact, at the step where it uses most of its friction: |T|/(μN), T (N) and N (N)
+    /// (zeros for a contact that never closes or has μ = 0).
+    pub(crate) peak_friction_use: Vec<(f64, f64, f64)>,
 }
 
 /// The Newmark average-acceleration stepper of a problem at one excitation frequency (see the
@@ -645,6 +648,16 @@ impl<'a> Newmark<'a> {
         let half_range = (0..n)
             .map(|i| 0.5 * (hi[i] - lo[i]))
             .fold(0.0_f64, f64::max);
+        let peak_friction_use = (0..nc)
+            .map(|c| {
+                let mu = problem.contacts[c].law.mu;
+                forces
+                    .iter()
+                    .filter(|f| f[c].0 > 0.0 && mu > 0.0)
+                    .map(|f| (f[c].1.abs() / (mu * f[c].0), f[c].1, f[c].0))
+                    .fold((0.0, 0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a })
+            })
+            .collect();
         Ok(PeriodEnd {
             state: TimeState {
                 q: st.q,
@@ -654,6 +667,7 @@ impl<'a> Newmark<'a> {
             stuck_all_period: stuck_all,
             half_range,
             switch_margin,
+            peak_friction_use,
         })
     }
 }

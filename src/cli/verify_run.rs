@@ -471,7 +471,7 @@ pub fn run(options: &VerifyOptions) -> Result<VerifyReport, CommandError> {
     for o in &outputs {
         csv.push_str(&format!(",{o}_hbm_amp,{o}_time_amp"));
     }
-    csv.push_str(",rel_diff,dt_change,periods,settled,nonharmonic_energy,hill_stable,floquet_re,stays,hill_agrees,monodromy_stable,monodromy_re,monodromy_freq_hz,neutral_sliders,orbit_defect,hill_monodromy_agree,reached_curve,reached_distance,error\n");
+    csv.push_str(",rel_diff,dt_change,periods,settled,nonharmonic_energy,hill_stable,floquet_re,stays,hill_agrees,monodromy_stable,monodromy_re,monodromy_freq_hz,neutral_sliders,grazing_nudged,orbit_defect,hill_monodromy_agree,reached_curve,reached_distance,error\n");
     let mut text = format!(
         "{label}: time integration (Newmark average acceleration, {} steps/period and twice that)\n",
         settings.steps_per_period
@@ -508,7 +508,7 @@ pub fn run(options: &VerifyOptions) -> Result<VerifyReport, CommandError> {
         let v = c.verification.as_ref();
         let mono = c.monodromy.as_ref();
         csv.push_str(&format!(
-            ",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            ",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             opt(v.map(|v| v.hbm_difference)),
             opt(v.map(|v| v.dt_change)),
             opt(v.map(|v| v.fine.periods)),
@@ -523,6 +523,14 @@ pub fn run(options: &VerifyOptions) -> Result<VerifyReport, CommandError> {
             opt(mono.map(|m| m.floquet_freq_hz)),
             mono.map(|m| {
                 m.neutral_sliders
+                    .iter()
+                    .map(|&i| problem.contacts[i].name.clone())
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            })
+            .unwrap_or_default(),
+            mono.map(|m| {
+                m.grazing_nudged
                     .iter()
                     .map(|&i| problem.contacts[i].name.clone())
                     .collect::<Vec<_>>()
