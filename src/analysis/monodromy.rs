@@ -272,41 +272,64 @@ pub fn monodromy_stability(
     let mut best: Option<(f64, Mat<f64>, Vec<bool>)> = None;
     let mut iterations = 0;
     let mut converged = false;
-    for it in 0..=monodromy.max_shooting {
-        let Linearisation {
-            matrix: m,
-            image: py,
-            stuck,
-        } = monodromy_matrix(&stepper, k0, &y, &scale, n, h)?;
-        let free: Vec<usize> = (0..y.len())
-            .filter(|&i| i < 2 * n || !stuck[i - 2 * n])
-            .collect();
-        let defect = free
-            .iter()
-            .map(|&i| (py[i] - y[i]).abs())
-            .fold(0.0_f64, f64::max);
-        if best.as_ref().is_none_or(|b| defect < b.0) {
-            best = Some((defect, m.clone(), stuck.clone()));
+    // Shooting; then, if a contact of the orbit found grazes the slip limit with its slider
+    // still (the time-domain limit orbit can differ from the harmonic-balance one by enough to
+    // hide the grazing from the first probe), its slider is nudged inwards and the shooting
+    // repeated (at most twice).
+    for _round in 0..3 {
+        best = None;
+        converged = false;
+        for it in 0..=monodromy.max_shooting {
+            let Linearisation {
+                matrix: m,
+                image: py,
+                stuck,
+            } = monodromy_matrix(&stepper, k0, &y, &scale, n, h)?;
+            let free: Vec<usize> = (0..y.len())
+                .filter(|&i| i < 2 * n || !stuck[i - 2 * n])
+                .collect();
+            let defect = free
+                .iter()
+                .map(|&i| (py[i] - y[i]).abs())
+                .fold(0.0_f64, f64::max);
+            if best.as_ref().is_none_or(|b| defect < b.0) {
+                best = Some((defect, m.clone(), stuck.clone()));
+            }
+            iterations = it;
+            if defect <= monodromy.shooting_tolerance {
+                converged = true;
+                break;
+            }
+            if it == monodromy.max_shooting {
+                break;
+            }
+            // Newton: (M − I) δ = −(P(y) − y) on the free components.
+            let k = free.len();
+            let a = Mat::from_fn(k, k, |r, c| {
+                m[(free[r], free[c])] - if r == c { 1.0 } else { 0.0 }
+            });
+            let rhs: Vec<f64> = free.iter().map(|&i| y[i] - py[i]).collect();
+            let Ok(delta) = solve_dense(&a, &rhs) else {
+                break;
+            };
+            for (r, &i) in free.iter().enumerate() {
+                y[i] += delta[r];
+            }
         }
-        iterations = it;
-        if defect <= monodromy.shooting_tolerance {
-            converged = true;
-            break;
+        let orbit = stepper.period_map(&unpack(&y, &scale, n), k0)?;
+        let mut moved = false;
+        for (c, p) in problem.contacts.iter().enumerate() {
+            let (use_ratio, t, nf) = orbit.peak_friction_use[c];
+            let still = orbit.slider_range[c] <= 1e-9 * amplitude;
+            if still && use_ratio > 1.0 - GRAZING_NUDGE && !nudged.contains(&c) {
+                y[2 * n + c] +=
+                    t.signum() * GRAZING_NUDGE * p.law.mu * nf / p.law.kt / scale[2 * n + c];
+                nudged.push(c);
+                moved = true;
+            }
         }
-        if it == monodromy.max_shooting {
+        if !moved {
             break;
-        }
-        // Newton: (M − I) δ = −(P(y) − y) on the free components.
-        let k = free.len();
-        let a = Mat::from_fn(k, k, |r, c| {
-            m[(free[r], free[c])] - if r == c { 1.0 } else { 0.0 }
-        });
-        let rhs: Vec<f64> = free.iter().map(|&i| y[i] - py[i]).collect();
-        let Ok(delta) = solve_dense(&a, &rhs) else {
-            break;
-        };
-        for (r, &i) in free.iter().enumerate() {
-            y[i] += delta[r];
         }
     }
     let Some((defect, m, stuck)) = best else {

@@ -348,6 +348,8 @@ pub(crate) struct PeriodEnd {
     /// Per contact, at the step where it uses most of its friction: |T|/(μN), T (N) and N (N)
     /// (zeros for a contact that never closes or has μ = 0).
     pub(crate) peak_friction_use: Vec<(f64, f64, f64)>,
+    /// Per contact: range max − min of its slider over the period (m).
+    pub(crate) slider_range: Vec<f64>,
 }
 
 /// The Newmark average-acceleration stepper of a problem at one excitation frequency (see the
@@ -596,6 +598,8 @@ impl<'a> Newmark<'a> {
         let mut stuck_all = vec![true; nc];
         let mut lo = st.q.clone();
         let mut hi = st.q.clone();
+        let mut w_lo = st.w.clone();
+        let mut w_hi = st.w.clone();
         // Per step and contact: (N, T, kₙ v).
         let mut forces: Vec<Vec<(f64, f64, f64)>> = Vec::with_capacity(count);
         for k in k0..k0 + count {
@@ -604,6 +608,10 @@ impl<'a> Newmark<'a> {
             for i in 0..n {
                 lo[i] = lo[i].min(st.q[i]);
                 hi[i] = hi[i].max(st.q[i]);
+            }
+            for c in 0..nc {
+                w_lo[c] = w_lo[c].min(st.w[c]);
+                w_hi[c] = w_hi[c].max(st.w[c]);
             }
             forces.push(
                 problem
@@ -668,6 +676,7 @@ impl<'a> Newmark<'a> {
             half_range,
             switch_margin,
             peak_friction_use,
+            slider_range: (0..nc).map(|c| w_hi[c] - w_lo[c]).collect(),
         })
     }
 }
