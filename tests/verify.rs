@@ -201,6 +201,13 @@ fn verify_command_writes_csv_json_and_figure_for_one_frequency() {
             .unwrap();
     assert_eq!(json.as_array().unwrap().len(), 1);
     assert!(dir.path().join("verify_160Hz.png").exists());
+    assert!(dir.path().join("verify_160Hz_phase.png").exists());
+    assert!(dir.path().join("verify_160Hz_hysteresis.png").exists());
+    // The monodromy of the damped 160 Hz point: stable, as Hill says, and its orbit found.
+    assert_eq!(col("monodromy_stable"), "true");
+    assert_eq!(col("hill_monodromy_agree"), "true");
+    let defect: f64 = col("orbit_defect").parse().unwrap();
+    assert!(defect < 1e-6, "{defect}");
     // From rest at the static deflection, one case per initial state: two rows, no error.
     let dir2 = tempfile::tempdir().unwrap();
     let st = std::process::Command::new(env!("CARGO_BIN_EXE_fricbound"))
@@ -228,6 +235,13 @@ fn verify_command_writes_csv_json_and_figure_for_one_frequency() {
     assert_eq!(rows.len(), 2, "{csv2}");
     assert!(rows[0].starts_with("160,-1,static,") && rows[1].starts_with("160,1,static,"));
     assert!(rows.iter().all(|r| r.ends_with(',')), "{csv2}");
+    // Each static start names the uniform-m curve it came nearest to.
+    let header2: Vec<&str> = csv2.lines().next().unwrap().split(',').collect();
+    let reached = header2.iter().position(|h| *h == "reached_curve").unwrap();
+    for r in &rows {
+        let cells: Vec<&str> = r.split(',').collect();
+        assert!(cells[reached].starts_with("m="), "{r}");
+    }
     // An initial state outside [-1, 1] is a usage error.
     let bad_m = std::process::Command::new(env!("CARGO_BIN_EXE_fricbound"))
         .args([

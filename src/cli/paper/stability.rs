@@ -159,9 +159,12 @@ pub fn stability_markdown(study: &StabilityStudy) -> String {
          harmonics 0..{}), without and with a small damper damping (sub-folders \
          `stability-3rd`, `stability-3rd-damped`). An unstable stretch of a limit curve is not a \
          state the damper keeps there, so the band is no bound of the reachable response there. \
-         Hill's linearisation of the Jenkins contact is the AFT Jacobian: where a contact \
-         stick-slips, check the verdict with `fricbound verify` (its `monodromy_re` is the \
-         time integration's own Floquet exponent; see the README's \"Stability\").\n\n",
+         Hill's linearisation of the Jenkins contact is the AFT Jacobian of the periodic forces, \
+         exact where the contacts are fully stuck or open; on stick-slip points its growth \
+         rates are not reliable (against the monodromy of the time integration they were \
+         found much too large on the m = +1 curve, and damped states called unstable that \
+         the time integration keeps; README, \"Stability\"): read the stretches below as \
+         warnings and confirm them with `fricbound verify` (`monodromy_re`).\n\n",
         study.harmonics
     ));
     md.push_str("| damper damping | curve | points | unstable | unstable stretches (Hz) | largest Re λ (1/s) |\n");
