@@ -189,6 +189,21 @@ fn paper_quick_writes_every_figure_and_a_summary_of_computed_numbers() {
         assert!(summary.contains(statement), "paper statement `{statement}`");
     }
     assert!(summary.contains("Do the limits bound"));
+    // The stability section: both limit curves, without and with damper damping.
+    assert!(summary.contains("## Stability of the limit curves"));
+    let stability: serde_json::Value =
+        serde_json::from_str(&read(&out.join("stability.json"))).unwrap();
+    let curves = stability["curves"].as_array().unwrap();
+    assert_eq!(curves.len(), 4, "{stability}");
+    assert!(stability["failed"].as_array().unwrap().is_empty());
+    for c in curves {
+        let unstable = c["unstable_points"].as_u64().unwrap();
+        assert!(unstable <= c["points"].as_u64().unwrap());
+        assert_eq!(
+            unstable == 0,
+            c["unstable_hz"].as_array().unwrap().is_empty()
+        );
+    }
 
     // The numbers are the runs' own: the ratio of the limit peaks of Fig. 13 (3rd resonance)
     // in the summary is the one of its peaks.csv, and the study's largest ratio is at least it.

@@ -201,6 +201,13 @@ fn verify_command_writes_csv_json_and_figure_for_one_frequency() {
             .unwrap();
     assert_eq!(json.as_array().unwrap().len(), 1);
     assert!(dir.path().join("verify_160Hz.png").exists());
+    assert!(dir.path().join("verify_160Hz_phase.png").exists());
+    assert!(dir.path().join("verify_160Hz_hysteresis.png").exists());
+    // The monodromy of the damped 160 Hz point: stable, as Hill says, and its orbit found.
+    assert_eq!(col("monodromy_stable"), "true");
+    assert_eq!(col("hill_monodromy_agree"), "true");
+    let defect: f64 = col("orbit_defect").parse().unwrap();
+    assert!(defect < 1e-6, "{defect}");
     // From rest at the static deflection, one case per initial state: two rows, no error.
     let dir2 = tempfile::tempdir().unwrap();
     let st = std::process::Command::new(env!("CARGO_BIN_EXE_fricbound"))
@@ -228,6 +235,13 @@ fn verify_command_writes_csv_json_and_figure_for_one_frequency() {
     assert_eq!(rows.len(), 2, "{csv2}");
     assert!(rows[0].starts_with("160,-1,static,") && rows[1].starts_with("160,1,static,"));
     assert!(rows.iter().all(|r| r.ends_with(',')), "{csv2}");
+    // Each static start names the uniform-m curve it came nearest to.
+    let header2: Vec<&str> = csv2.lines().next().unwrap().split(',').collect();
+    let reached = header2.iter().position(|h| *h == "reached_curve").unwrap();
+    for r in &rows {
+        let cells: Vec<&str> = r.split(',').collect();
+        assert!(cells[reached].starts_with("m="), "{r}");
+    }
     // An initial state outside [-1, 1] is a usage error.
     let bad_m = std::process::Command::new(env!("CARGO_BIN_EXE_fricbound"))
         .args([
@@ -247,4 +261,47 @@ fn verify_command_writes_csv_json_and_figure_for_one_frequency() {
         .output()
         .unwrap();
     assert_eq!(bad.status.code(), Some(2));
+}
+
+#[test]
+fn static_start_is_a_nonlinear_equilibrium_with_the_chosen_tangential_forces() {
+    // Without the harmonic load, the start of `--from static` is an equilibrium: integrated
+    // over a few periods it stays at rest, and every contact carries T = m mu N there.
+    for m in [-1.0, 0.3, 1.0] {
+        let mut problem = paper(1);
+        problem.harmonic_loads.clear();
+        for c in &mut problem.contacts {
+            c.law.initial_state = m;
+        }
+        let start = verify::static_state(&problem).unwrap();
+        for (c, p) in problem.contacts.iter().enumerate() {
+            let u = p.tangential_of(&start.q);
+            let n = p.law.kn * (p.normal_of(&start.q) - p.gap);
+            assert!(n > 0.0, "contact {c} closed");
+            let t = p.law.kt * (u - start.sliders[c]);
+            assert!(
+                (t - m * p.law.mu * n).abs() <= 1e-9 * p.law.mu * n,
+                "m = {m}: T = {t}, N = {n}"
+            );
+        }
+        let settings = VerifySettings {
+            steps_per_period: 64,
+            max_periods: 3,
+            min_periods: 3,
+            ..VerifySettings::for_harmonics(1)
+        };
+        let run = verify::integrate(&problem, 160.0, &start, 1, &settings).unwrap();
+        let scale = start.q.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+        let drift = run.output_coefficients[0][0] - start.q[problem.outputs[0]];
+        println!(
+            "m = {m}: static output {:.6e} m, drift after 3 periods {drift:.3e} m",
+            start.q[problem.outputs[0]]
+        );
+        assert!(drift.abs() < 1e-9 * scale, "m = {m}: drift {drift}");
+        assert!(
+            run.amplitudes[0] < 1e-9 * scale,
+            "m = {m}: {}",
+            run.amplitudes[0]
+        );
+    }
 }

@@ -43,12 +43,16 @@
 //!   every FRF point when the scene sets `analysis.stability`.
 //! - [`verify::verify_point`]: time integration (Newmark, implicit contact return mapping) from
 //!   a harmonic-balance point to its steady state, with a dt check ([`verify::PointVerification`]).
+//! - [`monodromy::monodromy_stability`]: Floquet multipliers of the time integration's periodic
+//!   orbit (shooting, monodromy matrix by central differences of the period map, sliders as
+//!   state), the independent check of Hill's verdict ([`monodromy::MonodromyStability`]).
 
 pub mod error_estimate;
 pub mod frf;
 pub mod limits;
 pub mod linear;
 pub mod modes;
+pub mod monodromy;
 pub mod peaks;
 pub mod stability;
 pub mod verify;

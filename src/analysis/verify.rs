@@ -100,6 +100,9 @@ pub enum VerifyError {
     /// The static deflection could not be solved.
     #[error("static deflection: {0}")]
     Static(String),
+    /// The monodromy matrix of the periodic orbit could not be computed.
+    #[error("monodromy: {0}")]
+    Monodromy(String),
     /// The initial coefficients do not match the problem's layout.
     #[error("initial coefficients have length {found}, expected {expected}")]
     WrongLength {
@@ -143,6 +146,21 @@ pub struct TimeResponse {
     pub nonharmonic_energy: f64,
     /// Each output DOF sampled over the last period (m), `steps_per_period` values.
     pub last_period: Vec<Vec<f64>>,
+    /// Each output DOF's velocity q̇ over the last period (m/s), at the same instants.
+    pub last_period_velocity: Vec<Vec<f64>>,
+    /// Each contact's tangential relative displacement u (m) and force T (N) over the last
+    /// period, at the same instants: its hysteresis loop.
+    pub contact_loops: Vec<ContactLoop>,
+}
+
+/// One contact's tangential relative displacement and force over a period.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ContactLoop {
+    /// Tangential relative displacement u = aₜ·q (m).
+    pub u: Vec<f64>,
+    /// Tangential force T = kₜ (u − w) (N): the spring to the committed slider, which is the
+    /// stick force, ±μN in slip and 0 open (the slider then follows u).
+    pub t: Vec<f64>,
 }
 
 /// Result of [`verify_point`]: the time integration at two time steps against the HBM point.
@@ -190,6 +208,8 @@ struct ContactEval {
     dt_dv: f64,
     dn_dv: f64,
     slider: f64,
+    /// Closed and sticking (the slider did not move).
+    stuck: bool,
 }
 
 /// Return mapping of the Jenkins law (paper Eqs. 4-6) at u, v from the committed slider `w0`,
@@ -210,6 +230,7 @@ fn return_map(point: &ContactPoint, liftoff: bool, u: f64, v: f64, w0: f64) -> C
             dt_dv: 0.0,
             dn_dv,
             slider: u,
+            stuck: false,
         };
     }
     let limit = law.mu * n;
@@ -222,6 +243,7 @@ fn return_map(point: &ContactPoint, liftoff: bool, u: f64, v: f64, w0: f64) -> C
             dt_dv: 0.0,
             dn_dv,
             slider: w0,
+            stuck: true,
         }
     } else {
         let s = trial.signum();
@@ -232,12 +254,13 @@ fn return_map(point: &ContactPoint, liftoff: bool, u: f64, v: f64, w0: f64) -> C
             dt_dv: s * law.mu * law.kn,
             dn_dv,
             slider: u - s * limit / law.kt,
+            stuck: false,
         }
     }
 }
 
 /// Adds the contact forces at `q` (from committed sliders `w0`) to `f`, their tangent to `kc`
-/// if given, and writes the trial sliders to `w1`.
+/// if given, and writes the trial sliders to `w1` and whether each contact sticks to `stuck`.
 fn contact_forces(
     problem: &Problem,
     q: &[f64],
@@ -245,6 +268,7 @@ fn contact_forces(
     f: &mut [f64],
     mut kc: Option<&mut Mat<f64>>,
     w1: &mut [f64],
+    stuck: &mut [bool],
 ) {
     let liftoff = problem.effects.contact.liftoff;
     for (ci, p) in problem.contacts.iter().enumerate() {
@@ -252,6 +276,7 @@ fn contact_forces(
         let v = p.normal_of(q) - p.gap;
         let e = return_map(p, liftoff, u, v, w0[ci]);
         w1[ci] = e.slider;
+        stuck[ci] = e.stuck;
         for &(i, a) in &p.tangential {
             f[i] += a * e.t;
         }
@@ -296,6 +321,366 @@ fn external_load(problem: &Problem, tau: f64, f: &mut [f64]) {
     }
 }
 
+/// The full state of the Newmark scheme at one instant: positions q (m), velocities v (m/s),
+/// accelerations a (m/s²) and committed sliders w (m).
+#[derive(Debug, Clone)]
+pub(crate) struct StepState {
+    pub(crate) q: Vec<f64>,
+    pub(crate) v: Vec<f64>,
+    pub(crate) a: Vec<f64>,
+    pub(crate) w: Vec<f64>,
+}
+
+/// One period of the step map from a [`TimeState`] (see [`Newmark::period_map`]).
+#[derive(Debug, Clone)]
+pub(crate) struct PeriodEnd {
+    /// The state one period later.
+    pub(crate) state: TimeState,
+    /// Per contact: closed and sticking at every step of the period (its slider never moved).
+    pub(crate) stuck_all_period: Vec<bool>,
+    /// Largest half range (max − min)/2 of a DOF's displacement over the period (m).
+    pub(crate) half_range: f64,
+    /// After each step of the period: the smallest distance of a contact from a switch of its
+    /// law, relative to its largest normal load over the period (closed: (μN − |T|)/(μ N_max),
+    /// and N/N_max; open: −kₙ v / N_max; a contact that never closes counts 1). 0 where some
+    /// contact slips or sits at a switch.
+    pub(crate) switch_margin: Vec<f64>,
+    /// Per contact, at the step where it uses most of its friction: |T|/(μN), T (N) and N (N)
+    /// (zeros for a contact that never closes or has μ = 0).
+    pub(crate) peak_friction_use: Vec<(f64, f64, f64)>,
+    /// Per contact: range max − min of its slider over the period (m).
+    pub(crate) slider_range: Vec<f64>,
+}
+
+/// The Newmark average-acceleration stepper of a problem at one excitation frequency (see the
+/// module docs): dense M, C, K, the step sizes and the step Newton's settings.
+pub(crate) struct Newmark<'a> {
+    problem: &'a Problem,
+    model: DenseModel,
+    /// Excitation circular frequency ω (rad/s).
+    pub(crate) omega: f64,
+    /// Steps per period.
+    pub(crate) steps: usize,
+    dt: f64,
+    dtau: f64,
+    load_scale: f64,
+    newton_tolerance: f64,
+    accept_tolerance: f64,
+    max_newton: usize,
+}
+
+impl<'a> Newmark<'a> {
+    /// The stepper at `freq_hz` with `settings.steps_per_period` (at least 8) steps per period.
+    pub(crate) fn new(
+        problem: &'a Problem,
+        freq_hz: f64,
+        settings: &VerifySettings,
+    ) -> Result<Self, VerifyError> {
+        check_supported(problem)?;
+        let omega = 2.0 * PI * freq_hz;
+        let steps = settings.steps_per_period.max(8);
+        let load_scale = problem
+            .static_load
+            .iter()
+            .map(|v| v.abs())
+            .chain(problem.harmonic_loads.iter().map(|l| l.cos.hypot(l.sin)))
+            .fold(0.0_f64, f64::max)
+            .max(1e-30);
+        Ok(Self {
+            problem,
+            model: DenseModel {
+                m: problem.model.mass.to_dense(),
+                c: problem.model.damping.to_dense(),
+                k: problem.model.stiffness.to_dense(),
+            },
+            omega,
+            steps,
+            dt: 2.0 * PI / (omega * steps as f64),
+            dtau: 2.0 * PI / steps as f64,
+            load_scale,
+            newton_tolerance: settings.newton_tolerance,
+            accept_tolerance: settings.newton_tolerance,
+            max_newton: settings.max_newton,
+        })
+    }
+
+    /// A stepper whose step Newton aims at `target` (relative residual) but accepts its best
+    /// iterate when that is below the settings' tolerance: at a kink of the contact law
+    /// (lift-off, stick-slip) Newton can cycle between the two pieces at the round-off level
+    /// of a tight target.
+    pub(crate) fn with_target_tolerance(mut self, target: f64) -> Self {
+        self.newton_tolerance = target.min(self.accept_tolerance);
+        self
+    }
+
+    /// The scheme's state at τ = `k0`·dτ from `start`: the sliders return-mapped at q₀ (a slider that
+    /// would carry more than μN is moved to the slip limit) and the acceleration from the
+    /// equations of motion, M a₀ = F(0) − C v₀ − K q₀ − F_c(q₀).
+    pub(crate) fn start(&self, start: &TimeState, k0: usize) -> Result<StepState, VerifyError> {
+        let problem = self.problem;
+        let n = problem.model.n_dofs();
+        let nc = problem.contacts.len();
+        if start.q.len() != n || start.qdot.len() != n {
+            return Err(VerifyError::WrongLength {
+                expected: n,
+                found: start.q.len().min(start.qdot.len()),
+            });
+        }
+        if start.sliders.len() != nc {
+            return Err(VerifyError::WrongLength {
+                expected: nc,
+                found: start.sliders.len(),
+            });
+        }
+        let mut rhs = vec![0.0; n];
+        external_load(problem, k0 as f64 * self.dtau, &mut rhs);
+        mat_vec_add(&self.model.c, -1.0, &start.qdot, &mut rhs);
+        mat_vec_add(&self.model.k, -1.0, &start.q, &mut rhs);
+        let mut fc = vec![0.0; n];
+        let mut w = start.sliders.clone();
+        let mut stuck = vec![false; nc];
+        contact_forces(
+            problem,
+            &start.q,
+            &start.sliders,
+            &mut fc,
+            None,
+            &mut w,
+            &mut stuck,
+        );
+        rhs.iter_mut().zip(&fc).for_each(|(r, f)| *r -= f);
+        let a = solve_dense(&self.model.m, &rhs).map_err(|e| VerifyError::Unsupported {
+            reason: format!("mass matrix not invertible ({e}): every DOF needs mass"),
+        })?;
+        Ok(StepState {
+            q: start.q.clone(),
+            v: start.qdot.clone(),
+            a,
+            w,
+        })
+    }
+
+    /// Advances `st` by one step, from τ = k·dτ to (k + 1)·dτ (`step_index` counts steps from
+    /// the start of the integration, for the error's time), and writes whether each contact
+    /// sticks at the end of the step to `stuck`.
+    pub(crate) fn step(
+        &self,
+        st: &mut StepState,
+        k: usize,
+        step_index: usize,
+        stuck: &mut [bool],
+    ) -> Result<(), VerifyError> {
+        let problem = self.problem;
+        let n = problem.model.n_dofs();
+        let (dt, model) = (self.dt, &self.model);
+        let (c4, c2) = (4.0 / (dt * dt), 2.0 / dt);
+        let tau1 = (k + 1) as f64 * self.dtau;
+        // Predictor: constant acceleration.
+        let mut q1: Vec<f64> = (0..n)
+            .map(|i| st.q[i] + dt * st.v[i] + 0.5 * dt * dt * st.a[i])
+            .collect();
+        let failed = |residual: f64| VerifyError::StepFailed {
+            time_s: (step_index + 1) as f64 * dt,
+            residual,
+        };
+        let nc = problem.contacts.len();
+        // The step residual at q₁ (relative to the load scale), with its tangent, the trial
+        // sliders and the stick flags.
+        let eval = |q1: &[f64]| -> (f64, Vec<f64>, Mat<f64>, Vec<f64>, Vec<bool>) {
+            let mut r = vec![0.0; n];
+            let a1: Vec<f64> = (0..n)
+                .map(|i| c4 * (q1[i] - st.q[i] - dt * st.v[i]) - st.a[i])
+                .collect();
+            let v1: Vec<f64> = (0..n).map(|i| c2 * (q1[i] - st.q[i]) - st.v[i]).collect();
+            external_load(problem, tau1, &mut r);
+            r.iter_mut().for_each(|x| *x = -*x);
+            mat_vec_add(&model.m, 1.0, &a1, &mut r);
+            mat_vec_add(&model.c, 1.0, &v1, &mut r);
+            mat_vec_add(&model.k, 1.0, q1, &mut r);
+            let mut tangent = Mat::from_fn(n, n, |i, j| {
+                c4 * model.m[(i, j)] + c2 * model.c[(i, j)] + model.k[(i, j)]
+            });
+            let mut w1 = st.w.clone();
+            let mut stuck1 = vec![false; nc];
+            contact_forces(
+                problem,
+                q1,
+                &st.w,
+                &mut r,
+                Some(&mut tangent),
+                &mut w1,
+                &mut stuck1,
+            );
+            let res = r.iter().fold(0.0_f64, |m, x| m.max(x.abs())) / self.load_scale;
+            (res, r, tangent, w1, stuck1)
+        };
+        let (mut res, mut r, mut tangent, mut w1, mut stuck1) = eval(&q1);
+        let mut converged = false;
+        // The best iterate within the accept tolerance: (residual, q₁, sliders, stick flags).
+        type Candidate = (f64, Vec<f64>, Vec<f64>, Vec<bool>);
+        let mut best: Option<Candidate> = None;
+        for _ in 0..self.max_newton {
+            if res <= self.newton_tolerance {
+                converged = true;
+                break;
+            }
+            if res <= self.accept_tolerance && best.as_ref().is_none_or(|b| res < b.0) {
+                best = Some((res, q1.clone(), w1.clone(), stuck1.clone()));
+            }
+            let dq = solve_dense(&tangent, &r).map_err(|_| failed(res))?;
+            // A correction at the round-off level of q₁ cannot lower the residual further: the
+            // residual's own round-off (the inertia term 4/dt² M (q₁ − q₀ − dt v₀) is large at
+            // small dt) is then above the tolerance, and the step has converged.
+            let q_size = q1.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+            if dq.iter().all(|d| d.abs() <= 1e-13 * q_size) {
+                converged = true;
+                break;
+            }
+            // Backtracking on the residual: at a kink of the contact law (lift-off, stick to
+            // slip) full Newton steps can cycle between the two pieces.
+            let mut alpha = 1.0;
+            loop {
+                let trial: Vec<f64> = q1.iter().zip(&dq).map(|(x, d)| x - alpha * d).collect();
+                let e = eval(&trial);
+                if e.0 < res || alpha < 1e-3 {
+                    q1 = trial;
+                    (res, r, tangent, w1, stuck1) = e;
+                    break;
+                }
+                alpha *= 0.5;
+            }
+        }
+        let mut w_trial = w1;
+        stuck.copy_from_slice(&stuck1);
+        let last_res = res;
+        if !converged {
+            let Some((_, q_best, w_best, stuck_best)) = best else {
+                return Err(failed(last_res));
+            };
+            q1 = q_best;
+            w_trial = w_best;
+            stuck.copy_from_slice(&stuck_best);
+        }
+        for i in 0..n {
+            let a1 = c4 * (q1[i] - st.q[i] - dt * st.v[i]) - st.a[i];
+            st.v[i] = c2 * (q1[i] - st.q[i]) - st.v[i];
+            st.a[i] = a1;
+        }
+        st.q.copy_from_slice(&q1);
+        st.w.copy_from_slice(&w_trial);
+        Ok(())
+    }
+
+    /// The period map: integrates one excitation period from `start` at τ = `k0`·dτ (the load
+    /// is periodic, so the map from any phase is one period) and returns the state at its end.
+    pub(crate) fn period_map(
+        &self,
+        start: &TimeState,
+        k0: usize,
+    ) -> Result<PeriodEnd, VerifyError> {
+        let end = self.advance(start, k0, self.steps)?;
+        Ok(end)
+    }
+
+    /// Integrates `count` steps from `start` at τ = `k0`·dτ (see [`Self::period_map`]).
+    pub(crate) fn advance(
+        &self,
+        start: &TimeState,
+        k0: usize,
+        count: usize,
+    ) -> Result<PeriodEnd, VerifyError> {
+        let problem = self.problem;
+        let nc = problem.contacts.len();
+        let n = problem.model.n_dofs();
+        let liftoff = problem.effects.contact.liftoff;
+        let mut st = self.start(start, k0)?;
+        let mut stuck = vec![false; nc];
+        let mut stuck_all = vec![true; nc];
+        let mut lo = st.q.clone();
+        let mut hi = st.q.clone();
+        let mut w_lo = st.w.clone();
+        let mut w_hi = st.w.clone();
+        // Per step and contact: (N, T, kₙ v).
+        let mut forces: Vec<Vec<(f64, f64, f64)>> = Vec::with_capacity(count);
+        for k in k0..k0 + count {
+            self.step(&mut st, k, k - k0, &mut stuck)?;
+            stuck_all.iter_mut().zip(&stuck).for_each(|(a, s)| *a &= *s);
+            for i in 0..n {
+                lo[i] = lo[i].min(st.q[i]);
+                hi[i] = hi[i].max(st.q[i]);
+            }
+            for c in 0..nc {
+                w_lo[c] = w_lo[c].min(st.w[c]);
+                w_hi[c] = w_hi[c].max(st.w[c]);
+            }
+            forces.push(
+                problem
+                    .contacts
+                    .iter()
+                    .enumerate()
+                    .map(|(c, p)| {
+                        let u = p.tangential_of(&st.q);
+                        let knv = p.law.kn * (p.normal_of(&st.q) - p.gap);
+                        let nf = if liftoff { knv.max(0.0) } else { knv };
+                        (nf, p.law.kt * (u - st.w[c]), knv)
+                    })
+                    .collect(),
+            );
+        }
+        let n_max: Vec<f64> = (0..nc)
+            .map(|c| forces.iter().map(|f| f[c].0).fold(0.0_f64, f64::max))
+            .collect();
+        let switch_margin = forces
+            .iter()
+            .map(|f| {
+                (0..nc)
+                    .map(|c| {
+                        let (nf, t, knv) = f[c];
+                        let law = &problem.contacts[c].law;
+                        if n_max[c] <= 0.0 {
+                            1.0
+                        } else if nf > 0.0 {
+                            let normal = nf / n_max[c];
+                            if law.mu > 0.0 {
+                                normal.min((law.mu * nf - t.abs()) / (law.mu * n_max[c]))
+                            } else {
+                                normal
+                            }
+                        } else {
+                            -knv / n_max[c]
+                        }
+                    })
+                    .fold(1.0_f64, f64::min)
+            })
+            .collect();
+        let half_range = (0..n)
+            .map(|i| 0.5 * (hi[i] - lo[i]))
+            .fold(0.0_f64, f64::max);
+        let peak_friction_use = (0..nc)
+            .map(|c| {
+                let mu = problem.contacts[c].law.mu;
+                forces
+                    .iter()
+                    .filter(|f| f[c].0 > 0.0 && mu > 0.0)
+                    .map(|f| (f[c].1.abs() / (mu * f[c].0), f[c].1, f[c].0))
+                    .fold((0.0, 0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a })
+            })
+            .collect();
+        Ok(PeriodEnd {
+            state: TimeState {
+                q: st.q,
+                qdot: st.v,
+                sliders: st.w,
+            },
+            stuck_all_period: stuck_all,
+            half_range,
+            switch_margin,
+            peak_friction_use,
+            slider_range: (0..nc).map(|c| w_hi[c] - w_lo[c]).collect(),
+        })
+    }
+}
+
 /// Integrates the problem at `freq_hz` from `start` over whole periods until a periodic steady
 /// state or the budget (see the module docs), and analyses the last period on harmonics 0..`h_max`.
 pub fn integrate(
@@ -305,110 +690,43 @@ pub fn integrate(
     h_max: usize,
     settings: &VerifySettings,
 ) -> Result<TimeResponse, VerifyError> {
-    check_supported(problem)?;
+    let stepper = Newmark::new(problem, freq_hz, settings)?;
     let n = problem.model.n_dofs();
-    let nc = problem.contacts.len();
-    if start.q.len() != n || start.qdot.len() != n || start.sliders.len() != nc {
-        return Err(VerifyError::WrongLength {
-            expected: n,
-            found: start.q.len(),
-        });
-    }
-    let model = DenseModel {
-        m: problem.model.mass.to_dense(),
-        c: problem.model.damping.to_dense(),
-        k: problem.model.stiffness.to_dense(),
-    };
-    let omega = 2.0 * PI * freq_hz;
-    let steps = settings.steps_per_period.max(8);
-    let dt = 2.0 * PI / (omega * steps as f64);
-    let dtau = 2.0 * PI / steps as f64;
-    let load_scale = problem
-        .static_load
-        .iter()
-        .map(|v| v.abs())
-        .chain(problem.harmonic_loads.iter().map(|l| l.cos.hypot(l.sin)))
-        .fold(0.0_f64, f64::max)
-        .max(1e-30);
-
-    let mut q = start.q.clone();
-    let mut v = start.qdot.clone();
-    let mut w = start.sliders.clone();
-    let mut w_trial = w.clone();
-    // Initial acceleration: M a₀ = F(0) − C v₀ − K q₀ − F_c(q₀).
-    let mut rhs = vec![0.0; n];
-    external_load(problem, 0.0, &mut rhs);
-    mat_vec_add(&model.c, -1.0, &v, &mut rhs);
-    mat_vec_add(&model.k, -1.0, &q, &mut rhs);
-    let mut fc = vec![0.0; n];
-    contact_forces(problem, &q, &w, &mut fc, None, &mut w_trial);
-    w.copy_from_slice(&w_trial);
-    rhs.iter_mut().zip(&fc).for_each(|(r, f)| *r -= f);
-    let mut a = solve_dense(&model.m, &rhs).map_err(|e| VerifyError::Unsupported {
-        reason: format!("mass matrix not invertible ({e}): every DOF needs mass"),
-    })?;
+    let omega = stepper.omega;
+    let steps = stepper.steps;
+    let mut st = stepper.start(start, 0)?;
+    let mut stuck = vec![false; problem.contacts.len()];
 
     let outputs = &problem.outputs;
     let mut history: Vec<Vec<f64>> = vec![vec![0.0; steps]; outputs.len()];
     let mut all_history: Vec<Vec<f64>> = vec![vec![0.0; steps]; n];
-    let mut period_start = (q.clone(), v.clone());
+    let mut velocity: Vec<Vec<f64>> = vec![vec![0.0; steps]; outputs.len()];
+    let nc = problem.contacts.len();
+    let mut loops: Vec<ContactLoop> = (0..nc)
+        .map(|_| ContactLoop {
+            u: vec![0.0; steps],
+            t: vec![0.0; steps],
+        })
+        .collect();
+    let mut period_start = (st.q.clone(), st.v.clone());
     let mut last_change = f64::INFINITY;
     let mut settled = false;
     let mut periods = 0;
-    let (c4, c2) = (4.0 / (dt * dt), 2.0 / dt);
-    let mut q1 = vec![0.0; n];
-    let mut r = vec![0.0; n];
     for period in 1..=settings.max_periods.max(1) {
         periods = period;
         for k in 0..steps {
             for (i, hist) in all_history.iter_mut().enumerate() {
-                hist[k] = q[i];
+                hist[k] = st.q[i];
             }
-            let tau1 = (k + 1) as f64 * dtau;
-            // Predictor: constant acceleration.
-            for i in 0..n {
-                q1[i] = q[i] + dt * v[i] + 0.25 * dt * dt * 2.0 * a[i];
+            for (o, &d) in outputs.iter().enumerate() {
+                velocity[o][k] = st.v[d];
             }
-            let mut converged = false;
-            let mut last_res = f64::INFINITY;
-            for _ in 0..settings.max_newton {
-                let a1: Vec<f64> = (0..n)
-                    .map(|i| c4 * (q1[i] - q[i] - dt * v[i]) - a[i])
-                    .collect();
-                let v1: Vec<f64> = (0..n).map(|i| c2 * (q1[i] - q[i]) - v[i]).collect();
-                external_load(problem, tau1, &mut r);
-                r.iter_mut().for_each(|x| *x = -*x);
-                mat_vec_add(&model.m, 1.0, &a1, &mut r);
-                mat_vec_add(&model.c, 1.0, &v1, &mut r);
-                mat_vec_add(&model.k, 1.0, &q1, &mut r);
-                let mut tangent = Mat::from_fn(n, n, |i, j| {
-                    c4 * model.m[(i, j)] + c2 * model.c[(i, j)] + model.k[(i, j)]
-                });
-                contact_forces(problem, &q1, &w, &mut r, Some(&mut tangent), &mut w_trial);
-                last_res = r.iter().fold(0.0_f64, |m, x| m.max(x.abs())) / load_scale;
-                if last_res <= settings.newton_tolerance {
-                    converged = true;
-                    break;
-                }
-                let dq = solve_dense(&tangent, &r).map_err(|_| VerifyError::StepFailed {
-                    time_s: ((period - 1) * steps + k + 1) as f64 * dt,
-                    residual: last_res,
-                })?;
-                q1.iter_mut().zip(&dq).for_each(|(x, d)| *x -= d);
+            for (c, p) in problem.contacts.iter().enumerate() {
+                let u = p.tangential_of(&st.q);
+                loops[c].u[k] = u;
+                loops[c].t[k] = p.law.kt * (u - st.w[c]);
             }
-            if !converged {
-                return Err(VerifyError::StepFailed {
-                    time_s: ((period - 1) * steps + k + 1) as f64 * dt,
-                    residual: last_res,
-                });
-            }
-            for i in 0..n {
-                let a1 = c4 * (q1[i] - q[i] - dt * v[i]) - a[i];
-                v[i] = c2 * (q1[i] - q[i]) - v[i];
-                a[i] = a1;
-            }
-            q.copy_from_slice(&q1);
-            w.copy_from_slice(&w_trial);
+            stepper.step(&mut st, k, (period - 1) * steps + k, &mut stuck)?;
         }
         // Periodicity: change of (q, q̇/ω) at the period start relative to the amplitude.
         let amp = (0..n)
@@ -417,14 +735,14 @@ pub fn integrate(
             .max(1e-300);
         let change = (0..n)
             .map(|i| {
-                (q[i] - period_start.0[i])
+                (st.q[i] - period_start.0[i])
                     .abs()
-                    .max((v[i] - period_start.1[i]).abs() / omega)
+                    .max((st.v[i] - period_start.1[i]).abs() / omega)
             })
             .fold(0.0_f64, f64::max)
             / amp;
         last_change = change;
-        period_start = (q.clone(), v.clone());
+        period_start = (st.q.clone(), st.v.clone());
         if period >= settings.min_periods && change <= settings.periodicity_tolerance {
             settled = true;
             break;
@@ -462,6 +780,8 @@ pub fn integrate(
         output_coefficients,
         nonharmonic_energy,
         last_period: history,
+        last_period_velocity: velocity,
+        contact_loops: loops,
     })
 }
 
@@ -574,36 +894,109 @@ pub fn hbm_state(
     })
 }
 
-/// A start at rest (q̇ = 0) at the static deflection with every contact stuck by its kₜ, kₙ
-/// springs about the rest position ([`crate::analysis::linear::stuck_guess`] at h = 0), and each
-/// contact's slider placed so that its tangential force is T = m μ N there (N = kₙ v, zero when
-/// open), m = `initial_state` ∈ [−1, 1]. Unless m makes T equal the stuck spring force this is
-/// not an equilibrium: the integration starts with the transient the changed slider causes.
-pub fn static_state(problem: &Problem, initial_state: f64) -> Result<TimeState, VerifyError> {
+/// A start at rest (q̇ = 0) at a nonlinear static equilibrium in which every closed contact
+/// carries the tangential force T = m μ N of its initial state m (`law.initial_state`, the
+/// paper's T(τ_ini) = m μ N of Eqs. 14-15 applied to the static state): Newton with
+/// backtracking on
+///
+/// ```text
+/// K q + Σ_c [ aₜ m μ N(q) + aₙ N(q) ] = F_static,   N = kₙ max(v, 0) (kₙ v without lift-off),
+/// ```
+///
+/// from the stuck static deflection ([`crate::analysis::linear::stuck_guess`] at h = 0), to a
+/// residual of 10⁻¹² of the load. Each slider is then placed at w = u − m μ N / kₜ, so that the
+/// return mapping gives back T = m μ N (|m| ≤ 1: the contact sticks) and the start is an
+/// equilibrium of the equations of motion without the harmonic load; an open contact's slider
+/// is at u. An error if Newton does not converge in 100 iterations.
+pub fn static_state(problem: &Problem) -> Result<TimeState, VerifyError> {
     let set = HarmonicSet::new(vec![0]);
-    let q = crate::analysis::linear::stuck_guess(problem, &set, 0.0)
+    let mut q = crate::analysis::linear::stuck_guess(problem, &set, 0.0)
         .map_err(|e| VerifyError::Static(e.to_string()))?;
+    let n = q.len();
     let liftoff = problem.effects.contact.liftoff;
+    let k = problem.model.stiffness.to_dense();
+    let f = &problem.static_load;
+    let fnorm = f.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-30);
+    let normal = |p: &ContactPoint, q: &[f64]| -> (f64, f64) {
+        let v = p.normal_of(q) - p.gap;
+        if liftoff && v <= 0.0 {
+            (0.0, 0.0)
+        } else {
+            (p.law.kn * v, p.law.kn)
+        }
+    };
+    let residual = |q: &[f64], jac: Option<&mut Mat<f64>>| -> Vec<f64> {
+        let mut r: Vec<f64> = f.iter().map(|x| -x).collect();
+        mat_vec_add(&k, 1.0, q, &mut r);
+        let mut jac = jac;
+        if let Some(j) = jac.as_deref_mut() {
+            j.copy_from(&k);
+        }
+        for p in &problem.contacts {
+            let (nf, dn) = normal(p, q);
+            let m_mu = p.law.initial_state * p.law.mu;
+            for &(i, a) in &p.tangential {
+                r[i] += a * m_mu * nf;
+            }
+            for &(i, a) in &p.normal {
+                r[i] += a * nf;
+            }
+            if let Some(j) = jac.as_deref_mut() {
+                for &(b, ab) in &p.normal {
+                    for &(i, a) in &p.tangential {
+                        j[(i, b)] += a * m_mu * dn * ab;
+                    }
+                    for &(i, a) in &p.normal {
+                        j[(i, b)] += a * dn * ab;
+                    }
+                }
+            }
+        }
+        r
+    };
+    let norm = |r: &[f64]| r.iter().map(|x| x * x).sum::<f64>().sqrt() / fnorm;
+    let mut jac = Mat::<f64>::zeros(n, n);
+    let mut rel = f64::INFINITY;
+    let mut converged = false;
+    for _ in 0..100 {
+        let r = residual(&q, Some(&mut jac));
+        rel = norm(&r);
+        if rel <= 1e-12 {
+            converged = true;
+            break;
+        }
+        let dq = solve_dense(&jac, &r).map_err(|e| VerifyError::Static(e.to_string()))?;
+        // Backtracking on the residual norm keeps the lift-off kink from cycling.
+        let mut alpha = 1.0;
+        loop {
+            let trial: Vec<f64> = q.iter().zip(&dq).map(|(x, d)| x - alpha * d).collect();
+            if norm(&residual(&trial, None)) < rel || alpha < 1e-4 {
+                q = trial;
+                break;
+            }
+            alpha *= 0.5;
+        }
+    }
+    if !converged {
+        return Err(VerifyError::Static(format!(
+            "Newton did not converge in 100 iterations (residual {rel:.3e} of the load)"
+        )));
+    }
     let sliders = problem
         .contacts
         .iter()
         .map(|p| {
             let u = p.tangential_of(&q);
-            let v = p.normal_of(&q) - p.gap;
-            let n = if liftoff {
-                (p.law.kn * v).max(0.0)
-            } else {
-                p.law.kn * v
-            };
-            if n > 0.0 {
-                u - initial_state * p.law.mu * n / p.law.kt
+            let (nf, _) = normal(p, &q);
+            if nf > 0.0 {
+                u - p.law.initial_state * p.law.mu * nf / p.law.kt
             } else {
                 u
             }
         })
         .collect();
     Ok(TimeState {
-        qdot: vec![0.0; q.len()],
+        qdot: vec![0.0; n],
         q,
         sliders,
     })

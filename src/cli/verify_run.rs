@@ -15,6 +15,7 @@ use rayon::prelude::*;
 
 use crate::analysis::frf::PointSolver;
 use crate::analysis::linear;
+use crate::analysis::monodromy::{self, MonodromySettings, MonodromyStability};
 use crate::analysis::stability;
 use crate::analysis::verify::{self, PointVerification, VerifySettings};
 use crate::report::files::write_atomic;
@@ -34,7 +35,7 @@ pub enum StartFrom {
     /// On the harmonic-balance solution at τ = 0 (sliders from the AFT's march).
     #[default]
     Hbm,
-    /// At rest at the stuck static deflection, sliders set to T = m μ N
+    /// At rest at the static equilibrium in which every contact carries T = m μ N
     /// ([`crate::analysis::verify::static_state`]).
     Static,
 }
@@ -84,6 +85,22 @@ pub struct VerifyCase {
     pub stays: Option<bool>,
     /// Whether Hill's verdict agrees (stable ⇔ stays).
     pub hill_agrees: Option<bool>,
+    /// Floquet multipliers of the time integration's periodic orbit through the HBM point
+    /// (shooting from its state, monodromy matrix of the period map; whatever `from` is).
+    pub monodromy: Option<MonodromyStability>,
+    /// Whether Hill's verdict equals the monodromy's.
+    pub hill_monodromy_agree: Option<bool>,
+    /// Why the monodromy could not be computed, if it could not.
+    pub monodromy_error: Option<String>,
+    /// `--from static`: the uniform-m curve (m = −1, +1 and the scene's intermediate m) whose
+    /// HBM point at this frequency is nearest to the settled motion, as `m=<value>`.
+    pub reached_curve: Option<String>,
+    /// `--from static`: the largest relative difference of the output amplitudes (last
+    /// period, dt/2) from that curve's HBM point.
+    pub reached_distance: Option<f64>,
+    /// `--from static`: the relative difference from every compared curve's HBM point, as
+    /// (m, difference).
+    pub curve_distances: Vec<(f64, f64)>,
     /// Why the case failed, if it did.
     pub error: Option<String>,
 }
@@ -99,6 +116,49 @@ pub struct VerifyReport {
     pub cases: Vec<VerifyCase>,
 }
 
+/// The HBM point at `freq` (Hz) by Newton from the stuck linear guess, or from the
+/// open-contact guess if that fails.
+fn hbm_point(
+    problem: &crate::model::Problem,
+    freq: f64,
+) -> Option<(PointSolver<'_>, crate::analysis::frf::FrfPoint)> {
+    let mut solver = PointSolver::new(problem).ok()?;
+    let set = solver.system().unknowns().clone();
+    let omega = 2.0 * PI * freq;
+    let point = [linear::stuck_guess, linear::open_guess]
+        .iter()
+        .filter_map(|g| g(problem, &set, omega).ok())
+        .find_map(|guess| solver.solve(&guess, freq).ok())?;
+    Some((solver, point))
+}
+
+/// Relative distance of `time` amplitudes from `hbm` ones: the largest over outputs.
+fn relative_distance(time: &[f64], hbm: &[f64]) -> f64 {
+    time.iter()
+        .zip(hbm)
+        .map(|(t, h)| (t - h).abs() / h.abs().max(1e-300))
+        .fold(0.0_f64, f64::max)
+}
+
+/// For each uniform m of `curve_ms`, the distance of `time` amplitudes from that curve's HBM
+/// point at `freq` (curves whose point does not converge are left out).
+fn curve_distances(
+    problem: &crate::model::Problem,
+    freq: f64,
+    curve_ms: &[f64],
+    time: &[f64],
+) -> Vec<(f64, f64)> {
+    curve_ms
+        .iter()
+        .filter_map(|&m| {
+            let mut pm = problem.clone();
+            pm.contacts.iter_mut().for_each(|c| c.law.initial_state = m);
+            let (_, point) = hbm_point(&pm, freq)?;
+            Some((m, relative_distance(time, &point.amplitudes)))
+        })
+        .collect()
+}
+
 fn one_case(
     scene_problem: &crate::model::Problem,
     freq: f64,
@@ -106,6 +166,7 @@ fn one_case(
     from: StartFrom,
     settings: &VerifySettings,
     fig_dir: &std::path::Path,
+    curve_ms: &[f64],
 ) -> VerifyCase {
     let mut problem_m = scene_problem.clone();
     if let Some(m) = initial_state {
@@ -124,39 +185,48 @@ fn one_case(
         verification: None,
         stays: None,
         hill_agrees: None,
+        monodromy: None,
+        hill_monodromy_agree: None,
+        monodromy_error: None,
+        reached_curve: None,
+        reached_distance: None,
+        curve_distances: Vec::new(),
         error: None,
     };
     let omega = 2.0 * PI * freq;
-    let mut solver = match PointSolver::new(problem) {
-        Ok(s) => s,
-        Err(e) => {
-            case.error = Some(e.to_string());
-            return case;
-        }
-    };
-    let set = solver.system().unknowns().clone();
-    let point = [linear::stuck_guess, linear::open_guess]
-        .iter()
-        .filter_map(|g| g(problem, &set, omega).ok())
-        .find_map(|guess| solver.solve(&guess, freq).ok());
-    let Some(point) = point else {
+    if let Err(e) = PointSolver::new(problem) {
+        case.error = Some(e.to_string());
+        return case;
+    }
+    let Some((mut solver, point)) = hbm_point(problem, freq) else {
         case.error = Some(format!("harmonic balance did not converge at {freq} Hz"));
         return case;
     };
+    let set = solver.system().unknowns().clone();
     case.hbm_amplitudes = point.amplitudes.clone();
     if let Ok(s) = stability::point_stability(solver.system(), &point.coefficients, omega) {
         case.hill_stable = Some(s.stable);
         case.floquet_re = Some(s.floquet_re);
     }
+    let hbm_start = verify::hbm_state(
+        problem,
+        &set,
+        &point.coefficients,
+        freq,
+        settings.steps_per_period,
+    );
+    match hbm_start.as_ref().map_err(|e| e.clone()).and_then(|s| {
+        monodromy::monodromy_stability(problem, freq, s, settings, &MonodromySettings::default())
+    }) {
+        Ok(m) => {
+            case.hill_monodromy_agree = case.hill_stable.map(|h| h == m.stable);
+            case.monodromy = Some(m);
+        }
+        Err(e) => case.monodromy_error = Some(e.to_string()),
+    }
     let start = match from {
-        StartFrom::Hbm => verify::hbm_state(
-            problem,
-            &set,
-            &point.coefficients,
-            freq,
-            settings.steps_per_period,
-        ),
-        StartFrom::Static => verify::static_state(problem, initial_state.unwrap_or(0.0)),
+        StartFrom::Hbm => hbm_start,
+        StartFrom::Static => verify::static_state(problem),
     };
     let outcome = start.and_then(|start| {
         verify::verify_from(
@@ -177,7 +247,20 @@ fn one_case(
                 Some(m) => format!("verify_{freq}Hz_m{m}"),
                 None => format!("verify_{freq}Hz"),
             };
+            if from == StartFrom::Static {
+                case.curve_distances = curve_distances(problem, freq, curve_ms, &v.fine.amplitudes);
+                if let Some(&(m, d)) = case
+                    .curve_distances
+                    .iter()
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+                {
+                    case.reached_curve = Some(format!("m={m}"));
+                    case.reached_distance = Some(d);
+                }
+            }
             let _ = time_history_figure(problem, &set, &point.coefficients, &v, fig_dir, &stem);
+            let _ = phase_figure(problem, &v, fig_dir, &format!("{stem}_phase"));
+            let _ = hysteresis_figure(problem, &v, fig_dir, &format!("{stem}_hysteresis"));
             case.verification = Some(v);
         }
         Err(e) => case.error = Some(e.to_string()),
@@ -238,14 +321,102 @@ fn time_history_figure(
     )
 }
 
+/// Phase portrait: q̇ against q of each output over the last integrated period (fine dt).
+fn phase_figure(
+    problem: &crate::model::Problem,
+    v: &PointVerification,
+    dir: &std::path::Path,
+    stem: &str,
+) -> Result<(), plot::PlotError> {
+    let closed = |x: &[f64]| -> Vec<f64> { x.iter().chain(x.first()).copied().collect() };
+    let owned: Vec<(String, Vec<f64>, Vec<f64>)> = problem
+        .outputs
+        .iter()
+        .enumerate()
+        .map(|(o, &d)| {
+            (
+                problem.model.dof_names[d].clone(),
+                closed(&v.fine.last_period[o]),
+                closed(&v.fine.last_period_velocity[o]),
+            )
+        })
+        .collect();
+    let curves: Vec<Curve> = owned
+        .iter()
+        .enumerate()
+        .map(|(i, (label, x, y))| Curve {
+            label,
+            x,
+            y,
+            color: palette(i),
+            dashed: false,
+            markers: false,
+        })
+        .collect();
+    let (png, svg) = figure_files(dir, stem);
+    plot::plot_lines(
+        &format!(
+            "Phase portrait at {} Hz (last of {} periods)",
+            v.fine.freq_hz, v.fine.periods
+        ),
+        "displacement q (m)",
+        "velocity dq/dt (m/s)",
+        false,
+        &curves,
+        &png,
+        &svg,
+    )
+}
+
+/// Hysteresis loops: T against the tangential relative displacement u of every contact over
+/// the last integrated period (fine dt).
+fn hysteresis_figure(
+    problem: &crate::model::Problem,
+    v: &PointVerification,
+    dir: &std::path::Path,
+    stem: &str,
+) -> Result<(), plot::PlotError> {
+    let loops: Vec<plot::Loop> = problem
+        .contacts
+        .iter()
+        .zip(&v.fine.contact_loops)
+        .enumerate()
+        .map(|(i, (c, l))| plot::Loop {
+            label: &c.name,
+            u: &l.u,
+            t: &l.t,
+            color: palette(i),
+        })
+        .collect();
+    let (png, svg) = figure_files(dir, stem);
+    plot::plot_hysteresis(
+        &format!(
+            "Contact hysteresis at {} Hz (time integration, last of {} periods)",
+            v.fine.freq_hz, v.fine.periods
+        ),
+        &loops,
+        &png,
+        &svg,
+    )
+}
+
 fn opt<T: std::fmt::Display>(v: Option<T>) -> String {
     v.map(|x| x.to_string()).unwrap_or_default()
 }
 
 /// Runs `fricbound verify`.
 pub fn run(options: &VerifyOptions) -> Result<VerifyReport, CommandError> {
-    let (label, _scene, problem, _limits) =
+    let (label, _scene, problem, limits) =
         load_scene(options.scene.as_deref(), &options.overrides)?;
+    // The curves a `--from static` case is compared with: the two limits and the scene's
+    // uniform intermediate states (m = 0 too when the scene has no limit analysis).
+    let mut curve_ms: Vec<f64> = vec![-1.0, 1.0];
+    match &limits {
+        Some(l) => curve_ms.extend(l.intermediate.iter().copied()),
+        None => curve_ms.push(0.0),
+    }
+    curve_ms.sort_by(f64::total_cmp);
+    curve_ms.dedup();
     let dir = options.out.clone().unwrap_or_else(|| {
         default_out_dir(options.scene.as_deref(), &options.overrides).join("verify")
     });
@@ -281,7 +452,7 @@ pub fn run(options: &VerifyOptions) -> Result<VerifyReport, CommandError> {
     let cases: Vec<VerifyCase> = jobs
         .par_iter()
         .map(|&(f, m)| {
-            let c = one_case(&problem, f, m, options.from, &settings, &dir);
+            let c = one_case(&problem, f, m, options.from, &settings, &dir, &curve_ms);
             if let Some(b) = &bar {
                 b.inc(1);
             }
@@ -300,13 +471,13 @@ pub fn run(options: &VerifyOptions) -> Result<VerifyReport, CommandError> {
     for o in &outputs {
         csv.push_str(&format!(",{o}_hbm_amp,{o}_time_amp"));
     }
-    csv.push_str(",rel_diff,dt_change,periods,settled,nonharmonic_energy,hill_stable,floquet_re,stays,hill_agrees,error\n");
+    csv.push_str(",rel_diff,dt_change,periods,settled,nonharmonic_energy,hill_stable,floquet_re,stays,hill_agrees,monodromy_stable,monodromy_re,monodromy_freq_hz,neutral_sliders,grazing_nudged,orbit_defect,hill_monodromy_agree,reached_curve,reached_distance,error\n");
     let mut text = format!(
         "{label}: time integration (Newmark average acceleration, {} steps/period and twice that)\n",
         settings.steps_per_period
     );
     text.push_str(
-        "freq_hz  m     rel_diff   dt_change  periods settled hill_stable stays agrees\n",
+        "freq_hz  m     rel_diff   dt_change  periods settled hill_stable stays agrees monodromy_re hill=monodromy\n",
     );
     let mut problems = Vec::new();
     for c in &cases {
@@ -335,8 +506,9 @@ pub fn run(options: &VerifyOptions) -> Result<VerifyReport, CommandError> {
             ));
         }
         let v = c.verification.as_ref();
+        let mono = c.monodromy.as_ref();
         csv.push_str(&format!(
-            ",{},{},{},{},{},{},{},{},{},{}\n",
+            ",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             opt(v.map(|v| v.hbm_difference)),
             opt(v.map(|v| v.dt_change)),
             opt(v.map(|v| v.fine.periods)),
@@ -346,11 +518,34 @@ pub fn run(options: &VerifyOptions) -> Result<VerifyReport, CommandError> {
             opt(c.floquet_re),
             opt(c.stays),
             opt(c.hill_agrees),
+            opt(mono.map(|m| m.stable)),
+            opt(mono.map(|m| m.floquet_re)),
+            opt(mono.map(|m| m.floquet_freq_hz)),
+            mono.map(|m| {
+                m.neutral_sliders
+                    .iter()
+                    .map(|&i| problem.contacts[i].name.clone())
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            })
+            .unwrap_or_default(),
+            mono.map(|m| {
+                m.grazing_nudged
+                    .iter()
+                    .map(|&i| problem.contacts[i].name.clone())
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            })
+            .unwrap_or_default(),
+            opt(mono.map(|m| m.periodicity_defect)),
+            opt(c.hill_monodromy_agree),
+            c.reached_curve.clone().unwrap_or_default(),
+            opt(c.reached_distance),
             c.error.clone().unwrap_or_default().replace(',', ";"),
         ));
         match v {
             Some(v) => text.push_str(&format!(
-                "{:<8} {:<5} {:<10.3e} {:<10.3e} {:<7} {:<7} {:<11} {:<5} {}\n",
+                "{:<8} {:<5} {:<10.3e} {:<10.3e} {:<7} {:<7} {:<11} {:<5} {:<6} {:<12} {}\n",
                 c.freq_hz,
                 opt(c.initial_state),
                 v.hbm_difference,
@@ -359,7 +554,10 @@ pub fn run(options: &VerifyOptions) -> Result<VerifyReport, CommandError> {
                 v.fine.settled,
                 opt(c.hill_stable),
                 opt(c.stays),
-                opt(c.hill_agrees)
+                opt(c.hill_agrees),
+                mono.map(|m| format!("{:.3}", m.floquet_re))
+                    .unwrap_or_else(|| "-".into()),
+                opt(c.hill_monodromy_agree)
             )),
             None => text.push_str(&format!(
                 "{:<8} {:<5} failed: {}\n",

@@ -20,6 +20,8 @@
 //! - `comparison`: the paper's statements, the criteria of agreement ([`Agreement`]) and where
 //!   fricbound and the paper differ;
 //! - `markdown`: `summary.md` ([`markdown()`]);
+//! - `stability`: Hill stability of the 3rd-resonance limit curves without and with damper
+//!   damping ([`stability_study`]), a section of `summary.md` and `stability.json`;
 //! - `runner`: the command itself ([`paper`], [`PaperOptions`], [`PaperReport`]).
 
 mod comparison;
@@ -28,6 +30,7 @@ mod from_runs;
 mod markdown;
 mod numbers;
 mod runner;
+mod stability;
 
 pub use comparison::Agreement;
 pub use figures::{FigureJob, FigureResult, FIGURES};
@@ -37,3 +40,4 @@ pub use numbers::{
     AnalysisRow, BetaRow, BoundRow, KeyNumbers, Located, LoopRow, ResonanceEnds, SweepRow,
 };
 pub use runner::{paper, paper_summary_line, PaperOptions, PaperReport};
+pub use stability::{stability_markdown, stability_study, CurveStability, StabilityStudy};

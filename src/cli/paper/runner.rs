@@ -8,6 +8,7 @@ use std::time::Instant;
 use super::figures::{FigureResult, FIGURES};
 use super::from_runs::key_numbers;
 use super::markdown::markdown;
+use super::stability::{stability_markdown, stability_study, StabilityStudy};
 use crate::cli::{create_dir, run, CommandError, RunOptions, RunOutcome};
 use crate::report::files;
 
@@ -31,6 +32,8 @@ pub struct PaperReport {
     pub figures: Vec<FigureResult>,
     /// Wall time of the whole study (s).
     pub elapsed_s: f64,
+    /// Hill stability of the 3rd-resonance limit curves, without and with damper damping.
+    pub stability: StabilityStudy,
 }
 
 /// `fricbound paper`: runs every figure scene into `<out>/<figure id>/` and writes
@@ -83,18 +86,35 @@ pub fn paper(options: &PaperOptions) -> Result<PaperReport, CommandError> {
             &figures,
             options.quick,
             started.elapsed().as_secs_f64(),
+            None,
         )?;
     }
+    let stability = stability_study(&dir, options.quick, options.quiet);
+    write_summary(
+        &dir,
+        &figures,
+        options.quick,
+        started.elapsed().as_secs_f64(),
+        Some(&stability),
+    )?;
     let report = PaperReport {
         dir,
         elapsed_s: started.elapsed().as_secs_f64(),
         figures,
+        stability,
     };
     let failed: Vec<&str> = report
         .figures
         .iter()
         .filter(|f| f.outcome.is_err())
         .map(|f| f.job.id)
+        .chain(
+            report
+                .stability
+                .failed
+                .iter()
+                .map(|f| f.split(':').next().unwrap_or("stability")),
+        )
         .collect();
     if failed.is_empty() {
         Ok(report)
@@ -106,15 +126,22 @@ pub fn paper(options: &PaperOptions) -> Result<PaperReport, CommandError> {
     }
 }
 
-/// Writes `summary.md` and `summary.json` (the key numbers) of the figures run so far.
+/// Writes `summary.md` and `summary.json` (the key numbers) of the figures run so far, and
+/// the stability section and `stability.json` once the stability runs are done.
 fn write_summary(
     dir: &Path,
     figures: &[FigureResult],
     quick: bool,
     elapsed_s: f64,
+    stability: Option<&StabilityStudy>,
 ) -> Result<(), CommandError> {
     let numbers = key_numbers(figures);
-    let text = markdown(figures, &numbers, quick, elapsed_s);
+    let mut text = markdown(figures, &numbers, quick, elapsed_s);
+    if let Some(s) = stability {
+        text.push_str(&stability_markdown(s));
+        let json = serde_json::to_vec_pretty(s).expect("stability rows serialise");
+        files::write_atomic(&dir.join("stability.json"), &json)?;
+    }
     files::write_atomic(&dir.join("summary.md"), text.as_bytes())?;
     let json = serde_json::to_vec_pretty(&numbers).expect("summary numbers serialise");
     files::write_atomic(&dir.join("summary.json"), &json)?;
