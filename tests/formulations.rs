@@ -365,53 +365,9 @@ fn schur_formulation_refuses_dependent_contact_rows() {
     assert_ne!(p.formulation(), Formulation::Schur);
 }
 
-/// A chain of `n` unit masses (springs of 10⁴ N/m, the first one grounded) with `jenkins`
-/// Jenkins elements to ground spread along it, excited at its free end, H = 5.
+/// The chain of unit masses with Jenkins elements to ground of the Jacobian study, at H = 5.
 fn chain_scene(n: usize, jenkins: usize) -> String {
-    let k = 1.0e4;
-    let mut stiffness = vec![vec![0.0; n]; n];
-    for i in 0..n {
-        stiffness[i][i] += k;
-        if i + 1 < n {
-            stiffness[i][i] += k;
-            stiffness[i + 1][i + 1] += k;
-            stiffness[i][i + 1] -= k;
-            stiffness[i + 1][i] -= k;
-        }
-    }
-    let matrix = |f: &dyn Fn(usize, usize) -> f64| {
-        let rows: Vec<String> = (0..n)
-            .map(|i| {
-                let row: Vec<String> = (0..n).map(|j| format!("{:.6e}", f(i, j))).collect();
-                format!("[{}]", row.join(", "))
-            })
-            .collect();
-        format!("[{}]", rows.join(",\n"))
-    };
-    let dofs: Vec<String> = (0..n).map(|i| format!("\"x{i}\"")).collect();
-    let mut s = format!(
-        "title = \"chain\"\n[model]\ndofs = [{}]\nmass = {}\nstiffness = {}\ndamping = {}\n",
-        dofs.join(", "),
-        matrix(&|i, j| if i == j { 1.0 } else { 0.0 }),
-        matrix(&|i, j| stiffness[i][j]),
-        matrix(&|i, j| 0.002 * stiffness[i][j] + if i == j { 0.1 } else { 0.0 }),
-    );
-    let step = n / jenkins;
-    for j in 0..jenkins {
-        s += &format!(
-            "[[contacts]]\nname = \"g{j}\"\ndamper = [\"x{}\"]\ntangent = [1.0]\nnormal = [0.0]\n\
-             kt = 1.0e5\nkn = 1.0e5\nmu = 0.3\ngap = -1.0e-4\n",
-            j * step + step / 2
-        );
-    }
-    s += &format!(
-        "[[harmonic_loads]]\ndof = \"x{}\"\nharmonic = 1\ncos = 20.0\n[harmonics]\nmax = 5\n\
-         samples = 128\n[analysis]\nfreq_start_hz = 1.0\nfreq_end_hz = 40.0\n[output]\n\
-         dofs = [\"x{}\"]\n",
-        n - 1,
-        n - 1
-    );
-    s
+    fricbound::study::jacobian::chain_scene(n, jenkins, 5)
 }
 
 /// `auto` takes, on a dense model, the formulation the cost estimate finds fastest (dense

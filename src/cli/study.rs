@@ -11,7 +11,7 @@ use std::io::Write as _;
 use std::path::PathBuf;
 use std::sync::Mutex;
 
-use clap::Subcommand;
+use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use plotters::style::RGBColor;
 
@@ -28,42 +28,32 @@ use crate::study::jacobian::{self, CaseResult, FormulationRow};
 pub enum StudyCommand {
     /// What accuracy costs in time: each setting (harmonics, samples, tolerance, interior modes,
     /// effect switches) against a converged reference.
-    Accuracy {
-        /// Scene file (TOML).
-        scene: PathBuf,
-        /// Short setting lists (seconds on the paper case).
-        #[arg(long)]
-        quick: bool,
-        /// Output folder (default: out/<scene name>-accuracy).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Override a scene field by its dotted path (applied to every setting).
-        #[arg(long = "set", value_name = "FIELD=VALUE")]
-        overrides: Vec<String>,
-        /// No progress bar.
-        #[arg(long)]
-        quiet: bool,
-    },
+    Accuracy(StudyArgs),
     /// The analytic Jacobian against finite differences, and the dense, sparse, condensed and
     /// schur formulations side by side (time per residual, Jacobian, Newton iteration and FRF
     /// point), on the scene and on the paper case, chains with Jenkins elements to ground and
     /// the reduced blade pair; the formulation `auto` picks is marked.
-    Jacobian {
-        /// Scene file (TOML).
-        scene: PathBuf,
-        /// Small ladder and short budgets (seconds).
-        #[arg(long)]
-        quick: bool,
-        /// Output folder (default: out/<scene name>-jacobian).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Override a field of the scene by its dotted path (the scene's case only).
-        #[arg(long = "set", value_name = "FIELD=VALUE")]
-        overrides: Vec<String>,
-        /// No progress bar.
-        #[arg(long)]
-        quiet: bool,
-    },
+    Jacobian(StudyArgs),
+}
+
+/// The arguments every study takes.
+#[derive(Debug, Clone, Args)]
+pub struct StudyArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Short setting lists and budgets (seconds on the paper case).
+    #[arg(long)]
+    pub quick: bool,
+    /// Output folder (default: out/<scene name>-accuracy or -jacobian).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Override a scene field by its dotted path (accuracy: applied to every setting;
+    /// jacobian: the scene's own case only).
+    #[arg(long = "set", value_name = "FIELD=VALUE")]
+    pub overrides: Vec<String>,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 /// What a study produced: the summary text and, when some setting failed or did not cover the
@@ -115,20 +105,12 @@ fn csv_row(r: &SettingResult, e: &SettingErrors) -> String {
 /// Runs a study command.
 pub fn run(command: &StudyCommand) -> Result<StudyReport, CommandError> {
     match command {
-        StudyCommand::Accuracy {
-            scene,
-            quick,
-            out,
-            overrides,
-            quiet,
-        } => accuracy_study(scene, *quick, out.clone(), overrides, *quiet),
-        StudyCommand::Jacobian {
-            scene,
-            quick,
-            out,
-            overrides,
-            quiet,
-        } => jacobian_study(scene, *quick, out.clone(), overrides, *quiet),
+        StudyCommand::Accuracy(a) => {
+            accuracy_study(&a.scene, a.quick, a.out.clone(), &a.overrides, a.quiet)
+        }
+        StudyCommand::Jacobian(a) => {
+            jacobian_study(&a.scene, a.quick, a.out.clone(), &a.overrides, a.quiet)
+        }
     }
 }
 
