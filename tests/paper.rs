@@ -10,7 +10,8 @@ use fricbound::scene;
 use fricbound::study::sweep;
 
 /// Every figure scene, as shipped in `meshes/paper-wedge/` and as built into the binary, is
-/// valid with and without the `--quick` overrides, at every one of its sweep points.
+/// valid with the study's overrides (envelope, and `--quick`) and without `--quick`, at every one of its sweep points;
+/// Figs. 13a, 15a and 15b ask for the envelope in the full study.
 #[test]
 fn every_figure_scene_is_valid_at_every_sweep_point() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("meshes/paper-wedge");
@@ -21,8 +22,7 @@ fn every_figure_scene_is_valid_at_every_sweep_point() {
             "{} differs from the built-in text",
             job.id
         );
-        let quick: Vec<String> = job.quick.iter().map(|s| s.to_string()).collect();
-        for overrides in [Vec::new(), quick] {
+        for overrides in [job.overrides(false), job.overrides(true)] {
             let s = scene::parse(job.text, job.scene_file, &overrides)
                 .unwrap_or_else(|e| panic!("{}: {e}", job.id));
             let problem = s
@@ -36,6 +36,15 @@ fn every_figure_scene_is_valid_at_every_sweep_point() {
                 }
             }
         }
+    }
+    for id in ["fig13-3rd", "fig15a", "fig15b"] {
+        let job = FIGURES.iter().find(|j| j.id == id).unwrap();
+        assert!(job.computes_envelope(false), "{id}");
+        let s = scene::parse(job.text, job.scene_file, &job.overrides(false)).unwrap();
+        assert!(
+            s.limits.as_ref().is_some_and(|l| l.envelope.is_some()),
+            "{id}: no envelope"
+        );
     }
     // One scene per figure of §4, Figs. 12-19.
     let ids: Vec<&str> = FIGURES.iter().map(|j| j.id).collect();
@@ -241,4 +250,93 @@ fn paper_quick_writes_every_figure_and_a_summary_of_computed_numbers() {
         .count();
     assert_eq!(rows, with_scan);
     assert!(with_scan >= 15, "{with_scan} bound checks");
+
+    // The envelope over all initial states next to the two-point limits (Figs. 13a, 15b and,
+    // unless --quick skips it, 15a): its columns in the figure's limits.csv, a row per analysis
+    // in the envelope section whose numbers are the ones of limits.json, and its excess in the
+    // key-number row on bounds.
+    let with_envelope: Vec<&serde_json::Value> = analyses
+        .iter()
+        .filter(|a| !a["envelope"].is_null())
+        .collect();
+    let skipped: Vec<&str> = json["envelope_skipped"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    for id in ["fig13-3rd", "fig15b"] {
+        assert!(
+            with_envelope.iter().any(|a| a["figure"] == id),
+            "no envelope for {id}"
+        );
+        assert!(!skipped.contains(&id), "{id} skipped");
+        let header = read(&out.join(id).join("limits.csv"));
+        let header = header.lines().next().unwrap();
+        assert!(
+            header.contains("y2_envelope_min_amp") && header.contains("y2_envelope_max_amp"),
+            "{id}: {header}"
+        );
+    }
+    let fig15a = with_envelope
+        .iter()
+        .filter(|a| a["figure"] == "fig15a")
+        .count();
+    assert!(
+        fig15a == 3 || (fig15a == 0 && skipped == ["fig15a"]),
+        "fig15a: {fig15a} envelopes, skipped {skipped:?}"
+    );
+    let section = summary
+        .split("## The envelope over all initial states")
+        .nth(1)
+        .expect("no envelope section")
+        .split("\n## ")
+        .next()
+        .unwrap();
+    let rows: Vec<&str> = section
+        .lines()
+        .filter(|l| l.starts_with("| fig") && !l.starts_with("| figure"))
+        .collect();
+    assert_eq!(rows.len(), with_envelope.len(), "{section}");
+    if !skipped.is_empty() {
+        assert!(
+            section.contains("Not computed in this run:** fig15a"),
+            "{section}"
+        );
+    }
+    // Fig. 13a's row: the largest excess above the upper limit is limits.json's, and where.
+    let limits: serde_json::Value =
+        serde_json::from_str(&read(&out.join("fig13-3rd/limits.json"))).unwrap();
+    let check = &limits["envelope"]["check"];
+    let above = 100.0 * check["max_excess_above"].as_f64().unwrap();
+    let row = rows
+        .iter()
+        .find(|l| l.starts_with("| fig13-3rd |"))
+        .unwrap();
+    assert!(
+        row.contains(&format!("| {above:.3} %")),
+        "{above:.3} % not in {row}"
+    );
+    let fig13 = with_envelope
+        .iter()
+        .find(|a| a["figure"] == "fig13-3rd")
+        .unwrap();
+    assert_eq!(fig13["envelope"]["above_pct"].as_f64().unwrap(), above);
+    if above > 1e-4 {
+        let f = check["above_at"][0].as_f64().unwrap();
+        assert!(row.contains(&format!("at {f:.3} Hz (m_left = ")), "{row}");
+    }
+    // Every envelope found a state at every grid frequency, over the whole grid.
+    for a in &with_envelope {
+        assert_eq!(a["envelope"]["unsolved"].as_u64(), Some(0), "{a}");
+        assert!(a["envelope"]["compared"].as_u64().unwrap() >= 41, "{a}");
+    }
+    let bound_row = summary
+        .lines()
+        .find(|l| l.starts_with("| do the limits bound the other solutions?"))
+        .unwrap();
+    assert!(
+        bound_row.contains("envelope over all m per side: "),
+        "{bound_row}"
+    );
 }

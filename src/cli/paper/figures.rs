@@ -1,6 +1,7 @@
 //! The jobs of the paper's §4 study and their results: one [`FigureJob`] per figure (its
-//! scene, built into the binary, and its coarser `--quick` settings), the list [`FIGURES`] in
-//! the paper's order, and the [`FigureResult`] of running one.
+//! scene, built into the binary, its coarser `--quick` settings and whether it computes the
+//! response envelope), the list [`FIGURES`] in the paper's order, and the [`FigureResult`] of
+//! running one.
 
 use crate::cli::RunReport;
 
@@ -17,6 +18,45 @@ pub struct FigureJob {
     pub caption: &'static str,
     /// `--set` overrides applied with `--quick`.
     pub quick: &'static [&'static str],
+    /// Whether the figure's limit analyses also compute the response envelope over all
+    /// initial states (one m per damper side), and in which mode of the study.
+    pub envelope: EnvelopeUse,
+}
+
+/// When a figure computes the response envelope (`[limits] envelope = "sides"`, set by the
+/// override [`ENVELOPE_OVERRIDE`]) next to its two-point limits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EnvelopeUse {
+    /// Never.
+    Off,
+    /// In the full study and with `--quick`.
+    Always,
+    /// In the full study only: with `--quick` it would cost more than a few seconds.
+    FullOnly,
+}
+
+/// The override that asks a figure's limit analyses for the envelope, one m per damper side.
+pub const ENVELOPE_OVERRIDE: &str = "limits.envelope=\"sides\"";
+
+impl FigureJob {
+    /// Whether the figure computes the envelope in this mode of the study.
+    pub fn computes_envelope(&self, quick: bool) -> bool {
+        match self.envelope {
+            EnvelopeUse::Off => false,
+            EnvelopeUse::Always => true,
+            EnvelopeUse::FullOnly => !quick,
+        }
+    }
+
+    /// The `--set` overrides the study applies to the figure's scene: the envelope when the
+    /// figure computes it, then the `--quick` settings.
+    pub fn overrides(&self, quick: bool) -> Vec<String> {
+        let envelope = self
+            .computes_envelope(quick)
+            .then(|| ENVELOPE_OVERRIDE.to_string());
+        let coarse = self.quick.iter().filter(|_| quick).map(|s| s.to_string());
+        envelope.into_iter().chain(coarse).collect()
+    }
 }
 
 /// Coarser limit-analysis settings for `--quick`.
@@ -35,12 +75,16 @@ macro_rules! quick_limits {
 /// in from that file (so the name and the text cannot disagree).
 macro_rules! figure {
     ($id:literal, $file:literal, $caption:literal, $quick:expr) => {
+        figure!($id, $file, $caption, $quick, EnvelopeUse::Off)
+    };
+    ($id:literal, $file:literal, $caption:literal, $quick:expr, $envelope:expr) => {
         FigureJob {
             id: $id,
             scene_file: $file,
             text: include_str!(concat!("../../../meshes/paper-wedge/", $file)),
             caption: $caption,
             quick: $quick,
+            envelope: $envelope,
         }
     };
 }
@@ -63,19 +107,22 @@ pub static FIGURES: [FigureJob; 13] = [
         "fig13-3rd",
         "fig13-3rd.toml",
         "limits and contact states around the 3rd resonance, F0 = 120 N (Figs. 13a, 14a)",
-        quick_limits!("limits.intermediate=[0.0]")
+        quick_limits!("limits.intermediate=[0.0]"),
+        EnvelopeUse::Always
     ),
     figure!(
         "fig15a",
         "fig15a.toml",
         "limits at F0 = 60, 130 and 400 N (Fig. 15a)",
-        quick_limits!()
+        quick_limits!(),
+        EnvelopeUse::Always
     ),
     figure!(
         "fig15b",
         "fig15b.toml",
         "limits and intermediate curves near the optimum, F0 = 60 N (Fig. 15b)",
-        quick_limits!()
+        quick_limits!(),
+        EnvelopeUse::Always
     ),
     figure!(
         "fig16a-d",

@@ -5,9 +5,10 @@
 //! window; a sweep value whose limit peak is not an interior maximum, or whose curve failed, is
 //! left out of maxima and rankings and listed instead.
 
-use super::figures::{FigureJob, FigureResult};
+use super::figures::{EnvelopeUse, FigureJob, FigureResult};
 use super::numbers::{
-    AnalysisRow, BetaRow, BoundRow, KeyNumbers, Located, LoopRow, ResonanceEnds, SweepRow,
+    AnalysisRow, BetaRow, BoundRow, EnvelopeRow, KeyNumbers, Located, LoopRow, ResonanceEnds,
+    SweepRow,
 };
 use crate::analysis::limits::LimitAnalysis;
 use crate::analysis::linear::LinearCurve;
@@ -127,6 +128,20 @@ fn analysis_row(
                 .any(|&x| x != crate::contact::ContactState::Stuck)
         }),
     });
+    let envelope = a.envelope.as_ref().map(|e| EnvelopeRow {
+        sides: e.groups.clone(),
+        compared: e.check.compared,
+        points_above: e.check.points_above,
+        points_below: e.check.points_below,
+        above_pct: 100.0 * e.check.max_excess_above,
+        above_at: e.check.above_at.clone(),
+        below_pct: 100.0 * e.check.max_excess_below,
+        below_at: e.check.below_at.clone(),
+        peak_above_pct: 100.0 * e.check.peak_excess_above,
+        unsolved: e.unsolved,
+        solves: e.solves,
+        elapsed_s: e.elapsed_s,
+    });
     Some(AnalysisRow {
         figure: figure.to_string(),
         at,
@@ -142,6 +157,7 @@ fn analysis_row(
         always_stuck_side,
         intermediates_outside,
         bound,
+        envelope,
     })
 }
 
@@ -296,6 +312,17 @@ pub fn key_numbers(figures: &[FigureResult]) -> KeyNumbers {
             RunOutcome::Frf(_) => {}
         }
     }
+    // Figures that compute the envelope in the full study, run without it (`--quick`).
+    k.envelope_skipped = figures
+        .iter()
+        .filter(|f| f.report().is_some() && f.job.envelope != EnvelopeUse::Off)
+        .filter(|f| {
+            !k.analyses
+                .iter()
+                .any(|r| r.figure == f.job.id && r.envelope.is_some())
+        })
+        .map(|f| f.job.id.to_string())
+        .collect();
     for row in &k.analyses {
         if row.refined {
             let at = if row.at.is_empty() {

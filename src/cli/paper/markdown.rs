@@ -1,6 +1,6 @@
 //! `summary.md`: the document around the comparison with the paper ([`markdown`]): the header,
-//! the key-number table and the differences (from the comparison), the bound checks, one
-//! section per figure with its images and numbers, the continuation retries and the failures.
+//! the key-number table and the differences (from the comparison), the bound checks, the
+//! envelope over all initial states against the limits, one section per figure with its images and numbers, the continuation retries and the failures.
 
 use std::fmt::Write as _;
 
@@ -34,6 +34,7 @@ pub fn markdown(figures: &[FigureResult], k: &KeyNumbers, quick: bool, elapsed_s
 
     key_table(&mut s, k);
     bounds_table(&mut s, k);
+    envelope_table(&mut s, k);
     figure_sections(&mut s, figures, k);
     differences(&mut s, k);
     if !k.retries.is_empty() {
@@ -98,6 +99,79 @@ fn bounds_table(s: &mut String, k: &KeyNumbers) {
             } else {
                 r.intermediates_outside.join(", ")
             }
+        );
+    }
+    s.push('\n');
+}
+
+/// The `## The envelope over all initial states` section: per limit analysis that computed the
+/// response envelope (one m per side), where and by how much it leaves the band of the two
+/// limit curves.
+fn envelope_table(s: &mut String, k: &KeyNumbers) {
+    let rows: Vec<&AnalysisRow> = k.analyses.iter().filter(|r| r.envelope.is_some()).collect();
+    if rows.is_empty() && k.envelope_skipped.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "## The envelope over all initial states
+"
+    );
+    let _ = writeln!(
+        s,
+        "For Figs. 13a, 15a and 15b the limit analysis also computes the response envelope \
+         (`[limits] envelope = \"sides\"`): at every grid frequency the largest and smallest \
+         amplitude of y2 over all initial states m ∈ [−1, 1] per damper side, by bounded \
+         optimisation with the implicit-function sensitivity dA/dm, and at the limit curves' \
+         peaks. Where the envelope leaves the band of the two limit curves, the two-point limits \
+         fail to bound the response; the excesses are relative to the limit curve at that \
+         frequency, with the m per side that attains them. The envelope's columns \
+         (`y2_envelope_min_amp`, `y2_envelope_max_amp`) are in the figure's `limits.csv`, its \
+         details in `limits.json` → `envelope`, and it is drawn (black) in `limits_y2.png`.\n"
+    );
+    if !k.envelope_skipped.is_empty() {
+        let _ = writeln!(
+            s,
+            "**Not computed in this run:** {} (`--quick` skips the envelope there: it costs more \
+             than a few seconds; run without `--quick`).\n",
+            k.envelope_skipped.join(", ")
+        );
+    }
+    if rows.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "| figure | at | envelope above the upper limit (largest, where, m per side) | envelope below the lower limit | grid frequencies above / below / compared | envelope at the limit peaks above the larger limit peak | solves, time |\n| --- | --- | --- | --- | --- | --- | --- |"
+    );
+    for r in rows {
+        let Some(e) = &r.envelope else { continue };
+        let place = |p: &Option<(f64, Vec<f64>)>, pct: f64| {
+            p.as_ref()
+                .filter(|_| pct > 1e-4)
+                .map(|(f, m)| format!(" at {f:.3} Hz ({})", e.m_text(m)))
+                .unwrap_or_default()
+        };
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.3} %{} | {:.3} %{} | {} / {} / {}{} | {:.3} % | {}, {:.1} s |",
+            r.figure,
+            if r.at.is_empty() { "—" } else { &r.at },
+            e.above_pct,
+            place(&e.above_at, e.above_pct),
+            e.below_pct,
+            place(&e.below_at, e.below_pct),
+            e.points_above,
+            e.points_below,
+            e.compared,
+            if e.unsolved > 0 {
+                format!(" ({} unsolved)", e.unsolved)
+            } else {
+                String::new()
+            },
+            e.peak_above_pct,
+            e.solves,
+            e.elapsed_s
         );
     }
     s.push('\n');

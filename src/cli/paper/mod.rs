@@ -12,8 +12,9 @@
 //! reported in the summary and the others still run; the command then ends with an error.
 //!
 //! The files, lowest first:
-//! - `figures`: the study's jobs ([`FigureJob`], [`FIGURES`]) and the result of one
-//!   ([`FigureResult`]);
+//! - `figures`: the study's jobs ([`FigureJob`], [`FIGURES`]), which of them compute the
+//!   response envelope over all initial states ([`EnvelopeUse`]: Figs. 13a, 15a, 15b, with
+//!   [`ENVELOPE_OVERRIDE`]) and the result of one ([`FigureResult`]);
 //! - `numbers`: what the summary reports ([`KeyNumbers`] and its rows), written as
 //!   `summary.json`;
 //! - `from_runs`: the key numbers computed from the runs ([`key_numbers`]);
@@ -33,11 +34,12 @@ mod runner;
 mod stability;
 
 pub use comparison::Agreement;
-pub use figures::{FigureJob, FigureResult, FIGURES};
+pub use figures::{EnvelopeUse, FigureJob, FigureResult, ENVELOPE_OVERRIDE, FIGURES};
 pub use from_runs::{key_numbers, PEAK_TOLERANCE};
 pub use markdown::markdown;
 pub use numbers::{
-    AnalysisRow, BetaRow, BoundRow, KeyNumbers, Located, LoopRow, ResonanceEnds, SweepRow,
+    AnalysisRow, BetaRow, BoundRow, EnvelopeRow, KeyNumbers, Located, LoopRow, ResonanceEnds,
+    SweepRow,
 };
 pub use runner::{paper, paper_summary_line, PaperOptions, PaperReport};
 pub use stability::{stability_markdown, stability_study, CurveStability, StabilityStudy};

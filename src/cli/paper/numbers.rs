@@ -34,6 +34,49 @@ pub struct BoundRow {
     pub above_stuck_limit_vs_slipping: bool,
 }
 
+/// The response envelope of one limit analysis over all initial states (one m per damper
+/// side, `[limits] envelope = "sides"`) against the two limit curves, first output DOF (y2).
+/// Excesses are relative to the limit curve there, in %.
+#[derive(Debug, Clone, Serialize)]
+pub struct EnvelopeRow {
+    /// Name of each side, the order of every `m` vector.
+    pub sides: Vec<String>,
+    /// Grid frequencies compared (band and envelope both exist).
+    pub compared: usize,
+    /// Grid frequencies where the envelope's max exceeds the upper limit (by more than 10⁻⁶).
+    pub points_above: usize,
+    /// Grid frequencies where the envelope's min lies below the lower limit.
+    pub points_below: usize,
+    /// Largest excess of the envelope's max above the upper limit, pointwise (%).
+    pub above_pct: f64,
+    /// Where: frequency (Hz) and the m per side attaining it.
+    pub above_at: Option<(f64, Vec<f64>)>,
+    /// Largest excess of the envelope's min below the lower limit, pointwise (%).
+    pub below_pct: f64,
+    /// Where: frequency (Hz) and the m per side attaining it.
+    pub below_at: Option<(f64, Vec<f64>)>,
+    /// Largest envelope max at the limit peaks over the larger limit peak (%).
+    pub peak_above_pct: f64,
+    /// Grid frequencies where no state could be solved.
+    pub unsolved: usize,
+    /// Newton solves of the search.
+    pub solves: usize,
+    /// Wall time of the envelope (s).
+    pub elapsed_s: f64,
+}
+
+impl EnvelopeRow {
+    /// `m_left = −0.622, m_right = +0.000`: the m of each side.
+    pub fn m_text(&self, m: &[f64]) -> String {
+        self.sides
+            .iter()
+            .zip(m)
+            .map(|(side, m)| format!("m_{side} = {m:+.3}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
 /// One limit analysis of the study.
 #[derive(Debug, Clone, Serialize)]
 pub struct AnalysisRow {
@@ -65,6 +108,8 @@ pub struct AnalysisRow {
     pub intermediates_outside: Vec<String>,
     /// Bound check, when the scene asked for a scan.
     pub bound: Option<BoundRow>,
+    /// The response envelope against the limits, when the figure computes it.
+    pub envelope: Option<EnvelopeRow>,
 }
 
 /// One value of a peak sweep.
@@ -171,4 +216,7 @@ pub struct KeyNumbers {
     pub retries: Vec<String>,
     /// Sweep points or figures that failed, one line each.
     pub failures: Vec<String>,
+    /// Figures that compute the envelope in the full study but skipped it in this (`--quick`)
+    /// run.
+    pub envelope_skipped: Vec<String>,
 }

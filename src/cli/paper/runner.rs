@@ -56,11 +56,7 @@ pub fn paper(options: &PaperOptions) -> Result<PaperReport, CommandError> {
             scene: Some(Path::new("meshes/paper-wedge").join(job.scene_file)),
             scene_text: Some(job.text.to_string()),
             out: Some(dir.join(job.id)),
-            overrides: if options.quick {
-                job.quick.iter().map(|s| s.to_string()).collect()
-            } else {
-                Vec::new()
-            },
+            overrides: job.overrides(options.quick),
             quiet: options.quiet,
         };
         // A limit analysis with a failed or incomplete case has no numbers to compare with the
