@@ -103,6 +103,7 @@ class LimitsResult:
     bounds: Optional[Dict[str, float]]
     scanned: List[Dict[str, Any]]
     variability: Dict[str, float]
+    envelope: Optional[Dict[str, Any]]
     unfinished: List[str]
     status: str
     @property

@@ -174,7 +174,14 @@ class LimitsResult(_Result):
     - ``bounds``: the bound check of a ``bound_scan`` (largest excess above / below, m) or None;
       ``scanned``: the scanned cases' peaks;
     - ``variability``: upper and lower peak (m), their ratio, peak-frequency change (%),
-      widest band; ``status``, ``unfinished``.
+      widest band; ``status``, ``unfinished``;
+    - ``envelope`` (with ``[limits] envelope = "sides"`` or ``"points"``, else None): a dict
+      with ``mode``, ``groups`` (the sides or points, the order of every m), ``freq_hz`` (g,),
+      ``min``, ``max`` (g, outputs): the smallest and largest amplitude over all initial
+      states (m, NaN where none was solved), ``min_m``, ``max_m`` (g, outputs, groups): the m
+      attaining them, ``check``: where and by how much the limit curves fail to bound it
+      (relative excesses, ``above_at``/``below_at`` = (frequency, m)), ``solves``,
+      ``unsolved``, ``elapsed_s``.
     """
 
     def __init__(self, d: Dict[str, Any]):
@@ -191,7 +198,8 @@ class LimitsResult(_Result):
 
     def to_pandas(self):
         """The common grid as a DataFrame: ``freq_hz``, ``lower``, ``upper``,
-        ``<case>_amp`` per limit curve, ``regime``."""
+        ``<case>_amp`` per limit curve, ``regime``, and with an envelope ``envelope_min``,
+        ``envelope_max`` (first output DOF)."""
         pd = _pandas()
         cols: Dict[str, Any] = {
             "freq_hz": self.grid_freq_hz,
@@ -201,6 +209,10 @@ class LimitsResult(_Result):
         for k, c in enumerate(self.limits):
             cols[f"{c.name}_amp"] = self.grid_amplitudes[:, k]
         cols["regime"] = self.grid_regime
+        env = getattr(self, "envelope", None)
+        if env is not None and len(env["freq_hz"]) == len(self.grid_freq_hz):
+            cols["envelope_min"] = env["min"][:, 0]
+            cols["envelope_max"] = env["max"][:, 0]
         return pd.DataFrame(cols)
 
     def __repr__(self) -> str:

@@ -1,13 +1,14 @@
 //! Library results into dicts of numpy arrays, lists and scalars (the pure-Python layer wraps
 //! them in result classes). Units as in the library: frequencies in Hz, displacements in m.
 
-use numpy::ndarray::Array2;
-use numpy::{PyArray1, PyArray2};
+use numpy::ndarray::{Array2, Array3};
+use numpy::{PyArray1, PyArray2, PyArray3};
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use fricbound::analysis::frf::{FrfPoint, FrfRun};
+use fricbound::analysis::limits::envelope::{Envelope, EnvelopeBound};
 use fricbound::analysis::limits::{CaseCurve, LimitAnalysis, Peak, Regime};
 use fricbound::analysis::modes::{EigenMethod, NaturalModes};
 use fricbound::contact::harmonic::Block;
@@ -15,6 +16,65 @@ use fricbound::model::Problem;
 use fricbound::report::files;
 use fricbound::scene::SweepSpec;
 use fricbound::study::sweep::SweepPoint;
+
+/// The response envelope (`[limits] envelope`): per grid frequency and output DOF the smallest
+/// and largest amplitude over the initial states (m; NaN where no state was solved), the m of
+/// each group attaining them, and the check of the two limit curves against it.
+fn envelope_dict<'py>(py: Python<'py>, e: &Envelope) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let n = e.points.len();
+    let outputs = e.points.first().map_or(0, |p| p.max.len());
+    let groups = e.groups.len();
+    d.set_item("mode", format!("{:?}", e.mode).to_lowercase())?;
+    d.set_item("groups", e.groups.clone())?;
+    d.set_item(
+        "freq_hz",
+        PyArray1::from_vec(py, e.points.iter().map(|p| p.freq_hz).collect()),
+    )?;
+    let amplitude = |b: &Option<EnvelopeBound>| b.as_ref().map_or(f64::NAN, |b| b.amplitude);
+    let mins: Vec<&[Option<EnvelopeBound>]> = e.points.iter().map(|p| p.min.as_slice()).collect();
+    let maxs: Vec<&[Option<EnvelopeBound>]> = e.points.iter().map(|p| p.max.as_slice()).collect();
+    let bounds = |rows: &[&[Option<EnvelopeBound>]]| {
+        array2(
+            py,
+            n,
+            outputs,
+            rows.iter().flat_map(|r| r.iter().map(amplitude)).collect(),
+        )
+    };
+    let states = |rows: &[&[Option<EnvelopeBound>]]| {
+        let mut m = Array3::from_elem((n, outputs, groups), f64::NAN);
+        for (k, r) in rows.iter().enumerate() {
+            for (o, b) in r.iter().enumerate().take(outputs) {
+                if let Some(b) = b {
+                    for (g, x) in b.m.iter().enumerate().take(groups) {
+                        m[(k, o, g)] = *x;
+                    }
+                }
+            }
+        }
+        PyArray3::from_owned_array(py, m)
+    };
+    d.set_item("min", bounds(&mins)?)?;
+    d.set_item("max", bounds(&maxs)?)?;
+    d.set_item("min_m", states(&mins))?;
+    d.set_item("max_m", states(&maxs))?;
+    let c = &e.check;
+    let cd = PyDict::new(py);
+    cd.set_item("compared", c.compared)?;
+    cd.set_item("max_excess_above", c.max_excess_above)?;
+    cd.set_item("above_at", c.above_at.clone())?;
+    cd.set_item("max_excess_below", c.max_excess_below)?;
+    cd.set_item("below_at", c.below_at.clone())?;
+    cd.set_item("points_above", c.points_above)?;
+    cd.set_item("points_below", c.points_below)?;
+    cd.set_item("peak_excess_above", c.peak_excess_above)?;
+    d.set_item("check", cd)?;
+    d.set_item("solves", e.solves)?;
+    d.set_item("unsolved", e.unsolved)?;
+    d.set_item("elapsed_s", e.elapsed_s)?;
+    Ok(d)
+}
 
 /// A row-major `rows × cols` numpy array from flat values.
 pub fn array2<'py>(
@@ -299,6 +359,10 @@ pub fn limits_dict<'py>(
         d.set_item("bounds", bd)?;
     } else {
         d.set_item("bounds", py.None())?;
+    }
+    match &a.envelope {
+        Some(e) => d.set_item("envelope", envelope_dict(py, e)?)?,
+        None => d.set_item("envelope", py.None())?,
     }
     let scanned = PyList::empty(py);
     for s in &a.scanned {

@@ -255,3 +255,29 @@ def test_incomplete_and_too_large_runs_say_so():
     assert len(r) == 20
     with pytest.raises(MemoryError, match="harmonics.max"):
         fricbound.run(Scene.paper().set("harmonics.max", 10000).set("harmonics.samples", 32768))
+
+
+def test_limits_with_envelope_returns_it_as_arrays():
+    """`[limits] envelope = "sides"` through `set`: the envelope comes back on the common grid,
+    every bound between the smallest and largest limit-curve amplitude it must contain, and its
+    check names where the limits fail to bound it."""
+    scene = Scene.from_toml(PAPER / "fig13-3rd.toml")
+    scene.set("limits.envelope", "sides").set("limits.grid_points", 9)
+    r = fricbound.limits(scene)
+    env = r.envelope
+    assert env is not None and env["mode"] == "sides"
+    assert env["groups"] == ["left", "right"]
+    n = len(r.grid_freq_hz)
+    assert env["min"].shape == (n, 1) and env["max"].shape == (n, 1)
+    assert env["max_m"].shape == (n, 1, 2)
+    solved = ~np.isnan(env["max"][:, 0])
+    assert solved.all()
+    # The limit curves are states of the search box: the envelope contains them.
+    assert (env["max"][:, 0] >= r.grid_upper * (1 - 1e-6)).all()
+    assert (env["min"][:, 0] <= r.grid_lower * (1 + 1e-6)).all()
+    assert (np.abs(env["max_m"]) <= 1 + 1e-12).all()
+    assert env["check"]["compared"] == n
+    df = r.to_pandas()
+    assert "envelope_max" in df.columns
+    scene_off = Scene.from_toml(PAPER / "fig13-3rd.toml").set("limits.grid_points", 9)
+    assert fricbound.limits(scene_off).envelope is None
