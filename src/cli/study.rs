@@ -121,6 +121,16 @@ fn io_error(path: &std::path::Path, source: std::io::Error) -> CommandError {
     })
 }
 
+/// The scene file's label (its path) and text.
+fn read_scene(scene_path: &std::path::Path) -> Result<(String, String), CommandError> {
+    let label = scene_path.display().to_string();
+    let text = std::fs::read_to_string(scene_path).map_err(|source| SceneError::Io {
+        file: label.clone(),
+        source,
+    })?;
+    Ok((label, text))
+}
+
 fn accuracy_study(
     scene_path: &std::path::Path,
     quick: bool,
@@ -128,11 +138,7 @@ fn accuracy_study(
     user: &[String],
     quiet: bool,
 ) -> Result<StudyReport, CommandError> {
-    let label = scene_path.display().to_string();
-    let text = std::fs::read_to_string(scene_path).map_err(|source| SceneError::Io {
-        file: label.clone(),
-        source,
-    })?;
+    let (label, text) = read_scene(scene_path)?;
     let (scene, problem, base) = accuracy::load(&text, &label, user)?;
     let (reference, check, settings) = accuracy::settings(&scene, &problem, quick);
     let stem = scene_path
@@ -470,11 +476,7 @@ fn jacobian_study(
     user: &[String],
     quiet: bool,
 ) -> Result<StudyReport, CommandError> {
-    let label = scene_path.display().to_string();
-    let text = std::fs::read_to_string(scene_path).map_err(|source| SceneError::Io {
-        file: label.clone(),
-        source,
-    })?;
+    let (label, text) = read_scene(scene_path)?;
     // The scene's own FRF (a limit or sweep scene without its `[limits]` and `[sweep]`).
     let (_, mut problem, _) = accuracy::load(&text, &label, user)?;
     jacobian::quiet(&mut problem);
