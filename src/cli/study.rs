@@ -131,6 +131,23 @@ fn read_scene(scene_path: &std::path::Path) -> Result<(String, String), CommandE
     Ok((label, text))
 }
 
+/// The study's output folder, created (`out` or `out/<scene stem>-<study>`), and the stem.
+fn study_dir(
+    scene_path: &std::path::Path,
+    out: Option<PathBuf>,
+    study: &str,
+) -> Result<(PathBuf, String), CommandError> {
+    let stem = scene_path
+        .file_stem()
+        .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{stem}-{study}")));
+    std::fs::create_dir_all(&dir).map_err(|source| CommandError::OutputDir {
+        path: dir.display().to_string(),
+        source,
+    })?;
+    Ok((dir, stem))
+}
+
 fn accuracy_study(
     scene_path: &std::path::Path,
     quick: bool,
@@ -141,14 +158,7 @@ fn accuracy_study(
     let (label, text) = read_scene(scene_path)?;
     let (scene, problem, base) = accuracy::load(&text, &label, user)?;
     let (reference, check, settings) = accuracy::settings(&scene, &problem, quick);
-    let stem = scene_path
-        .file_stem()
-        .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
-    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{stem}-accuracy")));
-    std::fs::create_dir_all(&dir).map_err(|source| CommandError::OutputDir {
-        path: dir.display().to_string(),
-        source,
-    })?;
+    let (dir, _) = study_dir(scene_path, out, "accuracy")?;
     let bar = (!quiet).then(|| {
         let bar = ProgressBar::new(2 + settings.len() as u64);
         bar.set_style(
@@ -480,14 +490,7 @@ fn jacobian_study(
     // The scene's own FRF (a limit or sweep scene without its `[limits]` and `[sweep]`).
     let (_, mut problem, _) = accuracy::load(&text, &label, user)?;
     jacobian::quiet(&mut problem);
-    let stem = scene_path
-        .file_stem()
-        .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
-    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{stem}-jacobian")));
-    std::fs::create_dir_all(&dir).map_err(|source| CommandError::OutputDir {
-        path: dir.display().to_string(),
-        source,
-    })?;
+    let (dir, stem) = study_dir(scene_path, out, "jacobian")?;
     let budget = jacobian::Budget::new(quick);
     let h = problem.harmonics.iter().copied().max().unwrap_or(0);
     let mut cases = vec![jacobian::Case {
