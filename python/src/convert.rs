@@ -11,7 +11,6 @@ use fricbound::analysis::frf::{FrfPoint, FrfRun};
 use fricbound::analysis::limits::envelope::{Envelope, EnvelopeBound};
 use fricbound::analysis::limits::{CaseCurve, LimitAnalysis, Peak, Regime};
 use fricbound::analysis::modes::{EigenMethod, NaturalModes};
-use fricbound::contact::harmonic::Block;
 use fricbound::model::Problem;
 use fricbound::report::files;
 use fricbound::scene::SweepSpec;
@@ -125,19 +124,7 @@ pub fn problem_names(d: &Bound<'_, PyDict>, problem: &Problem) -> PyResult<()> {
             .map(|s| s.name.clone())
             .collect::<Vec<_>>(),
     )?;
-    d.set_item(
-        "blocks",
-        problem
-            .unknown_harmonics()
-            .blocks()
-            .iter()
-            .map(|b| match b {
-                Block::Constant => "0".to_string(),
-                Block::Cos(h) => format!("c{h}"),
-                Block::Sin(h) => format!("s{h}"),
-            })
-            .collect::<Vec<_>>(),
-    )?;
+    d.set_item("blocks", problem.unknown_harmonics().block_labels())?;
     Ok(())
 }
 

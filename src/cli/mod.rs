@@ -40,7 +40,6 @@ use crate::analysis::frf::{self, FrfError, FrfObserver, FrfPoint, Jump, JumpKind
 use crate::analysis::limits::LimitSettings;
 use crate::analysis::linear::{self, LinearCase};
 use crate::analysis::peaks::{self, ExtremumKind};
-use crate::contact::harmonic::Block;
 use crate::model::Problem;
 use crate::numerics::NewtonFailure;
 use crate::report::files::{self, FrfWriter, RunInfo, WriteError};
@@ -237,7 +236,7 @@ impl RunContext<'_> {
             scene: self.label.clone(),
             scene_hash: scene_hash(&self.scene),
             dofs: problem.model.dof_names.clone(),
-            blocks: block_names(problem),
+            blocks: problem.unknown_harmonics().block_labels(),
             contacts: problem.contacts.iter().map(|c| c.name.clone()).collect(),
             outputs: problem
                 .outputs
@@ -286,20 +285,6 @@ pub fn scene_hash(scene: &Scene) -> String {
     let canonical = toml::to_string(scene).unwrap_or_default();
     let digest = Sha256::digest(canonical.as_bytes());
     digest.iter().map(|b| format!("{b:02x}")).collect()
-}
-
-/// Names of the harmonic blocks of the unknowns (`0`, `c1`, `s1`, ...), for the JSON files.
-fn block_names(problem: &Problem) -> Vec<String> {
-    problem
-        .unknown_harmonics()
-        .blocks()
-        .iter()
-        .map(|b| match b {
-            Block::Constant => "0".to_string(),
-            Block::Cos(h) => format!("c{h}"),
-            Block::Sin(h) => format!("s{h}"),
-        })
-        .collect()
 }
 
 /// Progress bar plus result writer.

@@ -37,6 +37,16 @@ impl Block {
             Block::Cos(h) | Block::Sin(h) => h,
         }
     }
+
+    /// The block's name in output files (the `blocks` list of `solution.json`): `0` for the
+    /// constant, `c<h>` / `s<h>` for the cosine and sine parts of harmonic h.
+    pub fn label(self) -> String {
+        match self {
+            Block::Constant => "0".to_string(),
+            Block::Cos(h) => format!("c{h}"),
+            Block::Sin(h) => format!("s{h}"),
+        }
+    }
 }
 
 /// An ordered set of distinct harmonics, e.g. `[0, 1, 2, 3]` or `[0, 1, 3, 5]`.
@@ -76,6 +86,11 @@ impl HarmonicSet {
     /// Coefficient blocks in unknown order.
     pub fn blocks(&self) -> &[Block] {
         &self.blocks
+    }
+
+    /// The names of the blocks in unknown order (see [`Block::label`]).
+    pub fn block_labels(&self) -> Vec<String> {
+        self.blocks.iter().map(|b| b.label()).collect()
     }
 
     /// Number of coefficient blocks (1 for h = 0, 2 per h ≥ 1).
