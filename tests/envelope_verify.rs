@@ -46,9 +46,28 @@ const TOLERANCE: f64 = 1e-3;
 
 #[test]
 fn settled_states_from_random_initial_sliders_lie_inside_the_envelope() {
+    let (settled, inside) = check_random_states(&[215.0, 218.0], 3, true);
+    assert_eq!((settled, inside), (6, 6));
+}
+
+/// The README's table: more frequencies and states (about a minute in release; run with
+/// `cargo test --release --test envelope_verify -- --ignored --nocapture`). A state that does
+/// not settle within the period budget is reported and not judged; every settled one must lie
+/// inside the envelope.
+#[test]
+#[ignore]
+fn more_frequencies_and_states_for_the_readme_table() {
+    let (settled, inside) = check_random_states(&[212.0, 215.0, 218.0, 222.0, 226.0], 6, false);
+    println!("{inside} of {settled} settled states inside the envelope");
+    assert_eq!(settled, inside);
+}
+
+/// At each of `freqs`, the envelope of y2 over m per side, then `per_freq` seeded random m
+/// vectors integrated from rest: (states that settled, of which inside the envelope). With
+/// `strict`, a state that does not settle fails the test.
+fn check_random_states(freqs: &[f64], per_freq: usize, strict: bool) -> (usize, usize) {
     let problem = fig13_damped();
     let (_, groups) = EnvelopeMode::Sides.groups(&problem);
-    let freqs = [215.0, 218.0];
     // The limit curves on the frequencies: the envelope's seeds, and the time integration's
     // check on states whose HBM amplitude is known.
     let cases = limits::two_point_cases(&problem);
@@ -56,12 +75,12 @@ fn settled_states_from_random_initial_sliders_lie_inside_the_envelope() {
         .iter()
         .map(|c| {
             let curve = limits::solve_case(&problem, c, None).unwrap_or_else(|e| panic!("{e}"));
-            limits::on_grid(&problem, c, &curve.points, &freqs).unwrap_or_else(|e| panic!("{e}"))
+            limits::on_grid(&problem, c, &curve.points, freqs).unwrap_or_else(|e| panic!("{e}"))
         })
         .collect();
     let settings = VerifySettings::for_harmonics(H);
     let mut random = Uniform(0x5eed_1234_abcd_0042);
-    let mut inside = 0;
+    let (mut settled, mut inside) = (0, 0);
     for (g, &f) in freqs.iter().enumerate() {
         let seeds: Vec<(Vec<f64>, Vec<f64>)> = cases
             .iter()
@@ -113,7 +132,7 @@ fn settled_states_from_random_initial_sliders_lie_inside_the_envelope() {
                 c.name
             );
         }
-        for _ in 0..3 {
+        for _ in 0..per_freq {
             let m = vec![random.next(), random.next()];
             let p = limits::LimitCase::per_side(&problem, &m).apply(&problem);
             let start = verify::static_state(&p).unwrap_or_else(|e| panic!("{e}"));
@@ -130,7 +149,14 @@ fn settled_states_from_random_initial_sliders_lie_inside_the_envelope() {
                 100.0 * (a / hi - 1.0),
                 100.0 * (a / lo - 1.0)
             );
-            assert!(response.settled, "{f} Hz, m = {m:?}: did not settle");
+            assert!(
+                !strict || response.settled,
+                "{f} Hz, m = {m:?}: did not settle"
+            );
+            if !response.settled {
+                continue;
+            }
+            settled += 1;
             assert!(
                 a <= hi * (1.0 + TOLERANCE) && a >= lo * (1.0 - TOLERANCE),
                 "{f} Hz, m = {m:?}: settled amplitude {a:.6e} outside the envelope \
@@ -139,5 +165,5 @@ fn settled_states_from_random_initial_sliders_lie_inside_the_envelope() {
             inside += 1;
         }
     }
-    assert_eq!(inside, 6);
+    (settled, inside)
 }
