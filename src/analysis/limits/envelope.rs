@@ -35,7 +35,7 @@
 //! evaluation there: only the contacts' initial states change between Newton solves
 //! ([`HbmSystem::set_initial_states`](crate::hbm::HbmSystem::set_initial_states)), so the
 //! operator, its Jacobian pattern and symbolic factorisation, the AFT plans and the arc-length
-//! scaling (41 linear solves over the range) are built once, not once per evaluation. Each
+//! scaling (42 linear solves over the range) are built once, not once per evaluation. Each
 //! evaluation costs one Newton solve and one extra solve per acting group.
 
 use rayon::prelude::*;
