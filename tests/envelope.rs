@@ -286,6 +286,54 @@ fn optimised_envelope_equals_a_dense_scan_on_the_paper_case() {
     }
 }
 
+/// The envelope reuses one point solver for every m and frequency of a stretch
+/// (`HbmSystem::set_initial_states`): each solve and sensitivity must equal, bit for bit, those of
+/// a solver built afresh for the problem with that m, whatever was solved before with the
+/// reused one (m in both regimes, both directions, two frequencies).
+#[test]
+fn reused_solver_equals_a_fresh_solver_for_every_m() {
+    let problem = fig13(&[]);
+    let (_, groups) = EnvelopeMode::Sides.groups(&problem);
+    let freqs = [213.0, 215.0];
+    let seeds = limit_states(&problem, &freqs);
+    let mut reused = PointSolver::new(&problem).unwrap();
+    let ms: [[f64; 2]; 5] = [
+        [1.0, 1.0],
+        [-0.6, 0.3],
+        [-1.0, -1.0],
+        [0.2, -0.8],
+        [-0.6, 0.3],
+    ];
+    let mut compared = 0;
+    for (f, s) in freqs.iter().zip(&seeds) {
+        let omega = 2.0 * PI * f;
+        for m in &ms {
+            let x0 = &s[0].1;
+            let case = per_side(&problem, m);
+            let p = case.apply(&problem);
+            let mut fresh = PointSolver::new(&p).unwrap();
+            let expected = fresh.solve(x0, *f);
+            reused.system().set_initial_states(&case.contact_states);
+            let got = reused.solve(x0, *f);
+            match (expected, got) {
+                (Ok(e), Ok(g)) => {
+                    assert_eq!(e, g, "{f} Hz, m = {m:?}: reused solver differs");
+                    let se = amplitude_sensitivity(fresh.system(), &e.coefficients, omega, &groups)
+                        .unwrap();
+                    let sg =
+                        amplitude_sensitivity(reused.system(), &g.coefficients, omega, &groups)
+                            .unwrap();
+                    assert_eq!(se, sg, "{f} Hz, m = {m:?}: sensitivity differs");
+                    compared += 1;
+                }
+                (Err(_), Err(_)) => {}
+                (e, g) => panic!("{f} Hz, m = {m:?}: fresh {e:?} vs reused {g:?}"),
+            }
+        }
+    }
+    assert!(compared >= 8, "only {compared} states solved");
+}
+
 /// First output's first-harmonic amplitude of full coefficients (y2, H = 1 blocks 0, c1, s1).
 fn limits_amplitude(problem: &Problem, x: &[f64]) -> f64 {
     let n = problem.model.n_dofs();

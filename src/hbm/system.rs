@@ -18,7 +18,7 @@
 
 use crate::contact::aft::AftWorkspace;
 use crate::contact::harmonic::{Block, HarmonicSet};
-use crate::contact::ContactState;
+use crate::contact::{ContactState, JenkinsLaw};
 use crate::hbm::error::HbmError;
 use crate::hbm::pattern::{ContactSlots, JacobianLayout};
 use crate::hbm::schur::RelativeCoordinates;
@@ -53,6 +53,9 @@ pub struct HbmSystem<'p> {
     layout: Option<JacobianLayout>,
     /// Relative contact coordinates of the schur formulation.
     relative: Option<Arc<RelativeCoordinates>>,
+    /// Initial tangential state m of every contact set by [`HbmSystem::set_initial_states`],
+    /// in place of the problem's `law.initial_state`; `None`: the problem's.
+    initial_states: Option<Vec<f64>>,
 }
 
 impl<'p> HbmSystem<'p> {
@@ -114,7 +117,36 @@ impl<'p> HbmSystem<'p> {
             layout: None,
             relative,
             unknowns,
+            initial_states: None,
         })
+    }
+
+    /// Sets the initial tangential state m ∈ [−1, 1] of every contact (one per contact, in the
+    /// problem's order), in place of the problem's `law.initial_state`, without rebuilding the
+    /// system (its Jacobian pattern, symbolic factorisation and AFT plans do not depend on m).
+    /// The response envelope solves many states of one problem that differ only in m. The
+    /// residual and Jacobian are then those of the problem with these initial states.
+    ///
+    /// # Panics
+    /// If `m` does not have one entry per contact.
+    #[track_caller]
+    pub fn set_initial_states(&mut self, m: &[f64]) {
+        assert_eq!(
+            m.len(),
+            self.problem.contacts.len(),
+            "one initial state per contact"
+        );
+        self.initial_states = Some(m.to_vec());
+    }
+
+    /// The Jenkins law contact `c` is evaluated with: the problem's, with the initial state set
+    /// by [`HbmSystem::set_initial_states`] if any.
+    pub fn law(&self, c: usize) -> JenkinsLaw {
+        let mut law = self.problem.contacts[c].law;
+        if let Some(m) = &self.initial_states {
+            law.initial_state = m[c];
+        }
+        law
     }
 
     /// Storage of the full Jacobian (dense or sparse, from the problem's formulation).
@@ -215,11 +247,12 @@ impl<'p> HbmSystem<'p> {
         jacobian: bool,
     ) -> Result<ContactState, HbmError> {
         self.contact_coefficients(c, x);
+        let law = self.law(c);
         let contact = &self.problem.contacts[c];
         let report = self
             .aft
             .evaluate(
-                &contact.law,
+                &law,
                 self.problem.effects.contact,
                 &self.u_coef,
                 &self.v_coef,
@@ -531,9 +564,10 @@ impl<'p> HbmSystem<'p> {
         u: &[f64],
         v: &[f64],
     ) -> Result<[Vec<f64>; 2], HbmError> {
+        let law = self.law(c);
         let contact = &self.problem.contacts[c];
         self.aft
-            .evaluate(&contact.law, self.problem.effects.contact, u, v, false)
+            .evaluate(&law, self.problem.effects.contact, u, v, false)
             .map_err(|source| HbmError::Aft {
                 contact: contact.name.clone(),
                 source,

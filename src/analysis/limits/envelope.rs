@@ -22,7 +22,8 @@
 //!
 //! A(m) is only piecewise smooth (flat in the m of a contact once it slips) and can have several
 //! local extrema, so each bound is sought from several starts: the corners of the box (all 2^k
-//! of them up to k = 4, the two uniform corners beyond), the two limit curves' solutions, the
+//! of them up to k = 4, the two uniform corners beyond; with one m per point also the corners of
+//! the sides' box, each side uniformly at ±1), the two limit curves' solutions, the
 //! best and worst scanned cases of the bound scan at that frequency, and the optimum of the
 //! previous grid frequency, and the centre m = 0 (warm start along the grid; the grid is cut into [`CHUNKS`]
 //! stretches solved in parallel, so results do not depend on the thread count). Every state
@@ -30,9 +31,12 @@
 //! amplitude among all of them. Newton for a new m starts from the solved state with the
 //! nearest m, and walks there in [`HOMOTOPY_STEPS`] steps of m when the direct solve fails.
 //!
-//! Cost: each evaluation rebuilds the point solver for the problem with the new m (a clone of
-//! the problem and its harmonic-balance operator), which is negligible for lumped models and
-//! dominates on large FE models.
+//! Cost: one point solver is built per stretch of the grid and per peak, and reused for every
+//! evaluation there: only the contacts' initial states change between Newton solves
+//! ([`HbmSystem::set_initial_states`](crate::hbm::HbmSystem::set_initial_states)), so the
+//! operator, its Jacobian pattern and symbolic factorisation, the AFT plans and the arc-length
+//! scaling (42 linear solves over the range) are built once, not once per evaluation. Each
+//! evaluation costs one Newton solve and one extra solve per acting group.
 
 use rayon::prelude::*;
 
@@ -193,6 +197,19 @@ pub struct EnvelopeSeeds {
     pub starts: Vec<Vec<f64>>,
 }
 
+impl EnvelopePoint {
+    /// The point at `freq_hz` where no state could be solved (k groups, `outputs` output DOFs).
+    pub fn unsolved(freq_hz: f64, k: usize, outputs: usize) -> Self {
+        Self {
+            freq_hz,
+            min: vec![None; outputs],
+            max: vec![None; outputs],
+            acting: vec![false; k],
+            solves: 0,
+        }
+    }
+}
+
 /// One solved state of the search.
 struct Solved {
     m: Vec<f64>,
@@ -200,10 +217,11 @@ struct Solved {
     sensitivity: AmplitudeSensitivity,
 }
 
-/// Solves states at one frequency for given m, from the nearest state solved so far.
-struct Evaluator<'a> {
-    problem: &'a Problem,
-    groups: &'a [Vec<usize>],
+/// Solves states at one frequency for given m, from the nearest state solved so far, with one
+/// point solver whose initial states are set per evaluation.
+struct Evaluator<'s, 'p> {
+    solver: &'s mut PointSolver<'p>,
+    groups: &'s [Vec<usize>],
     freq_hz: f64,
     solved: Vec<Solved>,
     /// m values whose state was kept under its effective m: (m, index in `solved`).
@@ -211,10 +229,10 @@ struct Evaluator<'a> {
     solves: usize,
 }
 
-impl<'a> Evaluator<'a> {
-    fn new(problem: &'a Problem, groups: &'a [Vec<usize>], freq_hz: f64) -> Self {
+impl<'s, 'p> Evaluator<'s, 'p> {
+    fn new(solver: &'s mut PointSolver<'p>, groups: &'s [Vec<usize>], freq_hz: f64) -> Self {
         Self {
-            problem,
+            solver,
             groups,
             freq_hz,
             solved: Vec::new(),
@@ -223,10 +241,13 @@ impl<'a> Evaluator<'a> {
         }
     }
 
-    /// The case with m per group.
-    fn case(&self, m: &[f64]) -> LimitCase {
+    /// The initial state of every contact with m per group (the scene's for contacts in no
+    /// group).
+    fn contact_states(&mut self, m: &[f64]) -> Vec<f64> {
         let mut states: Vec<f64> = self
-            .problem
+            .solver
+            .system()
+            .problem()
             .contacts
             .iter()
             .map(|c| c.law.initial_state)
@@ -236,10 +257,7 @@ impl<'a> Evaluator<'a> {
                 states[c] = m[g];
             }
         }
-        LimitCase {
-            name: "envelope".to_string(),
-            contact_states: states,
-        }
+        states
     }
 
     /// Newton at m from `x0`, then, when some group's contacts are stuck with a slider set in
@@ -279,12 +297,17 @@ impl<'a> Evaluator<'a> {
     /// Newton at m from `x0`; the solved state is kept. Its index, or `None`.
     fn solve_exactly(&mut self, m: &[f64], x0: &[f64]) -> Option<usize> {
         self.solves += 1;
-        let p = self.case(m).apply(self.problem);
-        let mut solver = PointSolver::new(&p).ok()?;
-        let point = solver.solve(x0, self.freq_hz).ok()?;
+        let states = self.contact_states(m);
+        self.solver.system().set_initial_states(&states);
+        let point = self.solver.solve(x0, self.freq_hz).ok()?;
         let omega = 2.0 * std::f64::consts::PI * self.freq_hz;
-        let sensitivity =
-            amplitude_sensitivity(solver.system(), &point.coefficients, omega, self.groups).ok()?;
+        let sensitivity = amplitude_sensitivity(
+            self.solver.system(),
+            &point.coefficients,
+            omega,
+            self.groups,
+        )
+        .ok()?;
         if sensitivity
             .gradient
             .iter()
@@ -359,8 +382,33 @@ fn corners(k: usize) -> Vec<Vec<f64>> {
     }
 }
 
+/// The corners of the damper sides' box [−1, 1]^sides (as [`corners`]) with every group given
+/// its side's m: with one m per contact point, the states where each side is uniformly at +1 or
+/// −1 (the two limit states and the mixed ones), which the corners of [−1, 1]^k leave out
+/// beyond k = 4. Empty when some group's contacts lie on several sides.
+fn side_corners(problem: &Problem, groups: &[Vec<usize>]) -> Vec<Vec<f64>> {
+    let side_of: Option<Vec<usize>> = groups
+        .iter()
+        .map(|g| {
+            let side = problem.contacts[*g.first()?].side;
+            g.iter()
+                .all(|&c| problem.contacts[c].side == side)
+                .then_some(side)
+        })
+        .collect();
+    let Some(side_of) = side_of else {
+        return Vec::new();
+    };
+    corners(problem.sides.len())
+        .into_iter()
+        .map(|corner| side_of.iter().map(|&s| corner[s]).collect())
+        .collect()
+}
+
 /// The envelope at one frequency: for every output DOF, the largest and smallest amplitude over
 /// m ∈ [−1, 1]^k (k = groups), sought from the seeds' states and starts and the box corners.
+/// Builds one point solver for `problem` and sets its initial states per evaluation (see
+/// [`envelope_at_with`]); a problem whose solver cannot be built has no bound.
 pub fn envelope_at(
     problem: &Problem,
     groups: &[Vec<usize>],
@@ -368,14 +416,36 @@ pub fn envelope_at(
     seeds: &EnvelopeSeeds,
     search: &BoxSettings,
 ) -> EnvelopePoint {
+    match PointSolver::new(problem) {
+        Ok(mut solver) => envelope_at_with(&mut solver, groups, freq_hz, seeds, search),
+        Err(_) => EnvelopePoint::unsolved(freq_hz, groups.len(), problem.outputs.len()),
+    }
+}
+
+/// [`envelope_at`] with a point solver already built for the problem (`solver`), reused for
+/// every evaluation: only the initial states of its contacts change between Newton solves
+/// ([`HbmSystem::set_initial_states`]), so its Jacobian pattern, symbolic factorisation,
+/// arc-length scaling and AFT plans are built once. The results are those of a solver built
+/// afresh for the problem with each m (tested). The solver's initial states are left at the
+/// last evaluation's.
+///
+/// [`HbmSystem::set_initial_states`]: crate::hbm::HbmSystem::set_initial_states
+pub fn envelope_at_with(
+    solver: &mut PointSolver<'_>,
+    groups: &[Vec<usize>],
+    freq_hz: f64,
+    seeds: &EnvelopeSeeds,
+    search: &BoxSettings,
+) -> EnvelopePoint {
     let k = groups.len();
-    let outputs = problem.outputs.len();
-    let mut ev = Evaluator::new(problem, groups, freq_hz);
+    let outputs = solver.system().problem().outputs.len();
+    let mut ev = Evaluator::new(solver, groups, freq_hz);
     for (m, x) in &seeds.states {
         ev.solve_from(m, x);
     }
     let mut starts: Vec<Vec<f64>> = seeds.states.iter().map(|(m, _)| m.clone()).collect();
     starts.extend(seeds.starts.iter().cloned());
+    starts.extend(side_corners(ev.solver.system().problem(), groups));
     starts.extend(corners(k));
     starts.push(vec![0.0; k]);
     let mut unique: Vec<Vec<f64>> = Vec::new();
@@ -490,6 +560,8 @@ pub fn envelope(
         .par_iter()
         .flat_map_iter(|&first| {
             let mut out: Vec<EnvelopePoint> = Vec::new();
+            // One solver per stretch, reused at every frequency of it.
+            let mut solver = PointSolver::new(problem).ok();
             for g in first..(first + chunk).min(n) {
                 let mut seeds = EnvelopeSeeds {
                     states: solved_seeds(&inputs.limits, g, &groups)
@@ -513,13 +585,11 @@ pub fn envelope(
                         seeds.states.push((b.m.clone(), b.coefficients.clone()));
                     }
                 }
-                out.push(envelope_at(
-                    problem,
-                    &groups,
-                    band[g].freq_hz,
-                    &seeds,
-                    search,
-                ));
+                let freq_hz = band[g].freq_hz;
+                out.push(match solver.as_mut() {
+                    Some(solver) => envelope_at_with(solver, &groups, freq_hz, &seeds, search),
+                    None => EnvelopePoint::unsolved(freq_hz, groups.len(), problem.outputs.len()),
+                });
             }
             out
         })

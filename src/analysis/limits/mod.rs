@@ -61,8 +61,8 @@ pub use bounds::{check_bounds, BoundCheck, ExcessStates};
 pub use case::{scan_cases, signed, two_point_cases, CaseSpec, LimitCase};
 pub use curve::{attempt_case, solve_case, CaseCurve, CurveStatus};
 pub use envelope::{
-    envelope, envelope_at, group_states, Envelope, EnvelopeAtPeak, EnvelopeBound, EnvelopeCheck,
-    EnvelopeInputs, EnvelopeMode, EnvelopePoint, EnvelopeSeeds,
+    envelope, envelope_at, envelope_at_with, group_states, Envelope, EnvelopeAtPeak, EnvelopeBound,
+    EnvelopeCheck, EnvelopeInputs, EnvelopeMode, EnvelopePoint, EnvelopeSeeds,
 };
 pub use error::LimitError;
 pub use grid::{classify, on_grid, GridPoint, GridSolution};

@@ -76,10 +76,12 @@ pub fn residual_derivative(
     let mut per_contact = vec![0.0; problem.contacts.len()];
     let mut states = Vec::with_capacity(problem.contacts.len());
     let mut effective_per_contact = Vec::with_capacity(problem.contacts.len());
-    for (c, contact) in problem.contacts.iter().enumerate() {
+    for c in 0..problem.contacts.len() {
         let state = system.contact_forces(c, x, false)?;
-        per_contact[c] = system.aft().initial_state_derivative(&contact.law);
-        effective_per_contact.push(system.aft().effective_initial_state(&contact.law, state));
+        // The law the system evaluates (its initial state may be set apart from the problem's).
+        let law = system.law(c);
+        per_contact[c] = system.aft().initial_state_derivative(&law);
+        effective_per_contact.push(system.aft().effective_initial_state(&law, state));
         states.push(state);
     }
     let effective = groups
