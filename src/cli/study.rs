@@ -1,6 +1,8 @@
-//! `fricbound study accuracy`: the accuracy study of a scene ([`crate::study::accuracy`]) with
-//! its files: `study.csv` (one row per setting, appended as each finishes), `study.md` and the
-//! error-against-time figure `accuracy_pareto.png`/`.svg` with the Pareto front.
+//! `fricbound study accuracy`: the accuracy study of a scene ([`crate::study::accuracy`]) on its
+//! FRF, or on each limit curve of a limit scene, with its files: `study.csv` (one row per curve
+//! and setting, appended as each finishes), `study.md` (a section per curve) and the
+//! error-against-time figure `accuracy_pareto.png`/`.svg` with the Pareto front (a limit scene:
+//! every curve in it, and one `accuracy_pareto_<curve>` figure per curve).
 //!
 //! `fricbound study jacobian`: the Jacobian study ([`crate::study::jacobian`]) of a scene and
 //! of the reference ladder, with `jacobian.csv` (one row per case and formulation, appended as
