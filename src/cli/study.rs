@@ -1,6 +1,8 @@
-//! `fricbound study accuracy`: the accuracy study of a scene ([`crate::study::accuracy`]) with
-//! its files: `study.csv` (one row per setting, appended as each finishes), `study.md` and the
-//! error-against-time figure `accuracy_pareto.png`/`.svg` with the Pareto front.
+//! `fricbound study accuracy`: the accuracy study of a scene ([`crate::study::accuracy`]) on its
+//! FRF, or on each limit curve of a limit scene, with its files: `study.csv` (one row per curve
+//! and setting, appended as each finishes), `study.md` (a section per curve) and the
+//! error-against-time figure `accuracy_pareto.png`/`.svg` with the Pareto front (a limit scene:
+//! every curve in it, and one `accuracy_pareto_<curve>` figure per curve).
 //!
 //! `fricbound study jacobian`: the Jacobian study ([`crate::study::jacobian`]) of a scene and
 //! of the reference ladder, with `jacobian.csv` (one row per case and formulation, appended as
@@ -20,7 +22,7 @@ use crate::hbm::cost::formulation_name;
 use crate::report::files::write_atomic;
 use crate::report::plot::{self, figure_files, Curve};
 use crate::scene::SceneError;
-use crate::study::accuracy::{self, SettingErrors, SettingResult};
+use crate::study::accuracy::{self, SettingErrors, SettingResult, StudyCurve};
 use crate::study::jacobian::{self, CaseResult, FormulationRow};
 
 /// Studies over solver settings.
@@ -66,10 +68,10 @@ pub struct StudyReport {
     pub incomplete: Option<String>,
 }
 
-/// Header of `study.csv` for a reference with `peaks` resonance peaks.
+/// Header of `study.csv` when the curves' references have at most `peaks` resonance peaks.
 fn csv_header(peaks: usize) -> String {
     let mut h = String::from(
-        "group,setting,status,unknowns,points,newton_iterations,time_s,curve_l2_err,\
+        "curve,group,setting,status,unknowns,points,newton_iterations,time_s,curve_l2_err,\
          peak_amp_err,peak_freq_err",
     );
     for k in 1..=peaks {
@@ -79,12 +81,13 @@ fn csv_header(peaks: usize) -> String {
     h
 }
 
-/// One `study.csv` row.
-fn csv_row(r: &SettingResult, e: &SettingErrors) -> String {
+/// One `study.csv` row, its peak cells padded (empty) to `peaks` peaks.
+fn csv_row(r: &SettingResult, e: &SettingErrors, peaks: usize) -> String {
     // Commas in a label or a status become semicolons: one cell each, no quoting.
     let status = r.status.replace(',', ";");
     let mut s = format!(
-        "{},{},{status},{},{},{},{:.4e},{:.3e},{:.3e},{:.3e}",
+        "{},{},{},{status},{},{},{},{:.4e},{:.3e},{:.3e},{:.3e}",
+        r.curve.replace(',', ";"),
         r.setting.group,
         r.setting.label.replace(',', ";"),
         r.unknowns,
@@ -97,6 +100,9 @@ fn csv_row(r: &SettingResult, e: &SettingErrors) -> String {
     );
     for (a, f) in &e.peaks {
         let _ = write!(s, ",{a:.3e},{f:.3e}");
+    }
+    for _ in e.peaks.len()..peaks {
+        s.push_str(",,");
     }
     s.push('\n');
     s
@@ -148,98 +154,71 @@ fn study_dir(
     Ok((dir, stem))
 }
 
-fn accuracy_study(
-    scene_path: &std::path::Path,
-    quick: bool,
-    out: Option<PathBuf>,
-    user: &[String],
-    quiet: bool,
-) -> Result<StudyReport, CommandError> {
-    let (label, text) = read_scene(scene_path)?;
-    let (scene, problem, base) = accuracy::load(&text, &label, user)?;
-    let (reference, check, settings) = accuracy::settings(&scene, &problem, quick);
-    let (dir, _) = study_dir(scene_path, out, "accuracy")?;
-    let bar = (!quiet).then(|| {
-        let bar = ProgressBar::new(2 + settings.len() as u64);
-        bar.set_style(
-            ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} {msg}",
-            )
-            .expect("static template"),
-        );
-        bar.set_message("reference");
-        bar
-    });
-    // The reference and its check first (every error needs the reference), side by side.
-    let (ref_result, check_result) = rayon::join(
-        || accuracy::run_setting(&text, &label, &base, &reference),
-        || accuracy::run_setting(&text, &label, &base, &check),
-    );
-    if let Some(bar) = &bar {
-        bar.inc(2);
+/// One curve's results: its reference, the reference's convergence check, and the settings
+/// with their errors (in setting order).
+struct CurveStudy<'a> {
+    curve: &'a StudyCurve,
+    reference: SettingResult,
+    check: SettingResult,
+    check_errors: SettingErrors,
+    results: Vec<SettingResult>,
+    errors: Vec<SettingErrors>,
+}
+
+impl CurveStudy<'_> {
+    /// (time, largest peak amplitude error) of every setting, and the Pareto front's indices.
+    fn pareto(&self) -> (Vec<(f64, f64)>, Vec<usize>) {
+        let pairs: Vec<(f64, f64)> = self
+            .results
+            .iter()
+            .zip(&self.errors)
+            .map(|(r, e)| (r.time_s, e.max_peak_amplitude()))
+            .collect();
+        let front = accuracy::pareto_front(&pairs);
+        (pairs, front)
     }
-    if ref_result.status != "complete" {
-        return Err(CommandError::Study {
-            scene: label,
-            reason: format!(
-                "the accuracy study's reference ({}) did not solve: {}",
-                reference.label, ref_result.status
-            ),
-        });
+
+    /// The Pareto front's setting labels, comma separated.
+    fn front_labels(&self) -> String {
+        self.pareto()
+            .1
+            .iter()
+            .map(|&i| self.results[i].setting.label.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
     }
-    let check_errors = accuracy::errors(&check_result, &ref_result);
-    // study.csv, its rows appended as settings finish.
-    let csv_path = dir.join("study.csv");
-    let mut file = std::fs::File::create(&csv_path).map_err(|e| io_error(&csv_path, e))?;
-    let header = csv_header(ref_result.peaks.len());
-    file.write_all(header.as_bytes())
-        .and_then(|()| file.write_all(csv_row(&check_result, &check_errors).as_bytes()))
-        .map_err(|e| io_error(&csv_path, e))?;
-    let file = Mutex::new((file, None::<std::io::Error>));
-    let results = accuracy::run_settings(&text, &label, &base, &settings, |r| {
-        let row = csv_row(r, &accuracy::errors(r, &ref_result));
-        let mut guard = file.lock().expect("no panics while holding the lock");
-        if guard.1.is_none() {
-            if let Err(e) = guard
-                .0
-                .write_all(row.as_bytes())
-                .and_then(|()| guard.0.flush())
-            {
-                guard.1 = Some(e);
-            }
-        }
-        if let Some(bar) = &bar {
-            bar.inc(1);
-            bar.set_message(r.setting.label.clone());
-        }
-    });
-    if let Some(bar) = &bar {
-        bar.finish_and_clear();
+}
+
+/// Figure file stem of a curve's own Pareto figure: `accuracy_pareto` for a scene's FRF,
+/// `accuracy_pareto_<curve>` for a limit curve.
+fn pareto_stem(curve: &StudyCurve, several: bool) -> String {
+    if several || curve.case.is_some() {
+        format!("accuracy_pareto_{}", curve.name)
+    } else {
+        "accuracy_pareto".to_string()
     }
-    if let Some(e) = file.into_inner().expect("lock not poisoned").1 {
-        return Err(io_error(&csv_path, e));
-    }
-    let errors: Vec<SettingErrors> = results
-        .iter()
-        .map(|r| accuracy::errors(r, &ref_result))
-        .collect();
-    // The figure: peak amplitude error against time, the Pareto front marked and labelled.
-    let pairs: Vec<(f64, f64)> = results
-        .iter()
-        .zip(&errors)
-        .map(|(r, e)| (r.time_s, e.max_peak_amplitude()))
-        .collect();
-    let front = accuracy::pareto_front(&pairs);
-    let front_x: Vec<f64> = front.iter().map(|&i| pairs[i].0).collect();
-    let front_y: Vec<f64> = front.iter().map(|&i| pairs[i].1).collect();
-    // The other settings as one series of lone points (NaN between them breaks the line).
-    let others: Vec<(f64, f64)> = (0..pairs.len())
+}
+
+/// Lone points (NaN between them breaks the line) of `pairs` not in `front`.
+fn lone_points(pairs: &[(f64, f64)], front: &[usize]) -> (Vec<f64>, Vec<f64>) {
+    (0..pairs.len())
         .filter(|i| !front.contains(i))
         .flat_map(|i| [pairs[i], (f64::NAN, f64::NAN)])
-        .collect();
-    let others_x: Vec<f64> = others.iter().map(|p| p.0).collect();
-    let others_y: Vec<f64> = others.iter().map(|p| p.1).collect();
-    let labels: Vec<String> = results.iter().map(|r| r.setting.label.clone()).collect();
+        .unzip()
+}
+
+/// One curve's figure: peak amplitude error against time, the Pareto front dashed and each of
+/// its settings labelled in the legend.
+fn curve_pareto_figure(
+    study: &CurveStudy,
+    title: &str,
+    dir: &std::path::Path,
+    stem: &str,
+) -> Result<(), CommandError> {
+    let (pairs, front) = study.pareto();
+    let front_x: Vec<f64> = front.iter().map(|&i| pairs[i].0).collect();
+    let front_y: Vec<f64> = front.iter().map(|&i| pairs[i].1).collect();
+    let (others_x, others_y) = lone_points(&pairs, &front);
     let fronts: Vec<([f64; 1], [f64; 1])> = front
         .iter()
         .map(|&i| ([pairs[i].0], [pairs[i].1]))
@@ -264,7 +243,7 @@ fn accuracy_study(
     ];
     for (k, (&i, (x, y))) in front.iter().zip(&fronts).enumerate() {
         series.push(Curve {
-            label: labels[i].as_str(),
+            label: study.results[i].setting.label.as_str(),
             x: &x[..],
             y: &y[..],
             color: plot::palette(k + 1),
@@ -272,9 +251,9 @@ fn accuracy_study(
             markers: true,
         });
     }
-    let (png, svg) = figure_files(&dir, "accuracy_pareto");
+    let (png, svg) = figure_files(dir, stem);
     plot::plot_lines(
-        &format!("What accuracy costs: {}", scene.title),
+        title,
         "wall time of the FRF (s)",
         "largest relative peak amplitude error",
         true,
@@ -282,31 +261,115 @@ fn accuracy_study(
         &png,
         &svg,
     )?;
-    // study.md
+    Ok(())
+}
+
+/// The figure of several curves: per curve, its Pareto front dashed and its other settings as
+/// points, in the curve's colour.
+fn curves_pareto_figure(
+    studies: &[CurveStudy],
+    title: &str,
+    dir: &std::path::Path,
+) -> Result<(), CommandError> {
+    /// One curve's points: labels, then the front's and the other settings' (time, error).
+    struct CurvePoints {
+        front_label: String,
+        others_label: String,
+        front: (Vec<f64>, Vec<f64>),
+        others: (Vec<f64>, Vec<f64>),
+    }
+    let data: Vec<CurvePoints> = studies
+        .iter()
+        .map(|s| {
+            let (pairs, front) = s.pareto();
+            CurvePoints {
+                front_label: format!("{}: Pareto front", s.curve.name),
+                others_label: format!("{}: other settings", s.curve.name),
+                front: front.iter().map(|&i| pairs[i]).unzip(),
+                others: lone_points(&pairs, &front),
+            }
+        })
+        .collect();
+    let mut series: Vec<Curve> = Vec::new();
+    for (k, d) in data.iter().enumerate() {
+        let color = plot::palette(k);
+        series.push(Curve {
+            label: &d.front_label,
+            x: &d.front.0,
+            y: &d.front.1,
+            color,
+            dashed: true,
+            markers: true,
+        });
+        series.push(Curve {
+            label: &d.others_label,
+            x: &d.others.0,
+            y: &d.others.1,
+            color,
+            dashed: false,
+            markers: true,
+        });
+    }
+    let (png, svg) = figure_files(dir, "accuracy_pareto");
+    plot::plot_lines(
+        title,
+        "wall time of the FRF (s)",
+        "largest relative peak amplitude error",
+        true,
+        &series,
+        &png,
+        &svg,
+    )?;
+    Ok(())
+}
+
+/// What a curve is, for `study.md`.
+fn curve_description(curve: &StudyCurve) -> String {
+    match &curve.case {
+        None => "The scene's FRF with its own initial states.".to_string(),
+        Some(case) => {
+            let first = case.contact_states.first().copied().unwrap_or(f64::NAN);
+            if case.contact_states.iter().all(|&m| m == first) {
+                format!(
+                    "Limit curve: every contact point starts at T = m·μN with m = {first:+} \
+                     (paper Eqs. 14-15)."
+                )
+            } else {
+                format!(
+                    "Limit case given per side or point: initial states m = {:?} (contact order).",
+                    case.contact_states
+                )
+            }
+        }
+    }
+}
+
+/// The `study.md` section of one curve.
+fn curve_section(
+    study: &CurveStudy,
+    reference: &accuracy::Setting,
+    check: &accuracy::Setting,
+    output: &str,
+    stem: &str,
+) -> String {
+    let (_, front) = study.pareto();
     let mut md = format!(
-        "# Accuracy study: {}\n\nScene `{label}`{}. Reference: {} ({} points, {:.2} s). \
-         Reference converged to: curve L2 {:.2e}, peak amplitude {:.2e}, peak frequency {:.2e} \
-         (against {}).\n\nSettings are varied one at a time from the scene as given; errors \
-         are relative to the reference, for the first output ({}). Times are wall times of \
-         the continuation with the settings running in parallel (one per core).\n\n\
+        "## Curve `{}`\n\n{} Reference: {} ({} points, {:.2} s). Reference converged to: curve \
+         L2 {:.2e}, peak amplitude {:.2e}, peak frequency {:.2e} (against {}). Errors are \
+         relative to this curve's reference, for the first output ({output}).\n\n\
          | group | setting | status | unknowns | points | Newton its | time (s) | curve L2 err | \
          peak amp err | peak freq err | Pareto |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
-        scene.title,
-        if user.is_empty() {
-            String::new()
-        } else {
-            format!(" with {}", user.join(" "))
-        },
+        study.curve.name,
+        curve_description(study.curve),
         reference.label,
-        ref_result.points,
-        ref_result.time_s,
-        check_errors.curve_l2,
-        check_errors.max_peak_amplitude(),
-        check_errors.max_peak_frequency(),
+        study.reference.points,
+        study.reference.time_s,
+        study.check_errors.curve_l2,
+        study.check_errors.max_peak_amplitude(),
+        study.check_errors.max_peak_frequency(),
         check.label,
-        problem.model.dof_names[problem.outputs[0]],
     );
-    for (i, (r, e)) in results.iter().zip(&errors).enumerate() {
+    for (i, (r, e)) in study.results.iter().zip(&study.errors).enumerate() {
         let _ = writeln!(
             md,
             "| {} | {} | {} | {} | {} | {} | {:.3} | {:.2e} | {:.2e} | {:.2e} | {} |",
@@ -325,30 +388,215 @@ fn accuracy_study(
     }
     let _ = writeln!(
         md,
-        "\nReference peaks (Hz, m): {:?}\n\n![error against time](accuracy_pareto.png)",
-        ref_result.peaks
+        "\nReference peaks (Hz, m): {:?}\n\n![error against time]({stem}.png)\n",
+        study.reference.peaks
     );
-    write_atomic(&dir.join("study.md"), md.as_bytes())?;
-    let unfinished: Vec<String> = results
+    md
+}
+
+fn accuracy_study(
+    scene_path: &std::path::Path,
+    quick: bool,
+    out: Option<PathBuf>,
+    user: &[String],
+    quiet: bool,
+) -> Result<StudyReport, CommandError> {
+    let (label, text) = read_scene(scene_path)?;
+    let curves = accuracy::study_curves(&text, &label, user)?;
+    let (scene, problem, base) = accuracy::load(&text, &label, user)?;
+    let (reference, check, settings) = accuracy::settings(&scene, &problem, quick);
+    let (dir, _) = study_dir(scene_path, out, "accuracy")?;
+    let several = curves.len() > 1;
+    let bar = (!quiet).then(|| {
+        let bar = ProgressBar::new((curves.len() * (2 + settings.len())) as u64);
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} {msg}",
+            )
+            .expect("static template"),
+        );
+        bar.set_message("references");
+        bar
+    });
+    // Every curve's reference and its check first (every error needs the reference), side by
+    // side.
+    let reference_jobs: Vec<(&StudyCurve, &accuracy::Setting)> = curves
         .iter()
-        .chain([&check_result])
-        .filter(|r| r.status != "complete")
-        .map(|r| format!("{} ({})", r.setting.label, r.status))
+        .flat_map(|c| [(c, &reference), (c, &check)])
         .collect();
-    let summary = format!(
-        "accuracy study of {label}: {} settings; reference {} converged to {:.2e} (peak \
-         amplitude against {}); Pareto front: {}\nresults in {}\n",
-        results.len(),
-        reference.label,
-        check_errors.max_peak_amplitude(),
-        check.label,
-        front
+    let mut references = accuracy::run_settings(&text, &label, &base, &reference_jobs, |_, _| {
+        if let Some(bar) = &bar {
+            bar.inc(1);
+        }
+    })
+    .into_iter();
+    let mut pairs: Vec<(SettingResult, SettingResult)> = Vec::with_capacity(curves.len());
+    while let (Some(r), Some(c)) = (references.next(), references.next()) {
+        pairs.push((r, c));
+    }
+    if let Some((curve, (r, _))) = curves
+        .iter()
+        .zip(&pairs)
+        .find(|(_, (r, _))| r.status != "complete")
+    {
+        return Err(CommandError::Study {
+            scene: label,
+            reason: format!(
+                "the accuracy study's reference ({}) did not solve{}: {}",
+                reference.label,
+                if several || curve.case.is_some() {
+                    format!(" on the curve `{}`", curve.name)
+                } else {
+                    String::new()
+                },
+                r.status
+            ),
+        });
+    }
+    let peaks = pairs.iter().map(|(r, _)| r.peaks.len()).max().unwrap_or(0);
+    // study.csv, its rows appended as settings finish (the reference checks first).
+    let csv_path = dir.join("study.csv");
+    let mut file = std::fs::File::create(&csv_path).map_err(|e| io_error(&csv_path, e))?;
+    let mut head = csv_header(peaks);
+    for (r, c) in &pairs {
+        head.push_str(&csv_row(c, &accuracy::errors(c, r), peaks));
+    }
+    file.write_all(head.as_bytes())
+        .map_err(|e| io_error(&csv_path, e))?;
+    let file = Mutex::new((file, None::<std::io::Error>));
+    let jobs: Vec<(&StudyCurve, &accuracy::Setting)> = curves
+        .iter()
+        .flat_map(|c| settings.iter().map(move |s| (c, s)))
+        .collect();
+    let results = accuracy::run_settings(&text, &label, &base, &jobs, |i, r| {
+        let reference = &pairs[i / settings.len().max(1)].0;
+        let row = csv_row(r, &accuracy::errors(r, reference), peaks);
+        let mut guard = file.lock().expect("no panics while holding the lock");
+        if guard.1.is_none() {
+            if let Err(e) = guard
+                .0
+                .write_all(row.as_bytes())
+                .and_then(|()| guard.0.flush())
+            {
+                guard.1 = Some(e);
+            }
+        }
+        if let Some(bar) = &bar {
+            bar.inc(1);
+            bar.set_message(format!("{}: {}", r.curve, r.setting.label));
+        }
+    });
+    if let Some(bar) = &bar {
+        bar.finish_and_clear();
+    }
+    if let Some(e) = file.into_inner().expect("lock not poisoned").1 {
+        return Err(io_error(&csv_path, e));
+    }
+    let mut results = results.into_iter();
+    let studies: Vec<CurveStudy> = curves
+        .iter()
+        .zip(pairs)
+        .map(|(curve, (reference, check))| {
+            let results: Vec<SettingResult> = results.by_ref().take(settings.len()).collect();
+            let errors = results
+                .iter()
+                .map(|r| accuracy::errors(r, &reference))
+                .collect();
+            CurveStudy {
+                curve,
+                check_errors: accuracy::errors(&check, &reference),
+                reference,
+                check,
+                results,
+                errors,
+            }
+        })
+        .collect();
+    // The figures: per curve, peak amplitude error against time with the Pareto front marked
+    // and labelled; with several curves also all of them in one figure.
+    for s in &studies {
+        let title = if several || s.curve.case.is_some() {
+            format!(
+                "What accuracy costs: {}, curve {}",
+                scene.title, s.curve.name
+            )
+        } else {
+            format!("What accuracy costs: {}", scene.title)
+        };
+        curve_pareto_figure(s, &title, &dir, &pareto_stem(s.curve, several))?;
+    }
+    if several {
+        curves_pareto_figure(
+            &studies,
+            &format!("What accuracy costs: {}, per curve", scene.title),
+            &dir,
+        )?;
+    }
+    // study.md
+    let output = &problem.model.dof_names[problem.outputs[0]];
+    let mut md = format!(
+        "# Accuracy study: {}\n\nScene `{label}`{}. Curves: {}. Settings are varied one at a \
+         time from the scene as given, on each curve against that curve's reference. Times are \
+         wall times of the continuation with the settings running in parallel (one per \
+         core).\n\n",
+        scene.title,
+        if user.is_empty() {
+            String::new()
+        } else {
+            format!(" with {}", user.join(" "))
+        },
+        curves
             .iter()
-            .map(|&i| results[i].setting.label.as_str())
+            .map(|c| format!("`{}`", c.name))
             .collect::<Vec<_>>()
             .join(", "),
-        dir.display()
     );
+    if several {
+        md.push_str("![error against time, every curve](accuracy_pareto.png)\n\n");
+    }
+    for s in &studies {
+        md.push_str(&curve_section(
+            s,
+            &reference,
+            &check,
+            output,
+            &pareto_stem(s.curve, several),
+        ));
+    }
+    write_atomic(&dir.join("study.md"), md.as_bytes())?;
+    let unfinished: Vec<String> = studies
+        .iter()
+        .flat_map(|s| s.results.iter().chain([&s.check]))
+        .filter(|r| r.status != "complete")
+        .map(|r| {
+            if several || r.curve != "frf" {
+                format!("{}: {} ({})", r.curve, r.setting.label, r.status)
+            } else {
+                format!("{} ({})", r.setting.label, r.status)
+            }
+        })
+        .collect();
+    let mut summary = format!(
+        "accuracy study of {label}: {} settings on {} curve(s)\n",
+        settings.len(),
+        curves.len()
+    );
+    for s in &studies {
+        let _ = writeln!(
+            summary,
+            "{}reference {} converged to {:.2e} (peak amplitude against {}); Pareto front: {}",
+            if several || s.curve.case.is_some() {
+                format!("curve {}: ", s.curve.name)
+            } else {
+                String::new()
+            },
+            reference.label,
+            s.check_errors.max_peak_amplitude(),
+            check.label,
+            s.front_labels()
+        );
+    }
+    let _ = writeln!(summary, "results in {}", dir.display());
     Ok(StudyReport {
         summary,
         incomplete: (!unfinished.is_empty())

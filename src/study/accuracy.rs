@@ -5,7 +5,8 @@
 //! samples per period, the Newton residual tolerance, the Craig-Bampton interior modes (scenes
 //! with `[reduction]`), and each effect switch (constant normal load, no lift-off, uncoupled
 //! statics). Every setting's FRF is compared with a reference: the most refined setting (the
-//! largest H with the most samples and the tightest tolerance), whose convergence is checked
+//! largest H with the most samples and the tightest tolerance, and on a reduced scene the most
+//! interior modes of the study), whose convergence is checked
 //! against the next refinement down (H one step lower): the difference is reported.
 //!
 //! Per setting: the error of each resonance peak of the first output (refined amplitude and
@@ -13,14 +14,18 @@
 //! first output's amplitude over the range both paths cover ([`curve_l2_error`]), the wall time
 //! of the continuation (peak refinement excluded), Newton iterations and unknowns.
 //!
-//! Limit scenes are studied on the FRF of the scene's own initial states (the `[limits]` and
-//! `[sweep]` tables are removed), not per limit curve.
+//! Limit scenes are studied per limit curve ([`study_curves`]): the two-point method's m = +1
+//! and m = −1 on every contact point (paper Eqs. 14-15) and each case the scene gives per damper
+//! side or per contact point (`[[limits.cases]]`), each against its own reference (the same
+//! case at the most refined setting). The `[limits]` and `[sweep]` tables are removed: a curve
+//! is the FRF of the scene with every contact's initial state set from the case.
 
 use std::time::Instant;
 
 use rayon::prelude::*;
 
 use crate::analysis::frf::{self, FrfPoint, Silent};
+use crate::analysis::limits::{two_point_cases, LimitCase};
 use crate::analysis::peaks;
 use crate::model::Problem;
 use crate::scene::{self, Scene, SceneError};
@@ -68,19 +73,34 @@ pub fn settings(scene: &Scene, problem: &Problem, quick: bool) -> (Setting, Sett
         o.extend([h_of(h), s_of(s.max(4 * h + 2))]);
         o
     };
+    // Craig-Bampton interior modes (scenes with `[reduction]`): a quarter, half, once and twice
+    // the scene's (`quick`: half and once); the reference takes the most.
+    let modes: Vec<usize> = scene.reduction.as_ref().map_or(Vec::new(), |r| {
+        let list = if quick {
+            vec![r.modes / 2, r.modes]
+        } else {
+            vec![r.modes / 4, r.modes / 2, r.modes, 2 * r.modes]
+        };
+        list.into_iter().filter(|&m| m >= 1).collect()
+    });
+    let modes_ref = modes.iter().copied().max();
     let fixed = |h: usize, s: usize, tol: f64| {
         let mut o = set_h(h, s);
         o.push(format!("analysis.residual_tolerance={tol:e}"));
+        if let Some(m) = modes_ref {
+            o.push(format!("reduction.modes={m}"));
+        }
         o
     };
+    let modes_label = modes_ref.map_or(String::new(), |m| format!("; modes = {m}"));
     let reference = Setting {
         group: "reference",
-        label: format!("H = {h_ref}; samples = {s_ref}; tol = {tol_ref:e}"),
+        label: format!("H = {h_ref}; samples = {s_ref}; tol = {tol_ref:e}{modes_label}"),
         overrides: fixed(h_ref, s_ref, tol_ref),
     };
     let check = Setting {
         group: "reference",
-        label: format!("H = {h_check}; samples = {s_ref}; tol = {tol_ref:e}"),
+        label: format!("H = {h_check}; samples = {s_ref}; tol = {tol_ref:e}{modes_label}"),
         overrides: fixed(h_check, s_ref, tol_ref),
     };
     let mut list = Vec::new();
@@ -122,19 +142,12 @@ pub fn settings(scene: &Scene, problem: &Problem, quick: bool) -> (Setting, Sett
             overrides: vec![format!("analysis.residual_tolerance={t:e}")],
         });
     }
-    if let Some(r) = &scene.reduction {
-        let modes: Vec<usize> = if quick {
-            vec![r.modes / 2, r.modes]
-        } else {
-            vec![r.modes / 4, r.modes / 2, r.modes, 2 * r.modes]
-        };
-        for m in modes.into_iter().filter(|&m| m >= 1) {
-            list.push(Setting {
-                group: "modes",
-                label: format!("modes = {m}"),
-                overrides: vec![format!("reduction.modes={m}")],
-            });
-        }
+    for m in modes {
+        list.push(Setting {
+            group: "modes",
+            label: format!("modes = {m}"),
+            overrides: vec![format!("reduction.modes={m}")],
+        });
     }
     for (label, o) in [
         ("constant normal load", "effects.normal_load=\"constant\""),
@@ -150,9 +163,57 @@ pub fn settings(scene: &Scene, problem: &Problem, quick: bool) -> (Setting, Sett
     (reference, check, list)
 }
 
+/// A response curve the study is made on: the scene's FRF, or one limit curve of a limit
+/// scene (its initial tangential states).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StudyCurve {
+    /// `frf` for the scene's FRF, otherwise the limit case's name (`m+1`, `m-1`, or the name of
+    /// a `[[limits.cases]]` entry).
+    pub name: String,
+    /// The initial state m of every contact point; `None`: the scene's own.
+    pub case: Option<LimitCase>,
+}
+
+impl StudyCurve {
+    /// The scene's FRF with its own initial states.
+    pub fn frf() -> Self {
+        Self {
+            name: "frf".to_string(),
+            case: None,
+        }
+    }
+}
+
+/// The curves a study of the scene covers: the FRF for a scene without `[limits]`; for a limit
+/// scene, the two limit curves (m = +1, m = −1 on every point) and each case the scene gives per
+/// side or per point (`[[limits.cases]]`). The uniform intermediate curves
+/// (`limits.intermediate`) and the bound scan are not studied. `user` are the user's overrides.
+pub fn study_curves(
+    scene_text: &str,
+    label: &str,
+    user: &[String],
+) -> Result<Vec<StudyCurve>, SceneError> {
+    let scene = scene::parse(scene_text, label, user)?;
+    if scene.limits.is_none() {
+        return Ok(vec![StudyCurve::frf()]);
+    }
+    let (problem, limits) = scene.validate_with_limits(label)?;
+    let specs = limits.map(|l| l.cases).unwrap_or_default();
+    Ok(two_point_cases(&problem)
+        .into_iter()
+        .chain(specs.iter().map(|c| LimitCase::from_spec(&problem, c)))
+        .map(|case| StudyCurve {
+            name: case.name.clone(),
+            case: Some(case),
+        })
+        .collect())
+}
+
 /// What one setting gave.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SettingResult {
+    /// The curve (`frf` or the limit case's name).
+    pub curve: String,
     /// The setting.
     pub setting: Setting,
     /// `complete`, `incomplete: …` or `failed: …`.
@@ -198,18 +259,21 @@ impl SettingErrors {
     }
 }
 
-/// Solves one setting of `scene_text` (named `label`, with the base overrides `base`) and
-/// refines its peaks; a setting that does not validate or solve is reported `failed: …`.
+/// Solves one setting of `scene_text` (named `label`, with the base overrides `base`) on one
+/// curve (the scene's initial states replaced by the curve's case, if any) and refines its
+/// peaks; a setting that does not validate or solve is reported `failed: …`.
 pub fn run_setting(
     scene_text: &str,
     label: &str,
     base: &[String],
+    curve: &StudyCurve,
     setting: &Setting,
 ) -> SettingResult {
     let mut overrides = base.to_vec();
     overrides.extend(setting.overrides.iter().cloned());
     overrides.push("accuracy.estimate=false".into());
     let failed = |status: String| SettingResult {
+        curve: curve.name.clone(),
         setting: setting.clone(),
         status,
         unknowns: 0,
@@ -223,6 +287,18 @@ pub fn run_setting(
     {
         Ok(p) => p,
         Err(e) => return failed(format!("failed: {e}")),
+    };
+    let problem = match &curve.case {
+        None => problem,
+        Some(case) if case.contact_states.len() == problem.contacts.len() => case.apply(&problem),
+        Some(case) => {
+            return failed(format!(
+                "failed: the case `{}` gives {} contact states, the setting's problem has {} contact points",
+                case.name,
+                case.contact_states.len(),
+                problem.contacts.len()
+            ))
+        }
     };
     let unknowns = problem.model.n_dofs() * problem.unknown_harmonics().n_blocks();
     let started = Instant::now();
@@ -249,6 +325,7 @@ pub fn run_setting(
         .map(|p| (p.freq_hz, p.amplitude))
         .collect();
     SettingResult {
+        curve: curve.name.clone(),
         setting: setting.clone(),
         status,
         unknowns,
@@ -331,23 +408,23 @@ pub fn pareto_front(points: &[(f64, f64)]) -> Vec<usize> {
     front
 }
 
-/// Runs `settings` in parallel (rayon), calling `done` with each result as it finishes (from
-/// the worker threads).
+/// Runs the (curve, setting) `jobs` in parallel (rayon), calling `done` with each job's index
+/// and result as it finishes (from the worker threads). The results come back in job order.
 pub fn run_settings<F>(
     scene_text: &str,
     label: &str,
     base: &[String],
-    settings: &[Setting],
+    jobs: &[(&StudyCurve, &Setting)],
     done: F,
 ) -> Vec<SettingResult>
 where
-    F: Fn(&SettingResult) + Sync,
+    F: Fn(usize, &SettingResult) + Sync,
 {
-    settings
-        .par_iter()
-        .map(|s| {
-            let r = run_setting(scene_text, label, base, s);
-            done(&r);
+    jobs.par_iter()
+        .enumerate()
+        .map(|(i, (curve, setting))| {
+            let r = run_setting(scene_text, label, base, curve, setting);
+            done(i, &r);
             r
         })
         .collect()
