@@ -9,7 +9,9 @@ Main entry points (units SI, frequencies in Hz):
 
 - :class:`Scene` (``from_toml``, ``from_matrices``, ``paper``, ``set``, ``check``);
 - :func:`run` (one FRF), :func:`limits` (two-point limit analysis), :func:`sweep` (peaks of
-  the limit cases over a scene field), :func:`modes`, :func:`reduce` (Craig-Bampton);
+  the limit cases over a scene field), :func:`modes`, :func:`reduce` (Craig-Bampton),
+  :func:`verify` (time integration), :func:`linear`, :func:`accuracy_study` (what each
+  solver setting costs in time and gives in accuracy);
 - :mod:`fricbound.dask`: independent solves mapped over a Dask cluster.
 
 Errors: bad input raises ``ValueError`` naming the file, the field (dotted path) and the
@@ -27,6 +29,7 @@ import numpy as np
 from . import _native
 from ._native import SolveError
 from ._results import (
+    AccuracyStudy,
     ContinuationPath,
     Curve,
     FrfResult,
@@ -43,6 +46,8 @@ __version__ = _native.__version__
 
 __all__ = [
     "Scene",
+    "accuracy_study",
+    "AccuracyStudy",
     "run",
     "limits",
     "sweep",
@@ -152,6 +157,24 @@ def verify(
     s = _scene(scene)
     cases = _native.verify(*s._args(), [float(f) for f in freqs_hz], steps_per_period, max_periods)
     return VerifyResult(cases, s.check()["outputs"])
+
+
+def accuracy_study(scene: "Scene | str", quick: bool = False, progress: Progress = None) -> AccuracyStudy:
+    """What accuracy costs in time (``fricbound study accuracy`` without its files): one
+    setting at a time is changed from the scene as given (harmonics H = 1 … 15 and odd-only
+    sets, AFT samples per period, Newton tolerance, Craig-Bampton interior modes on reduced
+    scenes, each effect switch) and each setting's FRF is compared with the most refined
+    setting, whose convergence is checked against the next refinement down. A limit scene is
+    studied per limit curve (m = +1, m = −1 and its ``[[limits.cases]]``). ``quick`` uses the
+    short lists (seconds on the paper case). Settings are solved in parallel (rayon);
+    ``progress`` is called with ``{"kind": "setting", "curve": ..., "setting": ..., "done":
+    n, "total": total}`` as each setting finishes.
+
+    Returns an :class:`AccuracyStudy`. Raises ``ValueError`` on a bad scene and
+    :class:`SolveError` when a curve's reference does not solve (no error can be measured
+    then); a setting that fails is a row with its ``setting_status``.
+    """
+    return AccuracyStudy(_native.accuracy_study(*_scene(scene)._args(), bool(quick), progress))
 
 
 def linear(scene: "Scene | str", case: str = "open", points: Optional[int] = None) -> LinearResult:

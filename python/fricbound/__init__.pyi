@@ -136,6 +136,29 @@ class VerifyResult:
     outputs: List[str]
     def to_pandas(self) -> Any: ...
 
+class AccuracyStudy:
+    curve: List[str]
+    role: List[str]
+    group: List[str]
+    setting: List[str]
+    setting_status: List[str]
+    unknowns: _F
+    points: _F
+    newton_iterations: _F
+    time_s: _F
+    curve_l2: _F
+    peak_amp_err: _F
+    peak_freq_err: _F
+    pareto: List[bool]
+    references: Dict[str, Dict[str, Any]]
+    outputs: List[str]
+    status: str
+    @property
+    def complete(self) -> bool: ...
+    def rows(self, curve: Optional[str] = ..., role: str = ...) -> npt.NDArray[np.int_]: ...
+    def pareto_front(self, curve: Optional[str] = ...) -> List[str]: ...
+    def to_pandas(self) -> Any: ...
+
 class LinearResult:
     case: str
     freq_hz: _F
@@ -182,6 +205,9 @@ def verify(
     steps_per_period: Optional[int] = ...,
     max_periods: Optional[int] = ...,
 ) -> VerifyResult: ...
+def accuracy_study(
+    scene: Union[Scene, str], quick: bool = ..., progress: Progress = ...
+) -> AccuracyStudy: ...
 def linear(scene: Union[Scene, str], case: str = ..., points: Optional[int] = ...) -> LinearResult: ...
 def modes(scene: Union[Scene, str], count: int = ..., case: str = ...) -> ModesResult: ...
 def reduce(

@@ -43,3 +43,6 @@ def verify(
 def linear(
     text: str, label: str, overrides: List[str], case: str, points: Optional[int] = None
 ) -> Dict[str, Any]: ...
+def accuracy_study(
+    text: str, label: str, overrides: List[str], quick: bool, progress: _Progress = None
+) -> Dict[str, Any]: ...

@@ -344,3 +344,53 @@ class ReducedModel(_Result):
 
     def __repr__(self) -> str:
         return f"ReducedModel({len(self.boundary)} boundary DOFs + {self.n_modes} modes)"
+
+
+class AccuracyStudy(_Result):
+    """The accuracy study (:func:`fricbound.accuracy_study`, as ``fricbound study accuracy``):
+    one row per (curve, setting), each curve's ``reference`` and ``check`` first (``role``),
+    then the settings varied one at a time (``role == "setting"``). Columns (numpy arrays or
+    lists, one entry per row): ``curve`` (``frf``, or the limit case ``m+1``, ``m-1``, a
+    ``[[limits.cases]]`` name), ``role``, ``group`` (``harmonics``, ``samples``, ``tolerance``,
+    ``modes``, ``effect``, ``reference``), ``setting`` (label), ``setting_status``,
+    ``unknowns``, ``points``, ``newton_iterations``, ``time_s`` (wall time of the
+    continuation, settings run in parallel), ``curve_l2`` (relative L2 error of the first
+    output's amplitude against the curve's reference), ``peak_amp_err`` and ``peak_freq_err``
+    (largest relative error of the resonance peaks' amplitude and frequency; NaN where a peak
+    is missing), ``pareto`` (on the curve's Pareto front of time against peak error). Per
+    curve, ``references[curve]`` holds the reference's ``setting``, ``peaks_hz``,
+    ``peaks_amp`` and how far its check differs (``check_curve_l2``,
+    ``check_peak_amp_err``)."""
+
+    def rows(self, curve: Optional[str] = None, role: str = "setting") -> np.ndarray:
+        """Indices of the rows of ``curve`` (every curve when None) with ``role``."""
+        return np.array(
+            [
+                i
+                for i, (c, r) in enumerate(zip(self.curve, self.role))
+                if (curve is None or c == curve) and r == role
+            ],
+            dtype=int,
+        )
+
+    def pareto_front(self, curve: Optional[str] = None) -> "List[str]":
+        """Labels of the settings on the Pareto front of ``curve`` (the first curve when
+        None), fastest first."""
+        curve = curve if curve is not None else self.curve[0]
+        idx = [i for i in self.rows(curve) if self.pareto[i]]
+        idx.sort(key=lambda i: self.time_s[i])
+        return [self.setting[i] for i in idx]
+
+    def to_pandas(self):
+        """One row per (curve, setting), the columns above (as ``study.csv``, with the largest
+        peak errors)."""
+        pd = _pandas()
+        cols = [
+            "curve", "role", "group", "setting", "setting_status", "unknowns", "points",
+            "newton_iterations", "time_s", "curve_l2", "peak_amp_err", "peak_freq_err", "pareto",
+        ]
+        return pd.DataFrame({c: getattr(self, c) for c in cols})
+
+    def __repr__(self) -> str:
+        curves = list(dict.fromkeys(self.curve))
+        return f"AccuracyStudy({len(self.curve)} rows, curves {curves})"

@@ -14,6 +14,7 @@ use fricbound::analysis::modes::{EigenMethod, NaturalModes};
 use fricbound::model::Problem;
 use fricbound::report::files;
 use fricbound::scene::SweepSpec;
+use fricbound::study::accuracy::{CurveStudy, SettingErrors, SettingResult, StudyPlan};
 use fricbound::study::sweep::SweepPoint;
 
 /// The response envelope (`[limits] envelope`): per grid frequency and output DOF the smallest
@@ -541,5 +542,93 @@ pub fn reduced_dict<'py>(
         "recover",
         r.recovery.iter().map(|x| x.dof).collect::<Vec<_>>(),
     )?;
+    Ok(d)
+}
+
+/// The accuracy study as a dict: one row per (curve, setting) including each curve's
+/// reference and check (`role`), as columns (`curve`, `role`, `group`, `setting`,
+/// `setting_status`,
+/// `unknowns`, `points`, `newton_iterations`, `time_s`, `curve_l2`, `peak_amp_err`,
+/// `peak_freq_err`, `pareto`), and per curve the reference's label and peaks.
+pub fn accuracy_dict<'py>(
+    py: Python<'py>,
+    plan: &StudyPlan,
+    studies: &[CurveStudy],
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    problem_names(&d, &plan.problem)?;
+    let mut curve = Vec::new();
+    let mut role = Vec::new();
+    let mut rows: Vec<(&SettingResult, SettingErrors, bool)> = Vec::new();
+    for s in studies {
+        let front = s.pareto().1;
+        let check = (&s.check, s.check_errors.clone(), false);
+        let reference = (
+            &s.reference,
+            SettingErrors {
+                curve_l2: 0.0,
+                peaks: vec![(0.0, 0.0); s.reference.peaks.len()],
+            },
+            false,
+        );
+        for (r, label) in [(reference, "reference"), (check, "check")] {
+            curve.push(s.curve.name.clone());
+            role.push(label);
+            rows.push(r);
+        }
+        for (i, (r, e)) in s.results.iter().zip(&s.errors).enumerate() {
+            curve.push(s.curve.name.clone());
+            role.push("setting");
+            rows.push((r, e.clone(), front.contains(&i)));
+        }
+    }
+    d.set_item("curve", curve)?;
+    d.set_item("role", role)?;
+    d.set_item(
+        "group",
+        rows.iter().map(|r| r.0.setting.group).collect::<Vec<_>>(),
+    )?;
+    d.set_item(
+        "setting",
+        rows.iter()
+            .map(|r| r.0.setting.label.clone())
+            .collect::<Vec<_>>(),
+    )?;
+    d.set_item(
+        "setting_status",
+        rows.iter().map(|r| r.0.status.clone()).collect::<Vec<_>>(),
+    )?;
+    let column = |f: &dyn Fn(&(&SettingResult, SettingErrors, bool)) -> f64| {
+        PyArray1::from_vec(py, rows.iter().map(f).collect())
+    };
+    d.set_item("unknowns", column(&|r| r.0.unknowns as f64))?;
+    d.set_item("points", column(&|r| r.0.points as f64))?;
+    d.set_item(
+        "newton_iterations",
+        column(&|r| r.0.newton_iterations as f64),
+    )?;
+    d.set_item("time_s", column(&|r| r.0.time_s))?;
+    d.set_item("curve_l2", column(&|r| r.1.curve_l2))?;
+    d.set_item("peak_amp_err", column(&|r| r.1.max_peak_amplitude()))?;
+    d.set_item("peak_freq_err", column(&|r| r.1.max_peak_frequency()))?;
+    d.set_item("pareto", rows.iter().map(|r| r.2).collect::<Vec<_>>())?;
+    let references = PyDict::new(py);
+    for s in studies {
+        let r = PyDict::new(py);
+        r.set_item("setting", &s.reference.setting.label)?;
+        r.set_item(
+            "peaks_hz",
+            s.reference.peaks.iter().map(|p| p.0).collect::<Vec<_>>(),
+        )?;
+        r.set_item(
+            "peaks_amp",
+            s.reference.peaks.iter().map(|p| p.1).collect::<Vec<_>>(),
+        )?;
+        r.set_item("check_curve_l2", s.check_errors.curve_l2)?;
+        r.set_item("check_peak_amp_err", s.check_errors.max_peak_amplitude())?;
+        references.set_item(&s.curve.name, r)?;
+    }
+    d.set_item("references", references)?;
+    d.set_item("status", "complete")?;
     Ok(d)
 }

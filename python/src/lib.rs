@@ -4,7 +4,7 @@
 //! parser ([`fricbound::scene::parse`]), solves go to the same library functions the CLI calls
 //! ([`fricbound::analysis::frf::solve`], [`fricbound::analysis::limits::analyse`],
 //! [`fricbound::study::sweep::run`], [`fricbound::analysis::modes::natural_modes`],
-//! [`fricbound::analysis::verify::verify_point`],
+//! [`fricbound::analysis::verify::verify_point`], [`fricbound::study::accuracy::StudyPlan`],
 //! [`fricbound_reduction::craig_bampton`]), and results come back as dicts of numpy arrays that
 //! the pure-Python layer (`python/fricbound/`) wraps in result classes.
 //!
@@ -44,5 +44,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve::reduce, m)?)?;
     m.add_function(wrap_pyfunction!(solve::verify, m)?)?;
     m.add_function(wrap_pyfunction!(solve::linear, m)?)?;
+    m.add_function(wrap_pyfunction!(solve::accuracy_study, m)?)?;
     Ok(())
 }

@@ -16,6 +16,9 @@ use fricbound::analysis::modes::natural_modes;
 use fricbound::model::Problem;
 use fricbound::numerics::interrupt;
 use fricbound::scene::{self, Scene, SceneError};
+use fricbound::study::accuracy::{
+    SettingErrors, SettingResult, StudyError, StudyObserver, StudyPlan,
+};
 
 use crate::convert;
 use crate::SolveError;
@@ -131,6 +134,13 @@ enum Event {
     },
     /// A limit, intermediate or scanned curve ended.
     Curve { name: String, status: String },
+    /// A setting of the accuracy study finished.
+    StudySetting {
+        curve: String,
+        setting: String,
+        done: usize,
+        total: usize,
+    },
     /// A sweep value finished.
     SweepValue {
         value: f64,
@@ -157,6 +167,18 @@ impl Event {
                 d.set_item("kind", "curve")?;
                 d.set_item("name", name)?;
                 d.set_item("status", status)?;
+            }
+            Event::StudySetting {
+                curve,
+                setting,
+                done,
+                total,
+            } => {
+                d.set_item("kind", "setting")?;
+                d.set_item("curve", curve)?;
+                d.set_item("setting", setting)?;
+                d.set_item("done", done)?;
+                d.set_item("total", total)?;
             }
             Event::SweepValue {
                 value,
@@ -580,4 +602,58 @@ pub fn linear<'py>(
         convert::array2(py, curve.freqs_hz.len(), outputs, flat)?,
     )?;
     Ok(d)
+}
+
+/// Forwards the accuracy study's finished jobs to the calling thread.
+struct StudyEvents {
+    tx: std::sync::Mutex<mpsc::Sender<Event>>,
+    done: std::sync::atomic::AtomicUsize,
+    total: usize,
+}
+
+impl StudyObserver for StudyEvents {
+    fn setting(&self, result: &SettingResult, _errors: &SettingErrors) {
+        if let Ok(tx) = self.tx.lock() {
+            let _ = tx.send(Event::StudySetting {
+                curve: result.curve.clone(),
+                setting: result.setting.label.clone(),
+                done: self.done.load(std::sync::atomic::Ordering::Relaxed),
+                total: self.total,
+            });
+        }
+    }
+
+    fn job_done(&self) {
+        self.done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    }
+}
+
+/// The accuracy study of the scene (`fricbound study accuracy`): every setting's errors
+/// against its curve's reference, time, Newton iterations and unknowns, per curve (the FRF, or
+/// each limit curve of a limit scene). `quick` uses the short setting lists.
+#[pyfunction]
+#[pyo3(signature = (text, label, overrides, quick, progress=None))]
+pub fn accuracy_study<'py>(
+    py: Python<'py>,
+    text: &str,
+    label: &str,
+    overrides: Vec<String>,
+    quick: bool,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let plan = StudyPlan::new(text, label, &overrides, quick).map_err(scene_error)?;
+    check_memory(label, &plan.problem, rayon_threads())?;
+    let result = in_background(py, progress.as_ref(), |tx| {
+        let events = StudyEvents {
+            tx: std::sync::Mutex::new(tx),
+            done: std::sync::atomic::AtomicUsize::new(0),
+            total: plan.jobs(),
+        };
+        plan.run(&events)
+    })?;
+    let studies = result.map_err(|e| match e {
+        StudyError::Scene(e) => scene_error(e),
+        e @ StudyError::ReferenceFailed { .. } => SolveError::new_err(format!("{label}: {e}")),
+    })?;
+    convert::accuracy_dict(py, &plan, &studies)
 }

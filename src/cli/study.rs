@@ -22,7 +22,10 @@ use crate::hbm::cost::formulation_name;
 use crate::report::files::write_atomic;
 use crate::report::plot::{self, figure_files, Curve};
 use crate::scene::SceneError;
-use crate::study::accuracy::{self, SettingErrors, SettingResult, StudyCurve};
+use crate::study::accuracy::{
+    self, CurveStudy, SettingErrors, SettingResult, StudyCurve, StudyError, StudyObserver,
+    StudyPlan,
+};
 use crate::study::jacobian::{self, CaseResult, FormulationRow};
 
 /// Studies over solver settings.
@@ -152,41 +155,6 @@ fn study_dir(
         source,
     })?;
     Ok((dir, stem))
-}
-
-/// One curve's results: its reference, the reference's convergence check, and the settings
-/// with their errors (in setting order).
-struct CurveStudy<'a> {
-    curve: &'a StudyCurve,
-    reference: SettingResult,
-    check: SettingResult,
-    check_errors: SettingErrors,
-    results: Vec<SettingResult>,
-    errors: Vec<SettingErrors>,
-}
-
-impl CurveStudy<'_> {
-    /// (time, largest peak amplitude error) of every setting, and the Pareto front's indices.
-    fn pareto(&self) -> (Vec<(f64, f64)>, Vec<usize>) {
-        let pairs: Vec<(f64, f64)> = self
-            .results
-            .iter()
-            .zip(&self.errors)
-            .map(|(r, e)| (r.time_s, e.max_peak_amplitude()))
-            .collect();
-        let front = accuracy::pareto_front(&pairs);
-        (pairs, front)
-    }
-
-    /// The Pareto front's setting labels, comma separated.
-    fn front_labels(&self) -> String {
-        self.pareto()
-            .1
-            .iter()
-            .map(|&i| self.results[i].setting.label.as_str())
-            .collect::<Vec<_>>()
-            .join(", ")
-    }
 }
 
 /// Figure file stem of a curve's own Pareto figure: `accuracy_pareto` for a scene's FRF,
@@ -360,7 +328,7 @@ fn curve_section(
          | group | setting | status | unknowns | points | Newton its | time (s) | curve L2 err | \
          peak amp err | peak freq err | Pareto |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
         study.curve.name,
-        curve_description(study.curve),
+        curve_description(&study.curve),
         reference.label,
         study.reference.points,
         study.reference.time_s,
@@ -394,6 +362,56 @@ fn curve_section(
     md
 }
 
+/// Writes `study.csv` as the study runs (header and reference checks once the references are
+/// solved, then one row per finished setting) and advances the progress bar; the first write
+/// error is kept and reported at the end.
+struct CsvRows<'a> {
+    file: Mutex<(std::fs::File, Option<std::io::Error>)>,
+    peaks: std::sync::atomic::AtomicUsize,
+    bar: Option<&'a ProgressBar>,
+}
+
+impl CsvRows<'_> {
+    fn write(&self, text: &str) {
+        let mut guard = self.file.lock().expect("no panics while holding the lock");
+        if guard.1.is_none() {
+            if let Err(e) = guard
+                .0
+                .write_all(text.as_bytes())
+                .and_then(|()| guard.0.flush())
+            {
+                guard.1 = Some(e);
+            }
+        }
+    }
+}
+
+impl StudyObserver for CsvRows<'_> {
+    fn references(&self, pairs: &[(SettingResult, SettingResult)], peaks: usize) {
+        self.peaks
+            .store(peaks, std::sync::atomic::Ordering::Relaxed);
+        let mut head = csv_header(peaks);
+        for (r, c) in pairs {
+            head.push_str(&csv_row(c, &accuracy::errors(c, r), peaks));
+        }
+        self.write(&head);
+    }
+
+    fn setting(&self, result: &SettingResult, errors: &SettingErrors) {
+        let peaks = self.peaks.load(std::sync::atomic::Ordering::Relaxed);
+        self.write(&csv_row(result, errors, peaks));
+        if let Some(bar) = self.bar {
+            bar.set_message(format!("{}: {}", result.curve, result.setting.label));
+        }
+    }
+
+    fn job_done(&self) {
+        if let Some(bar) = self.bar {
+            bar.inc(1);
+        }
+    }
+}
+
 fn accuracy_study(
     scene_path: &std::path::Path,
     quick: bool,
@@ -402,13 +420,11 @@ fn accuracy_study(
     quiet: bool,
 ) -> Result<StudyReport, CommandError> {
     let (label, text) = read_scene(scene_path)?;
-    let curves = accuracy::study_curves(&text, &label, user)?;
-    let (scene, problem, base) = accuracy::load(&text, &label, user)?;
-    let (reference, check, settings) = accuracy::settings(&scene, &problem, quick);
+    let plan = StudyPlan::new(&text, &label, user, quick)?;
     let (dir, _) = study_dir(scene_path, out, "accuracy")?;
-    let several = curves.len() > 1;
+    let several = plan.curves.len() > 1;
     let bar = (!quiet).then(|| {
-        let bar = ProgressBar::new((curves.len() * (2 + settings.len())) as u64);
+        let bar = ProgressBar::new(plan.jobs() as u64);
         bar.set_style(
             ProgressStyle::with_template(
                 "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} {msg}",
@@ -418,100 +434,36 @@ fn accuracy_study(
         bar.set_message("references");
         bar
     });
-    // Every curve's reference and its check first (every error needs the reference), side by
-    // side.
-    let reference_jobs: Vec<(&StudyCurve, &accuracy::Setting)> = curves
-        .iter()
-        .flat_map(|c| [(c, &reference), (c, &check)])
-        .collect();
-    let mut references = accuracy::run_settings(&text, &label, &base, &reference_jobs, |_, _| {
-        if let Some(bar) = &bar {
-            bar.inc(1);
-        }
-    })
-    .into_iter();
-    let mut pairs: Vec<(SettingResult, SettingResult)> = Vec::with_capacity(curves.len());
-    while let (Some(r), Some(c)) = (references.next(), references.next()) {
-        pairs.push((r, c));
-    }
-    if let Some((curve, (r, _))) = curves
-        .iter()
-        .zip(&pairs)
-        .find(|(_, (r, _))| r.status != "complete")
-    {
-        return Err(CommandError::Study {
-            scene: label,
-            reason: format!(
-                "the accuracy study's reference ({}) did not solve{}: {}",
-                reference.label,
-                if several || curve.case.is_some() {
-                    format!(" on the curve `{}`", curve.name)
-                } else {
-                    String::new()
-                },
-                r.status
-            ),
-        });
-    }
-    let peaks = pairs.iter().map(|(r, _)| r.peaks.len()).max().unwrap_or(0);
     // study.csv, its rows appended as settings finish (the reference checks first).
     let csv_path = dir.join("study.csv");
-    let mut file = std::fs::File::create(&csv_path).map_err(|e| io_error(&csv_path, e))?;
-    let mut head = csv_header(peaks);
-    for (r, c) in &pairs {
-        head.push_str(&csv_row(c, &accuracy::errors(c, r), peaks));
-    }
-    file.write_all(head.as_bytes())
-        .map_err(|e| io_error(&csv_path, e))?;
-    let file = Mutex::new((file, None::<std::io::Error>));
-    let jobs: Vec<(&StudyCurve, &accuracy::Setting)> = curves
-        .iter()
-        .flat_map(|c| settings.iter().map(move |s| (c, s)))
-        .collect();
-    let results = accuracy::run_settings(&text, &label, &base, &jobs, |i, r| {
-        let reference = &pairs[i / settings.len().max(1)].0;
-        let row = csv_row(r, &accuracy::errors(r, reference), peaks);
-        let mut guard = file.lock().expect("no panics while holding the lock");
-        if guard.1.is_none() {
-            if let Err(e) = guard
-                .0
-                .write_all(row.as_bytes())
-                .and_then(|()| guard.0.flush())
-            {
-                guard.1 = Some(e);
-            }
-        }
-        if let Some(bar) = &bar {
-            bar.inc(1);
-            bar.set_message(format!("{}: {}", r.curve, r.setting.label));
-        }
-    });
+    let file = std::fs::File::create(&csv_path).map_err(|e| io_error(&csv_path, e))?;
+    let observer = CsvRows {
+        file: Mutex::new((file, None)),
+        peaks: std::sync::atomic::AtomicUsize::new(0),
+        bar: bar.as_ref(),
+    };
+    let studies = plan.run(&observer).map_err(|e| match e {
+        StudyError::Scene(e) => CommandError::from(e),
+        StudyError::ReferenceFailed { .. } => CommandError::Study {
+            scene: label.clone(),
+            reason: e.to_string(),
+        },
+    })?;
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
-    if let Some(e) = file.into_inner().expect("lock not poisoned").1 {
+    if let Some(e) = observer.file.into_inner().expect("lock not poisoned").1 {
         return Err(io_error(&csv_path, e));
     }
-    let mut results = results.into_iter();
-    let studies: Vec<CurveStudy> = curves
-        .iter()
-        .zip(pairs)
-        .map(|(curve, (reference, check))| {
-            let results: Vec<SettingResult> = results.by_ref().take(settings.len()).collect();
-            let errors = results
-                .iter()
-                .map(|r| accuracy::errors(r, &reference))
-                .collect();
-            CurveStudy {
-                curve,
-                check_errors: accuracy::errors(&check, &reference),
-                reference,
-                check,
-                results,
-                errors,
-            }
-        })
-        .collect();
+    let StudyPlan {
+        scene,
+        problem,
+        reference,
+        check,
+        settings,
+        curves,
+        ..
+    } = plan;
     // The figures: per curve, peak amplitude error against time with the Pareto front marked
     // and labelled; with several curves also all of them in one figure.
     for s in &studies {
@@ -523,7 +475,7 @@ fn accuracy_study(
         } else {
             format!("What accuracy costs: {}", scene.title)
         };
-        curve_pareto_figure(s, &title, &dir, &pareto_stem(s.curve, several))?;
+        curve_pareto_figure(s, &title, &dir, &pareto_stem(&s.curve, several))?;
     }
     if several {
         curves_pareto_figure(
@@ -560,7 +512,7 @@ fn accuracy_study(
             &reference,
             &check,
             output,
-            &pareto_stem(s.curve, several),
+            &pareto_stem(&s.curve, several),
         ));
     }
     write_atomic(&dir.join("study.md"), md.as_bytes())?;
