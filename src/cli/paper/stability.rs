@@ -126,7 +126,7 @@ pub fn stability_study(dir: &Path, quick: bool, quiet: bool) -> StabilityStudy {
                             .points
                             .iter()
                             .filter_map(|p| p.stability)
-                            .filter(|s| !s.stable)
+                            .filter(|s| s.is_unstable())
                             .map(|s| s.floquet_re)
                             .collect();
                         study.curves.push(CurveStability {
