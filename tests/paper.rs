@@ -212,6 +212,14 @@ fn paper_quick_writes_every_figure_and_a_summary_of_computed_numbers() {
             unstable == 0,
             c["unstable_hz"].as_array().unwrap().is_empty()
         );
+        // Both limit curves stick-slip on one side over part of the range: the monodromy
+        // gives those points' verdicts (hill+monodromy), Hill the stuck ones.
+        let by_monodromy = c["monodromy_points"].as_u64().unwrap();
+        assert!(
+            by_monodromy > 0 && by_monodromy < c["points"].as_u64().unwrap(),
+            "{c}"
+        );
+        assert!(c["unreliable_points"].as_u64().unwrap() <= by_monodromy);
     }
 
     // The numbers are the runs' own: the ratio of the limit peaks of Fig. 13 (3rd resonance)

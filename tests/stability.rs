@@ -94,7 +94,7 @@ fn the_branch_past_the_fold_is_unstable_and_the_linear_branch_stable() {
 }
 
 #[test]
-fn stability_off_adds_no_columns_and_on_adds_three() {
+fn stability_off_adds_no_columns_and_on_adds_five() {
     let dir = tempfile::tempdir().unwrap();
     // The error estimate's columns off, so that the headers compare the stability columns.
     let base = [
@@ -117,7 +117,9 @@ fn stability_off_adds_no_columns_and_on_adds_three() {
     assert!(out.status.success(), "{}", text(&out.stderr));
     let (header, rows) = csv(&on.path().join("frf.csv"));
     assert!(
-        header.ends_with("newton_iters,stable,floquet_re,floquet_freq_hz"),
+        header.ends_with(
+            "newton_iters,stable,floquet_re,floquet_freq_hz,stability_method,stability_reliable"
+        ),
         "{header}"
     );
     assert!(rows.iter().all(|r| r.len() == header.split(',').count()));
@@ -170,7 +172,9 @@ fn a_limit_analysis_reports_where_each_limit_curve_is_unstable() {
         let name = c["case"].as_str().unwrap();
         let (header, rows) = csv(&dir.path().join(format!("curve_{name}.csv")));
         assert!(
-            header.ends_with(",stable,floquet_re,floquet_freq_hz"),
+            header.ends_with(
+                ",stable,floquet_re,floquet_freq_hz,stability_method,stability_reliable"
+            ),
             "{header}"
         );
         let (f, s) = (column(&header, "freq_hz"), column(&header, "stable"));

@@ -6,12 +6,13 @@ use std::time::Instant;
 
 use crate::analysis::error_estimate::{ErrorEstimator, EstimateProblems, PointAccuracy};
 use crate::analysis::linear;
+use crate::analysis::monodromy::point_monodromy;
 use crate::analysis::stability::{point_stability, PointStability, StabilityError};
 use crate::contact::harmonic::{Block, HarmonicSet};
 use crate::contact::ContactState;
 use crate::hbm::operator::HbmOperator;
 use crate::hbm::{HbmError, HbmSystem};
-use crate::model::Problem;
+use crate::model::{Problem, StabilityMethod};
 use crate::numerics::continuation::AdaptiveScale;
 use crate::numerics::golden;
 use crate::numerics::linalg::LinearSolveError;
@@ -415,23 +416,55 @@ fn full_point(system: &mut HbmOperator<'_>, p: &PathPoint) -> Result<FrfPoint, H
     })
 }
 
-/// The point with its Hill stability at ω (rad/s) when the problem asks for it
+/// The point with its stability at ω (rad/s) when the problem asks for it
 /// (`analysis.stability`): computed for the points of a continuation path (FRF runs and every
 /// limit, intermediate and scanned curve), not for the extra solves of peak refinements and
-/// common grids.
+/// common grids. The method is `analysis.stability_method`: Hill's verdict (marked unreliable
+/// on stick-slip points, [`crate::analysis::stability::hill_reliable`]), the monodromy's
+/// ([`point_monodromy`]), or Hill's replaced by the monodromy's where Hill is unreliable. A
+/// monodromy that fails (a time step whose Newton does not converge) leaves Hill's verdict
+/// (marked unreliable) or, with the monodromy alone, no verdict: empty cells.
 fn with_stability(
     system: &mut HbmOperator<'_>,
     mut point: FrfPoint,
     omega: f64,
 ) -> Result<FrfPoint, HbmError> {
-    if system.full_ref().problem().analysis.stability {
-        point.stability = Some(
+    let analysis = system.full_ref().problem().analysis;
+    if !analysis.stability {
+        return Ok(point);
+    }
+    let method = analysis.stability_method;
+    let mut verdict = None;
+    if method.uses_hill() {
+        verdict = Some(
             point_stability(system.full(), &point.coefficients, omega).map_err(|e| match e {
                 StabilityError::Hbm(e) => e,
                 other => HbmError::Stability(other.to_string()),
             })?,
         );
     }
+    let monodromy_needed = match method {
+        StabilityMethod::Hill => false,
+        StabilityMethod::Monodromy => true,
+        StabilityMethod::HillMonodromy => verdict.is_some_and(|v| !v.reliable),
+    };
+    if monodromy_needed {
+        let full = system.full_ref();
+        match point_monodromy(
+            full.problem(),
+            full.unknowns(),
+            &point.coefficients,
+            point.freq_hz,
+            analysis.monodromy_steps_per_period,
+        ) {
+            Ok(m) => verdict = Some(m.point_stability()),
+            Err(_) => match &mut verdict {
+                Some(v) => v.reliable = false,
+                None => verdict = Some(PointStability::failed()),
+            },
+        }
+    }
+    point.stability = verdict;
     Ok(point)
 }
 

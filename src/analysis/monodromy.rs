@@ -71,8 +71,9 @@ use std::f64::consts::PI;
 use faer::{c64, Mat};
 use serde::Serialize;
 
-use crate::analysis::stability::STABILITY_TOLERANCE;
-use crate::analysis::verify::{Newmark, TimeState, VerifyError, VerifySettings};
+use crate::analysis::stability::{PointStability, VerdictSource, STABILITY_TOLERANCE};
+use crate::analysis::verify::{hbm_state, Newmark, TimeState, VerifyError, VerifySettings};
+use crate::contact::harmonic::HarmonicSet;
 use crate::model::Problem;
 use crate::numerics::linalg::solve_dense;
 
@@ -364,4 +365,54 @@ pub fn monodromy_stability(
         section_margin,
         grazing_nudged: nudged,
     })
+}
+
+impl MonodromyStability {
+    /// The verdict as a point's [`PointStability`]: reliable where the shooting converged to
+    /// the periodic orbit.
+    pub fn point_stability(&self) -> PointStability {
+        PointStability {
+            stable: self.stable,
+            floquet_re: self.floquet_re,
+            floquet_freq_hz: self.floquet_freq_hz,
+            method: VerdictSource::Monodromy,
+            reliable: self.orbit_converged,
+        }
+    }
+}
+
+/// The monodromy verdict of a converged harmonic-balance point (full coefficients `x` on
+/// `set` at `freq_hz`), as `fricbound verify` computes it: the time integration's state at
+/// τ = 0 from the point ([`hbm_state`]), Newton shooting to the periodic orbit and the
+/// multipliers of its monodromy matrix ([`monodromy_stability`], default
+/// [`MonodromySettings`]), with `steps_per_period` Newmark steps per period (0: 256·H, the
+/// default of `verify`). This is the per-point verdict of `analysis.stability_method =
+/// "monodromy"` (and of `"hill+monodromy"` on stick-slip points).
+///
+/// Cost: each shooting iteration integrates 2·(2n + n_contacts) + 1 periods (29 on the paper
+/// system), usually 1-3 iterations.
+pub fn point_monodromy(
+    problem: &Problem,
+    set: &HarmonicSet,
+    x: &[f64],
+    freq_hz: f64,
+    steps_per_period: usize,
+) -> Result<MonodromyStability, VerifyError> {
+    let defaults = VerifySettings::for_harmonics(set.max_harmonic());
+    let settings = VerifySettings {
+        steps_per_period: if steps_per_period == 0 {
+            defaults.steps_per_period
+        } else {
+            steps_per_period
+        },
+        ..defaults
+    };
+    let start = hbm_state(problem, set, x, freq_hz, settings.steps_per_period)?;
+    monodromy_stability(
+        problem,
+        freq_hz,
+        &start,
+        &settings,
+        &MonodromySettings::default(),
+    )
 }

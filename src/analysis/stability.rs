@@ -66,6 +66,7 @@ use faer::{c64, Mat, MatRef};
 use serde::Serialize;
 
 use crate::contact::harmonic::{Block, HarmonicSet};
+use crate::contact::ContactState;
 use crate::hbm::{HbmError, HbmSystem};
 use crate::model::LinearModel;
 
@@ -78,10 +79,36 @@ pub const MAX_HILL_UNKNOWNS: usize = 600;
 /// called stable (neutral within round-off).
 pub const STABILITY_TOLERANCE: f64 = 1e-6;
 
+/// The method that gave a point its verdict.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum VerdictSource {
+    /// Hill's method (this module).
+    Hill,
+    /// The monodromy of the time integration's periodic orbit
+    /// ([`crate::analysis::monodromy`]).
+    Monodromy,
+    /// No verdict: the monodromy was asked for and failed (a time step whose Newton did not
+    /// converge) and Hill's method was not run ([`PointStability::failed`]).
+    Failed,
+}
+
+impl VerdictSource {
+    /// The label written in `frf.csv`, `curve_*.csv` and the JSON files.
+    pub fn label(self) -> &'static str {
+        match self {
+            VerdictSource::Hill => "hill",
+            VerdictSource::Monodromy => "monodromy",
+            VerdictSource::Failed => "failed",
+        }
+    }
+}
+
 /// The stability of one converged point.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PointStability {
-    /// Leading Floquet exponent's real part at most [`STABILITY_TOLERANCE`]·ω.
+    /// Leading Floquet exponent's real part at most [`STABILITY_TOLERANCE`]·ω (written null
+    /// in JSON when there is no verdict, [`VerdictSource::Failed`]).
     pub stable: bool,
     /// Real part of the leading Floquet exponent (1/s): > 0 grows, < 0 decays.
     pub floquet_re: f64,
@@ -90,6 +117,89 @@ pub struct PointStability {
     /// λ + ikω, so this frequency is defined modulo the excitation frequency; the kept copy is
     /// the one whose content is most centred.
     pub floquet_freq_hz: f64,
+    /// Which method gave the verdict.
+    pub method: VerdictSource,
+    /// Whether the verdict can be trusted: Hill's on points where every contact with friction
+    /// is stuck or open all period ([`hill_reliable`]), the monodromy's where its shooting
+    /// converged to the periodic orbit.
+    pub reliable: bool,
+}
+
+/// As the fields `stable` (null without a verdict), `floquet_re`, `floquet_freq_hz`,
+/// `stability_method` and `stability_reliable`.
+impl Serialize for PointStability {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut st = serializer.serialize_struct("PointStability", 5)?;
+        st.serialize_field("stable", &self.has_verdict().then_some(self.stable))?;
+        st.serialize_field("floquet_re", &self.floquet_re)?;
+        st.serialize_field("floquet_freq_hz", &self.floquet_freq_hz)?;
+        st.serialize_field("stability_method", &self.method)?;
+        st.serialize_field("stability_reliable", &self.reliable)?;
+        st.end()
+    }
+}
+
+impl PointStability {
+    /// No verdict: the monodromy failed at the point and Hill's method was not asked for.
+    pub fn failed() -> Self {
+        Self {
+            stable: false,
+            floquet_re: f64::NAN,
+            floquet_freq_hz: f64::NAN,
+            method: VerdictSource::Failed,
+            reliable: false,
+        }
+    }
+
+    /// Whether the point has a verdict and it is unstable (what figures dash and stretches
+    /// count).
+    pub fn is_unstable(&self) -> bool {
+        self.method != VerdictSource::Failed && !self.stable
+    }
+
+    /// Whether the point has a verdict at all.
+    pub fn has_verdict(&self) -> bool {
+        self.method != VerdictSource::Failed
+    }
+}
+
+/// Which methods gave the verdicts `verdicts` (e.g. the points of a curve), for legends and
+/// summaries: `Hill`, `Hill, unreliable on stick-slip` when some Hill verdict is not
+/// reliable, `monodromy`, or `monodromy on stick-slip, Hill elsewhere` when both gave
+/// verdicts.
+pub fn methods_text<'a>(verdicts: impl IntoIterator<Item = &'a PointStability>) -> &'static str {
+    let (mut hill, mut hill_unreliable, mut monodromy) = (false, false, false);
+    for v in verdicts {
+        match v.method {
+            VerdictSource::Hill => {
+                hill = true;
+                hill_unreliable |= !v.reliable;
+            }
+            VerdictSource::Monodromy => monodromy = true,
+            VerdictSource::Failed => {}
+        }
+    }
+    match (hill, monodromy) {
+        (true, true) => "monodromy on stick-slip, Hill elsewhere",
+        (false, true) => "monodromy",
+        _ if hill_unreliable => "Hill, unreliable on stick-slip",
+        _ => "Hill",
+    }
+}
+
+/// Whether Hill's verdict can be trusted at a point with these contact states: every contact
+/// is stuck or open over the whole period, or has no friction (μ = 0: a one-sided spring,
+/// such as the lift-off fold of `tests/data/liftoff-fold.toml`, where Hill agrees with the
+/// monodromy). On stick-slip points the AFT Jacobian linearises the steady-state force map,
+/// not the slider's dynamics, and Hill's growth rates were measured 20-55 times the
+/// monodromy's on the paper case (README, section Stability).
+pub fn hill_reliable(problem: &crate::model::Problem, states: &[ContactState]) -> bool {
+    problem
+        .contacts
+        .iter()
+        .zip(states)
+        .all(|(c, s)| c.law.mu == 0.0 || matches!(s, ContactState::Stuck | ContactState::Open))
 }
 
 /// Why the Floquet exponents of a point could not be computed.
@@ -315,12 +425,15 @@ pub fn verdict(exponents: &[c64], omega: f64) -> PointStability {
         stable: lead.re <= STABILITY_TOLERANCE * omega,
         floquet_re: lead.re,
         floquet_freq_hz: lead.im.abs() / (2.0 * std::f64::consts::PI),
+        method: VerdictSource::Hill,
+        reliable: true,
     }
 }
 
 /// The stability of the converged point with full coefficients `x` at ω (rad/s) of `system`:
 /// its Jacobian (the system's strategy, analytic by default) in dense form, the Floquet
-/// exponents and the verdict. The system's contact states are left as they were.
+/// exponents and the verdict, `reliable` from the contact states at the point
+/// ([`hill_reliable`]). The system's contact states are left as they were.
 pub fn point_stability(
     system: &mut HbmSystem<'_>,
     x: &[f64],
@@ -331,6 +444,7 @@ pub fn point_stability(
     let (mut r, mut dr) = (vec![0.0; dim], vec![0.0; dim]);
     let states = system.states.clone();
     let evaluated = system.residual_and_jacobian(x, omega, &mut r, &mut jacobian, &mut dr);
+    let reliable = hill_reliable(system.problem(), &system.states);
     system.states = states;
     evaluated?;
     let dense = jacobian.to_dense();
@@ -340,7 +454,10 @@ pub fn point_stability(
         dense.as_ref(),
         omega,
     )?;
-    Ok(verdict(&exponents, omega))
+    Ok(PointStability {
+        reliable,
+        ..verdict(&exponents, omega)
+    })
 }
 
 /// The stretches of a path (frequencies in Hz, `[from, to]` with from ≤ to) over which
@@ -353,7 +470,7 @@ pub fn unstable_stretches(
     let mut stretches = Vec::new();
     let mut current: Option<[f64; 2]> = None;
     for (freq_hz, stability) in points {
-        if stability.is_some_and(|s| !s.stable) {
+        if stability.is_some_and(|s| s.is_unstable()) {
             let span = current.get_or_insert([freq_hz, freq_hz]);
             span[0] = span[0].min(freq_hz);
             span[1] = span[1].max(freq_hz);

@@ -47,6 +47,17 @@ use crate::contact::{ContactPoint, NormalLoad};
 use crate::model::Problem;
 use crate::numerics::linalg::solve_dense;
 
+/// Most DOFs of a model the dense time integration (and the monodromy) accepts: lumped or
+/// reduced models.
+pub const MAX_VERIFY_DOFS: usize = 2000;
+
+/// Fewest Newmark steps per period a scene may ask of the monodromy
+/// (`analysis.monodromy_steps_per_period`).
+pub const MIN_MONODROMY_STEPS: usize = 8;
+
+/// Most Newmark steps per period a scene may ask of the monodromy.
+pub const MAX_MONODROMY_STEPS: usize = 1 << 16;
+
 /// Settings of a time integration.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VerifySettings {
@@ -192,9 +203,9 @@ fn check_supported(problem: &Problem) -> Result<(), VerifyError> {
         });
     }
     let n = problem.model.n_dofs();
-    if n > 2000 {
+    if n > MAX_VERIFY_DOFS {
         return Err(VerifyError::Unsupported {
-            reason: format!("{n} DOFs: the dense time integration is for lumped or reduced models (≤ 2000 DOFs)"),
+            reason: format!("{n} DOFs: the dense time integration is for lumped or reduced models (≤ {MAX_VERIFY_DOFS} DOFs)"),
         });
     }
     Ok(())

@@ -6,12 +6,12 @@ use std::sync::Mutex;
 use super::{CommandError, RunContext, RunOutcome, RunReport};
 use crate::analysis::frf::FrfPoint;
 use crate::analysis::limits::{self, CaseCurve, LimitAnalysis, Regime};
-use crate::analysis::stability::{stretches_text, unstable_stretches};
+use crate::analysis::stability::{methods_text, stretches_text, unstable_stretches};
 use crate::report::files::{self, frf_header, frf_row};
 use crate::report::limit_files;
 use crate::report::plot::{
-    figure_files, palette, plot_hysteresis, plot_limits, Curve, LimitFigure, Loop, UNSTABLE_COLOR,
-    UNSTABLE_LABEL,
+    figure_files, palette, plot_hysteresis, plot_limits, unstable_label, Curve, LimitFigure, Loop,
+    UNSTABLE_COLOR,
 };
 
 /// Writes one curve's path as `curve_<name>.csv` (same columns as `frf.csv`): the whole path of
@@ -308,7 +308,7 @@ fn write_json(
         json["envelope"] = serde_json::to_value(e).expect("result types serialise");
     }
     if stability {
-        json["stability"] = band_stability_json(a);
+        json["stability"] = band_stability_json(a, ctx.problem.analysis.stability_method);
     }
     let bytes = serde_json::to_vec_pretty(&json).expect("JSON values serialise");
     files::write_atomic(&ctx.dir.join("limits.json"), &bytes)?;
@@ -316,9 +316,12 @@ fn write_json(
 }
 
 /// `limits.json` → `stability`: for each limit curve (the two that form the band), the
-/// stretches where Hill's method finds it unstable, and the grid frequencies where the band
+/// stretches where the scene's stability method finds it unstable, and the grid frequencies where the band
 /// exists but is bounded by an unstable limit point (a state the structure does not keep).
-fn band_stability_json(a: &LimitAnalysis) -> serde_json::Value {
+fn band_stability_json(
+    a: &LimitAnalysis,
+    method: crate::model::StabilityMethod,
+) -> serde_json::Value {
     let curves: Vec<serde_json::Value> = a
         .limits
         .iter()
@@ -327,15 +330,20 @@ fn band_stability_json(a: &LimitAnalysis) -> serde_json::Value {
             serde_json::json!({
                 "case": c.case.name,
                 "unstable_hz": stretches,
-                "unstable_points": c.points.iter().filter(|p| p.stability.is_some_and(|s| !s.stable)).count(),
+                "unstable_points": c.points.iter().filter(|p| p.stability.is_some_and(|s| s.is_unstable())).count(),
+                "unreliable_points": c.points.iter().filter(|p| p.stability.is_some_and(|s| !s.reliable)).count(),
                 "points": c.points.len(),
+                "verdicts": methods_text(c.points.iter().filter_map(|p| p.stability.as_ref())),
                 "text": stretches_text(&stretches),
             })
         })
         .collect();
     serde_json::json!({
-        "method": "Hill (Floquet exponents of the harmonic-balance Jacobian); a limit curve is \
-                   not a reachable bound where it is unstable",
+        "method": method.label(),
+        "about": "hill: Floquet exponents of the harmonic-balance Jacobian (unreliable on stick-slip \
+                  points); monodromy: Floquet multipliers of the time integration's periodic orbit; \
+                  hill+monodromy: the monodromy where Hill is unreliable. A limit curve is not a \
+                  reachable bound where it is unstable",
         "limit_curves": curves,
     })
 }
@@ -387,6 +395,12 @@ fn plot(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandError> {
             .map(|c| unstable_overlay(&c.points, k))
             .filter(|(x, _)| !x.is_empty())
             .collect();
+        let overlay_label = unstable_label(
+            limit_curves
+                .iter()
+                .chain(&intermediate)
+                .flat_map(|c| c.points.iter().filter_map(|p| p.stability.as_ref())),
+        );
         let mut curves = curves_with_references(ctx, &series, &open_y, &stuck_y);
         let (env_min, env_max) = envelope_series(a, k);
         if !env_max.is_empty() {
@@ -407,7 +421,7 @@ fn plot(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandError> {
         }
         for (i, (x, y)) in overlays.iter().enumerate() {
             curves.push(Curve {
-                label: if i == 0 { UNSTABLE_LABEL } else { "" },
+                label: if i == 0 { &overlay_label } else { "" },
                 x,
                 y,
                 color: UNSTABLE_COLOR,
@@ -505,8 +519,9 @@ pub(super) fn summary(a: &LimitAnalysis, elapsed: f64) -> String {
         if c.points.iter().any(|p| p.stability.is_some()) {
             let _ = writeln!(
                 s,
-                "  {:<24} Hill stability: {}",
+                "  {:<24} stability ({}): {}",
                 c.case.name,
+                methods_text(c.points.iter().filter_map(|p| p.stability.as_ref())),
                 match unstable_stretches(c.points.iter().map(|p| (p.freq_hz, p.stability))) {
                     v if v.is_empty() => "stable throughout".to_string(),
                     v => format!("UNSTABLE over {}", stretches_text(&v)),
@@ -662,14 +677,14 @@ fn reference_ys(ctx: &RunContext<'_>, k: usize) -> (Vec<f64>, Vec<f64>) {
 fn unstable_overlay(points: &[FrfPoint], k: usize) -> (Vec<f64>, Vec<f64>) {
     if !points
         .iter()
-        .any(|p| p.stability.is_some_and(|s| !s.stable))
+        .any(|p| p.stability.is_some_and(|s| s.is_unstable()))
     {
         return (Vec::new(), Vec::new());
     }
     points
         .iter()
         .map(|p| {
-            if p.stability.is_some_and(|s| !s.stable) {
+            if p.stability.is_some_and(|s| s.is_unstable()) {
                 (p.freq_hz, p.amplitudes.get(k).copied().unwrap_or(f64::NAN))
             } else {
                 (f64::NAN, f64::NAN)

@@ -92,15 +92,16 @@ pub struct VerifyCase {
     pub hill_monodromy_agree: Option<bool>,
     /// Why the monodromy could not be computed, if it could not.
     pub monodromy_error: Option<String>,
-    /// `--from static`: the uniform-m curve (m = −1, +1 and the scene's intermediate m) whose
-    /// HBM point at this frequency is nearest to the settled motion, as `m=<value>`.
+    /// `--from static`: the curve (m = −1, +1, the scene's uniform intermediate m, as
+    /// `m=<value>`, and its `[[limits.cases]]`, by name) whose HBM point at this frequency is
+    /// nearest to the motion at the end of the integration.
     pub reached_curve: Option<String>,
     /// `--from static`: the largest relative difference of the output amplitudes (last
     /// period, dt/2) from that curve's HBM point.
     pub reached_distance: Option<f64>,
     /// `--from static`: the relative difference from every compared curve's HBM point, as
-    /// (m, difference).
-    pub curve_distances: Vec<(f64, f64)>,
+    /// (label, difference).
+    pub curve_distances: Vec<(String, f64)>,
     /// Why the case failed, if it did.
     pub error: Option<String>,
 }
@@ -140,23 +141,73 @@ fn relative_distance(time: &[f64], hbm: &[f64]) -> f64 {
         .fold(0.0_f64, f64::max)
 }
 
-/// For each uniform m of `curve_ms`, the distance of `time` amplitudes from that curve's HBM
-/// point at `freq` (curves whose point does not converge are left out).
+/// A curve a `--from static` case is compared with: its label in `reached_curve` (`m=<value>`
+/// for a uniform m, the case's name for a per-side or per-point `[[limits.cases]]` entry) and
+/// the initial state of every contact.
+#[derive(Debug, Clone)]
+pub struct ComparedCurve {
+    /// `m=<value>` or the case name.
+    pub label: String,
+    /// m of each contact point, in the problem's contact order.
+    pub contact_states: Vec<f64>,
+}
+
+/// For each curve of `curves`, the distance of `time` amplitudes from that curve's HBM point
+/// at `freq` (curves whose point does not converge are left out).
 fn curve_distances(
     problem: &crate::model::Problem,
     freq: f64,
-    curve_ms: &[f64],
+    curves: &[ComparedCurve],
     time: &[f64],
-) -> Vec<(f64, f64)> {
-    curve_ms
+) -> Vec<(String, f64)> {
+    curves
         .iter()
-        .filter_map(|&m| {
+        .filter_map(|curve| {
             let mut pm = problem.clone();
-            pm.contacts.iter_mut().for_each(|c| c.law.initial_state = m);
+            pm.contacts
+                .iter_mut()
+                .zip(&curve.contact_states)
+                .for_each(|(c, m)| c.law.initial_state = *m);
             let (_, point) = hbm_point(&pm, freq)?;
-            Some((m, relative_distance(time, &point.amplitudes)))
+            Some((
+                curve.label.clone(),
+                relative_distance(time, &point.amplitudes),
+            ))
         })
         .collect()
+}
+
+/// The curves a `--from static` case is compared with: the two limits (m = ±1), the scene's
+/// uniform intermediate states (m = 0 too when the scene has no limit analysis) and its
+/// per-side or per-point `[[limits.cases]]`.
+pub fn compared_curves(
+    problem: &crate::model::Problem,
+    limits: Option<&crate::analysis::limits::run::LimitSettings>,
+) -> Vec<ComparedCurve> {
+    let mut ms: Vec<f64> = vec![-1.0, 1.0];
+    match limits {
+        Some(l) => ms.extend(l.intermediate.iter().copied()),
+        None => ms.push(0.0),
+    }
+    ms.sort_by(f64::total_cmp);
+    ms.dedup();
+    let mut curves: Vec<ComparedCurve> = ms
+        .into_iter()
+        .map(|m| ComparedCurve {
+            label: format!("m={m}"),
+            contact_states: vec![m; problem.contacts.len()],
+        })
+        .collect();
+    if let Some(l) = limits {
+        for spec in &l.cases {
+            let case = crate::analysis::limits::case::LimitCase::from_spec(problem, spec);
+            curves.push(ComparedCurve {
+                label: case.name,
+                contact_states: case.contact_states,
+            });
+        }
+    }
+    curves
 }
 
 fn one_case(
@@ -166,7 +217,7 @@ fn one_case(
     from: StartFrom,
     settings: &VerifySettings,
     fig_dir: &std::path::Path,
-    curve_ms: &[f64],
+    curves: &[ComparedCurve],
 ) -> VerifyCase {
     let mut problem_m = scene_problem.clone();
     if let Some(m) = initial_state {
@@ -248,14 +299,14 @@ fn one_case(
                 None => format!("verify_{freq}Hz"),
             };
             if from == StartFrom::Static {
-                case.curve_distances = curve_distances(problem, freq, curve_ms, &v.fine.amplitudes);
-                if let Some(&(m, d)) = case
+                case.curve_distances = curve_distances(problem, freq, curves, &v.fine.amplitudes);
+                if let Some((label, d)) = case
                     .curve_distances
                     .iter()
                     .min_by(|a, b| a.1.total_cmp(&b.1))
                 {
-                    case.reached_curve = Some(format!("m={m}"));
-                    case.reached_distance = Some(d);
+                    case.reached_curve = Some(label.clone());
+                    case.reached_distance = Some(*d);
                 }
             }
             let _ = time_history_figure(problem, &set, &point.coefficients, &v, fig_dir, &stem);
@@ -408,15 +459,7 @@ fn opt<T: std::fmt::Display>(v: Option<T>) -> String {
 pub fn run(options: &VerifyOptions) -> Result<VerifyReport, CommandError> {
     let (label, _scene, problem, limits) =
         load_scene(options.scene.as_deref(), &options.overrides)?;
-    // The curves a `--from static` case is compared with: the two limits and the scene's
-    // uniform intermediate states (m = 0 too when the scene has no limit analysis).
-    let mut curve_ms: Vec<f64> = vec![-1.0, 1.0];
-    match &limits {
-        Some(l) => curve_ms.extend(l.intermediate.iter().copied()),
-        None => curve_ms.push(0.0),
-    }
-    curve_ms.sort_by(f64::total_cmp);
-    curve_ms.dedup();
+    let curves = compared_curves(&problem, limits.as_ref());
     let dir = options.out.clone().unwrap_or_else(|| {
         default_out_dir(options.scene.as_deref(), &options.overrides).join("verify")
     });
@@ -452,7 +495,7 @@ pub fn run(options: &VerifyOptions) -> Result<VerifyReport, CommandError> {
     let cases: Vec<VerifyCase> = jobs
         .par_iter()
         .map(|&(f, m)| {
-            let c = one_case(&problem, f, m, options.from, &settings, &dir, &curve_ms);
+            let c = one_case(&problem, f, m, options.from, &settings, &dir, &curves);
             if let Some(b) = &bar {
                 b.inc(1);
             }
@@ -585,4 +628,33 @@ pub fn run(options: &VerifyOptions) -> Result<VerifyReport, CommandError> {
         incomplete: (!problems.is_empty()).then(|| problems.join(", ")),
         cases,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn static_starts_are_compared_with_the_per_side_cases_too() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("meshes/paper-wedge/fig16c.toml");
+        let (_, _, problem, limits) = load_scene(Some(&path), &[]).unwrap();
+        let curves = compared_curves(&problem, limits.as_ref());
+        let labels: Vec<&str> = curves.iter().map(|c| c.label.as_str()).collect();
+        assert_eq!(
+            labels,
+            ["m=-1", "m=-0.5", "m=0", "m=0.5", "m=1", "left+0.5"],
+            "{labels:?}"
+        );
+        // The per-side case: m = +0.5 on the blade-1 side, the scene's own state elsewhere.
+        let side_case = &curves[5].contact_states;
+        for (c, m) in problem.contacts.iter().zip(side_case) {
+            let expected = if problem.sides[c.side].name == "left" {
+                0.5
+            } else {
+                c.law.initial_state
+            };
+            assert_eq!(*m, expected, "contact {}", c.name);
+        }
+    }
 }

@@ -16,5 +16,5 @@ pub mod reduce;
 
 pub use problem::{
     Analysis, Coupling, DofSplit, Effects, ErrorEstimateSettings, FeOrigin, Formulation,
-    HarmonicLoad, JacobianStrategy, LinearModel, Problem, CHORD_MIN_UNKNOWNS,
+    HarmonicLoad, JacobianStrategy, LinearModel, Problem, StabilityMethod, CHORD_MIN_UNKNOWNS,
 };

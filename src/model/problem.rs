@@ -103,6 +103,52 @@ pub enum Formulation {
     Schur,
 }
 
+/// Which method gives each converged point its stability verdict (scene field
+/// `analysis.stability_method`; see [`crate::analysis::stability`] and
+/// [`crate::analysis::monodromy`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+pub enum StabilityMethod {
+    /// Hill's method on every point (default): the harmonic-balance Jacobian's quadratic
+    /// eigenproblem. Exact on points where every contact is stuck, open or frictionless, a
+    /// warning only on stick-slip points (flagged `stability_reliable = false`).
+    #[default]
+    #[serde(rename = "hill")]
+    Hill,
+    /// The monodromy matrix of the time integration's periodic orbit (shooting from the
+    /// harmonic-balance point) on every point: linearises the non-smooth Jenkins dynamics.
+    #[serde(rename = "monodromy")]
+    Monodromy,
+    /// Hill on every point, and the monodromy on the points where Hill is not reliable (some
+    /// contact with friction slips or separates for part of the period); the monodromy's
+    /// verdict replaces Hill's there.
+    #[serde(rename = "hill+monodromy")]
+    HillMonodromy,
+}
+
+impl StabilityMethod {
+    /// The scene's spelling.
+    pub fn label(self) -> &'static str {
+        match self {
+            StabilityMethod::Hill => "hill",
+            StabilityMethod::Monodromy => "monodromy",
+            StabilityMethod::HillMonodromy => "hill+monodromy",
+        }
+    }
+
+    /// Whether Hill's eigen solve runs (on every point, or as the first pass).
+    pub fn uses_hill(self) -> bool {
+        matches!(self, StabilityMethod::Hill | StabilityMethod::HillMonodromy)
+    }
+
+    /// Whether the monodromy may run on some point.
+    pub fn uses_monodromy(self) -> bool {
+        matches!(
+            self,
+            StabilityMethod::Monodromy | StabilityMethod::HillMonodromy
+        )
+    }
+}
+
 /// Settings of a frequency-response analysis: the continuation over the range (frequencies in
 /// Hz; arc-length steps in the scaled space where a unit of frequency is 1 Hz, see
 /// [`crate::numerics::continuation`]) and how the harmonic balance is formed and stored.
@@ -119,6 +165,11 @@ pub struct Analysis {
     /// Hill stability of every converged point ([`crate::analysis::stability`]); off costs
     /// nothing.
     pub stability: bool,
+    /// Which method gives the verdict when `stability` is on.
+    pub stability_method: StabilityMethod,
+    /// Newmark steps per period of the monodromy's time integration (0: 256·H, the default of
+    /// `fricbound verify`).
+    pub monodromy_steps_per_period: usize,
     /// The a-posteriori error estimate on every converged point (scene table `[accuracy]`).
     pub error_estimate: ErrorEstimateSettings,
 }

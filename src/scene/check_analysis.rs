@@ -4,7 +4,8 @@
 //! and the `[output]` table into the response DOFs.
 
 use crate::analysis::stability::{harmonics_supported, MAX_HILL_UNKNOWNS};
-use crate::contact::ContactPoint;
+use crate::analysis::verify::{MAX_MONODROMY_STEPS, MAX_VERIFY_DOFS, MIN_MONODROMY_STEPS};
+use crate::contact::{ContactPoint, NormalLoad};
 use crate::model::{
     Analysis, Coupling, ErrorEstimateSettings, LinearModel, Problem, CHORD_MIN_UNKNOWNS,
 };
@@ -123,6 +124,28 @@ pub(super) fn analysis(a: &AnalysisSpec, ck: &Checker) -> Result<Analysis, Scene
             return Err(ck.err(field, format!("must be ≤ {MAX_POINTS}, got {v}")));
         }
     }
+    if a.stability_method.is_some() && !a.stability {
+        return Err(ck.err(
+            "analysis.stability_method",
+            "chooses how stability is computed, but analysis.stability is off: set analysis.stability = true",
+        ));
+    }
+    if let Some(steps) = a.monodromy_steps_per_period {
+        if !a.stability_method.is_some_and(|m| m.uses_monodromy()) {
+            return Err(ck.err(
+                "analysis.monodromy_steps_per_period",
+                "is used only by the monodromy: set analysis.stability_method = \"monodromy\" or \"hill+monodromy\"",
+            ));
+        }
+        if !(MIN_MONODROMY_STEPS..=MAX_MONODROMY_STEPS).contains(&steps) {
+            return Err(ck.err(
+                "analysis.monodromy_steps_per_period",
+                format!(
+                    "must be between {MIN_MONODROMY_STEPS} and {MAX_MONODROMY_STEPS}, got {steps}"
+                ),
+            ));
+        }
+    }
     let residual_tolerance = ck.positive("analysis.residual_tolerance", a.residual_tolerance)?;
     let step_tolerance = ck.positive("analysis.step_tolerance", a.step_tolerance)?;
     Ok(Analysis {
@@ -143,6 +166,8 @@ pub(super) fn analysis(a: &AnalysisSpec, ck: &Checker) -> Result<Analysis, Scene
         formulation: a.formulation,
         linear_points: a.linear_points,
         stability: a.stability,
+        stability_method: a.stability_method.unwrap_or_default(),
+        monodromy_steps_per_period: a.monodromy_steps_per_period.unwrap_or(0),
         error_estimate: ErrorEstimateSettings::default(),
     })
 }
@@ -168,16 +193,41 @@ pub(super) fn error_estimate(
 /// With `analysis.stability` on: Hill's method needs the 0th harmonic among the unknowns
 /// (a coupled scene) and the harmonics 0..H without gaps, and its dense eigen solve at most
 /// [`MAX_HILL_UNKNOWNS`] unknowns (DOFs × coefficient blocks, after any reduction).
+///
+/// With a method that uses the monodromy (`analysis.stability_method`): the time integration
+/// needs variable normal load and a dense model of at most [`MAX_VERIFY_DOFS`] DOFs; the
+/// Hill size limit applies only where Hill's method runs.
 pub(super) fn check_stability(ck: &Checker, problem: &Problem) -> Result<(), SceneError> {
     if !problem.analysis.stability {
         return Ok(());
     }
+    let method = problem.analysis.stability_method;
     let field = "analysis.stability";
     if problem.effects.coupling != Coupling::Coupled {
         return Err(ck.err(
             field,
-            "Hill stability needs the 0th harmonic among the unknowns: set effects.coupling = \"coupled\"",
+            "Hill stability and the monodromy need the 0th harmonic among the unknowns: set effects.coupling = \"coupled\"",
         ));
+    }
+    if method.uses_monodromy() {
+        let field = "analysis.stability_method";
+        if problem.effects.contact.normal_load == NormalLoad::Constant
+            && !problem.contacts.is_empty()
+        {
+            return Err(ck.err(
+                field,
+                "the monodromy integrates the equations of motion in time, where a constant normal load has no meaning: set effects.normal_load = \"variable\" or use \"hill\"",
+            ));
+        }
+        if problem.model.n_dofs() > MAX_VERIFY_DOFS {
+            return Err(ck.err(
+                field,
+                format!(
+                    "the monodromy's dense time integration is for lumped or reduced models of at most {MAX_VERIFY_DOFS} DOFs, this one has {}",
+                    problem.model.n_dofs()
+                ),
+            ));
+        }
     }
     let set = problem.unknown_harmonics();
     if !harmonics_supported(&set) {
@@ -190,7 +240,7 @@ pub(super) fn check_stability(ck: &Checker, problem: &Problem) -> Result<(), Sce
         ));
     }
     let unknowns = problem.model.n_dofs() * set.n_blocks();
-    if unknowns > MAX_HILL_UNKNOWNS {
+    if method.uses_hill() && unknowns > MAX_HILL_UNKNOWNS {
         return Err(ck.err(
             field,
             format!(

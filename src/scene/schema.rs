@@ -292,6 +292,13 @@ pub struct AnalysisSpec {
     /// Hill stability (Floquet exponents) of every converged point; default off.
     #[serde(default)]
     pub stability: bool,
+    /// Which method gives the stability verdict: `hill` (default), `monodromy` or
+    /// `hill+monodromy`; needs `stability = true`.
+    #[serde(default)]
+    pub stability_method: Option<crate::model::StabilityMethod>,
+    /// Newmark steps per period of the monodromy's time integration (default 256·H).
+    #[serde(default)]
+    pub monodromy_steps_per_period: Option<usize>,
 }
 
 /// Default most continuation points.

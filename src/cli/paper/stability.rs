@@ -1,13 +1,14 @@
 //! The stability part of the study: where the limit curves of the paper's damper around the
-//! 3rd resonance (Fig. 13a, F0 = 120 N) are unstable by Hill's method, with the damper's own
-//! damping C_D = 0 as printed in Table 1 and with a small damper damping (5 N s/m on xD and
-//! yD). Two extra runs of `fig13-3rd.toml` (limit curves only, `analysis.stability = true`),
-//! each into its own sub-folder, summarised in a section of `summary.md` and in
-//! `stability.json`.
+//! 3rd resonance (Fig. 13a, F0 = 120 N) are unstable, with the damper's own damping C_D = 0 as
+//! printed in Table 1 and with a small damper damping (5 N s/m on xD and yD). Two extra runs of
+//! `fig13-3rd.toml` (limit curves only, `analysis.stability = true`,
+//! `analysis.stability_method = "hill+monodromy"`), each into its own sub-folder, summarised
+//! in a section of `summary.md` and in `stability.json`.
 //!
-//! Hill's verdict uses the AFT Jacobian for the Jenkins contacts; where a contact stick-slips
-//! it is checked against the monodromy of the time integration by `fricbound verify` (see the
-//! README's "Stability"), and the section says so.
+//! Hill's verdict uses the AFT Jacobian for the Jenkins contacts, exact where every contact is
+//! stuck or open; where a contact stick-slips it is replaced by the monodromy of the time
+//! integration's periodic orbit (README, "Stability"), with 256 Newmark steps per period
+//! (64 with `--quick`).
 
 use std::path::{Path, PathBuf};
 
@@ -43,6 +44,7 @@ const JOBS: [StabilityJob; 2] = [
 fn common_overrides(quick: bool) -> Vec<String> {
     let mut o = vec![
         "analysis.stability=true".to_string(),
+        "analysis.stability_method=hill+monodromy".to_string(),
         "limits.intermediate=[]".to_string(),
         "limits.bound_scan=[]".to_string(),
     ];
@@ -52,11 +54,13 @@ fn common_overrides(quick: bool) -> Vec<String> {
                 "harmonics.max=1",
                 "analysis.max_step=0.25",
                 "limits.grid_points=41",
+                "analysis.monodromy_steps_per_period=64",
             ]
             .map(String::from),
         );
     } else {
         o.push("harmonics.max=5".to_string());
+        o.push("analysis.monodromy_steps_per_period=256".to_string());
     }
     o
 }
@@ -70,8 +74,13 @@ pub struct CurveStability {
     pub curve: String,
     /// Points on the curve.
     pub points: usize,
-    /// Points Hill calls unstable.
+    /// Points found unstable (Hill's verdict where every contact is stuck or open, the
+    /// monodromy's on stick-slip points).
     pub unstable_points: usize,
+    /// Points whose verdict is the monodromy's.
+    pub monodromy_points: usize,
+    /// Points whose verdict is not reliable (the monodromy's shooting did not converge).
+    pub unreliable_points: usize,
     /// Unstable stretches `[from_hz, to_hz]`.
     pub unstable_hz: Vec<[f64; 2]>,
     /// Largest leading-exponent real part over the curve (1/s).
@@ -103,7 +112,7 @@ pub fn stability_study(dir: &Path, quick: bool, quiet: bool) -> StabilityStudy {
     for s in &JOBS {
         if !quiet {
             eprintln!(
-                "{}: Hill stability of the limit curves, {}",
+                "{}: stability of the limit curves (Hill, monodromy on stick-slip), {}",
                 s.id, s.damper_damping
             );
         }
@@ -126,7 +135,7 @@ pub fn stability_study(dir: &Path, quick: bool, quiet: bool) -> StabilityStudy {
                             .points
                             .iter()
                             .filter_map(|p| p.stability)
-                            .filter(|s| !s.stable)
+                            .filter(|s| s.is_unstable())
                             .map(|s| s.floquet_re)
                             .collect();
                         study.curves.push(CurveStability {
@@ -134,6 +143,21 @@ pub fn stability_study(dir: &Path, quick: bool, quiet: bool) -> StabilityStudy {
                             curve: c.case.name.clone(),
                             points: c.points.len(),
                             unstable_points: unstable.len(),
+                            monodromy_points: c
+                                .points
+                                .iter()
+                                .filter(|p| {
+                                    p.stability.is_some_and(|s| {
+                                        s.method
+                                            == crate::analysis::stability::VerdictSource::Monodromy
+                                    })
+                                })
+                                .count(),
+                            unreliable_points: c
+                                .points
+                                .iter()
+                                .filter(|p| p.stability.is_some_and(|s| !s.reliable))
+                                .count(),
                             unstable_hz: stretches,
                             max_floquet_re: c
                                 .points
@@ -155,26 +179,27 @@ pub fn stability_study(dir: &Path, quick: bool, quiet: bool) -> StabilityStudy {
 pub fn stability_markdown(study: &StabilityStudy) -> String {
     let mut md = String::from("\n## Stability of the limit curves (3rd resonance, Fig. 13a)\n\n");
     md.push_str(&format!(
-        "Hill's method on every point of the two limit curves of `fig13-3rd.toml` (F0 = 120 N, \
+        "The stability of every point of the two limit curves of `fig13-3rd.toml` (F0 = 120 N, \
          harmonics 0..{}), without and with a small damper damping (sub-folders \
-         `stability-3rd`, `stability-3rd-damped`). An unstable stretch of a limit curve is not a \
-         state the damper keeps there, so the band is no bound of the reachable response there. \
-         Hill's linearisation of the Jenkins contact is the AFT Jacobian of the periodic forces, \
-         exact where the contacts are fully stuck or open; on stick-slip points its growth \
-         rates are not reliable (against the monodromy of the time integration they were \
-         found much too large on the m = +1 curve, and damped states called unstable that \
-         the time integration keeps; README, \"Stability\"): read the stretches below as \
-         warnings and confirm them with `fricbound verify` (`monodromy_re`).\n\n",
+         `stability-3rd`, `stability-3rd-damped`; `analysis.stability_method = \
+         \"hill+monodromy\"`). An unstable stretch of a limit curve is not a state the damper \
+         keeps there, so the band is no bound of the reachable response there. Hill's method \
+         (the AFT Jacobian of the periodic forces) gives the verdict where the contacts are \
+         fully stuck or open, where it is exact; on stick-slip points, where its growth rates \
+         are not reliable, the verdict is the monodromy's: the Floquet multipliers of the time \
+         integration's periodic orbit through the point (README, \"Stability\").\n\n",
         study.harmonics
     ));
-    md.push_str("| damper damping | curve | points | unstable | unstable stretches (Hz) | largest Re λ (1/s) |\n");
-    md.push_str("| --- | --- | --- | --- | --- | --- |\n");
+    md.push_str("| damper damping | curve | points | by the monodromy | unreliable | unstable | unstable stretches (Hz) | largest Re λ (1/s) |\n");
+    md.push_str("| --- | --- | --- | --- | --- | --- | --- | --- |\n");
     for c in &study.curves {
         md.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {} |\n",
             c.damper_damping,
             c.curve,
             c.points,
+            c.monodromy_points,
+            c.unreliable_points,
             c.unstable_points,
             if c.unstable_hz.is_empty() {
                 "none".to_string()

@@ -1,8 +1,8 @@
 //! The FRF figure: the nonlinear frequency response of one output DOF (first-harmonic
 //! amplitude, in path order, with markers) over the linear open- and stuck-contact references
 //! (dashed) on a log amplitude axis, with one strip per contact below it showing the contact
-//! state at each point; points found unstable by Hill's method are overdrawn black, dashed
-//! and marked.
+//! state at each point; points found unstable (by the scene's `analysis.stability_method`)
+//! are overdrawn black, dashed and marked, the legend naming the method.
 
 use std::path::Path;
 
@@ -14,7 +14,7 @@ use super::chart::ChartSpec;
 use super::series::{points, valid_runs, Line};
 use super::strips::{Strip, StripChart};
 use super::style::{
-    state_color, NONLINEAR_COLOR, OPEN_COLOR, STUCK_COLOR, UNSTABLE_COLOR, UNSTABLE_LABEL,
+    state_color, unstable_label, NONLINEAR_COLOR, OPEN_COLOR, STUCK_COLOR, UNSTABLE_COLOR,
 };
 use crate::analysis::frf::FrfPoint;
 use crate::analysis::linear::LinearCurve;
@@ -93,7 +93,7 @@ fn unstable_line(fig: &FrfFigure, out: usize, in_range: &dyn Fn(f64) -> bool) ->
     let gap = (f64::NAN, f64::NAN);
     let points = fig.points.iter().enumerate().flat_map(|(i, p)| {
         let start = fig.branch_starts.contains(&i).then_some(gap);
-        let unstable = p.stability.is_some_and(|s| !s.stable) && in_range(p.freq_hz);
+        let unstable = p.stability.is_some_and(|s| s.is_unstable()) && in_range(p.freq_hz);
         let here = if unstable {
             (
                 p.freq_hz,
@@ -105,7 +105,7 @@ fn unstable_line(fig: &FrfFigure, out: usize, in_range: &dyn Fn(f64) -> bool) ->
         start.into_iter().chain(std::iter::once(here))
     });
     Line {
-        label: UNSTABLE_LABEL.to_string(),
+        label: unstable_label(fig.points.iter().filter_map(|p| p.stability.as_ref())),
         runs: valid_runs(points, true),
         color: UNSTABLE_COLOR,
         dashed: true,

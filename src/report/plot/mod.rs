@@ -42,5 +42,5 @@ pub use hysteresis::{plot_hysteresis, Loop};
 pub use limits::{plot_limits, LimitFigure};
 pub use lines::plot_lines;
 pub use series::Curve;
-pub use style::{palette, UNSTABLE_COLOR, UNSTABLE_LABEL};
+pub use style::{palette, unstable_label, UNSTABLE_COLOR};
 pub use sweep::{plot_sweep, BandSpec, SweepFigure};

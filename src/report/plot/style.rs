@@ -7,6 +7,7 @@ use std::sync::OnceLock;
 
 use plotters::prelude::*;
 
+use crate::analysis::stability::{methods_text, PointStability};
 use crate::contact::ContactState;
 
 /// Name the embedded font is registered under.
@@ -37,10 +38,16 @@ pub(super) const OPEN_COLOR: RGBColor = RGBColor(110, 110, 110);
 /// Colour of the linear reference with the contacts stuck (and of the stuck state).
 pub(super) const STUCK_COLOR: RGBColor = RGBColor(31, 100, 180);
 
-/// Colour of the overlay on points found unstable by Hill's method (dashed, marked).
+/// Colour of the overlay on points found unstable (dashed, marked).
 pub const UNSTABLE_COLOR: RGBColor = RGBColor(0, 0, 0);
-/// Legend label of that overlay.
-pub const UNSTABLE_LABEL: &str = "unstable (Hill): dashed, marked";
+
+/// Legend label of that overlay, naming the method that gave the verdicts of `verdicts` (the
+/// points of the drawn paths): `unstable (Hill)`, `unstable (Hill, unreliable on stick-slip)`
+/// when some Hill verdict is not reliable, `unstable (monodromy)`, or `unstable (monodromy on
+/// stick-slip, Hill elsewhere)` when both gave verdicts.
+pub fn unstable_label<'a>(verdicts: impl IntoIterator<Item = &'a PointStability>) -> String {
+    format!("unstable ({}): dashed, marked", methods_text(verdicts))
+}
 
 /// Label of the shaded band in the legends.
 pub(super) const BAND_LABEL: &str = "variability band";
