@@ -68,6 +68,21 @@ pub(super) fn limit_settings(
     // The envelope's search holds a dense k × k curvature estimate and solves k sensitivities
     // per state: k = sides or contact points is kept to what that serves.
     if let Some(mode) = l.envelope {
+        if let Some(i) = scene
+            .contacts
+            .iter()
+            .position(|c| c.law == crate::contact::FrictionLaw::Jenkins2d)
+        {
+            return Err(ck.err(
+                "limits.envelope",
+                format!(
+                    "contact `{}` has 2D friction (`law = \"jenkins-2d\"`); the envelope \
+                     searches m ∈ [-1, 1] along one tangent per side and does not handle 2D \
+                     points yet (run the limits without `envelope`)",
+                    scene.contacts[i].name
+                ),
+            ));
+        }
         let k = match mode {
             crate::analysis::limits::EnvelopeMode::Sides => sides,
             crate::analysis::limits::EnvelopeMode::Points => scene.contacts.len(),

@@ -404,6 +404,7 @@ pub fn patch_contacts(
                     mu: spec.mu,
                     initial_state: spec.initial_state,
                 },
+                second_tangent: None,
             }
         })
         .collect())
