@@ -335,3 +335,58 @@ fn unsupported_paths_refuse_2d_points() {
     let p = problem(SPATIAL, &[]);
     assert_eq!(p.relative_coordinate_count(), 6);
 }
+
+/// A 3D blade pair (the generator's coarsest mesh, 2 node pairs per side) with 2D friction on
+/// its contact patches.
+fn blade_pair_3d(dir: &std::path::Path, three_d: bool) -> Result<Problem, String> {
+    use fricbound::fe::blade_pair::{generate, BladePairParams};
+    use fricbound::fe::msh_write::{write_msh, MshFormat};
+    let mesh = generate(&BladePairParams {
+        three_d,
+        refine: 1,
+        contact_pairs: Some(2),
+        ..BladePairParams::default()
+    })
+    .unwrap();
+    let file = dir.join("blade-pair.msh");
+    write_msh(&file, &mesh, MshFormat::Binary).unwrap();
+    let text = fricbound::study::scaling::blade_pair_scene(&file, three_d, 1).replace(
+        "tolerance = 1e-6\n",
+        "tolerance = 1e-6\nlaw = \"jenkins-2d\"\n",
+    );
+    assert_eq!(text.matches("jenkins-2d").count(), 2);
+    let label = dir.join("scene.toml").display().to_string();
+    scene::parse(&text, &label, &[])
+        .and_then(|s| s.validate(&label))
+        .map_err(|e| e.to_string())
+}
+
+#[test]
+fn contact_patches_of_a_3d_mesh_take_the_2d_law() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = blade_pair_3d(dir.path(), true).unwrap();
+    assert!(!p.contacts.is_empty());
+    // Per point: t₁, t₂, n orthonormal on the damper node's DOFs (the body's are their negatives).
+    for c in &p.contacts {
+        assert_eq!(c.friction_law(), FrictionLaw::Jenkins2d, "{}", c.name);
+        let rows: Vec<Vec<(usize, f64)>> = c.rows().map(|r| r.to_vec()).collect();
+        assert_eq!(rows.len(), 3);
+        let dot = |a: &[(usize, f64)], b: &[(usize, f64)]| -> f64 {
+            a.iter()
+                .map(|&(d, x)| b.iter().filter(|e| e.0 == d).map(|e| e.1 * x).sum::<f64>())
+                .sum()
+        };
+        for i in 0..3 {
+            for j in 0..3 {
+                // Damper and body entries each contribute the same product.
+                let expected = if i == j { 2.0 } else { 0.0 };
+                let g = dot(&rows[i], &rows[j]);
+                assert!((g - expected).abs() < 1e-12, "{}: ({i}, {j}) {g}", c.name);
+            }
+        }
+    }
+    // A planar mesh refuses the 2D law, naming the patch's field.
+    let err = blade_pair_3d(dir.path(), false).unwrap_err();
+    assert!(err.contains("contact_patches[0].law"), "{err}");
+    assert!(err.contains("needs a 3D mesh"), "{err}");
+}
