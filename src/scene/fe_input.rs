@@ -377,7 +377,7 @@ pub fn patch_contacts(
         if let Some(pair) = patch.pairs.iter().find(|p| p.damper_dofs.len() != 3) {
             return Err(SceneError::invalid(
                 file,
-                &format!("{field}.law"),
+                format!("{field}.law"),
                 format!(
                     "`jenkins-2d` friction needs a 3D mesh; the pair `{}` has {} DOFs per node: \
                      a planar mesh uses `jenkins-1d`",
