@@ -331,6 +331,13 @@ fn unsupported_paths_refuse_2d_points() {
         panic!("the time integration refuses 2D points");
     };
     assert!(err.to_string().contains("2D friction"), "{err}");
+    let p = problem(SPATIAL, &[]);
+    let mut system = HbmSystem::new(&p).unwrap();
+    let x = vec![0.0; system.dim()];
+    let Err(err) = limits::residual_derivative(&mut system, &x, &[vec![0, 1]]) else {
+        panic!("the initial-state sensitivity refuses 2D points");
+    };
+    assert!(err.to_string().contains("2D friction"), "{err}");
     // The schur formulation counts 3 relative coordinates per 2D point.
     let p = problem(SPATIAL, &[]);
     assert_eq!(p.relative_coordinate_count(), 6);
