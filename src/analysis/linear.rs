@@ -24,9 +24,11 @@ pub enum LinearCase {
 pub fn contact_stiffness(problem: &Problem) -> Vec<(usize, usize, f64)> {
     let mut k = Vec::new();
     for c in &problem.contacts {
-        for &(p, ap) in &c.tangential {
-            for &(q, aq) in &c.tangential {
-                k.push((p, q, c.law.kt * ap * aq));
+        for row in c.tangential_rows() {
+            for &(p, ap) in row {
+                for &(q, aq) in row {
+                    k.push((p, q, c.law.kt * ap * aq));
+                }
             }
         }
         for &(p, ap) in &c.normal {

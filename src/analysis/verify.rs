@@ -194,7 +194,22 @@ struct DenseModel {
     k: Mat<f64>,
 }
 
+/// Refuses 2D-friction points: the time integration marches the 1D Jenkins law only.
+fn check_friction_1d(problem: &Problem) -> Result<(), VerifyError> {
+    if let Some(c) = problem.contacts.iter().find(|c| c.second_tangent.is_some()) {
+        return Err(VerifyError::Unsupported {
+            reason: format!(
+                "contact `{}` has 2D friction (jenkins-2d); the time integration marches the 1D \
+                 Jenkins law only",
+                c.name
+            ),
+        });
+    }
+    Ok(())
+}
+
 fn check_supported(problem: &Problem) -> Result<(), VerifyError> {
+    check_friction_1d(problem)?;
     if problem.effects.contact.normal_load == NormalLoad::Constant && !problem.contacts.is_empty() {
         return Err(VerifyError::Unsupported {
             reason:
@@ -831,6 +846,7 @@ pub fn hbm_state(
     freq_hz: f64,
     samples: usize,
 ) -> Result<TimeState, VerifyError> {
+    check_friction_1d(problem)?;
     let n = problem.model.n_dofs();
     let nb = set.n_blocks();
     if x.len() != n * nb {
@@ -920,6 +936,7 @@ pub fn hbm_state(
 /// equilibrium of the equations of motion without the harmonic load; an open contact's slider
 /// is at u. An error if Newton does not converge in 100 iterations.
 pub fn static_state(problem: &Problem) -> Result<TimeState, VerifyError> {
+    check_friction_1d(problem)?;
     let set = HarmonicSet::new(vec![0]);
     let mut q = crate::analysis::linear::stuck_guess(problem, &set, 0.0)
         .map_err(|e| VerifyError::Static(e.to_string()))?;

@@ -12,10 +12,15 @@
 //! equations of motion M q̈ + C q̇ + K q + F_c = F_ex as F_c = aₜ T + aₙ N (virtual work), so
 //! the damper is pushed back along −n and the body along +n.
 //!
+//! A point with the 2D law (`jenkins-2d`) has a second tangential row u₂ = aₜ₂·q along a second
+//! tangent t₂ ⟂ t₁, n ([`SecondTangent`]); its tangential force (T₁, T₂) enters as aₜ₁T₁ + aₜ₂T₂.
+//!
 //! Each point belongs to a [`DamperSide`]; the limit method assigns one initial tangential
 //! state m to all points of a side (paper Eqs. 14-15).
 
 use serde::{Deserialize, Serialize};
+
+use crate::contact::aft2d::Jenkins2dLaw;
 
 /// How the normal force evolves over the period.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -87,11 +92,81 @@ pub struct ContactPoint {
     pub normal: Vec<(usize, f64)>,
     /// Initial normal gap g (m): v = aₙ·q − g; negative g is an interference.
     pub gap: f64,
-    /// Contact law.
+    /// Contact law: its kₜ, kₙ, μ, and the initial state along the first tangent direction.
     pub law: JenkinsLaw,
+    /// The second tangent direction of a point with the 2D Jenkins law (`jenkins-2d`), None
+    /// for the paper's 1D law (`jenkins-1d`, the default).
+    pub second_tangent: Option<SecondTangent>,
+}
+
+/// Which tangential friction law a contact point follows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum FrictionLaw {
+    /// The paper's Jenkins element along one tangent direction (Eqs. 4-6).
+    #[default]
+    #[serde(rename = "jenkins-1d")]
+    Jenkins1d,
+    /// The isotropic Jenkins element in the tangent plane, radial return onto the friction
+    /// circle ([`crate::contact::aft2d`]).
+    #[serde(rename = "jenkins-2d")]
+    Jenkins2d,
+}
+
+/// The second tangential relative displacement of a 2D-friction point and its share of the
+/// initial state.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SecondTangent {
+    /// Sparse row (dof index, coefficient) giving u₂ = t₂·r (m), t₂ orthonormal to t₁ and n.
+    pub row: Vec<(usize, f64)>,
+    /// Second component m₂ of the initial tangential state m = (m₁, m₂), |m| ≤ 1; m₁ is
+    /// [`JenkinsLaw::initial_state`]. The march starts at T(τ=0) = μN(τ=0)·m.
+    pub initial_state: f64,
 }
 
 impl ContactPoint {
+    /// The point's tangential friction law.
+    pub fn friction_law(&self) -> FrictionLaw {
+        match self.second_tangent {
+            None => FrictionLaw::Jenkins1d,
+            Some(_) => FrictionLaw::Jenkins2d,
+        }
+    }
+
+    /// The 2D law's parameters (None for a 1D point).
+    pub fn law_2d(&self) -> Option<Jenkins2dLaw> {
+        self.second_tangent.as_ref().map(|s| Jenkins2dLaw {
+            kt: self.law.kt,
+            kn: self.law.kn,
+            mu: self.law.mu,
+            initial_state: [self.law.initial_state, s.initial_state],
+        })
+    }
+
+    /// The tangential rows: [aₜ] for a 1D point, [aₜ₁, aₜ₂] for a 2D point.
+    pub fn tangential_rows(&self) -> impl Iterator<Item = &[(usize, f64)]> {
+        std::iter::once(self.tangential.as_slice())
+            .chain(self.second_tangent.as_ref().map(|s| s.row.as_slice()))
+    }
+
+    /// All rows in force order: aₜ (, aₜ₂ for a 2D point), aₙ.
+    pub fn rows(&self) -> impl Iterator<Item = &[(usize, f64)]> {
+        self.tangential_rows()
+            .chain(std::iter::once(self.normal.as_slice()))
+    }
+
+    /// Every (dof, coefficient) entry of the point's rows (tangential ones, then normal).
+    pub fn row_entries(&self) -> impl Iterator<Item = &(usize, f64)> {
+        self.tangential_rows().flatten().chain(&self.normal)
+    }
+
+    /// u₂ = aₜ₂ · q (0 for a 1D point).
+    pub fn second_tangential_of(&self, q: &[f64]) -> f64 {
+        self.second_tangent
+            .as_ref()
+            .map_or(0.0, |s| s.row.iter().map(|&(i, a)| a * q[i]).sum())
+    }
+
     /// u = aₜ · q.
     pub fn tangential_of(&self, q: &[f64]) -> f64 {
         self.tangential.iter().map(|&(i, a)| a * q[i]).sum()

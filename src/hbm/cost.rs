@@ -111,8 +111,8 @@ pub fn unknowns_for(p: &Problem, formulation: Formulation) -> usize {
 }
 
 /// Rows of the matrix factorised per Newton iteration on `p`: the unknowns, except for the
-/// schur formulation (2 relative coordinates per contact point, 1 where its normal or
-/// tangential direction is zero, and coefficient block).
+/// schur formulation (2 relative coordinates per contact point, 3 per 2D-friction point, 1
+/// fewer where a direction is zero, and coefficient block).
 pub fn factored_size(p: &Problem) -> usize {
     factored_size_for(p, p.formulation())
 }
@@ -263,20 +263,23 @@ pub fn estimate_for(p: &Problem, formulation: Formulation) -> CostEstimate {
         .contacts
         .iter()
         .map(|cp| {
-            let mut dofs: Vec<usize> = cp
-                .tangential
-                .iter()
-                .chain(&cp.normal)
-                .map(|&(d, _)| d)
-                .collect();
+            let mut dofs: Vec<usize> = cp.row_entries().map(|&(d, _)| d).collect();
             dofs.sort_unstable();
             dofs.dedup();
             (dofs.len() * dofs.len()) as f64
         })
         .sum();
     let contact_bytes = match formulation {
-        // The schur Jacobian keeps each contact's (2·b)² block on its relative coordinates.
-        Formulation::Schur => F64 * 4.0 * c * b * b,
+        // The schur Jacobian keeps each contact's (k·b)² block on its k relative coordinates
+        // (k = 2, or 3 for a 2D-friction point).
+        Formulation::Schur => {
+            let k2: f64 = p
+                .contacts
+                .iter()
+                .map(|cp| cp.rows().count().pow(2) as f64)
+                .sum();
+            F64 * k2 * b * b
+        }
         _ => (F64 + INDEX) * d2 * b * b,
     };
 

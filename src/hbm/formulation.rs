@@ -53,9 +53,9 @@ pub fn check_relative_coordinates(problem: &Problem) -> Result<(), RelativeCoord
         .zip(&active)
         .enumerate()
         .flat_map(|(p, (c, a))| {
-            [(c.tangential.as_slice(), a[0]), (c.normal.as_slice(), a[1])]
-                .into_iter()
-                .filter(|(_, on)| *on)
+            c.rows()
+                .zip(a.iter())
+                .filter(|(_, on)| **on)
                 .map(move |(row, _)| (row, p))
         })
         .unzip();

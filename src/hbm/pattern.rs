@@ -19,6 +19,8 @@ pub struct ContactSlots {
     pub dofs: usize,
     /// Tangential row as (local DOF index, coefficient).
     pub tangential: Vec<(usize, f64)>,
+    /// Second tangential row of a 2D-friction point (empty for a 1D point).
+    pub tangential2: Vec<(usize, f64)>,
     /// Normal row as (local DOF index, coefficient).
     pub normal: Vec<(usize, f64)>,
     /// Slots, indexed ((j · n_blocks + i) · d + a) · d + b.
@@ -29,17 +31,13 @@ pub struct ContactSlots {
 struct LocalRows {
     dofs: Vec<usize>,
     tangential: Vec<(usize, f64)>,
+    tangential2: Vec<(usize, f64)>,
     normal: Vec<(usize, f64)>,
 }
 
 impl LocalRows {
     fn of(c: &crate::contact::ContactPoint) -> Self {
-        let mut dofs: Vec<usize> = c
-            .tangential
-            .iter()
-            .chain(&c.normal)
-            .map(|&(d, _)| d)
-            .collect();
+        let mut dofs: Vec<usize> = c.row_entries().map(|&(d, _)| d).collect();
         dofs.sort_unstable();
         dofs.dedup();
         let to_local = |row: &[(usize, f64)]| -> Vec<(usize, f64)> {
@@ -48,10 +46,15 @@ impl LocalRows {
                 .collect()
         };
         let tangential = to_local(&c.tangential);
+        let tangential2 = c
+            .second_tangent
+            .as_ref()
+            .map_or_else(Vec::new, |s| to_local(&s.row));
         let normal = to_local(&c.normal);
         Self {
             dofs,
             tangential,
+            tangential2,
             normal,
         }
     }
@@ -165,6 +168,7 @@ impl JacobianLayout {
                 |LocalRows {
                      dofs,
                      tangential,
+                     tangential2,
                      normal,
                  }| {
                     let d = dofs.len();
@@ -181,6 +185,7 @@ impl JacobianLayout {
                     ContactSlots {
                         dofs: d,
                         tangential,
+                        tangential2,
                         normal,
                         slots,
                     }
@@ -220,6 +225,7 @@ impl JacobianLayout {
                 let LocalRows {
                     dofs,
                     tangential,
+                    tangential2,
                     normal,
                 } = LocalRows::of(c);
                 let d = dofs.len();
@@ -239,6 +245,7 @@ impl JacobianLayout {
                 ContactSlots {
                     dofs: d,
                     tangential,
+                    tangential2,
                     normal,
                     slots,
                 }
@@ -256,7 +263,8 @@ impl JacobianLayout {
 
     /// The layout of the schur formulation ([`crate::hbm::schur`]): no linear slots (the linear
     /// part is formed from ω when the Jacobian is factorised) and, per contact, its block on
-    /// the contact's own relative coordinates (u, v), slot ((j·blocks + i)·2 + a)·2 + b.
+    /// the contact's own k relative coordinates (u, v; or u₁, u₂, v for a 2D point), slot
+    /// offset + ((j·blocks + i)·k + a)·k + b.
     pub fn relative(
         problem: &Problem,
         set: &HarmonicSet,
@@ -264,16 +272,23 @@ impl JacobianLayout {
     ) -> Self {
         let nb = set.n_blocks();
         let dim = problem.model.n_dofs() * nb;
+        let offsets = coords.value_offsets().to_vec();
+        let rows: Vec<usize> = (0..problem.contacts.len())
+            .map(|p| coords.contact_rows(p))
+            .collect();
         let template = AssembledJacobian::implicit(std::sync::Arc::new(
             crate::hbm::schur::SchurJacobian(coords),
         ));
-        let per_contact = 4 * nb * nb;
         let contacts = (0..problem.contacts.len())
-            .map(|p| ContactSlots {
-                dofs: 2,
-                tangential: vec![(0, 1.0)],
-                normal: vec![(1, 1.0)],
-                slots: (p * per_contact..(p + 1) * per_contact).collect(),
+            .map(|p| {
+                let k = rows[p];
+                ContactSlots {
+                    dofs: k,
+                    tangential: vec![(0, 1.0)],
+                    tangential2: if k == 3 { vec![(1, 1.0)] } else { Vec::new() },
+                    normal: vec![(k - 1, 1.0)],
+                    slots: (offsets[p]..offsets[p + 1]).collect(),
+                }
             })
             .collect();
         Self {

@@ -1,8 +1,9 @@
 //! The `schur` formulation: Newton on all DOFs, each linear solve reduced to the relative
 //! contact coordinates by eliminating everything else per harmonic.
 //!
-//! A contact point acts on the structure only through its two relative displacements
-//! u = aₜ·x and v = aₙ·x ([`crate::contact`]). Stack those rows into B (n_q = 2 per contact ×
+//! A contact point acts on the structure only through its relative displacements u = aₜ·x and
+//! v = aₙ·x (and u₂ = aₜ₂·x for a 2D-friction point, [`crate::contact`]). Stack those rows into
+//! B (n_q = 2 per 1D contact, 3 per 2D contact, ×
 //! n DOFs, nonzero on the contact DOFs c only) and change coordinates on c:
 //!
 //! ```text
@@ -12,15 +13,15 @@
 //! so that y = (q, w, x_o) with x = T y and q = B x are the relative displacements themselves.
 //! In these coordinates the contact forces act on the q rows only, Tᵀ J T = Ã(ω) + [N_c 0; 0 0],
 //! with Ã = Tᵀ A T the linear harmonic-balance operator (block-diagonal over harmonics, real
-//! 2-block form per harmonic h ≥ 1) and N_c the contact Jacobian, one (2·blocks)² block per
-//! contact point. Per harmonic the z = (w, x_o) coordinates are eliminated exactly,
+//! 2-block form per harmonic h ≥ 1) and N_c the contact Jacobian, one (k·blocks)² block per
+//! contact point (k = 2, or 3 for a 2D point). Per harmonic the z = (w, x_o) coordinates are eliminated exactly,
 //!
 //! ```text
 //! S_h = Ã_qq − Ã_qz Ã_zz⁻¹ Ã_zq       (dynamic Schur complement on the relative coordinates)
 //! ```
 //!
 //! and Newton's linear system becomes (blockdiag_h S_h + N_c) y_q = r_q on n_q · blocks
-//! unknowns (n_q = 2 per contact point; 1 for a contact whose normal row is zero, a
+//! unknowns (n_q = 2 per contact point, 3 per 2D point; 1 fewer for a contact whose normal row is zero, a
 //! Jenkins element to ground with a constant normal load, whose v moves with no DOF and whose
 //! normal rows of N_c therefore act on nothing): with node-to-node pairs that is half the contact DOFs (4 per pair in 2D),
 //! an eighth of the dense LU work of the condensed formulation. Ã_zz is the structure with
@@ -47,8 +48,9 @@ use crate::numerics::linalg::{
     checked_lu, packed_complex_lu, packed_lu, LinearSolveError, PackedLu,
 };
 
-/// One contact's rows over the DOFs: (tangential, normal).
-type ContactRows = (Vec<(usize, f64)>, Vec<(usize, f64)>);
+/// One contact's rows over the DOFs, in force order: tangential (, second tangential of a 2D
+/// point), normal.
+type ContactRows = Vec<Vec<(usize, f64)>>;
 
 /// Unknown blocks of one harmonic: (cos or constant, sin).
 #[derive(Debug, Clone, Copy)]
@@ -75,11 +77,14 @@ pub struct RelativeCoordinates {
     k: Mat<f64>,
     m: Mat<f64>,
     c: Mat<f64>,
-    /// Per contact, its tangential and normal rows.
+    /// Per contact, its rows (2 for a 1D point, 3 for a 2D point).
     rows: Vec<ContactRows>,
-    /// Per contact, the relative coordinate of its tangential and normal rows (None for a
-    /// zero row, which carries no coordinate).
-    coordinate: Vec<[Option<usize>; 2]>,
+    /// Per contact, the relative coordinate of each of its rows (None for a zero row, which
+    /// carries no coordinate).
+    coordinate: Vec<Vec<Option<usize>>>,
+    /// Per contact, the offset of its (k·blocks)² block of Jacobian values (k = its rows), and
+    /// the total at the end.
+    value_offsets: Vec<usize>,
     /// Per DOF, the contacts whose rows touch it.
     dof_contacts: Vec<Vec<usize>>,
     /// Per unknown block: its harmonic and damping partner (block, sign).
@@ -108,7 +113,7 @@ struct ContactComponent {
 fn contact_components(
     problem: &Problem,
     rows: &[ContactRows],
-    coordinate: &[[Option<usize>; 2]],
+    coordinate: &[Vec<Option<usize>>],
     split: &DofSplit,
 ) -> Result<Vec<ContactComponent>, RelativeCoordinatesError> {
     let n_contacts = rows.len();
@@ -123,8 +128,8 @@ fn contact_components(
     }
     // The contact that first touched each contact DOF.
     let mut owner: Vec<Option<usize>> = vec![None; split.contact.len()];
-    for (p, (t, nr)) in rows.iter().enumerate() {
-        for &(d, _) in t.iter().chain(nr) {
+    for (p, contact_rows) in rows.iter().enumerate() {
+        for &(d, _) in contact_rows.iter().flatten() {
             let Some(l) = split.local[d] else {
                 continue; // every DOF of a contact row is a contact DOF
             };
@@ -152,14 +157,16 @@ fn contact_components(
     for contacts in groups {
         let mut dofs: Vec<usize> = contacts
             .iter()
-            .flat_map(|&p| rows[p].0.iter().chain(&rows[p].1).map(|&(d, _)| d))
+            .flat_map(|&p| rows[p].iter().flatten().map(|&(d, _)| d))
             .collect();
         dofs.sort_unstable();
         dofs.dedup();
-        // The group's non-zero rows: (contact, 0 tangential / 1 normal, coordinate).
+        // The group's non-zero rows: (contact, row index, coordinate).
         let active: Vec<(usize, usize, usize)> = contacts
             .iter()
-            .flat_map(|&p| (0..2).filter_map(move |a| coordinate[p][a].map(|q| (p, a, q))))
+            .flat_map(|&p| {
+                (0..rows[p].len()).filter_map(move |a| coordinate[p][a].map(|q| (p, a, q)))
+            })
             .collect();
         let (m, d) = (active.len(), dofs.len());
         if m > d {
@@ -170,8 +177,7 @@ fn contact_components(
         }
         let mut b = Mat::<f64>::zeros(m, d);
         for (row, &(p, a, _)) in active.iter().enumerate() {
-            let entries = if a == 0 { &rows[p].0 } else { &rows[p].1 };
-            for &(dof, v) in entries.iter() {
+            for &(dof, v) in rows[p][a].iter() {
                 let col = dofs.binary_search(&dof).expect("listed above");
                 b[(row, col)] += v;
             }
@@ -205,21 +211,29 @@ impl RelativeCoordinates {
         let rows: Vec<ContactRows> = problem
             .contacts
             .iter()
-            .map(|c| (c.tangential.clone(), c.normal.clone()))
+            .map(|c| c.rows().map(|r| r.to_vec()).collect())
             .collect();
         let mut n_q = 0;
-        let coordinate: Vec<[Option<usize>; 2]> = problem
+        let coordinate: Vec<Vec<Option<usize>>> = problem
             .nonzero_contact_rows()
             .iter()
             .map(|on| {
-                on.map(|on| {
-                    on.then(|| {
-                        n_q += 1;
-                        n_q - 1
+                on.iter()
+                    .map(|&on| {
+                        on.then(|| {
+                            n_q += 1;
+                            n_q - 1
+                        })
                     })
-                })
+                    .collect()
             })
             .collect();
+        let nb = set.n_blocks();
+        let mut value_offsets = vec![0];
+        for r in &rows {
+            let k = r.len() * nb;
+            value_offsets.push(value_offsets.last().expect("starts at 0") + k * k);
+        }
         let components = contact_components(problem, &rows, &coordinate, &split)?;
         let dense = |m: &crate::model::matrix::StructuralMatrix| m.to_dense();
         let (k, m, c) = (
@@ -228,8 +242,8 @@ impl RelativeCoordinates {
             dense(&problem.model.damping),
         );
         let mut dof_contacts: Vec<Vec<usize>> = vec![Vec::new(); n];
-        for (p, (t, nr)) in rows.iter().enumerate() {
-            for &(d, _) in t.iter().chain(nr) {
+        for (p, contact_rows) in rows.iter().enumerate() {
+            for &(d, _) in contact_rows.iter().flatten() {
                 if dof_contacts[d].last() != Some(&p) {
                     dof_contacts[d].push(p);
                 }
@@ -284,6 +298,7 @@ impl RelativeCoordinates {
             c,
             rows,
             coordinate,
+            value_offsets,
             dof_contacts,
             blocks,
             harmonics,
@@ -299,7 +314,20 @@ impl RelativeCoordinates {
         self.n
     }
 
-    /// Number of relative coordinates n_q (2 per contact point, 1 where a row is zero).
+    /// Offsets of each contact's block of Jacobian values (see [`Self::factor`]), one per
+    /// contact plus the total at the end.
+    pub fn value_offsets(&self) -> &[usize] {
+        &self.value_offsets
+    }
+
+    /// Number of rows (relative coordinates, zero rows included) of contact `p`: 2 for a 1D
+    /// point, 3 for a 2D point.
+    pub fn contact_rows(&self, p: usize) -> usize {
+        self.rows[p].len()
+    }
+
+    /// Number of relative coordinates n_q (2 per 1D point, 3 per 2D point, fewer where a row
+    /// is zero).
     pub fn n_relative(&self) -> usize {
         self.n_q
     }
@@ -458,9 +486,10 @@ impl RelativeCoordinates {
         })
     }
 
-    /// Factorises J at ω with the contact blocks `contact_values` (one (2·blocks)² block per
-    /// contact, indexed ((j·blocks + i)·2 + a)·2 + b for force a ∈ {T, N} of block j and
-    /// coordinate b ∈ {u, v} of block i).
+    /// Factorises J at ω with the contact blocks `contact_values` (one (k·blocks)² block per
+    /// contact from [`Self::value_offsets`], k = 2 rows for a 1D point and 3 for a 2D point,
+    /// indexed ((j·blocks + i)·k + a)·k + b for force a ∈ {T, (T₂,) N} of block j and
+    /// coordinate b ∈ {u, (u₂,) v} of block i).
     pub fn factor(
         self: &Arc<Self>,
         omega: f64,
@@ -478,18 +507,18 @@ impl RelativeCoordinates {
             eh.add_schur_complement(&mut s, n_q);
             eliminated.push(eh);
         }
-        let per_contact = 4 * nb * nb;
         for p in 0..self.rows.len() {
-            let values = &contact_values[p * per_contact..(p + 1) * per_contact];
+            let values = &contact_values[self.value_offsets[p]..self.value_offsets[p + 1]];
             // Entries on a zero row or column act on nothing (that row of B is zero).
-            let coordinate = self.coordinate[p];
+            let coordinate = &self.coordinate[p];
+            let k = coordinate.len();
             for j in 0..nb {
                 for i in 0..nb {
-                    for a in 0..2 {
+                    for a in 0..k {
                         let Some(qa) = coordinate[a] else { continue };
-                        for b in 0..2 {
+                        for b in 0..k {
                             let Some(qb) = coordinate[b] else { continue };
-                            let v = values[((j * nb + i) * 2 + a) * 2 + b];
+                            let v = values[((j * nb + i) * k + a) * k + b];
                             s[(j * n_q + qa, i * n_q + qb)] += v;
                         }
                     }
@@ -530,27 +559,29 @@ impl RelativeCoordinates {
                 y[j * n + i] += scale * v;
             }
         }
-        let per_contact = 4 * nb * nb;
         let dot = |row: &[(usize, f64)], block: usize| -> f64 {
             row.iter().map(|&(d, a)| a * x[block * n + d]).sum()
         };
-        for (p, (t, nr)) in self.rows.iter().enumerate() {
-            let values = &contact_values[p * per_contact..(p + 1) * per_contact];
-            let coords: Vec<[f64; 2]> = (0..nb).map(|i| [dot(t, i), dot(nr, i)]).collect();
+        for (p, rows) in self.rows.iter().enumerate() {
+            let values = &contact_values[self.value_offsets[p]..self.value_offsets[p + 1]];
+            let k = rows.len();
+            let coords: Vec<Vec<f64>> = (0..nb)
+                .map(|i| rows.iter().map(|r| dot(r, i)).collect())
+                .collect();
+            let mut force = vec![0.0; k];
             for j in 0..nb {
-                let mut force = [0.0; 2];
+                force.iter_mut().for_each(|f| *f = 0.0);
                 for (i, c) in coords.iter().enumerate() {
-                    for a in 0..2 {
-                        for b in 0..2 {
-                            force[a] += values[((j * nb + i) * 2 + a) * 2 + b] * c[b];
+                    for a in 0..k {
+                        for b in 0..k {
+                            force[a] += values[((j * nb + i) * k + a) * k + b] * c[b];
                         }
                     }
                 }
-                for &(d, a) in t {
-                    y[j * n + d] += scale * a * force[0];
-                }
-                for &(d, a) in nr {
-                    y[j * n + d] += scale * a * force[1];
+                for (row, f) in rows.iter().zip(&force) {
+                    for &(d, a) in row {
+                        y[j * n + d] += scale * a * f;
+                    }
                 }
             }
         }
@@ -572,18 +603,18 @@ impl RelativeCoordinates {
                 v += sign * hw * self.c[(p, q)];
             }
         }
-        let per_contact = 4 * nb * nb;
         let coef = |row: &[(usize, f64)], d: usize| -> f64 {
             row.iter().filter(|e| e.0 == d).map(|e| e.1).sum()
         };
         for &c in &self.dof_contacts[p] {
-            let (t, nr) = &self.rows[c];
-            let rows_p = [coef(t, p), coef(nr, p)];
-            let cols_q = [coef(t, q), coef(nr, q)];
-            let values = &contact_values[c * per_contact..(c + 1) * per_contact];
-            for a in 0..2 {
-                for b in 0..2 {
-                    v += rows_p[a] * values[((jb * nb + ib) * 2 + a) * 2 + b] * cols_q[b];
+            let rows = &self.rows[c];
+            let k = rows.len();
+            let rows_p: Vec<f64> = rows.iter().map(|r| coef(r, p)).collect();
+            let cols_q: Vec<f64> = rows.iter().map(|r| coef(r, q)).collect();
+            let values = &contact_values[self.value_offsets[c]..self.value_offsets[c + 1]];
+            for a in 0..k {
+                for b in 0..k {
+                    v += rows_p[a] * values[((jb * nb + ib) * k + a) * k + b] * cols_q[b];
                 }
             }
         }
@@ -653,7 +684,7 @@ enum ZPart {
 }
 
 /// The schur formulation's Jacobian storage for [`AssembledJacobian::implicit`]: the values
-/// are one (2·blocks)² block per contact point (see [`RelativeCoordinates::factor`]); the
+/// are one (k·blocks)² block per contact point (k = 2 rows, 3 for a 2D point) (see [`RelativeCoordinates::factor`]); the
 /// linear part is formed from the structural matrices at ω.
 ///
 /// [`AssembledJacobian::implicit`]: crate::numerics::jacobian::AssembledJacobian::implicit
@@ -665,8 +696,11 @@ impl ImplicitJacobian for SchurJacobian {
         self.0.n_dofs() * self.0.n_blocks()
     }
     fn values_len(&self) -> usize {
-        let nb = self.0.n_blocks();
-        self.0.n_contacts() * 4 * nb * nb
+        *self
+            .0
+            .value_offsets()
+            .last()
+            .expect("one offset per contact plus the total")
     }
     fn entry(&self, omega: f64, values: &[f64], i: usize, j: usize) -> f64 {
         self.0.entry(omega, values, i, j)

@@ -11,6 +11,13 @@ use crate::numerics::jacobian::{AssembledJacobian, Storage};
 /// loaded from rest (slider at zero): N = kₙ max(v, 0), T = clamp(kₜ u, −μN, μN). Newton with
 /// backtracking, on the Jacobian storage of the problem's formulation.
 pub fn static_solve(problem: &Problem) -> Result<Vec<f64>, HbmError> {
+    if let Some(c) = problem.contacts.iter().find(|c| c.second_tangent.is_some()) {
+        return Err(HbmError::TwoDimensionalFriction {
+            contact: c.name.clone(),
+            evaluation:
+                "the static pre-solve of effects.coupling = \"uncoupled\" (use \"coupled\")",
+        });
+    }
     let n = problem.model.n_dofs();
     let k = &problem.model.stiffness;
     let f = &problem.static_load;

@@ -17,6 +17,7 @@
 //! analytic AFT Jacobian or, as a checked alternative, from finite differences.
 
 use crate::contact::aft::AftWorkspace;
+use crate::contact::aft2d::Aft2dWorkspace;
 use crate::contact::harmonic::{Block, HarmonicSet};
 use crate::contact::{ContactState, JenkinsLaw};
 use crate::hbm::error::HbmError;
@@ -41,7 +42,11 @@ pub struct HbmSystem<'p> {
     static_offset: Vec<f64>,
     excitation: Vec<f64>,
     aft: AftWorkspace,
+    /// The march of the 2D-friction points; None when the problem has none (costs nothing).
+    aft2d: Option<Aft2dWorkspace>,
     u_coef: Vec<f64>,
+    /// Coefficients of the second tangential displacement u₂ (2D points only).
+    u2_coef: Vec<f64>,
     v_coef: Vec<f64>,
     /// Contact states of the last evaluation, one per contact.
     pub states: Vec<ContactState>,
@@ -78,6 +83,21 @@ impl<'p> HbmSystem<'p> {
         let nbf = force_set.n_blocks();
         let mut aft = AftWorkspace::new(&force_set, problem.samples);
         aft.settings = problem.march;
+        let aft2d = problem
+            .contacts
+            .iter()
+            .any(|c| c.law_2d().is_some())
+            .then(|| {
+                let mut w = Aft2dWorkspace::new(&force_set, problem.samples);
+                // The 2D march settles geometrically (slowly near grazing, see
+                // `aft2d::DEFAULT_MAX_PERIODS`): it keeps its own period budget unless the scene
+                // asks for more.
+                w.settings = crate::contact::aft::MarchSettings {
+                    max_periods: problem.march.max_periods.max(w.settings.max_periods),
+                    ..problem.march
+                };
+                w
+            });
         let mut excitation = vec![0.0; n * unknowns.n_blocks()];
         if let Some(j) = unknowns.constant_block() {
             excitation[j * n..(j + 1) * n].copy_from_slice(&problem.static_load);
@@ -109,7 +129,9 @@ impl<'p> HbmSystem<'p> {
             static_offset,
             excitation,
             aft,
+            aft2d,
             u_coef: vec![0.0; nbf],
+            u2_coef: vec![0.0; nbf],
             v_coef: vec![0.0; nbf],
             states: vec![ContactState::Open; problem.contacts.len()],
             strategy: problem.analysis.jacobian,
@@ -220,20 +242,41 @@ impl<'p> HbmSystem<'p> {
         &mut self.aft
     }
 
-    /// Fills û, v̂ of contact `c` on the AFT blocks from the unknowns x.
+    /// The 2D AFT workspace (None when the problem has no 2D-friction point); after
+    /// [`Self::contact_forces`] of a 2D point it holds that point's time histories.
+    pub fn aft2d(&mut self) -> Option<&mut Aft2dWorkspace> {
+        self.aft2d.as_mut()
+    }
+
+    /// Constant (0th-harmonic) forces (T̂₁⁰, N̂⁰) (N) of the last [`Self::contact_forces`] of
+    /// contact `c`, from whichever march (1D or 2D) its law uses; T̂₁⁰ is along the first tangent.
+    pub fn last_constant_forces(&self, c: usize) -> (f64, f64) {
+        match (
+            &self.aft2d,
+            self.problem.contacts[c].second_tangent.is_some(),
+        ) {
+            (Some(w), true) => (w.t_hat[0][0], w.n_hat[0]),
+            _ => (self.aft.t_hat[0], self.aft.n_hat[0]),
+        }
+    }
+
+    /// Fills û, v̂ (and û₂ for a 2D point) of contact `c` on the AFT blocks from the unknowns x.
     fn contact_coefficients(&mut self, c: usize, x: &[f64]) {
         let n = self.problem.model.n_dofs();
         let contact = &self.problem.contacts[c];
         self.u_coef.iter_mut().for_each(|v| *v = 0.0);
+        self.u2_coef.iter_mut().for_each(|v| *v = 0.0);
         self.v_coef.iter_mut().for_each(|v| *v = 0.0);
         for (j, &jf) in self.block_map.iter().enumerate() {
             let q = &x[j * n..(j + 1) * n];
             self.u_coef[jf] = contact.tangential_of(q);
+            self.u2_coef[jf] = contact.second_tangential_of(q);
             self.v_coef[jf] = contact.normal_of(q);
         }
         // The AFT set always has the constant block first (harmonic 0 sorts first).
         if !self.unknowns.has_constant() {
             self.u_coef[0] = contact.tangential_of(&self.static_offset);
+            self.u2_coef[0] = contact.second_tangential_of(&self.static_offset);
             self.v_coef[0] = contact.normal_of(&self.static_offset);
         }
         self.v_coef[0] -= contact.gap;
@@ -249,19 +292,23 @@ impl<'p> HbmSystem<'p> {
         self.contact_coefficients(c, x);
         let law = self.law(c);
         let contact = &self.problem.contacts[c];
-        let report = self
-            .aft
-            .evaluate(
+        let effects = self.problem.effects.contact;
+        let report = match (contact.law_2d(), self.aft2d.as_mut()) {
+            (Some(law), Some(aft2d)) => aft2d.evaluate(
                 &law,
-                self.problem.effects.contact,
-                &self.u_coef,
+                effects,
+                [&self.u_coef, &self.u2_coef],
                 &self.v_coef,
                 jacobian,
-            )
-            .map_err(|source| HbmError::Aft {
-                contact: contact.name.clone(),
-                source,
-            })?;
+            ),
+            _ => self
+                .aft
+                .evaluate(&law, effects, &self.u_coef, &self.v_coef, jacobian),
+        }
+        .map_err(|source| HbmError::Aft {
+            contact: contact.name.clone(),
+            source,
+        })?;
         self.states[c] = report.state;
         Ok(report.state)
     }
@@ -408,6 +455,11 @@ impl<'p> HbmSystem<'p> {
         for c in 0..problem.contacts.len() {
             self.contact_forces(c, x, jac.is_some())?;
             let contact = &problem.contacts[c];
+            if contact.second_tangent.is_some() {
+                let slots = jac.as_mut().map(|(jac, slots)| (&mut **jac, &slots[c]));
+                self.add_contact_terms_2d(c, r, slots);
+                continue;
+            }
             for (j, &jf) in self.block_map.iter().enumerate() {
                 let t = self.aft.t_hat[jf];
                 let nn = self.aft.n_hat[jf];
@@ -448,6 +500,66 @@ impl<'p> HbmSystem<'p> {
             }
         }
         Ok(())
+    }
+
+    /// The forces of 2D-friction contact `c` (just evaluated) into r, and their analytic
+    /// Jacobian at `slots`: forces (T̂₁, T̂₂, N̂) act along the rows (aₜ₁, aₜ₂, aₙ), and
+    /// ∂(T̂₁, T̂₂)/∂(û₁, û₂, v̂), ∂N̂/∂v̂ come from [`Aft2dWorkspace::evaluate`].
+    fn add_contact_terms_2d(
+        &mut self,
+        c: usize,
+        r: &mut [f64],
+        jac: Option<(&mut AssembledJacobian, &ContactSlots)>,
+    ) {
+        let n = self.problem.model.n_dofs();
+        let nb = self.block_map.len();
+        let contact = &self.problem.contacts[c];
+        let aft = self.aft2d.as_ref().expect("2D points have a 2D workspace");
+        let nbf = aft.harmonic_set().n_blocks();
+        let second = &contact
+            .second_tangent
+            .as_ref()
+            .expect("called for 2D points")
+            .row;
+        for (j, &jf) in self.block_map.iter().enumerate() {
+            let forces = [aft.t_hat[0][jf], aft.t_hat[1][jf], aft.n_hat[jf]];
+            for (row, force) in [&contact.tangential, second, &contact.normal]
+                .into_iter()
+                .zip(forces)
+            {
+                for &(p, a) in row {
+                    r[j * n + p] += a * force;
+                }
+            }
+        }
+        let Some((jac, lc)) = jac else {
+            return;
+        };
+        let d = lc.dofs;
+        let local_rows = [&lc.tangential, &lc.tangential2, &lc.normal];
+        let width = 3 * nbf;
+        for (j, &jf) in self.block_map.iter().enumerate() {
+            for (i, &if_) in self.block_map.iter().enumerate() {
+                let slots = &lc.slots[(j * nb + i) * d * d..(j * nb + i + 1) * d * d];
+                for force in 0..3 {
+                    for coordinate in 0..3 {
+                        let value = match (force, coordinate) {
+                            (2, 2) => aft.dn_dv[jf * nbf + if_],
+                            (2, _) => 0.0,
+                            (f, b) => aft.dt_dx[(f * nbf + jf) * width + b * nbf + if_],
+                        };
+                        if value == 0.0 {
+                            continue;
+                        }
+                        for &(a, ap) in local_rows[force] {
+                            for &(b, aq) in local_rows[coordinate] {
+                                jac.add_at(slots[a * d + b], ap * value * aq);
+                            }
+                        }
+                    }
+                }
+            }
+        }
     }
 
     /// Residual R(x, ω) into r (length [`Self::dim`]); ω in rad/s.
@@ -497,9 +609,10 @@ impl<'p> HbmSystem<'p> {
 
     /// The contact blocks of the schur storage by forward or central differences of each
     /// contact's AFT with respect to its own relative-coordinate coefficients (û, v̂ on every
-    /// unknown block): 2·blocks (forward) or 4·blocks (central) contact evaluations per
-    /// contact, the linear part being exact. Steps as in [`finite_difference_jacobian`],
-    /// relative to |coefficient| or, when smaller, the RMS of x.
+    /// unknown block; û₁, û₂, v̂ for a 2D point): k·blocks (forward) or 2k·blocks (central)
+    /// contact evaluations per contact of k coordinates, the linear part being exact. Steps as
+    /// in [`finite_difference_jacobian`], relative to |coefficient| or, when smaller, the RMS
+    /// of x.
     fn contact_difference_blocks(
         &mut self,
         x: &[f64],
@@ -519,36 +632,40 @@ impl<'p> HbmSystem<'p> {
             .collect::<Vec<_>>();
         for c in 0..problem.contacts.len() {
             self.contact_coefficients(c, x);
-            let (u0, v0) = (self.u_coef.clone(), self.v_coef.clone());
-            let base = self.contact_force_coefficients(c, &u0, &v0)?;
+            // The coordinates' coefficients in force order: û (, û₂), v̂.
+            let coordinates: Vec<Vec<f64>> = if problem.contacts[c].second_tangent.is_some() {
+                vec![
+                    self.u_coef.clone(),
+                    self.u2_coef.clone(),
+                    self.v_coef.clone(),
+                ]
+            } else {
+                vec![self.u_coef.clone(), self.v_coef.clone()]
+            };
+            let k = coordinates.len();
+            let base = self.contact_force_coefficients(c, &coordinates)?;
             for (i, &if_) in self.block_map.clone().iter().enumerate() {
-                for b in 0..2 {
-                    let value = if b == 0 { u0[if_] } else { v0[if_] };
+                for b in 0..k {
+                    let value = coordinates[b][if_];
                     let step = eps * value.abs().max(typical).max(1e-12);
                     let perturbed = |sign: f64| {
-                        let (mut u, mut v) = (u0.clone(), v0.clone());
-                        if b == 0 {
-                            u[if_] += sign * step;
-                        } else {
-                            v[if_] += sign * step;
-                        }
-                        (u, v)
+                        let mut shifted = coordinates.clone();
+                        shifted[b][if_] += sign * step;
+                        shifted
                     };
-                    let (up, vp) = perturbed(1.0);
-                    let plus = self.contact_force_coefficients(c, &up, &vp)?;
+                    let plus = self.contact_force_coefficients(c, &perturbed(1.0))?;
                     let minus = if central {
-                        let (um, vm) = perturbed(-1.0);
-                        Some(self.contact_force_coefficients(c, &um, &vm)?)
+                        Some(self.contact_force_coefficients(c, &perturbed(-1.0))?)
                     } else {
                         None
                     };
                     for (j, &jf) in self.block_map.iter().enumerate() {
-                        for a in 0..2 {
+                        for a in 0..k {
                             let d = match &minus {
                                 Some(m) => (plus[a][jf] - m[a][jf]) / (2.0 * step),
                                 None => (plus[a][jf] - base[a][jf]) / step,
                             };
-                            jac.add_at(slots[c][((j * nb + i) * 2 + a) * 2 + b], d);
+                            jac.add_at(slots[c][((j * nb + i) * k + a) * k + b], d);
                         }
                     }
                 }
@@ -557,22 +674,50 @@ impl<'p> HbmSystem<'p> {
         Ok(())
     }
 
-    /// T̂ and N̂ (AFT blocks) of contact `c` at given û, v̂ (v̂ including the gap).
+    /// The force coefficients (AFT blocks) of contact `c` at given coordinate coefficients in
+    /// force order: [T̂, N̂] from [û, v̂] for a 1D point, [T̂₁, T̂₂, N̂] from [û₁, û₂, v̂] for a 2D
+    /// point (v̂ including the gap).
     fn contact_force_coefficients(
         &mut self,
         c: usize,
-        u: &[f64],
-        v: &[f64],
-    ) -> Result<[Vec<f64>; 2], HbmError> {
+        coordinates: &[Vec<f64>],
+    ) -> Result<Vec<Vec<f64>>, HbmError> {
         let law = self.law(c);
         let contact = &self.problem.contacts[c];
-        self.aft
-            .evaluate(&law, self.problem.effects.contact, u, v, false)
-            .map_err(|source| HbmError::Aft {
-                contact: contact.name.clone(),
-                source,
-            })?;
-        Ok([self.aft.t_hat.clone(), self.aft.n_hat.clone()])
+        let effects = self.problem.effects.contact;
+        let error = |source| HbmError::Aft {
+            contact: contact.name.clone(),
+            source,
+        };
+        match (contact.law_2d(), self.aft2d.as_mut()) {
+            (Some(law), Some(aft)) => {
+                aft.evaluate(
+                    &law,
+                    effects,
+                    [&coordinates[0], &coordinates[1]],
+                    &coordinates[2],
+                    false,
+                )
+                .map_err(error)?;
+                Ok(vec![
+                    aft.t_hat[0].clone(),
+                    aft.t_hat[1].clone(),
+                    aft.n_hat.clone(),
+                ])
+            }
+            _ => {
+                self.aft
+                    .evaluate(
+                        &law,
+                        effects,
+                        &coordinates[0],
+                        &coordinates[1],
+                        false,
+                    )
+                    .map_err(error)?;
+                Ok(vec![self.aft.t_hat.clone(), self.aft.n_hat.clone()])
+            }
+        }
     }
 
     /// ∂R/∂x by forward or central differences (the strategy decides), given R at x.

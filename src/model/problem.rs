@@ -275,20 +275,21 @@ impl Problem {
         HarmonicSet::new(h)
     }
 
-    /// For each contact point, whether its tangential and its normal row are non-zero. A row
-    /// whose coefficients are all zero (a contact to ground with a zero normal direction, whose
-    /// normal load is constant: N = kn·gap) moves with no DOF; the schur formulation gives such
-    /// a contact its non-zero coordinate only.
-    pub fn nonzero_contact_rows(&self) -> Vec<[bool; 2]> {
+    /// For each contact point, whether each of its rows ([`ContactPoint::rows`]: tangential,
+    /// second tangential of a 2D point, normal) is non-zero. A row whose coefficients are all
+    /// zero (a contact to ground with a zero normal direction, whose normal load is constant:
+    /// N = kn·gap) moves with no DOF; the schur formulation gives such a contact its non-zero
+    /// coordinates only.
+    pub fn nonzero_contact_rows(&self) -> Vec<Vec<bool>> {
         let nonzero = |row: &[(usize, f64)]| row.iter().any(|&(_, a)| a != 0.0);
         self.contacts
             .iter()
-            .map(|c| [nonzero(&c.tangential), nonzero(&c.normal)])
+            .map(|c| c.rows().map(nonzero).collect())
             .collect()
     }
 
-    /// Number of relative contact coordinates: the non-zero tangential and normal rows of the
-    /// contact points ([`Self::nonzero_contact_rows`]), 2 per contact point unless a row is zero.
+    /// Number of relative contact coordinates: the non-zero rows of the contact points
+    /// ([`Self::nonzero_contact_rows`]), 2 per 1D point and 3 per 2D point unless a row is zero.
     pub fn relative_coordinate_count(&self) -> usize {
         self.nonzero_contact_rows()
             .iter()
@@ -301,7 +302,7 @@ impl Problem {
         let mut dofs: Vec<usize> = self
             .contacts
             .iter()
-            .flat_map(|c| c.tangential.iter().chain(&c.normal).map(|&(d, _)| d))
+            .flat_map(|c| c.row_entries().map(|&(d, _)| d))
             .collect();
         dofs.sort_unstable();
         dofs.dedup();

@@ -112,7 +112,7 @@ pub fn boundary(problem: &Problem, extra: &[usize]) -> Boundary {
     let mut used: Vec<(String, BTreeMap<&str, BTreeSet<&str>>)> = Vec::new();
     for c in &problem.contacts {
         let mut per_node: BTreeMap<&str, BTreeSet<&str>> = BTreeMap::new();
-        for &(d, _) in c.tangential.iter().chain(&c.normal) {
+        for &(d, _) in c.row_entries() {
             if let Some((node, dir)) = node_and_direction(&names[d]) {
                 per_node.entry(node).or_default().insert(dir);
             }
@@ -292,6 +292,9 @@ pub fn reduce(
     };
     for c in &mut out.contacts {
         c.tangential = remap(&c.tangential);
+        if let Some(second) = &mut c.second_tangent {
+            second.row = remap(&second.row);
+        }
         c.normal = remap(&c.normal);
     }
     out.static_load = static_load;

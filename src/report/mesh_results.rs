@@ -63,7 +63,7 @@ pub fn write_point(
     // Contact nodes: the nodes named by each contact's DOFs (`<node>.<direction>`).
     let mut state = vec![-1.0; fe.mesh.nodes.len()];
     for (c, contact) in problem.contacts.iter().enumerate() {
-        for &(d, _) in contact.tangential.iter().chain(&contact.normal) {
+        for &(d, _) in contact.row_entries() {
             let node = problem.model.dof_names[d]
                 .split('.')
                 .next()

@@ -42,7 +42,8 @@ pub(super) fn frequency_bound(
 ) -> Result<(), SceneError> {
     let mut k = diagonal(&model.stiffness);
     for c in contacts {
-        for (row, stiffness) in [(&c.tangential, c.law.kt), (&c.normal, c.law.kn)] {
+        let tangential = c.tangential_rows().map(|row| (row, c.law.kt));
+        for (row, stiffness) in tangential.chain([(c.normal.as_slice(), c.law.kn)]) {
             for &(d, a) in row {
                 k[d] += stiffness * a * a;
             }

@@ -92,12 +92,7 @@ pub(super) fn check_held_bodies(
     let mut contacts_of: Vec<Vec<usize>> = vec![Vec::new(); n_bodies];
     let mut touched: Vec<Vec<usize>> = Vec::with_capacity(problem.contacts.len());
     for (c, contact) in problem.contacts.iter().enumerate() {
-        let mut bodies: Vec<usize> = contact
-            .normal
-            .iter()
-            .chain(&contact.tangential)
-            .map(|&(d, _)| body_of[d])
-            .collect();
+        let mut bodies: Vec<usize> = contact.row_entries().map(|&(d, _)| body_of[d]).collect();
         bodies.sort_unstable();
         bodies.dedup();
         for &b in &bodies {
@@ -180,17 +175,22 @@ pub(super) fn check_held_bodies(
         if loaded {
             let resultant = project(&mut dofs.iter().map(|&d| (d, problem.static_load[d])));
             if resultant.iter().map(|v| v * v).sum::<f64>().sqrt() > load_tol {
-                // What the contacts can transmit: N ≥ 0 with T = ±μN.
-                let mut generators = Vec::with_capacity(2 * contacts.len());
+                // What the contacts can transmit: N ≥ 0 with T = ±μN (for a 2D point, the
+                // square pyramid around its friction cone, so that a load outside it is surely
+                // outside the cone).
+                let mut generators = Vec::with_capacity(4 * contacts.len());
                 for (k, &c) in contacts.iter().enumerate() {
-                    let t = project(&mut problem.contacts[c].tangential.iter().copied());
+                    let tangents: Vec<Vec<f64>> = problem.contacts[c]
+                        .tangential_rows()
+                        .map(|row| project(&mut row.iter().copied()))
+                        .collect();
                     let mu = problem.contacts[c].law.mu;
-                    for s in [1.0, -1.0] {
+                    for t in friction_edges(&tangents) {
                         generators.push(
                             normal[k]
                                 .iter()
                                 .zip(&t)
-                                .map(|(a, b)| a + s * mu * b)
+                                .map(|(a, b)| a + mu * b)
                                 .collect::<Vec<f64>>(),
                         );
                     }
@@ -297,10 +297,11 @@ fn check_static_contacts(
         let mut k = k_structure.clone();
         let mut rhs = Mat::<f64>::from_fn(n, 1, |i, _| problem.static_load[i]);
         for (_, contact) in contacts.iter().enumerate().filter(|(c, _)| closed[*c]) {
-            for (rows, stiffness) in [
-                (&contact.normal, contact.law.kn),
-                (&contact.tangential, contact.law.kt),
-            ] {
+            let tangential = contact.tangential_rows().map(|row| (row, contact.law.kt));
+            for (rows, stiffness) in [(contact.normal.as_slice(), contact.law.kn)]
+                .into_iter()
+                .chain(tangential)
+            {
                 for &(p, ap) in rows {
                     for &(q, aq) in rows {
                         k[(p, q)] += stiffness * ap * aq;
@@ -376,15 +377,13 @@ fn check_static_contacts(
             };
             let mut generators: Vec<Vec<f64>> = Vec::new();
             for &c in &pressed {
-                let (nn, tt) = (
-                    project(&contacts[c].normal),
-                    project(&contacts[c].tangential),
-                );
-                for sign in [1.0, -1.0] {
+                let nn = project(&contacts[c].normal);
+                let tangents: Vec<Vec<f64>> = contacts[c].tangential_rows().map(project).collect();
+                for tt in friction_edges(&tangents) {
                     generators.push(
                         nn.iter()
                             .zip(&tt)
-                            .map(|(a, t)| a + sign * contacts[c].law.mu * t)
+                            .map(|(a, t)| a + contacts[c].law.mu * t)
                             .collect(),
                     );
                 }
@@ -723,4 +722,18 @@ fn sym_eigen(a: &Mat<f64>) -> Option<(Vec<f64>, Mat<f64>)> {
     let values = order.iter().map(|&i| sv[i]).collect();
     let vectors = Mat::from_fn(n, n, |i, c| u[(i, order[c])]);
     Some((values, vectors))
+}
+
+/// The tangential edge directions of a contact's friction pyramid, from its projected tangent
+/// rows: ±t for a 1D point; the four corners ±t₁ ± t₂ of the square around the friction circle
+/// for a 2D point (a pyramid that contains the cone, so a load it cannot carry no cone can).
+fn friction_edges(tangents: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    match tangents {
+        [t] => vec![t.clone(), t.iter().map(|v| -v).collect()],
+        [t1, t2] => [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)]
+            .iter()
+            .map(|&(a, b)| t1.iter().zip(t2).map(|(x, y)| a * x + b * y).collect())
+            .collect(),
+        _ => Vec::new(),
+    }
 }

@@ -2,7 +2,7 @@
 //! every `[[contact_patches]]` entry of an FE mesh built into [`ContactPoint`]s, grouped into
 //! the [`DamperSide`]s they belong to.
 
-use crate::contact::{ContactPoint, DamperSide, JenkinsLaw};
+use crate::contact::{ContactPoint, DamperSide, FrictionLaw, JenkinsLaw, SecondTangent};
 use crate::scene::checker::{Checker, DofNames};
 use crate::scene::error::SceneError;
 use crate::scene::fe_input::{self, FeStructure};
@@ -146,14 +146,22 @@ fn contact_point(
     let mu = ck.friction(&f("mu"), c.mu)?;
     let gap = ck.finite(&f("gap"), c.gap)?;
     let m = ck.initial_state(&f("initial_state"), c.initial_state)?;
+    let second = second_tangent(ck, ci, c, &t, &nv)?;
     let mut tangential = Vec::new();
     let mut normal = Vec::new();
+    let mut tangential2 = Vec::new();
     for d in 0..dim {
         push_coefficient(&mut tangential, damper_idx[d], t[d]);
         push_coefficient(&mut normal, damper_idx[d], nv[d]);
+        if let Some(t2) = &second {
+            push_coefficient(&mut tangential2, damper_idx[d], t2[d]);
+        }
         if let Some(&b) = body_idx.get(d) {
             push_coefficient(&mut tangential, b, -t[d]);
             push_coefficient(&mut normal, b, -nv[d]);
+            if let Some(t2) = &second {
+                push_coefficient(&mut tangential2, b, -t2[d]);
+            }
         }
     }
     let side = side_index(sides, &c.side_name());
@@ -170,7 +178,106 @@ fn contact_point(
             mu,
             initial_state: m,
         },
+        second_tangent: second.map(|_| SecondTangent {
+            row: tangential2,
+            initial_state: c.initial_state2,
+        }),
     })
+}
+
+/// The unit second tangent t₂ of a `jenkins-2d` contact `ci` with unit tangent `t` and normal
+/// `nv` (3 components each): `tangent2` normalised, or n × t; None for a `jenkins-1d` point.
+/// Refuses a 2D law on a point without 3 DOFs, a zero or non-perpendicular t₂, a zero normal
+/// with no `tangent2`, and an initial state (m₁, m₂) outside the unit disc.
+fn second_tangent(
+    ck: &Checker,
+    ci: usize,
+    c: &ContactSpec,
+    t: &[f64],
+    nv: &[f64],
+) -> Result<Option<Vec<f64>>, SceneError> {
+    let f = |name: &str| format!("contacts[{ci}].{name}");
+    if c.law == FrictionLaw::Jenkins1d {
+        if c.tangent2.is_some() {
+            return Err(ck.err(
+                f("tangent2"),
+                "only a `law = \"jenkins-2d\"` point has a second tangent",
+            ));
+        }
+        if c.initial_state2 != 0.0 {
+            return Err(ck.err(
+                f("initial_state2"),
+                "only a `law = \"jenkins-2d\"` point has a second initial-state component",
+            ));
+        }
+        return Ok(None);
+    }
+    if t.len() != 3 {
+        return Err(ck.err(
+            f("law"),
+            format!(
+                "`jenkins-2d` friction needs a 3D point (3 DOFs in `damper`), this point has {}: \
+                 a planar model uses `jenkins-1d`",
+                t.len()
+            ),
+        ));
+    }
+    let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+    let t2 = match &c.tangent2 {
+        Some(t2) => {
+            if t2.len() != 3 {
+                return Err(ck.err(
+                    f("tangent2"),
+                    format!("has {} components but the point has 3 DOFs", t2.len()),
+                ));
+            }
+            for (i, x) in t2.iter().enumerate() {
+                ck.finite(&format!("contacts[{ci}].tangent2[{i}]"), *x)?;
+            }
+            let len = norm(t2);
+            if len == 0.0 {
+                return Err(ck.err(f("tangent2"), "must not be the zero vector"));
+            }
+            let t2: Vec<f64> = t2.iter().map(|x| x / len).collect();
+            for (name, other) in [("tangent", t), ("normal", nv)] {
+                let d = dot(&t2, other);
+                if d.abs() > 1e-9 {
+                    return Err(ck.err(
+                        f("tangent2"),
+                        format!("must be perpendicular to `{name}` (t₂·{name} = {d:.3e})"),
+                    ));
+                }
+            }
+            t2
+        }
+        None => {
+            if norm(nv) == 0.0 {
+                return Err(ck.err(
+                    f("tangent2"),
+                    "is needed when `normal` is the zero vector (the default t₂ = n × t needs a normal)",
+                ));
+            }
+            vec![
+                nv[1] * t[2] - nv[2] * t[1],
+                nv[2] * t[0] - nv[0] * t[2],
+                nv[0] * t[1] - nv[1] * t[0],
+            ]
+        }
+    };
+    ck.finite(&f("initial_state2"), c.initial_state2)?;
+    let radius = c.initial_state.hypot(c.initial_state2);
+    if radius > 1.0 {
+        return Err(ck.err(
+            f("initial_state2"),
+            format!(
+                "the initial state (initial_state, initial_state2) = ({}, {}) has length \
+                 {radius:.6} > 1: it must lie in the unit disc (T(0) = μN(0)·m)",
+                c.initial_state, c.initial_state2
+            ),
+        ));
+    }
+    Ok(Some(t2))
 }
 
 /// The unit tangent and normal (one component per point DOF, `dim` of them) of contact `ci`,

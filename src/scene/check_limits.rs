@@ -68,6 +68,29 @@ pub(super) fn limit_settings(
     // The envelope's search holds a dense k × k curvature estimate and solves k sensitivities
     // per state: k = sides or contact points is kept to what that serves.
     if let Some(mode) = l.envelope {
+        let two_d = crate::contact::FrictionLaw::Jenkins2d;
+        let first_2d = scene
+            .contacts
+            .iter()
+            .find(|c| c.law == two_d)
+            .map(|c| format!("contact `{}`", c.name))
+            .or_else(|| {
+                scene
+                    .contact_patches
+                    .iter()
+                    .find(|p| p.law == two_d)
+                    .map(|p| format!("contact patch `{}`", p.side))
+            });
+        if let Some(what) = first_2d {
+            return Err(ck.err(
+                "limits.envelope",
+                format!(
+                    "{what} has 2D friction (`law = \"jenkins-2d\"`); the envelope \
+                     searches m ∈ [-1, 1] along one tangent per side and does not handle 2D \
+                     points yet (run the limits without `envelope`)"
+                ),
+            ));
+        }
         let k = match mode {
             crate::analysis::limits::EnvelopeMode::Sides => sides,
             crate::analysis::limits::EnvelopeMode::Points => scene.contacts.len(),

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::contact::{ContactPoint, JenkinsLaw};
+use crate::contact::{ContactPoint, FrictionLaw, JenkinsLaw, SecondTangent};
 use crate::fe::{
     self, Direction, DofMap, GroupMaterial, Material, Mesh, PatchSpec, PlaneAssumption,
 };
@@ -152,6 +152,11 @@ pub struct ContactPatchSpec {
     /// 3D meshes: tangential direction of the patch (projected on each pair's tangent plane).
     #[serde(default)]
     pub tangent: Option<[f64; 3]>,
+    /// Tangential friction law of every point: `"jenkins-1d"` (default, along `tangent`) or
+    /// `"jenkins-2d"` (3D meshes: isotropic friction in each pair's tangent plane, second
+    /// tangent t₂ = n × t, initial state m = (`initial_state`, 0)).
+    #[serde(default)]
+    pub law: FrictionLaw,
 }
 
 fn default_pair_tolerance() -> f64 {
@@ -368,6 +373,20 @@ pub fn patch_contacts(
             "the patch has no node pair",
         ));
     }
+    if spec.law == FrictionLaw::Jenkins2d {
+        if let Some(pair) = patch.pairs.iter().find(|p| p.damper_dofs.len() != 3) {
+            return Err(SceneError::invalid(
+                file,
+                format!("{field}.law"),
+                format!(
+                    "`jenkins-2d` friction needs a 3D mesh; the pair `{}` has {} DOFs per node: \
+                     a planar mesh uses `jenkins-1d`",
+                    pair.name,
+                    pair.damper_dofs.len()
+                ),
+            ));
+        }
+    }
     let node_index = mesh.node_index_map();
     let position = |id: u64| mesh.nodes[node_index[&id]].coords;
     Ok(patch
@@ -404,6 +423,18 @@ pub fn patch_contacts(
                     mu: spec.mu,
                     initial_state: spec.initial_state,
                 },
+                second_tangent: (spec.law == FrictionLaw::Jenkins2d).then(|| {
+                    let (n, t) = (&pair.normal, &pair.tangent);
+                    let t2 = [
+                        n[1] * t[2] - n[2] * t[1],
+                        n[2] * t[0] - n[0] * t[2],
+                        n[0] * t[1] - n[1] * t[0],
+                    ];
+                    SecondTangent {
+                        row: row(&t2),
+                        initial_state: 0.0,
+                    }
+                }),
             }
         })
         .collect())

@@ -133,9 +133,22 @@ pub struct ContactSpec {
     /// Initial normal gap (m); negative for an interference.
     #[serde(default)]
     pub gap: f64,
-    /// Initial tangential state m ∈ [−1, 1].
+    /// Initial tangential state m ∈ [−1, 1] (for a `jenkins-2d` point, its component m₁ along
+    /// `tangent`).
     #[serde(default)]
     pub initial_state: f64,
+    /// Tangential friction law: `"jenkins-1d"` (default, the paper's element along `tangent`)
+    /// or `"jenkins-2d"` (isotropic friction in the tangent plane; 3 DOFs per point).
+    #[serde(default)]
+    pub law: crate::contact::FrictionLaw,
+    /// Second tangent direction of a `jenkins-2d` point (normalised here, perpendicular to
+    /// `tangent` and `normal`); default n × t.
+    #[serde(default)]
+    pub tangent2: Option<Vec<f64>>,
+    /// Component m₂ of the initial tangential state along the second tangent of a `jenkins-2d`
+    /// point; (m₁, m₂) must lie in the unit disc.
+    #[serde(default)]
+    pub initial_state2: f64,
 }
 
 impl ContactSpec {

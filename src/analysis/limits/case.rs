@@ -85,10 +85,17 @@ impl LimitCase {
         ms.all(|m| m == first).then_some(first)
     }
 
-    /// The problem with every contact's initial state set from the case.
+    /// The problem with every contact's initial state set from the case. The case's m is
+    /// along the first tangent: a 2D-friction point whose m₁ the case changes starts at
+    /// m = (m, 0) (m = ±1: T(0) on the friction circle at ±t₁).
     pub fn apply(&self, problem: &Problem) -> Problem {
         let mut p = problem.clone();
         for (c, m) in p.contacts.iter_mut().zip(&self.contact_states) {
+            if c.law.initial_state != *m {
+                if let Some(second) = &mut c.second_tangent {
+                    second.initial_state = 0.0;
+                }
+            }
             c.law.initial_state = *m;
         }
         p

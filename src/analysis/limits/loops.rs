@@ -132,6 +132,18 @@ pub fn hysteresis(problem: &Problem, x: &[f64]) -> Result<Vec<HysteresisLoop>, H
     let mut loops = Vec::new();
     for (c, contact) in problem.contacts.iter().enumerate() {
         system.contact_forces(c, x, false)?;
+        if contact.second_tangent.is_some() {
+            // A 2D point's loop along its first tangent: (u₁, T₁).
+            let aft = system.aft2d().expect("2D points have a 2D workspace");
+            loops.push(HysteresisLoop {
+                contact: contact.name.clone(),
+                u: aft.u[0].clone(),
+                t: aft.t[0].clone(),
+                v: aft.v.clone(),
+                n: aft.n.clone(),
+            });
+            continue;
+        }
         let aft = system.aft();
         loops.push(HysteresisLoop {
             contact: contact.name.clone(),

@@ -70,6 +70,12 @@ pub fn residual_derivative(
     groups: &[Vec<usize>],
 ) -> Result<ResidualDerivative, HbmError> {
     let problem = system.problem();
+    if let Some(c) = problem.contacts.iter().find(|c| c.second_tangent.is_some()) {
+        return Err(HbmError::TwoDimensionalFriction {
+            contact: c.name.clone(),
+            evaluation: "the initial-state sensitivity (response envelope)",
+        });
+    }
     let n = problem.model.n_dofs();
     let dim = system.dim();
     let constant = system.unknowns().constant_block();

@@ -27,8 +27,9 @@ pub fn side_statics(system: &mut HbmSystem<'_>, x: &[f64]) -> Result<Vec<SideSta
     ];
     for (c, contact) in problem.contacts.iter().enumerate() {
         system.contact_forces(c, x, false)?;
-        out[contact.side].tangential += system.aft().t_hat[0];
-        out[contact.side].normal += system.aft().n_hat[0];
+        let (tangential, normal) = system.last_constant_forces(c);
+        out[contact.side].tangential += tangential;
+        out[contact.side].normal += normal;
     }
     Ok(out)
 }
