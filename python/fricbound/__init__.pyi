@@ -64,6 +64,8 @@ class ContinuationPath:
     stable: Optional[npt.NDArray[np.bool_]]
     floquet_re: Optional[_F]
     floquet_freq_hz: Optional[_F]
+    stability_method: Optional[List[str]]
+    stability_reliable: Optional[npt.NDArray[np.bool_]]
     dofs: List[str]
     outputs: List[str]
     contacts: List[str]

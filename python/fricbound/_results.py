@@ -51,8 +51,12 @@ class ContinuationPath(_Result):
       relative to the load norm;
     - ``trunc_err``, ``sampling_err`` (n, outputs) or None: estimated relative error of the
       amplitudes from harmonic truncation and AFT sampling (``[accuracy]``, on by default);
-    - ``stable`` (n,) bool, ``floquet_re`` (n,) 1/s, ``floquet_freq_hz`` (n,) or None: Hill
-      stability, when the scene sets ``analysis.stability = true``.
+    - ``stable`` (n,) bool, ``floquet_re`` (n,) 1/s, ``floquet_freq_hz`` (n,) or None: the
+      stability verdict, when the scene sets ``analysis.stability = true``;
+      ``stability_method`` (n,) str: which method gave it (``hill``, ``monodromy``, or
+      ``failed``: no verdict, ``stable`` is then False and meaningless), set by
+      ``analysis.stability_method``; ``stability_reliable`` (n,) bool: whether the verdict can
+      be trusted (Hill's is not on stick-slip points).
     """
 
     trunc_err: Optional[np.ndarray] = None
@@ -60,6 +64,8 @@ class ContinuationPath(_Result):
     stable: Optional[np.ndarray] = None
     floquet_re: Optional[np.ndarray] = None
     floquet_freq_hz: Optional[np.ndarray] = None
+    stability_method: Optional[List[str]] = None
+    stability_reliable: Optional[np.ndarray] = None
 
     def __init__(self, fields: Dict[str, Any], names: Dict[str, Any]):
         fields = dict(fields)
@@ -90,7 +96,8 @@ class ContinuationPath(_Result):
         """A DataFrame with the columns of the CLI's ``frf.csv``: ``freq_hz``,
         ``<dof>_amp``, ``<dof>_peak`` per output, ``<contact>_state`` per contact,
         ``newton_iters``, then ``<dof>_trunc_err``, ``<dof>_sampling_err`` and ``stable``,
-        ``floquet_re``, ``floquet_freq_hz`` when present."""
+        ``floquet_re``, ``floquet_freq_hz``, ``stability_method``, ``stability_reliable``
+        when present."""
         pd = _pandas()
         cols: Dict[str, Any] = {"freq_hz": self.freq_hz}
         for k, name in enumerate(self.outputs):
@@ -107,6 +114,8 @@ class ContinuationPath(_Result):
             cols["stable"] = self.stable
             cols["floquet_re"] = self.floquet_re
             cols["floquet_freq_hz"] = self.floquet_freq_hz
+            cols["stability_method"] = self.stability_method
+            cols["stability_reliable"] = self.stability_reliable
         return pd.DataFrame(cols)
 
 
@@ -123,6 +132,8 @@ _PATH_KEYS = (
     "stable",
     "floquet_re",
     "floquet_freq_hz",
+    "stability_method",
+    "stability_reliable",
 )
 
 

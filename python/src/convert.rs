@@ -133,7 +133,8 @@ pub fn problem_names(d: &Bound<'_, PyDict>, problem: &Problem) -> PyResult<()> {
 /// `states` (n lists of contact-state labels), `newton_iterations`, `residual`,
 /// `coefficients` (n × DOFs·blocks, harmonic-major), `trunc_err` and `sampling_err`
 /// (n × outputs, NaN where not estimated; absent when the scene does not ask for the
-/// estimate), `stable`, `floquet_re`, `floquet_freq_hz` (absent without `analysis.stability`).
+/// estimate), `stable`, `floquet_re`, `floquet_freq_hz`, `stability_method`,
+/// `stability_reliable` (absent without `analysis.stability`).
 pub fn points_dict<'py>(py: Python<'py>, points: &[FrfPoint]) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let n = points.len();
@@ -202,6 +203,18 @@ pub fn points_dict<'py>(py: Python<'py>, points: &[FrfPoint]) -> PyResult<Bound<
         };
         d.set_item("floquet_re", field(&|s| s.floquet_re))?;
         d.set_item("floquet_freq_hz", field(&|s| s.floquet_freq_hz))?;
+        d.set_item(
+            "stability_method",
+            points
+                .iter()
+                .map(|p| p.stability.as_ref().map_or("", |s| s.method.label()))
+                .collect::<Vec<_>>(),
+        )?;
+        let reliable: Vec<bool> = points
+            .iter()
+            .map(|p| p.stability.as_ref().is_some_and(|s| s.reliable))
+            .collect();
+        d.set_item("stability_reliable", PyArray1::from_vec(py, reliable))?;
     }
     Ok(d)
 }

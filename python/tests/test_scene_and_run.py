@@ -1,5 +1,6 @@
 """The Python API against the CLI, the TOML scenes and bad input."""
 
+import csv
 import io
 import math
 import os
@@ -204,6 +205,15 @@ def test_stability_columns_when_asked():
     # A stable point has no growing exponent.
     assert np.all(r.floquet_re[r.stable] <= 1e-6 * 2 * math.pi * r.freq_hz[r.stable])
     assert "stable" in r.to_pandas().columns
+    # Which method decided, and whether it can be trusted, as the CLI's frf.csv columns.
+    assert list(r.stability_method) == ["hill"] * len(r)
+    rows = list(csv.DictReader(io.StringIO(r.csv)))
+    assert [row["stability_method"] for row in rows] == list(r.stability_method)
+    assert [row["stability_reliable"] == "true" for row in rows] == list(r.stability_reliable)
+    # Hill is trusted only where every contact is stuck or open all period.
+    for k in range(len(r)):
+        trusted = all(state in ("stuck", "open") for state in r.states[k])
+        assert bool(r.stability_reliable[k]) == trusted
 
 
 def test_modes_of_the_paper_structure():

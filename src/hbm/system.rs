@@ -707,13 +707,7 @@ impl<'p> HbmSystem<'p> {
             }
             _ => {
                 self.aft
-                    .evaluate(
-                        &law,
-                        effects,
-                        &coordinates[0],
-                        &coordinates[1],
-                        false,
-                    )
+                    .evaluate(&law, effects, &coordinates[0], &coordinates[1], false)
                     .map_err(error)?;
                 Ok(vec![self.aft.t_hat.clone(), self.aft.n_hat.clone()])
             }
