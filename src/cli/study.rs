@@ -219,17 +219,7 @@ fn curve_pareto_figure(
             markers: true,
         });
     }
-    let (png, svg) = figure_files(dir, stem);
-    plot::plot_lines(
-        title,
-        "wall time of the FRF (s)",
-        "largest relative peak amplitude error",
-        true,
-        &series,
-        &png,
-        &svg,
-    )?;
-    Ok(())
+    pareto_plot(title, &series, dir, stem)
 }
 
 /// The figure of several curves: per curve, its Pareto front dashed and its other settings as
@@ -278,13 +268,23 @@ fn curves_pareto_figure(
             markers: true,
         });
     }
-    let (png, svg) = figure_files(dir, "accuracy_pareto");
+    pareto_plot(title, &series, dir, "accuracy_pareto")
+}
+
+/// Draws error-against-time `series` (log-log) to `<dir>/<stem>.png` and `.svg`.
+fn pareto_plot(
+    title: &str,
+    series: &[Curve],
+    dir: &std::path::Path,
+    stem: &str,
+) -> Result<(), CommandError> {
+    let (png, svg) = figure_files(dir, stem);
     plot::plot_lines(
         title,
         "wall time of the FRF (s)",
         "largest relative peak amplitude error",
         true,
-        &series,
+        series,
         &png,
         &svg,
     )?;

@@ -56,25 +56,13 @@ use crate::contact::aft::{AftError, MarchReport, MarchSettings};
 use crate::contact::harmonic::{HarmonicSet, SampleBasis};
 use crate::contact::{ContactEffects, ContactState, NormalLoad};
 
+pub use crate::contact::point::Jenkins2dLaw;
+
 /// Default budget of periods of the 2D march. Where the path barely leaves the stuck region
 /// (grazing), the slider creeps towards it over hundreds of periods (measured: 422 for a
 /// circle of 0.996 times the stick radius, sampled 128 times): Newton restarts do not help
 /// there, since the period map is then nearly the identity.
 pub const DEFAULT_MAX_PERIODS: usize = 2000;
-
-/// Parameters of the isotropic 2D Jenkins element of one contact point.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Jenkins2dLaw {
-    /// Tangential contact stiffness kₜ (N/m), the same in every in-plane direction, > 0.
-    pub kt: f64,
-    /// Normal contact stiffness kₙ (N/m), > 0.
-    pub kn: f64,
-    /// Friction coefficient μ (–), ≥ 0.
-    pub mu: f64,
-    /// Initial tangential state m in the unit disc, components along t₁, t₂: the march starts
-    /// at T(τ=0) = μ N(τ=0) · m.
-    pub initial_state: [f64; 2],
-}
 
 /// What happened at one sample of the final period.
 #[derive(Debug, Clone, Copy, PartialEq)]

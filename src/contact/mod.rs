@@ -6,10 +6,10 @@
 //!
 //! | module | main types | job |
 //! |---|---|---|
-//! | [`point`] | [`ContactPoint`], [`DamperSide`], [`JenkinsLaw`], [`FrictionLaw`], [`SecondTangent`], [`ContactState`] | contact points (relative displacement rows, frame, gap, 1D or 2D friction), damper sides, the Jenkins law's parameters, contact states |
+//! | [`point`] | [`ContactPoint`], [`DamperSide`], [`JenkinsLaw`], [`Jenkins2dLaw`], [`FrictionLaw`], [`SecondTangent`], [`ContactState`] | contact points (relative displacement rows, frame, gap, 1D or 2D friction), damper sides, the Jenkins law's parameters, contact states |
 //! | [`harmonic`] | `HarmonicSet`, `Block`, `SampleBasis` | real Fourier basis, unknown ordering (harmonic-major), time sampling |
 //! | [`aft`] | `AftWorkspace`, `MarchSettings`, `AftError` | the alternating frequency/time march of the Jenkins law (paper Eqs. 4-6) and its analytic Jacobian |
-//! | [`aft2d`] | `Aft2dWorkspace`, `Jenkins2dLaw` | the march of the isotropic 2D Jenkins element in a contact's tangent plane (radial return onto the friction circle) and its analytic Jacobian through the periodic steady state |
+//! | [`aft2d`] | `Aft2dWorkspace` | the march of the isotropic 2D Jenkins element in a contact's tangent plane (radial return onto the friction circle) and its analytic Jacobian through the periodic steady state |
 //! | [`describing_function`] | [`jenkins_describing_function`] | the exact first harmonic under constant normal load (paper Eqs. 17-18), the AFT's reference |
 
 pub mod aft;
@@ -20,6 +20,6 @@ pub mod point;
 
 pub use describing_function::jenkins_describing_function;
 pub use point::{
-    ContactEffects, ContactPoint, ContactState, DamperSide, FrictionLaw, JenkinsLaw, NormalLoad,
-    SecondTangent,
+    ContactEffects, ContactPoint, ContactState, DamperSide, FrictionLaw, Jenkins2dLaw, JenkinsLaw,
+    NormalLoad, SecondTangent,
 };

@@ -20,8 +20,6 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::contact::aft2d::Jenkins2dLaw;
-
 /// How the normal force evolves over the period.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
@@ -77,6 +75,21 @@ pub struct JenkinsLaw {
     pub mu: f64,
     /// Initial tangential state m ∈ [−1, 1]: the march starts at T(τ=0) = m μ N(τ=0).
     pub initial_state: f64,
+}
+
+/// Parameters of the isotropic 2D Jenkins element of one contact point (marched by
+/// [`crate::contact::aft2d`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Jenkins2dLaw {
+    /// Tangential contact stiffness kₜ (N/m), the same in every in-plane direction, > 0.
+    pub kt: f64,
+    /// Normal contact stiffness kₙ (N/m), > 0.
+    pub kn: f64,
+    /// Friction coefficient μ (–), ≥ 0.
+    pub mu: f64,
+    /// Initial tangential state m in the unit disc, components along t₁, t₂: the march starts
+    /// at T(τ=0) = μ N(τ=0) · m.
+    pub initial_state: [f64; 2],
 }
 
 /// A contact point with its kinematics and law.
