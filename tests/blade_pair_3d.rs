@@ -1,0 +1,112 @@
+//! The 3D blade pair with 2D tangential friction (`meshes/blade-pair/blade-pair-3d.toml`):
+//! the scene validates into a Craig-Bampton-reduced model whose 56 patch contact points all
+//! carry the `jenkins-2d` law; fixed-frequency solves near the first bending pair, where
+//! contacts stick, slip and lift off, give the same solutions in the schur (`auto`) and dense
+//! formulations; and `fricbound run` of a narrow window completes with its result files and
+//! VTU output.
+
+mod support;
+
+use std::path::Path;
+
+use fricbound::analysis::frf::PointSolver;
+use fricbound::analysis::linear::stuck_guess;
+use fricbound::contact::{ContactState, FrictionLaw};
+use fricbound::model::{Formulation, Problem};
+use fricbound::scene;
+
+const SCENE: &str = "meshes/blade-pair/blade-pair-3d.toml";
+
+/// Fixed frequencies below the first bending pair (Hz), each solved by Newton from the stuck
+/// linear response; at these the patch points are stuck, open or in stick-slip with lift-off.
+const FREQUENCIES: [f64; 3] = [720.0, 780.0, 840.0];
+
+fn problem(overrides: &[&str]) -> Problem {
+    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    scene::load_problem(Path::new(SCENE), &o).unwrap().1
+}
+
+#[test]
+fn the_3d_scene_reduces_and_carries_2d_friction_on_every_patch_pair() {
+    let p = problem(&[]);
+    let friction_2d = p
+        .contacts
+        .iter()
+        .filter(|c| c.friction_law() == FrictionLaw::Jenkins2d)
+        .count();
+    // 28 pairs per side on two sides, plus the two frictionless axial retention springs.
+    assert_eq!(friction_2d, 56);
+    assert_eq!(p.contacts.len(), 58);
+    // Craig-Bampton: 336 contact DOFs, 1 output DOF, 21 interior coordinates (20 modes + 1).
+    assert!(p.model.n_dofs() < 400, "{} reduced DOFs", p.model.n_dofs());
+    assert_eq!(p.formulation(), Formulation::Schur);
+}
+
+#[test]
+fn schur_and_dense_solve_the_same_2d_friction_states() {
+    let schur = problem(&[]);
+    let mut dense = schur.clone();
+    dense.analysis.formulation = Formulation::Dense;
+    assert_eq!(dense.formulation(), Formulation::Dense);
+    let mut a = PointSolver::new(&schur).unwrap();
+    let mut b = PointSolver::new(&dense).unwrap();
+    let mut slipping = 0;
+    for f in FREQUENCIES {
+        let guess = stuck_guess(
+            &schur,
+            &schur.unknown_harmonics(),
+            2.0 * std::f64::consts::PI * f,
+        )
+        .unwrap();
+        let x = a.solve(&guess, f).unwrap();
+        let y = b.solve(&guess, f).unwrap();
+        let scale = x.coefficients.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let largest = x
+            .coefficients
+            .iter()
+            .zip(&y.coefficients)
+            .fold(0.0_f64, |m, (p, q)| m.max((p - q).abs()));
+        println!(
+            "{f} Hz: amplitude {:.6e} m, schur {} / dense {} Newton iterations, \
+             largest difference {:.2e} of the largest coefficient",
+            x.amplitudes[0],
+            x.newton_iterations,
+            y.newton_iterations,
+            largest / scale
+        );
+        assert!(
+            largest <= 1e-6 * scale,
+            "{f} Hz: {largest:.3e} vs {scale:.3e}"
+        );
+        assert_eq!(x.states, y.states, "{f} Hz");
+        // The first two contacts are the frictionless axial retention springs.
+        slipping += x.states[2..]
+            .iter()
+            .filter(|s| matches!(s, ContactState::StickSlip | ContactState::StickSlipLiftoff))
+            .count();
+    }
+    // The 2D friction law is exercised: some patch points slip.
+    assert!(slipping > 0);
+}
+
+#[test]
+fn a_short_frf_of_the_3d_scene_completes_with_vtu_output() {
+    let out = std::env::temp_dir().join(format!("fricbound-blade-3d-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let run = support::run_scene(
+        SCENE,
+        &out,
+        &["analysis.freq_start_hz=700", "analysis.freq_end_hz=760"],
+    );
+    assert!(run.status.success(), "{}", support::text(&run.stderr));
+    let (header, rows) = support::csv(&out.join("frf.csv"));
+    assert!(header.contains("left-1_state") && header.contains("right-28_state"));
+    assert!(rows.len() >= 3, "{} points", rows.len());
+    let last: f64 = rows.last().unwrap()[0].parse().unwrap();
+    assert!((last - 760.0).abs() < 1e-6, "ends at {last} Hz");
+    let files = support::names(&out);
+    for f in ["modes_stuck.vtu", "response_peak.vtu", "solution.json"] {
+        assert!(files.iter().any(|n| n == f), "{f} missing: {files:?}");
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
