@@ -8,7 +8,8 @@
 //! acceleration with the contact return mapping) at a period start τ = 2πp is
 //! z = (q, q̇, w): displacements, velocities and the slider position of every contact point
 //! (paper Eqs. 4-6: in stick the slider is frozen, in slip it follows so that T = ±μN, open it
-//! follows u). The accelerations are not state: the scheme starts each period from the
+//! follows u; a 2D point, `jenkins-2d`, has two slider coordinates along t₁, t₂ and slips by
+//! radial return onto the friction circle). The accelerations are not state: the scheme starts each period from the
 //! equations of motion. The period map P: z(τ = 0) ↦ z(τ = 2π) is one period of the scheme
 //! ([`crate::analysis::verify`]'s stepper), so its fixed points are the periodic orbits of the
 //! discretised equations of motion and the eigenvalues ρ of its Jacobian ∂P/∂z at a fixed point
@@ -25,7 +26,8 @@
 //!    iteration being the monodromy matrix at the iterate. Shooting converges to the periodic
 //!    orbit whether it is stable or not, which a forward integration does not.
 //! 2. The monodromy matrix: central differences of P, one pair of one-period integrations per
-//!    state component (2·(2n + n_contacts) periods: 28 for the paper's 6 DOFs and 2 contacts),
+//!    state component (2·(2n + n_w) periods, n_w the slider coordinates, one per 1D point and
+//!    two per 2D point: 28 for the paper's 6 DOFs and 2 contacts, 44 for its 3D version),
 //!    in variables scaled by the orbit's amplitude (velocities by ω times it), with a step of
 //!    [`MonodromySettings::relative_step`] and the step Newton aiming at 10⁻¹¹ of the load so
 //!    that its round-off is far below the differences (its best iterate within the usual
@@ -34,13 +36,15 @@
 //!    through the integrated dynamics (saltation included), not through a smoothed law.
 //! 3. The neutral sliders: a contact that is closed and sticks during the whole period keeps
 //!    its slider fixed, so the slider's row of ∂P/∂z is exactly the unit row and one multiplier
-//!    is exactly 1. Its eigenvector shifts the slider and, with it, the static state: it moves
+//!    is exactly 1 (two for a 2D point, one per slider coordinate). Its eigenvector shifts the slider and, with it, the static state: it moves
 //!    along the family of stuck states (the non-uniqueness the limit method is about: another
 //!    initial tangential state m), it is not an instability. That row and column are removed
 //!    before the eigen solve and the slider is held fixed in the shooting (where it would make
 //!    P(z) − z singular); [`MonodromyStability::neutral_sliders`] names them. A slider that slips
 //!    or opens during the period is reset by the slip and is forgotten: its multiplier is about 0
-//!    and is kept (it never leads).
+//!    and is kept (it never leads). A 2D slider that slips is reset along the slip direction
+//!    only and its offset across it contracted by μN/|T*| < 1 per slipping step, so its
+//!    multiplier lies inside the unit circle and is kept too.
 //!
 //! 4. The section: the period map may start at any phase τ₀ of the period (the multipliers do
 //!    not depend on it), and it must start where the law is smooth in the state. A contact at
@@ -72,7 +76,9 @@ use faer::{c64, Mat};
 use serde::Serialize;
 
 use crate::analysis::stability::{PointStability, VerdictSource, STABILITY_TOLERANCE};
-use crate::analysis::verify::{hbm_state, Newmark, TimeState, VerifyError, VerifySettings};
+use crate::analysis::verify::{
+    hbm_state, slider_offsets, Newmark, TimeState, VerifyError, VerifySettings,
+};
 use crate::contact::harmonic::HarmonicSet;
 use crate::model::Problem;
 use crate::numerics::linalg::solve_dense;
@@ -226,13 +232,25 @@ pub fn monodromy_stability(
     // way keeps it stuck, the other makes it slip by as much). Its slider is moved inwards by
     // GRAZING_NUDGE of μN at that instant, onto the stuck states next to the limit, whose
     // period map is smooth (the limit state is their closure).
+    let offsets = slider_offsets(problem);
+    // The slider of contact c moved by `length` (m) along its force T at the peak of its
+    // friction use (inwards: towards smaller |T| there).
+    let nudge = |sliders: &mut [f64], c: usize, t: [f64; 2], length: f64| {
+        let magnitude = t[0].hypot(t[1]);
+        if magnitude > 0.0 {
+            for (a, i) in (offsets[c]..offsets[c + 1]).enumerate() {
+                sliders[i] += t[a] / magnitude * length;
+            }
+        }
+    };
     let probe = stepper.period_map(start, 0)?;
     let mut nudged_start = start.clone();
     let mut nudged = Vec::new();
     for (c, p) in problem.contacts.iter().enumerate() {
         let (use_ratio, t, nf) = probe.peak_friction_use[c];
         if probe.stuck_all_period[c] && use_ratio > 1.0 - GRAZING_NUDGE {
-            nudged_start.sliders[c] += t.signum() * GRAZING_NUDGE * p.law.mu * nf / p.law.kt;
+            let length = GRAZING_NUDGE * p.law.mu * nf / p.law.kt;
+            nudge(&mut nudged_start.sliders, c, t, length);
             nudged.push(c);
         }
     }
@@ -259,7 +277,12 @@ pub fn monodromy_stability(
     } else {
         stepper.advance(start, 0, k0)?.state
     };
-    let scale: Vec<f64> = (0..2 * n + nc)
+    let slider_count = offsets[nc];
+    // The contact of each slider coordinate.
+    let slider_contact: Vec<usize> = (0..nc)
+        .flat_map(|c| std::iter::repeat_n(c, offsets[c + 1] - offsets[c]))
+        .collect();
+    let scale: Vec<f64> = (0..2 * n + slider_count)
         .map(|i| {
             if (n..2 * n).contains(&i) {
                 omega * amplitude
@@ -287,7 +310,7 @@ pub fn monodromy_stability(
                 stuck,
             } = monodromy_matrix(&stepper, k0, &y, &scale, n, h)?;
             let free: Vec<usize> = (0..y.len())
-                .filter(|&i| i < 2 * n || !stuck[i - 2 * n])
+                .filter(|&i| i < 2 * n || !stuck[slider_contact[i - 2 * n]])
                 .collect();
             let defect = free
                 .iter()
@@ -323,8 +346,12 @@ pub fn monodromy_stability(
             let (use_ratio, t, nf) = orbit.peak_friction_use[c];
             let still = orbit.slider_range[c] <= 1e-9 * amplitude;
             if still && use_ratio > 1.0 - GRAZING_NUDGE && !nudged.contains(&c) {
-                y[2 * n + c] +=
-                    t.signum() * GRAZING_NUDGE * p.law.mu * nf / p.law.kt / scale[2 * n + c];
+                // Sliders are scaled by the amplitude, as displacements.
+                let mut shift = vec![0.0; slider_count];
+                nudge(&mut shift, c, t, GRAZING_NUDGE * p.law.mu * nf / p.law.kt);
+                for (i, d) in shift.iter().enumerate() {
+                    y[2 * n + i] += d / scale[2 * n + i];
+                }
                 nudged.push(c);
                 moved = true;
             }
@@ -337,7 +364,7 @@ pub fn monodromy_stability(
         return Err(VerifyError::Monodromy("no monodromy matrix".into()));
     };
     let kept: Vec<usize> = (0..m.nrows())
-        .filter(|&i| i < 2 * n || !stuck[i - 2 * n])
+        .filter(|&i| i < 2 * n || !stuck[slider_contact[i - 2 * n]])
         .collect();
     let reduced = Mat::from_fn(kept.len(), kept.len(), |r, c| m[(kept[r], kept[c])]);
     let mut multipliers: Vec<c64> = reduced
@@ -389,8 +416,8 @@ impl MonodromyStability {
 /// default of `verify`). This is the per-point verdict of `analysis.stability_method =
 /// "monodromy"` (and of `"hill+monodromy"` on stick-slip points).
 ///
-/// Cost: each shooting iteration integrates 2·(2n + n_contacts) + 1 periods (29 on the paper
-/// system), usually 1-3 iterations.
+/// Cost: each shooting iteration integrates 2·(2n + n_w) + 1 periods (n_w slider coordinates:
+/// one per 1D point, two per 2D point; 29 on the paper system), usually 1-3 iterations.
 pub fn point_monodromy(
     problem: &Problem,
     set: &HarmonicSet,

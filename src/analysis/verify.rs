@@ -26,6 +26,15 @@
 //! periodic one. Only variable normal load is supported (a constant normal load is defined from
 //! the 0th harmonic of a periodic motion, which a time integration does not have).
 //!
+//! A point with the 2D law (`jenkins-2d`) has u, w, T ∈ ℝ² in its tangent plane (components
+//! along t₁, t₂) and the same mapping with the radial return of [`crate::contact::aft2d`]:
+//! trial T* = kₜ (u − w₀); |T*| ≤ μN stick, otherwise T = μN T*/|T*| and w₁ = u − T/kₜ; its
+//! consistent tangent is ∂T/∂u = (μN/|T*|) kₜ (I − d dᵀ), ∂T/∂v = μ kₙ d with d = T*/|T*|. A 1D
+//! point is the same mapping with the second components 0 (d = ±1, I − d dᵀ = 0: the 1D slip
+//! tangent 0), so one function serves both laws and gives the 1D results unchanged. The slider
+//! state of a problem ([`TimeState::sliders`]) holds one coordinate per 1D point and two per 2D
+//! point, in contact order ([`slider_offsets`]).
+//!
 //! Integration goes period by period (τ = ωt; period starts at τ = 2πp) until the state at the
 //! period start (q, q̇/ω) changes by less than a tolerance relative to the largest first-harmonic
 //! amplitude, or a budget of periods runs out. The last period's samples are then projected on
@@ -35,13 +44,16 @@
 //!
 //! [`verify_point`] starts on a harmonic-balance solution (positions and velocities at τ = 0
 //! from its coefficients; slider positions by marching the contact law on its periodic motion
-//! from T(0) = m μ N(0), as the AFT does) and integrates twice, with `steps_per_period` and
-//! twice as many steps: the change of the first-harmonic amplitudes is the reported dt error.
+//! from T(0) = m μ N(0), as the AFT does: for a 2D point by the AFT's own 2D march,
+//! [`crate::contact::aft2d::Aft2dWorkspace`], whose slider at the start of its periodic period
+//! is the slider at τ = 0) and integrates twice, with `steps_per_period` and twice as many
+//! steps: the change of the first-harmonic amplitudes is the reported dt error.
 
 use std::f64::consts::PI;
 
 use faer::Mat;
 
+use crate::contact::aft2d::Aft2dWorkspace;
 use crate::contact::harmonic::HarmonicSet;
 use crate::contact::{ContactPoint, NormalLoad};
 use crate::model::Problem;
@@ -131,8 +143,37 @@ pub struct TimeState {
     pub q: Vec<f64>,
     /// Velocities q̇ (m/s).
     pub qdot: Vec<f64>,
-    /// Slider position w of each contact point (m, along its tangential coordinate u).
+    /// Slider positions (m), in contact order: one coordinate w (along u) per 1D point, two
+    /// (w₁, w₂ along t₁, t₂) per 2D point; contact c's start at [`slider_offsets`]`[c]`.
     pub sliders: Vec<f64>,
+}
+
+/// Where each contact's slider coordinates start in [`TimeState::sliders`]: entry c is the
+/// first coordinate of contact c (1 coordinate for a 1D point, 2 for a 2D point), the last
+/// entry is the total count.
+pub fn slider_offsets(problem: &Problem) -> Vec<usize> {
+    let mut offsets = Vec::with_capacity(problem.contacts.len() + 1);
+    let mut next = 0;
+    offsets.push(0);
+    for c in &problem.contacts {
+        next += slider_dims(c);
+        offsets.push(next);
+    }
+    offsets
+}
+
+/// Slider coordinates of a point: 1 for the 1D law, 2 for the 2D law.
+fn slider_dims(point: &ContactPoint) -> usize {
+    if point.second_tangent.is_some() {
+        2
+    } else {
+        1
+    }
+}
+
+/// The tangential relative displacement (u₁, u₂) of a point at q (u₂ = 0 for a 1D point).
+fn tangential_pair(point: &ContactPoint, q: &[f64]) -> [f64; 2] {
+    [point.tangential_of(q), point.second_tangential_of(q)]
 }
 
 /// Steady state reached by a time integration.
@@ -167,11 +208,19 @@ pub struct TimeResponse {
 /// One contact's tangential relative displacement and force over a period.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct ContactLoop {
-    /// Tangential relative displacement u = aₜ·q (m).
+    /// Tangential relative displacement u = aₜ·q (m) (along t₁ for a 2D point).
     pub u: Vec<f64>,
     /// Tangential force T = kₜ (u − w) (N): the spring to the committed slider, which is the
-    /// stick force, ±μN in slip and 0 open (the slider then follows u).
+    /// stick force, ±μN in slip and 0 open (the slider then follows u) (T₁ for a 2D point).
     pub t: Vec<f64>,
+    /// A 2D point's second tangential relative displacement u₂ = aₜ₂·q (m); empty for a 1D
+    /// point.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub u2: Vec<f64>,
+    /// A 2D point's second tangential force component T₂ = kₜ (u₂ − w₂) (N); empty for a 1D
+    /// point.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub t2: Vec<f64>,
 }
 
 /// Result of [`verify_point`]: the time integration at two time steps against the HBM point.
@@ -194,22 +243,7 @@ struct DenseModel {
     k: Mat<f64>,
 }
 
-/// Refuses 2D-friction points: the time integration marches the 1D Jenkins law only.
-fn check_friction_1d(problem: &Problem) -> Result<(), VerifyError> {
-    if let Some(c) = problem.contacts.iter().find(|c| c.second_tangent.is_some()) {
-        return Err(VerifyError::Unsupported {
-            reason: format!(
-                "contact `{}` has 2D friction (jenkins-2d); the time integration marches the 1D \
-                 Jenkins law only",
-                c.name
-            ),
-        });
-    }
-    Ok(())
-}
-
 fn check_supported(problem: &Problem) -> Result<(), VerifyError> {
-    check_friction_1d(problem)?;
     if problem.effects.contact.normal_load == NormalLoad::Constant && !problem.contacts.is_empty() {
         return Err(VerifyError::Unsupported {
             reason:
@@ -226,21 +260,36 @@ fn check_supported(problem: &Problem) -> Result<(), VerifyError> {
     Ok(())
 }
 
-/// Per-contact result of the return mapping at a trial displacement.
+/// Per-contact result of the return mapping at a trial displacement (second tangential
+/// components 0 for a 1D point).
 struct ContactEval {
-    t: f64,
+    /// Tangential force (T₁, T₂) (N).
+    t: [f64; 2],
+    /// Normal force N (N).
     n: f64,
-    dt_du: f64,
-    dt_dv: f64,
+    /// ∂Tₐ/∂u_b, row-major 2×2 (N/m).
+    dt_du: [f64; 4],
+    /// ∂Tₐ/∂v (N/m).
+    dt_dv: [f64; 2],
+    /// ∂N/∂v (N/m).
     dn_dv: f64,
-    slider: f64,
+    /// Slider after the step (m).
+    slider: [f64; 2],
     /// Closed and sticking (the slider did not move).
     stuck: bool,
 }
 
 /// Return mapping of the Jenkins law (paper Eqs. 4-6) at u, v from the committed slider `w0`,
-/// with the AFT's conventions (closed iff N > 0).
-fn return_map(point: &ContactPoint, liftoff: bool, u: f64, v: f64, w0: f64) -> ContactEval {
+/// with the AFT's conventions (closed iff N > 0): for a 2D point the radial return onto the
+/// friction circle of [`crate::contact::aft2d`], for a 1D point the same with u₂ = w₂ = 0
+/// (which is the 1D law exactly: the slip direction is ±1 and the slip tangent 0).
+fn return_map(
+    point: &ContactPoint,
+    liftoff: bool,
+    u: [f64; 2],
+    v: f64,
+    w0: [f64; 2],
+) -> ContactEval {
     let law = &point.law;
     let nk = law.kn * v;
     let (n, dn_dv) = if liftoff && nk <= 0.0 {
@@ -250,43 +299,75 @@ fn return_map(point: &ContactPoint, liftoff: bool, u: f64, v: f64, w0: f64) -> C
     };
     if n <= 0.0 {
         return ContactEval {
-            t: 0.0,
+            t: [0.0; 2],
             n,
-            dt_du: 0.0,
-            dt_dv: 0.0,
+            dt_du: [0.0; 4],
+            dt_dv: [0.0; 2],
             dn_dv,
             slider: u,
             stuck: false,
         };
     }
     let limit = law.mu * n;
-    let trial = law.kt * (u - w0);
-    if trial.abs() <= limit {
+    let trial = [law.kt * (u[0] - w0[0]), law.kt * (u[1] - w0[1])];
+    let magnitude = trial[0].hypot(trial[1]);
+    if magnitude <= limit {
+        let second = if point.second_tangent.is_some() {
+            law.kt
+        } else {
+            0.0
+        };
         ContactEval {
             t: trial,
             n,
-            dt_du: law.kt,
-            dt_dv: 0.0,
+            dt_du: [law.kt, 0.0, 0.0, second],
+            dt_dv: [0.0; 2],
             dn_dv,
             slider: w0,
             stuck: true,
         }
     } else {
-        let s = trial.signum();
+        let d = [trial[0] / magnitude, trial[1] / magnitude];
+        let t = [limit * d[0], limit * d[1]];
+        // Consistent tangent of the radial return: (μN/|T*|) kₜ (I − d dᵀ).
+        let g = limit / magnitude * law.kt;
         ContactEval {
-            t: s * limit,
+            t,
             n,
-            dt_du: 0.0,
-            dt_dv: s * law.mu * law.kn,
+            dt_du: [
+                g * (1.0 - d[0] * d[0]),
+                -g * d[0] * d[1],
+                -g * d[1] * d[0],
+                g * (1.0 - d[1] * d[1]),
+            ],
+            dt_dv: [law.mu * law.kn * d[0], law.mu * law.kn * d[1]],
             dn_dv,
-            slider: u - s * limit / law.kt,
+            slider: [u[0] - t[0] / law.kt, u[1] - t[1] / law.kt],
             stuck: false,
         }
     }
 }
 
-/// Adds the contact forces at `q` (from committed sliders `w0`) to `f`, their tangent to `kc`
-/// if given, and writes the trial sliders to `w1` and whether each contact sticks to `stuck`.
+/// The committed slider of contact c from the slider coordinates `w` (`offsets` from
+/// [`slider_offsets`]); w₂ = 0 for a 1D point.
+fn slider_of(w: &[f64], offsets: &[usize], c: usize) -> [f64; 2] {
+    let o = offsets[c];
+    if offsets[c + 1] - o == 2 {
+        [w[o], w[o + 1]]
+    } else {
+        [w[o], 0.0]
+    }
+}
+
+/// Writes contact c's slider into the slider coordinates `w`.
+fn store_slider(w: &mut [f64], offsets: &[usize], c: usize, slider: [f64; 2]) {
+    let (o, dims) = (offsets[c], offsets[c + 1] - offsets[c]);
+    w[o..o + dims].copy_from_slice(&slider[..dims]);
+}
+
+/// Adds the contact forces at `q` (from committed slider coordinates `w0`) to `f`, their
+/// tangent to `kc` if given, and writes the trial slider coordinates to `w1` and whether each
+/// contact sticks to `stuck`.
 fn contact_forces(
     problem: &Problem,
     q: &[f64],
@@ -297,25 +378,36 @@ fn contact_forces(
     stuck: &mut [bool],
 ) {
     let liftoff = problem.effects.contact.liftoff;
+    let offsets = slider_offsets(problem);
     for (ci, p) in problem.contacts.iter().enumerate() {
-        let u = p.tangential_of(q);
+        let u = tangential_pair(p, q);
         let v = p.normal_of(q) - p.gap;
-        let e = return_map(p, liftoff, u, v, w0[ci]);
-        w1[ci] = e.slider;
+        let e = return_map(p, liftoff, u, v, slider_of(w0, &offsets, ci));
+        store_slider(w1, &offsets, ci, e.slider);
         stuck[ci] = e.stuck;
-        for &(i, a) in &p.tangential {
-            f[i] += a * e.t;
+        let tangential: Vec<&[(usize, f64)]> = p.tangential_rows().collect();
+        for (a, row) in tangential.iter().enumerate() {
+            for &(i, coef) in *row {
+                f[i] += coef * e.t[a];
+            }
         }
         for &(i, a) in &p.normal {
             f[i] += a * e.n;
         }
         if let Some(kc) = kc.as_deref_mut() {
-            for &(i, ai) in &p.tangential {
-                for &(j, aj) in &p.tangential {
-                    kc[(i, j)] += ai * e.dt_du * aj;
-                }
-                for &(j, aj) in &p.normal {
-                    kc[(i, j)] += ai * e.dt_dv * aj;
+            for (a, row_a) in tangential.iter().enumerate() {
+                for &(i, ai) in *row_a {
+                    for (b, row_b) in tangential.iter().enumerate() {
+                        let d = e.dt_du[2 * a + b];
+                        if d != 0.0 {
+                            for &(j, bj) in *row_b {
+                                kc[(i, j)] += ai * d * bj;
+                            }
+                        }
+                    }
+                    for &(j, aj) in &p.normal {
+                        kc[(i, j)] += ai * e.dt_dv[a] * aj;
+                    }
                 }
             }
             for &(i, ai) in &p.normal {
@@ -371,10 +463,12 @@ pub(crate) struct PeriodEnd {
     /// and N/N_max; open: −kₙ v / N_max; a contact that never closes counts 1). 0 where some
     /// contact slips or sits at a switch.
     pub(crate) switch_margin: Vec<f64>,
-    /// Per contact, at the step where it uses most of its friction: |T|/(μN), T (N) and N (N)
-    /// (zeros for a contact that never closes or has μ = 0).
-    pub(crate) peak_friction_use: Vec<(f64, f64, f64)>,
-    /// Per contact: range max − min of its slider over the period (m).
+    /// Per contact, at the step where it uses most of its friction: |T|/(μN), T = (T₁, T₂)
+    /// (N; T₂ = 0 for a 1D point) and N (N) (zeros for a contact that never closes or has
+    /// μ = 0).
+    pub(crate) peak_friction_use: Vec<(f64, [f64; 2], f64)>,
+    /// Per contact: range max − min of its slider over the period (m; the larger of its two
+    /// coordinates' ranges for a 2D point).
     pub(crate) slider_range: Vec<f64>,
 }
 
@@ -452,9 +546,10 @@ impl<'a> Newmark<'a> {
                 found: start.q.len().min(start.qdot.len()),
             });
         }
-        if start.sliders.len() != nc {
+        let slider_count = slider_offsets(problem)[nc];
+        if start.sliders.len() != slider_count {
             return Err(VerifyError::WrongLength {
-                expected: nc,
+                expected: slider_count,
                 found: start.sliders.len(),
             });
         }
@@ -626,8 +721,9 @@ impl<'a> Newmark<'a> {
         let mut hi = st.q.clone();
         let mut w_lo = st.w.clone();
         let mut w_hi = st.w.clone();
-        // Per step and contact: (N, T, kₙ v).
-        let mut forces: Vec<Vec<(f64, f64, f64)>> = Vec::with_capacity(count);
+        let offsets = slider_offsets(problem);
+        // Per step and contact: (N, T = (T₁, T₂), kₙ v).
+        let mut forces: Vec<Vec<(f64, [f64; 2], f64)>> = Vec::with_capacity(count);
         for k in k0..k0 + count {
             self.step(&mut st, k, k - k0, &mut stuck)?;
             stuck_all.iter_mut().zip(&stuck).for_each(|(a, s)| *a &= *s);
@@ -635,9 +731,9 @@ impl<'a> Newmark<'a> {
                 lo[i] = lo[i].min(st.q[i]);
                 hi[i] = hi[i].max(st.q[i]);
             }
-            for c in 0..nc {
-                w_lo[c] = w_lo[c].min(st.w[c]);
-                w_hi[c] = w_hi[c].max(st.w[c]);
+            for (i, &w) in st.w.iter().enumerate() {
+                w_lo[i] = w_lo[i].min(w);
+                w_hi[i] = w_hi[i].max(w);
             }
             forces.push(
                 problem
@@ -645,10 +741,12 @@ impl<'a> Newmark<'a> {
                     .iter()
                     .enumerate()
                     .map(|(c, p)| {
-                        let u = p.tangential_of(&st.q);
+                        let u = tangential_pair(p, &st.q);
+                        let w = slider_of(&st.w, &offsets, c);
                         let knv = p.law.kn * (p.normal_of(&st.q) - p.gap);
                         let nf = if liftoff { knv.max(0.0) } else { knv };
-                        (nf, p.law.kt * (u - st.w[c]), knv)
+                        let t = [p.law.kt * (u[0] - w[0]), p.law.kt * (u[1] - w[1])];
+                        (nf, t, knv)
                     })
                     .collect(),
             );
@@ -668,7 +766,7 @@ impl<'a> Newmark<'a> {
                         } else if nf > 0.0 {
                             let normal = nf / n_max[c];
                             if law.mu > 0.0 {
-                                normal.min((law.mu * nf - t.abs()) / (law.mu * n_max[c]))
+                                normal.min((law.mu * nf - t[0].hypot(t[1])) / (law.mu * n_max[c]))
                             } else {
                                 normal
                             }
@@ -688,8 +786,8 @@ impl<'a> Newmark<'a> {
                 forces
                     .iter()
                     .filter(|f| f[c].0 > 0.0 && mu > 0.0)
-                    .map(|f| (f[c].1.abs() / (mu * f[c].0), f[c].1, f[c].0))
-                    .fold((0.0, 0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a })
+                    .map(|f| (f[c].1[0].hypot(f[c].1[1]) / (mu * f[c].0), f[c].1, f[c].0))
+                    .fold((0.0, [0.0; 2], 0.0), |a, b| if b.0 > a.0 { b } else { a })
             })
             .collect();
         Ok(PeriodEnd {
@@ -702,7 +800,13 @@ impl<'a> Newmark<'a> {
             half_range,
             switch_margin,
             peak_friction_use,
-            slider_range: (0..nc).map(|c| w_hi[c] - w_lo[c]).collect(),
+            slider_range: (0..nc)
+                .map(|c| {
+                    (offsets[c]..offsets[c + 1])
+                        .map(|i| w_hi[i] - w_lo[i])
+                        .fold(0.0_f64, f64::max)
+                })
+                .collect(),
         })
     }
 }
@@ -727,11 +831,18 @@ pub fn integrate(
     let mut history: Vec<Vec<f64>> = vec![vec![0.0; steps]; outputs.len()];
     let mut all_history: Vec<Vec<f64>> = vec![vec![0.0; steps]; n];
     let mut velocity: Vec<Vec<f64>> = vec![vec![0.0; steps]; outputs.len()];
-    let nc = problem.contacts.len();
-    let mut loops: Vec<ContactLoop> = (0..nc)
-        .map(|_| ContactLoop {
-            u: vec![0.0; steps],
-            t: vec![0.0; steps],
+    let offsets = slider_offsets(problem);
+    let mut loops: Vec<ContactLoop> = problem
+        .contacts
+        .iter()
+        .map(|p| {
+            let second = if p.second_tangent.is_some() { steps } else { 0 };
+            ContactLoop {
+                u: vec![0.0; steps],
+                t: vec![0.0; steps],
+                u2: vec![0.0; second],
+                t2: vec![0.0; second],
+            }
         })
         .collect();
     let mut period_start = (st.q.clone(), st.v.clone());
@@ -748,9 +859,14 @@ pub fn integrate(
                 velocity[o][k] = st.v[d];
             }
             for (c, p) in problem.contacts.iter().enumerate() {
-                let u = p.tangential_of(&st.q);
-                loops[c].u[k] = u;
-                loops[c].t[k] = p.law.kt * (u - st.w[c]);
+                let u = tangential_pair(p, &st.q);
+                let w = slider_of(&st.w, &offsets, c);
+                loops[c].u[k] = u[0];
+                loops[c].t[k] = p.law.kt * (u[0] - w[0]);
+                if p.second_tangent.is_some() {
+                    loops[c].u2[k] = u[1];
+                    loops[c].t2[k] = p.law.kt * (u[1] - w[1]);
+                }
             }
             stepper.step(&mut st, k, (period - 1) * steps + k, &mut stuck)?;
         }
@@ -838,7 +954,9 @@ fn first_harmonic(samples: &[f64]) -> (f64, f64) {
 /// on `set`, which must contain the constant block) at `freq_hz`: q(0), q̇(0), and the slider of
 /// each contact from the contact law marched over the periodic motion sampled at `samples`
 /// points per period, starting from T(0) = m μ N(0) (the AFT's initial condition), until the
-/// slider repeats (at most 64 periods).
+/// slider repeats (at most 64 periods); for a 2D point, the slider at the start of the periodic
+/// period of the AFT's own 2D march ([`Aft2dWorkspace`], on the point's coefficients, with
+/// `samples` samples), an error if that march does not settle.
 pub fn hbm_state(
     problem: &Problem,
     set: &HarmonicSet,
@@ -846,7 +964,6 @@ pub fn hbm_state(
     freq_hz: f64,
     samples: usize,
 ) -> Result<TimeState, VerifyError> {
-    check_friction_1d(problem)?;
     let n = problem.model.n_dofs();
     let nb = set.n_blocks();
     if x.len() != n * nb {
@@ -884,36 +1001,59 @@ pub fn hbm_state(
         .map(|k| at(2.0 * PI * k as f64 / samples as f64).0)
         .collect();
     let liftoff = problem.effects.contact.liftoff;
-    let sliders = problem
-        .contacts
-        .iter()
-        .map(|p| {
-            let u0 = p.tangential_of(&qs[0]);
-            let v0 = p.normal_of(&qs[0]) - p.gap;
-            let n0 = if liftoff {
-                (p.law.kn * v0).max(0.0)
-            } else {
-                p.law.kn * v0
+    let mut sliders = Vec::with_capacity(slider_offsets(problem)[problem.contacts.len()]);
+    let mut aft2d: Option<Aft2dWorkspace> = None;
+    for p in &problem.contacts {
+        if let Some(law) = p.law_2d() {
+            // The AFT's 2D march on the point's own coefficients (u₁, u₂, v per block).
+            let row_coefficients = |row: &[(usize, f64)]| -> Vec<f64> {
+                (0..nb)
+                    .map(|j| row.iter().map(|&(i, a)| a * x[j * n + i]).sum())
+                    .collect()
             };
-            let mut w = if n0 > 0.0 {
-                u0 - p.law.initial_state * p.law.mu * n0 / p.law.kt
-            } else {
-                u0
-            };
-            for _ in 0..64 {
-                let w_start = w;
-                for qk in qs.iter().skip(1).chain(std::iter::once(&qs[0])) {
-                    let u = p.tangential_of(qk);
-                    let v = p.normal_of(qk) - p.gap;
-                    w = return_map(p, liftoff, u, v, w).slider;
-                }
-                if (w - w_start).abs() <= 1e-14 * (w.abs() + 1e-12) {
-                    break;
-                }
+            let rows: Vec<&[(usize, f64)]> = p.tangential_rows().collect();
+            let u1 = row_coefficients(rows[0]);
+            let u2 = row_coefficients(rows[1]);
+            let mut v = row_coefficients(&p.normal);
+            if let Some(j0) = set.constant_block() {
+                v[j0] -= p.gap;
             }
-            w
-        })
-        .collect();
+            let ws = aft2d.get_or_insert_with(|| Aft2dWorkspace::new(set, samples));
+            ws.evaluate(&law, problem.effects.contact, [&u1, &u2], &v, false)
+                .map_err(|e| VerifyError::Unsupported {
+                    reason: format!(
+                        "the 2D march of contact `{}` on the harmonic-balance point: {e}",
+                        p.name
+                    ),
+                })?;
+            sliders.extend_from_slice(&ws.slider_start);
+            continue;
+        }
+        let u0 = p.tangential_of(&qs[0]);
+        let v0 = p.normal_of(&qs[0]) - p.gap;
+        let n0 = if liftoff {
+            (p.law.kn * v0).max(0.0)
+        } else {
+            p.law.kn * v0
+        };
+        let mut w = if n0 > 0.0 {
+            u0 - p.law.initial_state * p.law.mu * n0 / p.law.kt
+        } else {
+            u0
+        };
+        for _ in 0..64 {
+            let w_start = w;
+            for qk in qs.iter().skip(1).chain(std::iter::once(&qs[0])) {
+                let u = p.tangential_of(qk);
+                let v = p.normal_of(qk) - p.gap;
+                w = return_map(p, liftoff, [u, 0.0], v, [w, 0.0]).slider[0];
+            }
+            if (w - w_start).abs() <= 1e-14 * (w.abs() + 1e-12) {
+                break;
+            }
+        }
+        sliders.push(w);
+    }
     Ok(TimeState {
         q: q0,
         qdot: qd0,
@@ -923,8 +1063,8 @@ pub fn hbm_state(
 
 /// A start at rest (q̇ = 0) at a nonlinear static equilibrium in which every closed contact
 /// carries the tangential force T = m μ N of its initial state m (`law.initial_state`, the
-/// paper's T(τ_ini) = m μ N of Eqs. 14-15 applied to the static state): Newton with
-/// backtracking on
+/// paper's T(τ_ini) = m μ N of Eqs. 14-15 applied to the static state; for a 2D point
+/// m = (m₁, m₂) and T = μN m along t₁, t₂): Newton with backtracking on
 ///
 /// ```text
 /// K q + Σ_c [ aₜ m μ N(q) + aₙ N(q) ] = F_static,   N = kₙ max(v, 0) (kₙ v without lift-off),
@@ -936,7 +1076,6 @@ pub fn hbm_state(
 /// equilibrium of the equations of motion without the harmonic load; an open contact's slider
 /// is at u. An error if Newton does not converge in 100 iterations.
 pub fn static_state(problem: &Problem) -> Result<TimeState, VerifyError> {
-    check_friction_1d(problem)?;
     let set = HarmonicSet::new(vec![0]);
     let mut q = crate::analysis::linear::stuck_guess(problem, &set, 0.0)
         .map_err(|e| VerifyError::Static(e.to_string()))?;
@@ -962,17 +1101,21 @@ pub fn static_state(problem: &Problem) -> Result<TimeState, VerifyError> {
         }
         for p in &problem.contacts {
             let (nf, dn) = normal(p, q);
-            let m_mu = p.law.initial_state * p.law.mu;
-            for &(i, a) in &p.tangential {
-                r[i] += a * m_mu * nf;
+            let m = initial_pair(p);
+            for (row, m_a) in p.tangential_rows().zip(m) {
+                for &(i, a) in row {
+                    r[i] += a * m_a * p.law.mu * nf;
+                }
             }
             for &(i, a) in &p.normal {
                 r[i] += a * nf;
             }
             if let Some(j) = jac.as_deref_mut() {
                 for &(b, ab) in &p.normal {
-                    for &(i, a) in &p.tangential {
-                        j[(i, b)] += a * m_mu * dn * ab;
+                    for (row, m_a) in p.tangential_rows().zip(m) {
+                        for &(i, a) in row {
+                            j[(i, b)] += a * m_a * p.law.mu * dn * ab;
+                        }
                     }
                     for &(i, a) in &p.normal {
                         j[(i, b)] += a * dn * ab;
@@ -1013,14 +1156,17 @@ pub fn static_state(problem: &Problem) -> Result<TimeState, VerifyError> {
     let sliders = problem
         .contacts
         .iter()
-        .map(|p| {
-            let u = p.tangential_of(&q);
+        .flat_map(|p| {
+            let u = tangential_pair(p, &q);
             let (nf, _) = normal(p, &q);
-            if nf > 0.0 {
-                u - p.law.initial_state * p.law.mu * nf / p.law.kt
-            } else {
-                u
-            }
+            let m = initial_pair(p);
+            (0..slider_dims(p)).map(move |a| {
+                if nf > 0.0 {
+                    u[a] - m[a] * p.law.mu * nf / p.law.kt
+                } else {
+                    u[a]
+                }
+            })
         })
         .collect();
     Ok(TimeState {
@@ -1028,6 +1174,17 @@ pub fn static_state(problem: &Problem) -> Result<TimeState, VerifyError> {
         q,
         sliders,
     })
+}
+
+/// The initial tangential state (m₁, m₂) of a point (m₂ = 0 for a 1D point).
+fn initial_pair(point: &ContactPoint) -> [f64; 2] {
+    [
+        point.law.initial_state,
+        point
+            .second_tangent
+            .as_ref()
+            .map_or(0.0, |s| s.initial_state),
+    ]
 }
 
 /// Integrates from `start` at dt and dt/2 (see [`verify_point`]) and compares with the HBM

@@ -420,22 +420,34 @@ fn phase_figure(
 }
 
 /// Hysteresis loops: T against the tangential relative displacement u of every contact over
-/// the last integrated period (fine dt).
+/// the last integrated period (fine dt); a 2D point draws two loops, T₁ against u₁ (labelled
+/// with its name) and T₂ against u₂ (`<name> t2`).
 fn hysteresis_figure(
     problem: &crate::model::Problem,
     v: &PointVerification,
     dir: &std::path::Path,
     stem: &str,
 ) -> Result<(), plot::PlotError> {
+    let second_labels: Vec<String> = problem
+        .contacts
+        .iter()
+        .map(|c| format!("{} t2", c.name))
+        .collect();
     let loops: Vec<plot::Loop> = problem
         .contacts
         .iter()
         .zip(&v.fine.contact_loops)
+        .zip(&second_labels)
+        .flat_map(|((c, l), second)| {
+            let first = (c.name.as_str(), &l.u, &l.t);
+            let other = (!l.u2.is_empty()).then_some((second.as_str(), &l.u2, &l.t2));
+            std::iter::once(first).chain(other)
+        })
         .enumerate()
-        .map(|(i, (c, l))| plot::Loop {
-            label: &c.name,
-            u: &l.u,
-            t: &l.t,
+        .map(|(i, (label, u, t))| plot::Loop {
+            label,
+            u,
+            t,
             color: palette(i),
         })
         .collect();
