@@ -19,7 +19,7 @@
 use crate::contact::aft::AftWorkspace;
 use crate::contact::aft2d::Aft2dWorkspace;
 use crate::contact::harmonic::{Block, HarmonicSet};
-use crate::contact::{ContactState, JenkinsLaw};
+use crate::contact::{ContactState, Jenkins2dLaw, JenkinsLaw};
 use crate::hbm::error::HbmError;
 use crate::hbm::pattern::{ContactSlots, JacobianLayout};
 use crate::hbm::schur::RelativeCoordinates;
@@ -58,9 +58,10 @@ pub struct HbmSystem<'p> {
     layout: Option<JacobianLayout>,
     /// Relative contact coordinates of the schur formulation.
     relative: Option<Arc<RelativeCoordinates>>,
-    /// Initial tangential state m of every contact set by [`HbmSystem::set_initial_states`],
-    /// in place of the problem's `law.initial_state`; `None`: the problem's.
-    initial_states: Option<Vec<f64>>,
+    /// Initial tangential state (m₁, m₂) of every contact set by
+    /// [`HbmSystem::set_initial_states`] or [`HbmSystem::set_initial_states_2d`], in place of
+    /// the problem's; `None`: the problem's. m₂ is used by 2D points only.
+    initial_states: Option<Vec<[f64; 2]>>,
 }
 
 impl<'p> HbmSystem<'p> {
@@ -151,8 +152,37 @@ impl<'p> HbmSystem<'p> {
     ///
     /// # Panics
     /// If `m` does not have one entry per contact.
+    ///
+    /// The m given is along the first tangent; a 2D point keeps the problem's m₂ when its m₁ is
+    /// the problem's, and starts at (m, 0) otherwise, as a limit case does
+    /// ([`crate::analysis::limits::LimitCase::apply`]).
     #[track_caller]
     pub fn set_initial_states(&mut self, m: &[f64]) {
+        assert_eq!(
+            m.len(),
+            self.problem.contacts.len(),
+            "one initial state per contact"
+        );
+        let states = self
+            .problem
+            .contacts
+            .iter()
+            .zip(m)
+            .map(|(c, &m1)| {
+                let m2 = c.second_tangent.as_ref().map_or(0.0, |s| s.initial_state);
+                [m1, if m1 == c.law.initial_state { m2 } else { 0.0 }]
+            })
+            .collect();
+        self.initial_states = Some(states);
+    }
+
+    /// [`Self::set_initial_states`] with both components (m₁, m₂) of every contact (m₂ is
+    /// ignored on 1D points; |m| ≤ 1 is the caller's to keep).
+    ///
+    /// # Panics
+    /// If `m` does not have one entry per contact.
+    #[track_caller]
+    pub fn set_initial_states_2d(&mut self, m: &[[f64; 2]]) {
         assert_eq!(
             m.len(),
             self.problem.contacts.len(),
@@ -166,9 +196,19 @@ impl<'p> HbmSystem<'p> {
     pub fn law(&self, c: usize) -> JenkinsLaw {
         let mut law = self.problem.contacts[c].law;
         if let Some(m) = &self.initial_states {
-            law.initial_state = m[c];
+            law.initial_state = m[c][0];
         }
         law
+    }
+
+    /// The 2D law contact `c` is evaluated with (None for a 1D point): the problem's, with the
+    /// initial state set by [`HbmSystem::set_initial_states`] if any.
+    pub fn law_2d(&self, c: usize) -> Option<Jenkins2dLaw> {
+        let mut law = self.problem.contacts[c].law_2d()?;
+        if let Some(m) = &self.initial_states {
+            law.initial_state = m[c];
+        }
+        Some(law)
     }
 
     /// Storage of the full Jacobian (dense or sparse, from the problem's formulation).
@@ -293,7 +333,7 @@ impl<'p> HbmSystem<'p> {
         let law = self.law(c);
         let contact = &self.problem.contacts[c];
         let effects = self.problem.effects.contact;
-        let report = match (contact.law_2d(), self.aft2d.as_mut()) {
+        let report = match (self.law_2d(c), self.aft2d.as_mut()) {
             (Some(law), Some(aft2d)) => aft2d.evaluate(
                 &law,
                 effects,
@@ -689,7 +729,7 @@ impl<'p> HbmSystem<'p> {
             contact: contact.name.clone(),
             source,
         };
-        match (contact.law_2d(), self.aft2d.as_mut()) {
+        match (self.law_2d(c), self.aft2d.as_mut()) {
             (Some(law), Some(aft)) => {
                 aft.evaluate(
                     &law,

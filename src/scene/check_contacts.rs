@@ -50,6 +50,24 @@ pub(super) fn contact_set(
         ck.finite(&f("gap"), p.gap)?;
         ck.positive(&f("tolerance"), p.tolerance)?;
         ck.initial_state(&f("initial_state"), p.initial_state)?;
+        ck.finite(&f("initial_state2"), p.initial_state2)?;
+        if p.law == FrictionLaw::Jenkins1d && p.initial_state2 != 0.0 {
+            return Err(ck.err(
+                f("initial_state2"),
+                "only a `law = \"jenkins-2d\"` patch has a second initial-state component",
+            ));
+        }
+        let radius = p.initial_state.hypot(p.initial_state2);
+        if radius > 1.0 {
+            return Err(ck.err(
+                f("initial_state2"),
+                format!(
+                    "the initial state (initial_state, initial_state2) = ({}, {}) has length \
+                     {radius:.6} > 1: it must lie in the unit disc (T(0) = μN(0)·m)",
+                    p.initial_state, p.initial_state2
+                ),
+            ));
+        }
         let Some(structure) = fe else {
             return Err(ck.err(
                 format!("contact_patches[{pi}]"),

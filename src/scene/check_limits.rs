@@ -68,32 +68,26 @@ pub(super) fn limit_settings(
     // The envelope's search holds a dense k × k curvature estimate and solves k sensitivities
     // per state: k = sides or contact points is kept to what that serves.
     if let Some(mode) = l.envelope {
+        // A group with 2D-friction points searches its m = (m₁, m₂) in the unit disc: two
+        // variables.
         let two_d = crate::contact::FrictionLaw::Jenkins2d;
-        let first_2d = scene
-            .contacts
+        let two_d_sides = side_names
             .iter()
-            .find(|c| c.law == two_d)
-            .map(|c| format!("contact `{}`", c.name))
-            .or_else(|| {
+            .filter(|side| {
                 scene
-                    .contact_patches
+                    .contacts
                     .iter()
-                    .find(|p| p.law == two_d)
-                    .map(|p| format!("contact patch `{}`", p.side))
-            });
-        if let Some(what) = first_2d {
-            return Err(ck.err(
-                "limits.envelope",
-                format!(
-                    "{what} has 2D friction (`law = \"jenkins-2d\"`); the envelope \
-                     searches m ∈ [-1, 1] along one tangent per side and does not handle 2D \
-                     points yet (run the limits without `envelope`)"
-                ),
-            ));
-        }
+                    .any(|c| c.law == two_d && &c.side_name() == *side)
+                    || scene
+                        .contact_patches
+                        .iter()
+                        .any(|p| p.law == two_d && &p.side == *side)
+            })
+            .count();
+        let two_d_points = scene.contacts.iter().filter(|c| c.law == two_d).count();
         let k = match mode {
-            crate::analysis::limits::EnvelopeMode::Sides => sides,
-            crate::analysis::limits::EnvelopeMode::Points => scene.contacts.len(),
+            crate::analysis::limits::EnvelopeMode::Sides => sides + two_d_sides,
+            crate::analysis::limits::EnvelopeMode::Points => scene.contacts.len() + two_d_points,
         };
         if k > MAX_ENVELOPE_GROUPS {
             return Err(ck.err(

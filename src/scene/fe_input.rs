@@ -143,9 +143,14 @@ pub struct ContactPatchSpec {
     /// Initial normal gap added to the meshed one (m); negative for an interference.
     #[serde(default)]
     pub gap: f64,
-    /// Initial tangential state m ∈ [−1, 1] of every point.
+    /// Initial tangential state m ∈ [−1, 1] of every point (its component m₁ along the
+    /// patch tangent for `jenkins-2d`).
     #[serde(default)]
     pub initial_state: f64,
+    /// `jenkins-2d` only: component m₂ of every point's initial state along its second
+    /// tangent t₂ = n × t, with (m₁, m₂) in the unit disc (T(0) = μN(0)·m); default 0.
+    #[serde(default)]
+    pub initial_state2: f64,
     /// Largest distance (m) between paired nodes.
     #[serde(default = "default_pair_tolerance")]
     pub tolerance: f64,
@@ -154,7 +159,7 @@ pub struct ContactPatchSpec {
     pub tangent: Option<[f64; 3]>,
     /// Tangential friction law of every point: `"jenkins-1d"` (default, along `tangent`) or
     /// `"jenkins-2d"` (3D meshes: isotropic friction in each pair's tangent plane, second
-    /// tangent t₂ = n × t, initial state m = (`initial_state`, 0)).
+    /// tangent t₂ = n × t, initial state m = (`initial_state`, `initial_state2`)).
     #[serde(default)]
     pub law: FrictionLaw,
 }
@@ -432,7 +437,7 @@ pub fn patch_contacts(
                     ];
                     SecondTangent {
                         row: row(&t2),
-                        initial_state: 0.0,
+                        initial_state: spec.initial_state2,
                     }
                 }),
             }

@@ -2,6 +2,20 @@
 //! of every output DOF over all admissible initial tangential states m ∈ [−1, 1]^k, with k one
 //! m per damper side (`sides`) or per contact point (`points`).
 //!
+//! # 2D friction: the disc
+//!
+//! A group (side or point) with a 2D-friction point (`jenkins-2d`) has a vector m = (m₁, m₂) in
+//! the unit disc (T(0) = μN(0)·m along t₁, t₂): two variables. The box search runs on
+//! s ∈ [−1, 1]² mapped onto the disc by the elliptical grid map
+//! m₁ = s₁ √(1 − s₂²/2), m₂ = s₂ √(1 − s₁²/2) ([`square_to_disc`]: smooth, one-to-one, the
+//! square's edges onto the circle, s = (±1, 0) onto the limit states m = (±1, 0)), with the
+//! gradient by the chain rule through it, and the moves to effective initial states mapped
+//! back ([`disc_to_square`]). The starts of a 2D group are those of a 1D one placed on t₁
+//! (m = (±1, 0) for the corners, the limit curves' states), plus, per 2D group, the two points
+//! m = (0, ±1) on t₂ with every other group at 0. The 1D points of a group with 2D points share
+//! its m₁ only. Cost: a 2D group adds one variable (one more sensitivity solve per evaluation
+//! where it acts) and two starts per bound.
+//!
 //! The two-point method (paper §3.3, Eqs. 14-15) solves only the corners m = ±1 on every
 //! side; the paper leaves the general search open (§3.3, §5). Here each bound is a box-
 //! constrained optimisation ([`minimise_in_box`]: projected quasi-Newton) of A(m), where every
@@ -48,7 +62,7 @@ use crate::numerics::box_minimize::{minimise_in_box, BoxSettings};
 use super::case::LimitCase;
 use super::grid::{GridPoint, GridSolution};
 use super::peak::Peak;
-use super::sensitivity::{amplitude_sensitivity, AmplitudeSensitivity};
+use super::sensitivity::{amplitude_sensitivity_of, AmplitudeSensitivity, StateVariable};
 
 /// How far inside the range of a contact's stuck initial states a state found beyond it is
 /// re-solved (units of m): the edge itself touches μN, where the march's slip test sits at
@@ -109,7 +123,8 @@ impl EnvelopeMode {
 pub struct EnvelopeBound {
     /// First-harmonic amplitude (m).
     pub amplitude: f64,
-    /// m of each group (side or point) attaining it.
+    /// m of each search variable attaining it: one per group (side or point), two (m₁, m₂)
+    /// for a group with 2D-friction points ([`Envelope::groups`] names them).
     pub m: Vec<f64>,
     /// Contact states there.
     pub states: Vec<ContactState>,
@@ -127,8 +142,8 @@ pub struct EnvelopePoint {
     pub min: Vec<Option<EnvelopeBound>>,
     /// Largest amplitude of each output DOF.
     pub max: Vec<Option<EnvelopeBound>>,
-    /// Whether each group's m acted at some state solved here (stuck over the whole period);
-    /// groups that never did were dropped from the search at this frequency.
+    /// Whether each variable's m acted at some state solved here (stuck over the whole period);
+    /// variables that never did were dropped from the search at this frequency.
     pub acting: Vec<bool>,
     /// Newton solves (each with its sensitivity) spent here.
     pub solves: usize,
@@ -171,7 +186,8 @@ pub struct EnvelopeCheck {
 pub struct Envelope {
     /// Sides or points.
     pub mode: EnvelopeMode,
-    /// Name of each group (side or contact), the order of every `m` vector.
+    /// Name of each search variable, the order of every `m` vector: the group's (side or
+    /// contact) name for m₁, `<group>_m2` for the second component of a group with 2D points.
     pub groups: Vec<String>,
     /// One point per grid frequency.
     pub points: Vec<EnvelopePoint>,
@@ -190,8 +206,8 @@ pub struct Envelope {
 /// What the envelope search starts from at one frequency.
 #[derive(Debug, Clone, Default)]
 pub struct EnvelopeSeeds {
-    /// (m per group, full coefficients): states solved at this frequency, or guesses from a
-    /// neighbouring frequency, each corrected by Newton first.
+    /// (m per group or per search variable, full coefficients): states solved at this
+    /// frequency, or guesses from a neighbouring frequency, each corrected by Newton first.
     pub states: Vec<(Vec<f64>, Vec<f64>)>,
     /// Further starting m vectors.
     pub starts: Vec<Vec<f64>>,
@@ -210,30 +226,197 @@ impl EnvelopePoint {
     }
 }
 
+/// The elliptical grid map of the square s ∈ [−1, 1]² onto the unit disc:
+/// m = (s₁ √(1 − s₂²/2), s₂ √(1 − s₁²/2)), and its Jacobian ∂m/∂s (row-major 2×2). Smooth and
+/// one-to-one; the square's edges go onto the unit circle.
+pub fn square_to_disc(s: [f64; 2]) -> ([f64; 2], [f64; 4]) {
+    let (r1, r2) = (
+        (1.0 - 0.5 * s[0] * s[0]).sqrt(),
+        (1.0 - 0.5 * s[1] * s[1]).sqrt(),
+    );
+    (
+        [s[0] * r2, s[1] * r1],
+        [r2, -0.5 * s[0] * s[1] / r2, -0.5 * s[0] * s[1] / r1, r1],
+    )
+}
+
+/// The inverse of [`square_to_disc`] (m in the unit disc; a point just outside it, by rounding,
+/// is first brought onto the circle).
+pub fn disc_to_square(m: [f64; 2]) -> [f64; 2] {
+    let radius = m[0].hypot(m[1]);
+    let (u, v) = if radius > 1.0 {
+        (m[0] / radius, m[1] / radius)
+    } else {
+        (m[0], m[1])
+    };
+    let root = |x: f64| x.max(0.0).sqrt();
+    let w = 2.0 * std::f64::consts::SQRT_2;
+    let (a, b) = (2.0 + u * u - v * v, 2.0 - u * u + v * v);
+    [
+        (0.5 * (root(a + w * u) - root(a - w * u))).clamp(-1.0, 1.0),
+        (0.5 * (root(b + w * v) - root(b - w * v))).clamp(-1.0, 1.0),
+    ]
+}
+
+/// The envelope's search variables for groups of contacts: one m₁ per group, and an m₂ for
+/// each group with a 2D-friction point, searched on the square of [`square_to_disc`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct SearchLayout {
+    /// The initial-state variables, group by group (m₁, then m₂ for a 2D group).
+    pub variables: Vec<StateVariable>,
+    /// Per group: its first variable, and whether it has a second one (2D).
+    groups: Vec<(usize, bool)>,
+}
+
+impl SearchLayout {
+    /// The layout of `groups` (contact indices) of `problem`.
+    pub fn new(problem: &Problem, groups: &[Vec<usize>]) -> Self {
+        let mut variables = Vec::new();
+        let mut layout = Vec::new();
+        for g in groups {
+            let two_d = g
+                .iter()
+                .any(|&c| problem.contacts[c].second_tangent.is_some());
+            layout.push((variables.len(), two_d));
+            for component in 0..1 + usize::from(two_d) {
+                variables.push(StateVariable {
+                    contacts: g.clone(),
+                    component,
+                });
+            }
+        }
+        Self {
+            variables,
+            groups: layout,
+        }
+    }
+
+    /// Number of search variables.
+    pub fn len(&self) -> usize {
+        self.variables.len()
+    }
+
+    /// Whether there is no variable.
+    pub fn is_empty(&self) -> bool {
+        self.variables.is_empty()
+    }
+
+    /// m per variable at search coordinates y (with ∂m/∂y per 2D group, row-major).
+    fn m_at(&self, y: &[f64]) -> (Vec<f64>, Vec<[f64; 4]>) {
+        let mut m = y.to_vec();
+        let mut jacobians = Vec::new();
+        for &(i, two_d) in &self.groups {
+            if two_d {
+                let (d, j) = square_to_disc([y[i], y[i + 1]]);
+                m[i] = d[0];
+                m[i + 1] = d[1];
+                jacobians.push(j);
+            }
+        }
+        (m, jacobians)
+    }
+
+    /// Search coordinates of m per variable.
+    fn search_coordinates(&self, m: &[f64]) -> Vec<f64> {
+        let mut y: Vec<f64> = m.iter().map(|v| v.clamp(-1.0, 1.0)).collect();
+        for &(i, two_d) in &self.groups {
+            if two_d {
+                let s = disc_to_square([m[i], m[i + 1]]);
+                y[i] = s[0];
+                y[i + 1] = s[1];
+            }
+        }
+        y
+    }
+
+    /// dA/dy from dA/dm at y.
+    fn chain(&self, y: &[f64], gradient_m: &[f64]) -> Vec<f64> {
+        let (_, jacobians) = self.m_at(y);
+        let mut g = gradient_m.to_vec();
+        let mut next = jacobians.iter();
+        for &(i, two_d) in &self.groups {
+            if two_d {
+                let j = next.next().expect("one Jacobian per 2D group");
+                g[i] = gradient_m[i] * j[0] + gradient_m[i + 1] * j[2];
+                g[i + 1] = gradient_m[i] * j[1] + gradient_m[i + 1] * j[3];
+            }
+        }
+        g
+    }
+
+    /// m per variable from one value per group (m₁ = value, m₂ = 0: along t₁) or from one per
+    /// variable (as is); `None` for another length.
+    pub fn expand(&self, m: &[f64]) -> Option<Vec<f64>> {
+        if m.len() == self.len() {
+            return Some(m.to_vec());
+        }
+        if m.len() != self.groups.len() {
+            return None;
+        }
+        let mut out = vec![0.0; self.len()];
+        for (&(i, _), &v) in self.groups.iter().zip(m) {
+            out[i] = v;
+        }
+        Some(out)
+    }
+
+    /// Search coordinates of the extra starts on the second tangents: per 2D group, m = (0, ±1)
+    /// there and 0 elsewhere.
+    fn second_tangent_starts(&self) -> Vec<Vec<f64>> {
+        let mut starts = Vec::new();
+        for &(i, two_d) in &self.groups {
+            if two_d {
+                for sign in [1.0, -1.0] {
+                    let mut y = vec![0.0; self.len()];
+                    y[i + 1] = sign;
+                    starts.push(y);
+                }
+            }
+        }
+        starts
+    }
+
+    /// The name of each variable: the group's for m₁, `<group>_m2` for m₂.
+    pub fn names(&self, group_names: &[String]) -> Vec<String> {
+        let mut names = Vec::with_capacity(self.len());
+        for (&(_, two_d), name) in self.groups.iter().zip(group_names) {
+            names.push(name.clone());
+            if two_d {
+                names.push(format!("{name}_m2"));
+            }
+        }
+        names
+    }
+}
+
 /// One solved state of the search.
 struct Solved {
+    /// Search coordinates.
+    y: Vec<f64>,
+    /// m per variable.
     m: Vec<f64>,
     point: FrfPoint,
     sensitivity: AmplitudeSensitivity,
 }
 
-/// Solves states at one frequency for given m, from the nearest state solved so far, with one
-/// point solver whose initial states are set per evaluation.
+/// Solves states at one frequency for given search coordinates y (m per variable through
+/// [`SearchLayout`]), from the nearest state solved so far, with one point solver whose initial
+/// states are set per evaluation.
 struct Evaluator<'s, 'p> {
     solver: &'s mut PointSolver<'p>,
-    groups: &'s [Vec<usize>],
+    layout: &'s SearchLayout,
     freq_hz: f64,
     solved: Vec<Solved>,
-    /// m values whose state was kept under its effective m: (m, index in `solved`).
+    /// y values whose state was kept under its effective y: (y, index in `solved`).
     aliases: Vec<(Vec<f64>, usize)>,
     solves: usize,
 }
 
 impl<'s, 'p> Evaluator<'s, 'p> {
-    fn new(solver: &'s mut PointSolver<'p>, groups: &'s [Vec<usize>], freq_hz: f64) -> Self {
+    fn new(solver: &'s mut PointSolver<'p>, layout: &'s SearchLayout, freq_hz: f64) -> Self {
         Self {
             solver,
-            groups,
+            layout,
             freq_hz,
             solved: Vec::new(),
             aliases: Vec::new(),
@@ -241,39 +424,45 @@ impl<'s, 'p> Evaluator<'s, 'p> {
         }
     }
 
-    /// The initial state of every contact with m per group (the scene's for contacts in no
-    /// group).
-    fn contact_states(&mut self, m: &[f64]) -> Vec<f64> {
-        let mut states: Vec<f64> = self
+    /// The initial state (m₁, m₂) of every contact with m per variable (the scene's for
+    /// contacts in no group).
+    fn contact_states(&mut self, m: &[f64]) -> Vec<[f64; 2]> {
+        let mut states: Vec<[f64; 2]> = self
             .solver
             .system()
             .problem()
             .contacts
             .iter()
-            .map(|c| c.law.initial_state)
+            .map(|c| {
+                [
+                    c.law.initial_state,
+                    c.second_tangent.as_ref().map_or(0.0, |s| s.initial_state),
+                ]
+            })
             .collect();
-        for (g, group) in self.groups.iter().enumerate() {
-            for &c in group {
-                states[c] = m[g];
+        for (v, variable) in self.layout.variables.iter().enumerate() {
+            for &c in &variable.contacts {
+                states[c][variable.component] = m[v];
             }
         }
         states
     }
 
-    /// Newton at m from `x0`, then, when some group's contacts are stuck with a slider set in
+    /// Newton at y from `x0`, then, when some group's contacts are stuck with a slider set in
     /// the transient (m beyond the range where they stay stuck from the start), the same state
     /// at the effective m of those groups ([`AmplitudeSensitivity::effective`]), where the
     /// gradient is the one-sided derivative into the range. The state is kept under the
-    /// effective m (and found again at m). Its index, or `None`.
-    fn solve_from(&mut self, m: &[f64], x0: &[f64]) -> Option<usize> {
-        let i = self.solve_exactly(m, x0)?;
+    /// effective y (and found again at y). Its index, or `None`.
+    fn solve_from(&mut self, y: &[f64], x0: &[f64]) -> Option<usize> {
+        let i = self.solve_exactly(y, x0)?;
+        let m = self.solved[i].m.clone();
         // The edge of the range, moved EDGE_INSET into it so that the re-solved state sticks
         // with a margin above the march's rounding test.
-        let effective: Vec<f64> = self.solved[i]
+        let mut effective: Vec<f64> = self.solved[i]
             .sensitivity
             .effective
             .iter()
-            .zip(m)
+            .zip(&m)
             .map(|(e, &m)| match e {
                 Some(e) if (e - m).abs() > 1e-9 => {
                     (e + EDGE_INSET * (e - m).signum()).clamp(-1.0, 1.0)
@@ -281,31 +470,43 @@ impl<'s, 'p> Evaluator<'s, 'p> {
                 _ => m,
             })
             .collect();
-        if effective.iter().zip(m).all(|(e, m)| (e - m).abs() <= 1e-9) {
+        if effective.iter().zip(&m).all(|(e, m)| (e - m).abs() <= 1e-9) {
             return Some(i);
         }
+        // A 2D group's effective m stays in the disc.
+        for &(g, two_d) in &self.layout.groups {
+            if two_d {
+                let r = effective[g].hypot(effective[g + 1]);
+                if r > 1.0 - EDGE_INSET {
+                    effective[g] *= (1.0 - EDGE_INSET) / r;
+                    effective[g + 1] *= (1.0 - EDGE_INSET) / r;
+                }
+            }
+        }
+        let y_effective = self.layout.search_coordinates(&effective);
         let x = self.solved[i].point.coefficients.clone();
-        match self.solve_exactly(&effective, &x) {
+        match self.solve_exactly(&y_effective, &x) {
             Some(j) => {
-                self.aliases.push((m.to_vec(), j));
+                self.aliases.push((y.to_vec(), j));
                 Some(j)
             }
             None => Some(i),
         }
     }
 
-    /// Newton at m from `x0`; the solved state is kept. Its index, or `None`.
-    fn solve_exactly(&mut self, m: &[f64], x0: &[f64]) -> Option<usize> {
+    /// Newton at y from `x0`; the solved state is kept. Its index, or `None`.
+    fn solve_exactly(&mut self, y: &[f64], x0: &[f64]) -> Option<usize> {
         self.solves += 1;
-        let states = self.contact_states(m);
-        self.solver.system().set_initial_states(&states);
+        let (m, _) = self.layout.m_at(y);
+        let states = self.contact_states(&m);
+        self.solver.system().set_initial_states_2d(&states);
         let point = self.solver.solve(x0, self.freq_hz).ok()?;
         let omega = 2.0 * std::f64::consts::PI * self.freq_hz;
-        let sensitivity = amplitude_sensitivity(
+        let sensitivity = amplitude_sensitivity_of(
             self.solver.system(),
             &point.coefficients,
             omega,
-            self.groups,
+            &self.layout.variables,
         )
         .ok()?;
         if sensitivity
@@ -317,40 +518,41 @@ impl<'s, 'p> Evaluator<'s, 'p> {
             return None;
         }
         self.solved.push(Solved {
-            m: m.to_vec(),
+            y: y.to_vec(),
+            m,
             point,
             sensitivity,
         });
         Some(self.solved.len() - 1)
     }
 
-    /// The state at m: one already solved there, Newton from the nearest solved m, or a walk
+    /// The state at y: one already solved there, Newton from the nearest solved y, or a walk
     /// from it in [`HOMOTOPY_STEPS`] steps.
-    fn at(&mut self, m: &[f64]) -> Option<usize> {
-        if let Some(i) = self.solved.iter().position(|s| s.m == m) {
+    fn at(&mut self, y: &[f64]) -> Option<usize> {
+        if let Some(i) = self.solved.iter().position(|s| s.y == y) {
             return Some(i);
         }
-        if let Some((_, i)) = self.aliases.iter().find(|(a, _)| a == m) {
+        if let Some((_, i)) = self.aliases.iter().find(|(a, _)| a == y) {
             return Some(*i);
         }
         let distance = |s: &Solved| {
-            s.m.iter()
-                .zip(m)
+            s.y.iter()
+                .zip(y)
                 .fold(0.0_f64, |a, (p, q)| a.max((p - q).abs()))
         };
         let nearest = (0..self.solved.len())
             .min_by(|&i, &j| distance(&self.solved[i]).total_cmp(&distance(&self.solved[j])))?;
         let x0 = self.solved[nearest].point.coefficients.clone();
-        if let Some(i) = self.solve_from(m, &x0) {
+        if let Some(i) = self.solve_from(y, &x0) {
             return Some(i);
         }
-        let m0 = self.solved[nearest].m.clone();
+        let y0 = self.solved[nearest].y.clone();
         let mut x = x0;
         let mut last = None;
         for step in 1..=HOMOTOPY_STEPS {
             let t = step as f64 / HOMOTOPY_STEPS as f64;
-            let mi: Vec<f64> = m0.iter().zip(m).map(|(a, b)| a + t * (b - a)).collect();
-            let i = self.solve_from(&mi, &x)?;
+            let yi: Vec<f64> = y0.iter().zip(y).map(|(a, b)| a + t * (b - a)).collect();
+            let i = self.solve_from(&yi, &x)?;
             x = self.solved[i].point.coefficients.clone();
             last = Some(i);
         }
@@ -406,7 +608,9 @@ fn side_corners(problem: &Problem, groups: &[Vec<usize>]) -> Vec<Vec<f64>> {
 }
 
 /// The envelope at one frequency: for every output DOF, the largest and smallest amplitude over
-/// m ∈ [−1, 1]^k (k = groups), sought from the seeds' states and starts and the box corners.
+/// m ∈ [−1, 1]^k (k = groups; the unit disc for the m = (m₁, m₂) of a group with 2D points),
+/// sought from the seeds' states and starts and the box corners. Seeds and starts give m per
+/// group (along t₁: m₂ = 0 for 2D groups) or per search variable ([`SearchLayout`]).
 /// Builds one point solver for `problem` and sets its initial states per evaluation (see
 /// [`envelope_at_with`]); a problem whose solver cannot be built has no bound.
 pub fn envelope_at(
@@ -418,7 +622,11 @@ pub fn envelope_at(
 ) -> EnvelopePoint {
     match PointSolver::new(problem) {
         Ok(mut solver) => envelope_at_with(&mut solver, groups, freq_hz, seeds, search),
-        Err(_) => EnvelopePoint::unsolved(freq_hz, groups.len(), problem.outputs.len()),
+        Err(_) => EnvelopePoint::unsolved(
+            freq_hz,
+            SearchLayout::new(problem, groups).len(),
+            problem.outputs.len(),
+        ),
     }
 }
 
@@ -437,21 +645,31 @@ pub fn envelope_at_with(
     seeds: &EnvelopeSeeds,
     search: &BoxSettings,
 ) -> EnvelopePoint {
-    let k = groups.len();
-    let outputs = solver.system().problem().outputs.len();
-    let mut ev = Evaluator::new(solver, groups, freq_hz);
+    let problem = solver.system().problem();
+    let layout = SearchLayout::new(problem, groups);
+    let k = layout.len();
+    let outputs = problem.outputs.len();
+    // Seeds and starts: m per group (along t₁) or per variable, into search coordinates.
+    let to_y = |m: &[f64]| layout.expand(m).map(|m| layout.search_coordinates(&m));
+    let mut ev = Evaluator::new(solver, &layout, freq_hz);
     for (m, x) in &seeds.states {
-        ev.solve_from(m, x);
+        if let Some(y) = to_y(m) {
+            ev.solve_from(&y, x);
+        }
     }
     let mut starts: Vec<Vec<f64>> = seeds.states.iter().map(|(m, _)| m.clone()).collect();
     starts.extend(seeds.starts.iter().cloned());
-    starts.extend(side_corners(ev.solver.system().problem(), groups));
-    starts.extend(corners(k));
-    starts.push(vec![0.0; k]);
+    starts.extend(side_corners(problem, groups));
+    starts.extend(corners(groups.len()));
+    starts.push(vec![0.0; groups.len()]);
     let mut unique: Vec<Vec<f64>> = Vec::new();
-    for s in starts {
-        if s.len() == k && !unique.contains(&s) {
-            unique.push(s);
+    for y in starts
+        .iter()
+        .filter_map(|m| to_y(m))
+        .chain(layout.second_tangent_starts())
+    {
+        if !unique.contains(&y) {
+            unique.push(y);
         }
     }
     let (lower, upper) = (vec![-1.0; k], vec![1.0; k]);
@@ -464,16 +682,15 @@ pub fn envelope_at_with(
                     .max(f64::MIN_POSITIVE);
                 for start in &unique {
                     // f = −sense·A/A_ref: minimising it maximises (sense = 1) or minimises A.
-                    minimise_in_box(start, &lower, &upper, search, |m| {
-                        let i = ev.at(m)?;
-                        let s = &ev.solved[i].sensitivity;
+                    minimise_in_box(start, &lower, &upper, search, |y| {
+                        let i = ev.at(y)?;
+                        let solved = &ev.solved[i];
+                        let s = &solved.sensitivity;
+                        let gradient = ev.layout.chain(&solved.y, &s.gradient[o]);
                         Some((
                             -sense * s.amplitudes[o] / reference,
-                            s.gradient[o]
-                                .iter()
-                                .map(|g| -sense * g / reference)
-                                .collect(),
-                            ev.solved[i].m.clone(),
+                            gradient.iter().map(|g| -sense * g / reference).collect(),
+                            solved.y.clone(),
                         ))
                     });
                 }
@@ -552,7 +769,9 @@ pub fn envelope(
     search: &BoxSettings,
 ) -> Envelope {
     let started = std::time::Instant::now();
-    let (names, groups) = mode.groups(problem);
+    let (group_names, groups) = mode.groups(problem);
+    let layout = SearchLayout::new(problem, &groups);
+    let names = layout.names(&group_names);
     let n = band.len();
     let chunk = n.div_ceil(CHUNKS).max(1);
     let starts: Vec<usize> = (0..n).step_by(chunk).collect();
@@ -588,7 +807,7 @@ pub fn envelope(
                 let freq_hz = band[g].freq_hz;
                 out.push(match solver.as_mut() {
                     Some(solver) => envelope_at_with(solver, &groups, freq_hz, &seeds, search),
-                    None => EnvelopePoint::unsolved(freq_hz, groups.len(), problem.outputs.len()),
+                    None => EnvelopePoint::unsolved(freq_hz, layout.len(), problem.outputs.len()),
                 });
             }
             out

@@ -39,7 +39,7 @@
 //! | `grid` | the common grid: [`GridPoint`], [`on_grid`], [`classify`] |
 //! | `bounds` | the bound check: [`BoundCheck`], [`check_bounds`] |
 //! | `sensitivity` | dA/dm by the implicit-function theorem: [`AmplitudeSensitivity`], [`amplitude_sensitivity`] |
-//! | `envelope` | the response envelope over m ∈ [−1, 1]^k: [`Envelope`], [`envelope()`], [`envelope_at`] |
+//! | `envelope` | the response envelope over m ∈ [−1, 1]^k (the unit disc per group with 2D points): [`Envelope`], [`envelope()`], [`envelope_at`], [`SearchLayout`] |
 //! | `loops` | contact loops: [`HysteresisLoop`], [`hysteresis`], [`LoopSet`] |
 //! | `run` | the analysis: [`LimitSettings`], [`analyse`], [`LimitAnalysis`], [`ScannedCase`], [`Variability`] |
 //!
@@ -62,7 +62,7 @@ pub use case::{scan_cases, signed, two_point_cases, CaseSpec, LimitCase};
 pub use curve::{attempt_case, solve_case, CaseCurve, CurveStatus};
 pub use envelope::{
     envelope, envelope_at, envelope_at_with, group_states, Envelope, EnvelopeAtPeak, EnvelopeBound,
-    EnvelopeCheck, EnvelopeInputs, EnvelopeMode, EnvelopePoint, EnvelopeSeeds,
+    EnvelopeCheck, EnvelopeInputs, EnvelopeMode, EnvelopePoint, EnvelopeSeeds, SearchLayout,
 };
 pub use error::LimitError;
 pub use grid::{classify, on_grid, GridPoint, GridSolution};
@@ -70,7 +70,7 @@ pub use loops::{hysteresis, HysteresisLoop, HysteresisRequest, LoopSet};
 pub use peak::{linear_resonance, refine_peak, Peak};
 pub use run::{analyse, LimitAnalysis, LimitSettings, ScannedCase, Variability};
 pub use sensitivity::{
-    amplitude_sensitivity, residual_derivative, AmplitudeSensitivity, ResidualDerivative,
-    SensitivityError,
+    amplitude_sensitivity, amplitude_sensitivity_of, residual_derivative, residual_derivative_of,
+    AmplitudeSensitivity, ResidualDerivative, SensitivityError, StateVariable,
 };
 pub use side::{side_states, side_statics, LimitLabel, Regime, SideState, SideStatics};
