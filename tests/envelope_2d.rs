@@ -316,3 +316,61 @@ fn contact_patches_set_the_second_initial_state_component() {
     assert!(err.contains("contact_patches[0].initial_state2"), "{err}");
     assert!(err.contains("only a `law = \"jenkins-2d\"` patch"), "{err}");
 }
+
+/// The 3D paper scene with one `[[limits.cases]]` entry of the given fields.
+fn with_case(fields: &str) -> Result<(Problem, Vec<limits::LimitCase>), String> {
+    let text = format!("{SPATIAL}\n[[limits.cases]]\n{fields}\n");
+    let (problem, settings) = scene::parse(&text, "scene", &[])
+        .and_then(|s| s.validate_with_limits("scene"))
+        .map_err(|e| e.to_string())?;
+    let cases = settings
+        .unwrap()
+        .cases
+        .iter()
+        .map(|spec| limits::LimitCase::from_spec(&problem, spec))
+        .collect();
+    Ok((problem, cases))
+}
+
+#[test]
+fn limit_cases_set_the_second_initial_state_component() {
+    let (problem, cases) = with_case("sides = { left = 0.3 }\nsides2 = { left = -0.5 }").unwrap();
+    assert_eq!(cases[0].name, "left+0.3_left_m2-0.5");
+    let applied = cases[0].apply(&problem);
+    assert_eq!(
+        applied.contacts[0].law_2d().unwrap().initial_state,
+        [0.3, -0.5]
+    );
+    assert_eq!(
+        applied.contacts[1].law_2d().unwrap().initial_state,
+        [0.0, 0.0]
+    );
+    let (problem, cases) = with_case("contacts2 = { right = 0.8 }").unwrap();
+    let applied = cases[0].apply(&problem);
+    assert_eq!(
+        applied.contacts[1].law_2d().unwrap().initial_state,
+        [0.0, 0.8]
+    );
+    // Without m₂ the case keeps the meaning of the 1D limit method: (m, 0).
+    let (problem, cases) = with_case("sides = { right = -1.0 }").unwrap();
+    assert_eq!(cases[0].second_states, None);
+    let applied = cases[0].apply(&problem);
+    assert_eq!(
+        applied.contacts[1].law_2d().unwrap().initial_state,
+        [-1.0, 0.0]
+    );
+    // Refusals name the field.
+    let err = with_case("sides = { left = 0.8 }\nsides2 = { left = 0.7 }").unwrap_err();
+    assert!(err.contains("limits.cases[0].sides2.left"), "{err}");
+    assert!(err.contains("unit disc"), "{err}");
+    let err = with_case("contacts2 = { nowhere = 0.1 }").unwrap_err();
+    assert!(err.contains("limits.cases[0].contacts2.nowhere"), "{err}");
+    let planar = format!("{PLANAR}\n[[limits.cases]]\nsides2 = {{ left = 0.1 }}\n");
+    let err = scene::parse(&planar, "scene", &[])
+        .and_then(|s| s.validate_with_limits("scene"))
+        .map(|_| ())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("limits.cases[0].sides2.left"), "{err}");
+    assert!(err.contains("no `jenkins-2d` point"), "{err}");
+}

@@ -110,7 +110,11 @@ pub(super) fn limit_settings(
     let mut cases = Vec::new();
     for (i, c) in l.cases.iter().enumerate() {
         let f = |name: &str| format!("limits.cases[{i}].{name}");
-        if c.sides.is_empty() && c.contacts.is_empty() {
+        if c.sides.is_empty()
+            && c.contacts.is_empty()
+            && c.sides2.is_empty()
+            && c.contacts2.is_empty()
+        {
             return Err(ck.err(
                 format!("limits.cases[{i}]"),
                 "give m for at least one damper side (`sides`) or contact (`contacts`)",
@@ -153,6 +157,84 @@ pub(super) fn limit_settings(
                 })?;
             contact_states.push((contact, check_m(field, m)?));
         }
+        // m₂ of 2D points: per side (for its `jenkins-2d` points) and per `jenkins-2d` contact,
+        // each (m₁, m₂) in the unit disc.
+        let two_d = crate::contact::FrictionLaw::Jenkins2d;
+        let mut side_states2 = Vec::new();
+        for (name, &m2) in &c.sides2 {
+            let field = format!("{}.{name}", f("sides2"));
+            let side = side_names.iter().position(|s| s == name).ok_or_else(|| {
+                ck.err(
+                    field.clone(),
+                    format!(
+                        "unknown damper side `{name}` (the scene has {})",
+                        side_names.join(", ")
+                    ),
+                )
+            })?;
+            let m2 = check_m(field.clone(), m2)?;
+            // m₁ of each 2D point of the side: the case's for the side, or the point's own.
+            let mut firsts: Vec<f64> = scene
+                .contacts
+                .iter()
+                .filter(|k| k.law == two_d && &k.side_name() == name)
+                .map(|k| {
+                    c.contacts
+                        .get(&k.name)
+                        .or(c.sides.get(name))
+                        .copied()
+                        .unwrap_or(k.initial_state)
+                })
+                .collect();
+            firsts.extend(
+                scene
+                    .contact_patches
+                    .iter()
+                    .filter(|p| p.law == two_d && &p.side == name)
+                    .map(|p| c.sides.get(name).copied().unwrap_or(p.initial_state)),
+            );
+            if firsts.is_empty() {
+                return Err(ck.err(
+                    field,
+                    format!("side `{name}` has no `jenkins-2d` point: m₂ needs 2D friction"),
+                ));
+            }
+            if let Some(m1) = firsts.iter().find(|m1| m1.hypot(m2) > 1.0) {
+                return Err(ck.err(
+                    field,
+                    format!("(m₁, m₂) = ({m1}, {m2}) lies outside the unit disc (T(0) = μN(0)·m)"),
+                ));
+            }
+            side_states2.push((side, m2));
+        }
+        let mut contact_states2 = Vec::new();
+        for (name, &m2) in &c.contacts2 {
+            let field = format!("{}.{name}", f("contacts2"));
+            let Some(contact) = scene.contacts.iter().position(|k| &k.name == name) else {
+                return Err(ck.err(field, format!("unknown contact `{name}`")));
+            };
+            let k = &scene.contacts[contact];
+            if k.law != two_d {
+                return Err(ck.err(
+                    field,
+                    format!("contact `{name}` is not `jenkins-2d`: m₂ needs 2D friction"),
+                ));
+            }
+            let m2 = check_m(field.clone(), m2)?;
+            let m1 = c
+                .contacts
+                .get(name)
+                .or(c.sides.get(&k.side_name()))
+                .copied()
+                .unwrap_or(k.initial_state);
+            if m1.hypot(m2) > 1.0 {
+                return Err(ck.err(
+                    field,
+                    format!("(m₁, m₂) = ({m1}, {m2}) lies outside the unit disc (T(0) = μN(0)·m)"),
+                ));
+            }
+            contact_states2.push((contact, m2));
+        }
         let name = match &c.name {
             Some(n) => {
                 ck.name(&f("name"), n)?;
@@ -163,6 +245,12 @@ pub(super) fn limit_settings(
                 .iter()
                 .chain(&c.contacts)
                 .map(|(k, m)| format!("{k}{}", signed(*m)))
+                .chain(
+                    c.sides2
+                        .iter()
+                        .chain(&c.contacts2)
+                        .map(|(k, m)| format!("{k}_m2{}", signed(*m))),
+                )
                 .collect::<Vec<_>>()
                 .join("_"),
         };
@@ -177,6 +265,8 @@ pub(super) fn limit_settings(
             name,
             sides: side_states,
             contacts: contact_states,
+            sides2: side_states2,
+            contacts2: contact_states2,
         });
     }
 

@@ -55,6 +55,12 @@ pub struct LimitCaseSpec {
     /// m ∈ [−1, 1] per contact name (wins over its side's value).
     #[serde(default)]
     pub contacts: BTreeMap<String, f64>,
+    /// Second component m₂ (along t₂) per damper side name, for its `jenkins-2d` points.
+    #[serde(default)]
+    pub sides2: BTreeMap<String, f64>,
+    /// Second component m₂ per `jenkins-2d` contact name (wins over its side's value).
+    #[serde(default)]
+    pub contacts2: BTreeMap<String, f64>,
 }
 
 /// The `[limits.hysteresis]` table.

@@ -15,6 +15,10 @@ pub struct CaseSpec {
     pub sides: Vec<(usize, f64)>,
     /// (contact index, m) pairs.
     pub contacts: Vec<(usize, f64)>,
+    /// (side index, m₂) pairs: the second component of the side's 2D points.
+    pub sides2: Vec<(usize, f64)>,
+    /// (contact index, m₂) pairs for 2D points (a point's own value wins over its side's).
+    pub contacts2: Vec<(usize, f64)>,
 }
 
 /// Initial tangential state of every contact point.
@@ -22,8 +26,14 @@ pub struct CaseSpec {
 pub struct LimitCase {
     /// Name used in file names and column headers (e.g. `m+1`, `m-0.5`, `left+0.5_right-0.5`).
     pub name: String,
-    /// m ∈ [−1, 1] of each contact point, in the problem's contact order.
+    /// m ∈ [−1, 1] of each contact point, in the problem's contact order (m₁ along t₁ for a
+    /// 2D point).
     pub contact_states: Vec<f64>,
+    /// m₂ of each contact point (0 on 1D points) when the case sets it (`sides2`,
+    /// `contacts2` of a scene's case); `None`: a 2D point starts at (m₁, 0) where the case
+    /// changes its m₁ and keeps the scene's m₂ otherwise ([`Self::apply`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub second_states: Option<Vec<f64>>,
 }
 
 impl LimitCase {
@@ -32,6 +42,7 @@ impl LimitCase {
         Self {
             name: format!("m{}", signed(m)),
             contact_states: vec![m; problem.contacts.len()],
+            second_states: None,
         }
     }
 
@@ -51,6 +62,7 @@ impl LimitCase {
                 .iter()
                 .map(|c| side_states[c.side])
                 .collect(),
+            second_states: None,
         }
     }
 
@@ -69,9 +81,33 @@ impl LimitCase {
         for &(c, m) in &spec.contacts {
             states[c] = m;
         }
+        let second_states = (!spec.sides2.is_empty() || !spec.contacts2.is_empty()).then(|| {
+            // The rule of `apply` first, then the case's m₂ on the 2D points.
+            let mut second: Vec<f64> = problem
+                .contacts
+                .iter()
+                .zip(&states)
+                .map(|(c, &m)| match &c.second_tangent {
+                    Some(s) if c.law.initial_state == m => s.initial_state,
+                    _ => 0.0,
+                })
+                .collect();
+            for &(side, m2) in &spec.sides2 {
+                for &c in &problem.sides[side].contacts {
+                    if problem.contacts[c].second_tangent.is_some() {
+                        second[c] = m2;
+                    }
+                }
+            }
+            for &(c, m2) in &spec.contacts2 {
+                second[c] = m2;
+            }
+            second
+        });
         Self {
             name: spec.name.clone(),
             contact_states: states,
+            second_states,
         }
     }
 
@@ -87,13 +123,16 @@ impl LimitCase {
 
     /// The problem with every contact's initial state set from the case. The case's m is
     /// along the first tangent: a 2D-friction point whose m₁ the case changes starts at
-    /// m = (m, 0) (m = ±1: T(0) on the friction circle at ±t₁).
+    /// m = (m, 0) (m = ±1: T(0) on the friction circle at ±t₁), unless the case sets m₂
+    /// ([`Self::second_states`]).
     pub fn apply(&self, problem: &Problem) -> Problem {
         let mut p = problem.clone();
-        for (c, m) in p.contacts.iter_mut().zip(&self.contact_states) {
-            if c.law.initial_state != *m {
-                if let Some(second) = &mut c.second_tangent {
-                    second.initial_state = 0.0;
+        for (i, (c, m)) in p.contacts.iter_mut().zip(&self.contact_states).enumerate() {
+            if let Some(second) = &mut c.second_tangent {
+                match &self.second_states {
+                    Some(s) => second.initial_state = s[i],
+                    None if c.law.initial_state != *m => second.initial_state = 0.0,
+                    None => {}
                 }
             }
             c.law.initial_state = *m;
