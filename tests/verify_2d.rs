@@ -1,8 +1,9 @@
 //! Time integration (`analysis::verify`) and the monodromy (`analysis::monodromy`) with 2D
 //! tangential friction (`law = "jenkins-2d"`): on the 3D paper system with the out-of-plane
 //! motion constrained the integration equals the planar 1D one; with an out-of-plane load
-//! (slip directions that rotate on one contact, the other stuck) an integration started on the
-//! harmonic-balance point (H = 5) stays on it, and the monodromy verdict agrees with Hill's.
+//! (slip directions that rotate) an integration started on the harmonic-balance point (H = 5)
+//! stays on it, at a unique-solution frequency (both contacts slipping) and at one where a
+//! contact sticks, and the monodromy verdict agrees with Hill's at both.
 
 use std::f64::consts::PI;
 
@@ -116,29 +117,23 @@ fn out_of_plane(load: f64) -> Problem {
     p
 }
 
-#[test]
-fn with_out_of_plane_motion_the_integration_stays_on_the_hbm_point_and_monodromy_agrees_with_hill()
-{
-    // 10 N at 205 Hz: the right contact stick-slips along rotating directions; the left one
-    // sticks (with m = 0; the HBM point is then one of the steady states friction allows, and
-    // the time integration started on it must stay on it). With the damper damping below, no
-    // unique-solution point was found on this scene: with out-of-plane loads of 1, 3 and 10 N
-    // at 150, 160, 170, 200 and 205 Hz (and 10 N from 140 to 230 Hz) the left contact sticks.
-    let (problem, freq) = (out_of_plane(10.0), 205.0);
-    let mut solver = PointSolver::new(&problem).unwrap();
-    let set = solver.system().unknowns().clone();
-    let guess = linear::stuck_guess(&problem, &set, 2.0 * PI * freq).unwrap();
-    let point = solver.solve(&guess, freq).unwrap();
-    println!("{freq} Hz: states {:?}", point.states);
-    assert_eq!(point.states[0], ContactState::Stuck);
-    assert!(point.states[1].is_unique(), "{:?}", point.states);
+/// Verifies the HBM point `point` of `problem` at `freq` (see the two tests below) and returns
+/// (Hill stable, monodromy stable, neutral sliders, kept multipliers).
+fn check_out_of_plane(
+    problem: &Problem,
+    solver: &mut PointSolver,
+    set: &HarmonicSet,
+    point: &fricbound::analysis::frf::FrfPoint,
+    freq: f64,
+) -> (bool, bool, Vec<usize>, usize) {
+    let set = set.clone();
     let omega = 2.0 * PI * freq;
     let settings = VerifySettings {
         steps_per_period: 1024,
         ..VerifySettings::for_harmonics(5)
     };
     let check = verify::verify_point(
-        &problem,
+        problem,
         &set,
         &point.coefficients,
         &point.amplitudes,
@@ -173,9 +168,9 @@ fn with_out_of_plane_motion_the_integration_stays_on_the_hbm_point_and_monodromy
     assert!(rotating >= 1);
 
     let hill = stability::point_stability(solver.system(), &point.coefficients, omega).unwrap();
-    let start = verify::hbm_state(&problem, &set, &point.coefficients, freq, 1280).unwrap();
+    let start = verify::hbm_state(problem, &set, &point.coefficients, freq, 1280).unwrap();
     let mono = monodromy_stability(
-        &problem,
+        problem,
         freq,
         &start,
         &VerifySettings::for_harmonics(5),
@@ -194,9 +189,61 @@ fn with_out_of_plane_motion_the_integration_stays_on_the_hbm_point_and_monodromy
         mono.neutral_sliders
     );
     assert!(mono.orbit_converged, "{mono:?}");
-    assert_eq!(hill.stable, mono.stable);
+    (
+        hill.stable,
+        mono.stable,
+        mono.neutral_sliders.clone(),
+        mono.multipliers_re.len(),
+    )
+}
+
+#[test]
+fn with_out_of_plane_motion_and_one_contact_stuck_the_integration_stays_and_monodromy_agrees_with_hill(
+) {
+    // 10 N at 205 Hz: the right contact stick-slips along rotating directions; the left one
+    // sticks (with m = 0; the HBM point is then one of the steady states friction allows, and
+    // the time integration started on it must stay on it).
+    let (problem, freq) = (out_of_plane(10.0), 205.0);
+    let mut solver = PointSolver::new(&problem).unwrap();
+    let set = solver.system().unknowns().clone();
+    let guess = linear::stuck_guess(&problem, &set, 2.0 * PI * freq).unwrap();
+    let point = solver.solve(&guess, freq).unwrap();
+    println!("{freq} Hz: states {:?}", point.states);
+    assert_eq!(point.states[0], ContactState::Stuck);
+    assert!(point.states[1].is_unique(), "{:?}", point.states);
+    let (hill, mono, neutral, kept) = check_out_of_plane(&problem, &mut solver, &set, &point, freq);
+    assert_eq!(hill, mono);
     // 2·9 structural states and 2 slider coordinates per 2D point not stuck all period (the
     // neutral sliders of a stuck one are removed).
-    assert_eq!(mono.neutral_sliders, vec![0]);
-    assert_eq!(mono.multipliers_re.len(), 18 + 2);
+    assert_eq!(neutral, vec![0]);
+    assert_eq!(kept, 18 + 2);
+}
+
+#[test]
+fn with_out_of_plane_motion_at_a_unique_solution_the_integration_stays_on_the_hbm_point() {
+    // 10 N: both contacts slip between 160.2 and 163.2 Hz on the FRF path (H = 3, measured
+    // with `fricbound run`); the first of these frequencies where Newton from the stuck guess
+    // (H = 5) lands on a point with both contacts slipping or separating: the only steady state
+    // there (paper §3.2).
+    let problem = out_of_plane(10.0);
+    let mut solver = PointSolver::new(&problem).unwrap();
+    let set = solver.system().unknowns().clone();
+    let (freq, point) = [161.5, 162.5, 161.0, 162.0, 163.0, 160.5]
+        .into_iter()
+        .find_map(|f| {
+            let guess = linear::stuck_guess(&problem, &set, 2.0 * PI * f).unwrap();
+            let point = solver.solve(&guess, f).ok()?;
+            println!("{f} Hz: states {:?}", point.states);
+            point
+                .states
+                .iter()
+                .all(|s| s.is_unique())
+                .then_some((f, point))
+        })
+        .expect("a frequency with both contacts slipping");
+    let (hill, mono, neutral, kept) = check_out_of_plane(&problem, &mut solver, &set, &point, freq);
+    println!("{freq} Hz: Hill stable {hill}, monodromy stable {mono}");
+    assert_eq!(hill, mono);
+    assert!(neutral.is_empty());
+    assert_eq!(kept, 18 + 4);
 }
