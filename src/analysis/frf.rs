@@ -4,7 +4,7 @@
 use std::f64::consts::PI;
 use std::time::Instant;
 
-use crate::analysis::error_estimate::{ErrorEstimator, EstimateProblems, PointAccuracy};
+use crate::analysis::error_estimate::{ErrorEstimator, EstimateProblems, PathPlace, PointAccuracy};
 use crate::analysis::linear;
 use crate::analysis::monodromy::point_monodromy;
 use crate::analysis::stability::{point_stability, PointStability, StabilityError};
@@ -469,7 +469,7 @@ fn with_stability(
 }
 
 impl<O: FrfObserver> Observer<HbmOperator<'_>> for Adapter<'_, '_, O> {
-    fn accepted(&mut self, system: &mut HbmOperator<'_>, p: &PathPoint) {
+    fn accepted(&mut self, system: &mut HbmOperator<'_>, p: &PathPoint, normal: Option<&[f64]>) {
         let mut point =
             match full_point(system, p).and_then(|point| with_stability(system, point, p.omega)) {
                 Ok(point) => point,
@@ -479,7 +479,11 @@ impl<O: FrfObserver> Observer<HbmOperator<'_>> for Adapter<'_, '_, O> {
                 }
             };
         if let Some(estimator) = &mut self.estimator {
-            point.accuracy = Some(estimator.estimate(&point.coefficients, p.omega));
+            let place = normal.map(|normal| PathPlace {
+                normal,
+                step: p.step,
+            });
+            point.accuracy = Some(estimator.estimate(&point.coefficients, p.omega, place));
         }
         self.observer.point(&point);
         self.points.push(point);
@@ -615,6 +619,7 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
             freq_hz,
             highest,
             (budget / 2).min(FILL_POINTS),
+            &mut adapter.estimator,
         );
         if let Some(summary) = &summary {
             run.turning_points.extend(&summary.turning_points);
@@ -640,7 +645,7 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
                     .max_points
                     .saturating_sub(adapter.points.len() + fill.len())
                     / 2;
-                branching.bridge(&mut system, &top, &bottom, budget)
+                branching.bridge(&mut system, &top, &bottom, budget, &mut adapter.estimator)
             }
             _ => Vec::new(),
         };
@@ -662,9 +667,11 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
             run.jumps.push(jump);
             for mut p in branch {
                 reached = reached.max(p.freq_hz);
-                if let Some(estimator) = &mut adapter.estimator {
+                // Points followed on a branch have their estimate (across the path) already;
+                // the others (solved at a fixed frequency) take it at their frequency.
+                if let (Some(estimator), None) = (&mut adapter.estimator, &p.accuracy) {
                     let omega = 2.0 * PI * p.freq_hz;
-                    p.accuracy = Some(estimator.estimate(&p.coefficients, omega));
+                    p.accuracy = Some(estimator.estimate(&p.coefficients, omega, None));
                 }
                 adapter.observer.point(&p);
                 adapter.points.push(p);
@@ -703,14 +710,17 @@ impl Branching<'_> {
     /// Follows the path silently from `x` (the operator's unknowns, converged at `from_hz`)
     /// toward `to_hz` (below or above) with at most `max_points` points. Returns the points in
     /// path order (the first is the start point) and the summary, None when the continuation
-    /// failed (its points up to the failure are kept).
-    fn follow(
+    /// failed (its points up to the failure are kept). With an `estimator`, each point gets
+    /// its error estimate across the path as it is accepted (the estimator is lent to the
+    /// branch's observer and given back).
+    fn follow<'e>(
         &self,
         system: &mut HbmOperator<'_>,
         x: &[f64],
         from_hz: f64,
         to_hz: f64,
         max_points: usize,
+        estimator: &mut Option<ErrorEstimator<'e>>,
     ) -> (Vec<FrfPoint>, Option<crate::numerics::PathSummary>) {
         let settings = ContinuationSettings {
             freq_start_hz: from_hz,
@@ -722,12 +732,13 @@ impl Branching<'_> {
             observer: &mut Silent,
             points: Vec::new(),
             failure: None,
-            estimator: None,
+            estimator: estimator.take(),
         };
         let mut continuation = Continuation::new(settings, self.x_scale.to_vec())
             .with_adaptive_scale(self.adaptive.clone())
             .with_amplitude_steps(self.amplitude_groups.to_vec());
         let summary = continuation.run(system, x, &mut collect).ok();
+        *estimator = collect.estimator.take();
         (collect.points, summary)
     }
 
@@ -742,12 +753,13 @@ impl Branching<'_> {
     /// is bridged in turn, up to [`MAX_BRIDGES`] branches and `budget` points. Returns the
     /// branches found, each in path order from its lowest point up, sorted by their lowest
     /// frequency.
-    fn bridge(
+    fn bridge<'e>(
         &self,
         system: &mut HbmOperator<'_>,
         below: &FrfPoint,
         above: &FrfPoint,
         budget: usize,
+        estimator: &mut Option<ErrorEstimator<'e>>,
     ) -> Vec<Vec<FrfPoint>> {
         let mut branches: Vec<Vec<FrfPoint>> = Vec::new();
         let mut gaps = vec![(below.clone(), above.clone())];
@@ -761,8 +773,8 @@ impl Branching<'_> {
                 continue;
             };
             let per_side = BRIDGE_POINTS.min((budget - used) / 2);
-            let (mut down, _) = self.follow(system, &x, freq_hz, lo.freq_hz, per_side);
-            let (up, _) = self.follow(system, &x, freq_hz, hi.freq_hz, per_side);
+            let (mut down, _) = self.follow(system, &x, freq_hz, lo.freq_hz, per_side, estimator);
+            let (up, _) = self.follow(system, &x, freq_hz, hi.freq_hz, per_side, estimator);
             down.reverse();
             // Both directions start with the point at `freq_hz`: keep one.
             let branch: Vec<FrfPoint> = down.into_iter().chain(up.into_iter().skip(1)).collect();
@@ -1098,6 +1110,67 @@ pub fn interpolate_on_path(points: &[FrfPoint], freq_hz: f64) -> Option<Vec<f64>
 pub fn amplitude_on_path(points: &[FrfPoint], freq_hz: f64) -> Option<f64> {
     let (lo, hi, t) = bracket_on_path(points, freq_hz)?;
     Some(lo.amplitudes[0] + t * (hi.amplitudes[0] - lo.amplitudes[0]))
+}
+
+/// The first-harmonic amplitude of output `output` (index into the problem's outputs) on a
+/// reference path where it crosses the hyperplane through `point` normal to `point`'s own path,
+/// and the frequency there (Hz): the reference's counterpart of the point at the same place
+/// along the path, against which a bordered error estimate (see
+/// [`crate::analysis::error_estimate`]) is compared. `normal` is the hyperplane as
+/// [`PointAccuracy::path_normal`] holds it (a covector on `point`'s full coefficients on
+/// `set`, then on ω in rad/s); the reference's coefficients on `reference_set` enter on the
+/// blocks of `set` (the hyperplane does not see the others). Each segment of the reference
+/// within a branch (not across a jump) whose ends lie on either side is a crossing,
+/// interpolated linearly; the one nearest the point in relative frequency and amplitude is
+/// returned. None when the reference does not cross the hyperplane.
+pub fn amplitude_across_path(
+    reference: &FrfRun,
+    reference_set: &HarmonicSet,
+    point: &FrfPoint,
+    set: &HarmonicSet,
+    normal: &[f64],
+    output: usize,
+) -> Option<(f64, f64)> {
+    let blocks = set.n_blocks();
+    let n = point.coefficients.len() / blocks.max(1);
+    if normal.len() != n * blocks + 1 {
+        return None;
+    }
+    let block_in_reference: Vec<Option<usize>> = set
+        .blocks()
+        .iter()
+        .map(|b| reference_set.blocks().iter().position(|c| c == b))
+        .collect();
+    let side = |q: &FrfPoint| -> f64 {
+        let mut g = normal[n * blocks] * 2.0 * PI * (q.freq_hz - point.freq_hz);
+        for (j, jr) in block_in_reference.iter().enumerate() {
+            for i in 0..n {
+                let on_reference = jr.map_or(0.0, |jr| q.coefficients[jr * n + i]);
+                g += normal[j * n + i] * (on_reference - point.coefficients[j * n + i]);
+            }
+        }
+        g
+    };
+    let sides: Vec<f64> = reference.points.iter().map(side).collect();
+    let starts = reference.branch_starts();
+    let a0 = point.amplitudes[output];
+    let mut best: Option<(f64, (f64, f64))> = None;
+    for k in 0..reference.points.len().saturating_sub(1) {
+        let (ga, gb) = (sides[k], sides[k + 1]);
+        if starts.contains(&(k + 1)) || ga * gb > 0.0 || (ga == 0.0 && gb == 0.0) {
+            continue;
+        }
+        let t = ga / (ga - gb);
+        let (p, q) = (&reference.points[k], &reference.points[k + 1]);
+        let freq_hz = p.freq_hz + t * (q.freq_hz - p.freq_hz);
+        let amplitude = p.amplitudes[output] + t * (q.amplitudes[output] - p.amplitudes[output]);
+        let distance =
+            ((freq_hz - point.freq_hz) / point.freq_hz).powi(2) + ((amplitude - a0) / a0).powi(2);
+        if best.is_none_or(|(d, _)| distance < d) {
+            best = Some((distance, (amplitude, freq_hz)));
+        }
+    }
+    best.map(|(_, found)| found)
 }
 
 #[cfg(test)]
