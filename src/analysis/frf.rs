@@ -1189,6 +1189,64 @@ mod tests {
         }
     }
 
+    fn line_point(freq_hz: f64, c1: f64, c3: f64) -> FrfPoint {
+        FrfPoint {
+            freq_hz,
+            amplitudes: vec![c1.abs()],
+            peaks: vec![0.0],
+            states: Vec::new(),
+            newton_iterations: 1,
+            residual: 0.0,
+            coefficients: vec![c1, 0.0, c3, 0.0],
+            accuracy: None,
+            stability: None,
+        }
+    }
+
+    /// The reference path c₁ = 1 + (f − 100) (one DOF, harmonics 1 and 3) crosses the
+    /// hyperplane through (100.5 Hz, c₁ = 1.3) normal to the direction (1 Hz, 1) at 100.4 Hz,
+    /// c₁ = 1.4 (the 3rd harmonic, which the point's set lacks, does not enter); the segment
+    /// across a jump to another branch, which crosses it too, is not a crossing.
+    #[test]
+    fn the_reference_is_read_where_it_crosses_the_hyperplane_normal_to_the_path() {
+        let mut points: Vec<FrfPoint> = (0..=10)
+            .map(|k| {
+                let f = 100.0 + 0.1 * k as f64;
+                line_point(f, 1.0 + (f - 100.0), 7.0)
+            })
+            .collect();
+        // The far branch: c1 = −5 at 99 Hz and 97 Hz, on one side of the hyperplane; the
+        // jump's segment from (101 Hz, 2) to (99 Hz, −5) crosses it.
+        points.push(line_point(99.0, -5.0, 0.0));
+        points.push(line_point(97.0, -5.0, 0.0));
+        let mut reference = run_with_jumps(vec![Jump {
+            from_hz: 101.0,
+            to_hz: 97.0,
+            first_point: 11,
+            kind: JumpKind::PastFold,
+        }]);
+        reference.points = points;
+        let point = FrfPoint {
+            coefficients: vec![1.3, 0.0],
+            ..line_point(100.5, 1.3, 0.0)
+        };
+        let set = HarmonicSet::new(vec![1]);
+        let reference_set = HarmonicSet::new(vec![1, 3]);
+        // Unit weight per Hz of frequency (ω in rad/s) and per unit of c1.
+        let normal = [1.0, 0.0, 1.0 / (2.0 * PI)];
+        let (amplitude, freq_hz) =
+            amplitude_across_path(&reference, &reference_set, &point, &set, &normal, 0).unwrap();
+        assert!((amplitude - 1.4).abs() < 1e-12, "{amplitude}");
+        assert!((freq_hz - 100.4).abs() < 1e-12, "{freq_hz}");
+        // Without the line but its last point, only the jump's segment crosses: none.
+        reference.points.drain(..10);
+        reference.jumps[0].first_point = 1;
+        assert_eq!(
+            amplitude_across_path(&reference, &reference_set, &point, &set, &normal, 0),
+            None
+        );
+    }
+
     /// A path that reached the end frequency but jumped over a stretch at a fold that no branch
     /// reached does not cover the range; one whose jumps left nothing uncovered (or only the
     /// round-off of a branch followed onto an end frequency) does.

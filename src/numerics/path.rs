@@ -112,8 +112,8 @@ pub trait Observer<S: ParametricResidual> {
     /// Σᵢ normalᵢ (xᵢ − x_pᵢ) + normalₙ (ω − ω_p) = 0, ω in rad/s. It is the unit tangent t of
     /// the continuation's scaled space (x / x_scale, ω / 2π) divided by the scales, so that the
     /// hyperplane is the one orthogonal to the path in the arc length's own metric (the
-    /// corrector's hyperplane of Eq. 9). None at points solved at a fixed frequency (the start
-    /// and end frequencies).
+    /// corrector's hyperplane of Eq. 9). None at points solved at a fixed frequency (the end
+    /// frequency of a path).
     fn accepted(&mut self, _system: &mut S, _point: &PathPoint, _normal: Option<&[f64]>) {}
     /// A step was rejected and will be retried with `new_step`.
     fn rejected(&mut self, _freq_hz: f64, _step: f64, _new_step: f64, _reason: &NewtonFailure) {}
