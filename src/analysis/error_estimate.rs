@@ -25,21 +25,43 @@
 //! harmonics, zero on the new ones): one Newton step as above, at the cost of one residual
 //! at twice the samples and one more solve with the same factors.
 //!
-//! Both are first-order estimates at a fixed frequency: near a fold of the path the Jacobian
-//! at fixed frequency is nearly singular and the amplitude at that frequency is sensitive to
-//! any change, so the estimates grow there, as the fixed-frequency error does. An estimate
-//! that cannot be formed (an AFT march that does not settle, a singular Jacobian) is NaN.
+//! # Across the path or at a fixed frequency
+//!
+//! On a continuation path (every point of an FRF run, limit and intermediate curves) the
+//! extended system is factorised bordered with the path's arc-length row, normal · (δx, δω)
+//! = 0, the normal being the path's tangent at the point in the continuation's scaled metric
+//! (paper Eq. 9; see [`crate::numerics::Observer::accepted`]). Its solutions give two steps
+//! from one factorisation: the step *across the path* (it may change the frequency and stays
+//! in the hyperplane orthogonal to the path: it moves the point onto the refined path at the
+//! same place along it), and, with one more solve for the path's direction z, the step *at the
+//! fixed frequency* (the across-path step slid along z back onto the point's frequency). The
+//! fixed-frequency Jacobian is singular at a fold of the path (a turning point), where the
+//! slide, hence the fixed-frequency estimate, grows without bound (806 % at H = 1, 395 at
+//! H = 3 on the reduced blade pair next to its fold); the bordered matrix is regular there.
+//! The point reports the fixed-frequency estimate unless the slide exceeds
+//! [`PathSwitch::SLIDE_STEPS`] continuation steps ([`PointAccuracy::across_path`] says
+//! which one it reports; both truncation estimates are kept in
+//! [`PointAccuracy::both_truncation`]). Away from folds the two differ where the path is
+//! steep: the across-path step measures the error across the path, the fixed-frequency one
+//! the (larger) error at a fixed frequency, which is what an FRF is read at. Points solved at
+//! a fixed frequency (the end frequency of a path, the bridge points between branches,
+//! refined peaks) take the plain fixed-frequency step. An estimate that cannot be formed (an
+//! AFT march that does not settle, a singular matrix) is NaN.
 //!
 //! Cost per point: one residual, Jacobian and factorisation of the system on 2H+1 harmonics
 //! (in the formulation the cost model picks for that system, see `extended_formulation`),
-//! one residual at twice the samples, and two solves with the same factors (before the
-//! sampling step reused the factors, it took a Jacobian and a factorisation of its own).
+//! one residual at twice the samples, and two solves with the same factors (three with the
+//! path's direction on a path point; before the sampling step reused the factors, it took a
+//! Jacobian and a factorisation of its own). The bordered factorisation adds one row and
+//! column (dense storage) or one solve for the border column (storages that eliminate the
+//! border by blocks).
 
 use crate::contact::harmonic::HarmonicSet;
 use crate::hbm::operator::HbmOperator;
 use crate::hbm::HbmError;
 use crate::model::{Formulation, Problem};
 use crate::numerics::jacobian::AssembledJacobian;
+use crate::numerics::linalg::LinearSolveError;
 use crate::numerics::ParametricResidual;
 
 /// The error estimate of one converged point, per output DOF (relative to its first-harmonic
@@ -50,6 +72,63 @@ pub struct PointAccuracy {
     pub truncation: Vec<f64>,
     /// AFT-sampling estimate per output DOF (relative).
     pub sampling: Vec<f64>,
+    /// True when the reported estimates are the steps across the path (bordered with the
+    /// path's normal), false when at a fixed frequency (see the module docs and
+    /// [`PathSwitch`]).
+    pub across_path: bool,
+    /// The hyperplane the across-path steps stay in (on a path point): the covector on the
+    /// point's full coefficients (harmonic-major, as `FrfPoint::coefficients`) followed by
+    /// the one on ω (rad/s); zero on coefficients the run's formulation eliminates. A
+    /// reference path crossing this hyperplane gives the true error at the same place along
+    /// the path (`crate::analysis::frf::amplitude_across_path`).
+    #[serde(skip)]
+    pub path_normal: Option<Vec<f64>>,
+    /// On a path point, both truncation estimates per output: at the fixed frequency and
+    /// across the path (the reported one is chosen by [`PathSwitch`]); empty elsewhere.
+    #[serde(skip)]
+    pub both_truncation: Option<(Vec<f64>, Vec<f64>)>,
+    /// On a path point, the arc length (scaled, Hz-equivalent, as the continuation's steps)
+    /// that the fixed-frequency truncation step slides along the path beyond the step across
+    /// it, and the continuation step that reached the point; NaN elsewhere.
+    #[serde(skip)]
+    pub slide_and_step: (f64, f64),
+}
+
+/// Where the path is at a converged point, for the estimate across it: the hyperplane normal
+/// to the path (see [`crate::numerics::Observer::accepted`]) and the arc-length step
+/// (Hz-equivalent) that reached the point.
+#[derive(Debug, Clone, Copy)]
+pub struct PathPlace<'a> {
+    /// Covector on the run operator's unknowns, then on ω (rad/s).
+    pub normal: &'a [f64],
+    /// The continuation step that reached the point (scaled arc length).
+    pub step: f64,
+}
+
+/// Which step a path point reports: the fixed-frequency one, unless it slides along the path
+/// (beyond the step across it) by more than [`Self::SLIDE_STEPS`] continuation steps. The
+/// fixed-frequency step is the across-path one plus a slide along the path's tangent back onto
+/// the point's frequency; next to a fold the tangent's frequency component vanishes, the
+/// fixed-frequency Jacobian is singular and the slide unbounded, far beyond the stretch of path
+/// where the tangent holds (the continuation turns its tangent by about 10° per step).
+///
+/// The threshold is set from measurements: on the paper case's steep flank below its 2nd
+/// resonance (H = 1, `zoom-2nd.toml`) the slide reaches 21 steps while the fixed-frequency
+/// estimate still tracks the error at a fixed frequency (within the criteria, see
+/// `tests/error_estimate.rs`), so the switch sits above that.
+pub struct PathSwitch;
+
+impl PathSwitch {
+    /// Continuation steps the fixed-frequency step may slide along the path.
+    pub const SLIDE_STEPS: f64 = 32.0;
+
+    /// True when the across-path step is reported (not at a path's first point, solved at a
+    /// fixed frequency, whose `step` is 0).
+    pub fn across(slide: f64, step: f64) -> bool {
+        // A slide that is not a number (the path's direction has no frequency component: at
+        // the fold itself) counts as beyond.
+        step > 0.0 && (slide.is_nan() || slide > Self::SLIDE_STEPS * step)
+    }
 }
 
 /// The two refined problems the estimate puts a point into: the harmonic set extended to 2H,
@@ -225,6 +304,9 @@ pub struct ErrorEstimator<'p> {
     truncation: Refined<'p>,
     /// The operator at twice the samples (residuals only).
     sampling: HbmOperator<'p>,
+    /// For each of the run's unknowns, its index among the full coefficients (the run's
+    /// operator restricts by selection).
+    full_index: Vec<usize>,
 }
 
 impl<'p> ErrorEstimator<'p> {
@@ -232,22 +314,60 @@ impl<'p> ErrorEstimator<'p> {
     /// harmonics), on the refined problems `refined` built from it.
     pub fn new(problem: &'p Problem, refined: &'p EstimateProblems) -> Result<Self, HbmError> {
         let set = problem.unknown_harmonics();
+        let sampling = HbmOperator::new(&refined.sampling)?;
+        let positions: Vec<f64> = (0..problem.model.n_dofs() * set.n_blocks())
+            .map(|i| i as f64)
+            .collect();
+        let full_index = sampling
+            .restrict(&positions)
+            .iter()
+            .map(|&i| i as usize)
+            .collect();
         Ok(Self {
             problem,
             truncation: Refined::new(&refined.truncation, &set)?,
-            sampling: HbmOperator::new(&refined.sampling)?,
+            sampling,
             set,
+            full_index,
         })
+    }
+
+    /// The border row on the extended unknowns for the path normal `normal` (the run's
+    /// unknowns, then ω), and the same normal on the full coefficients; None when it does not
+    /// fit or is not finite.
+    fn border(&self, normal: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
+        let (on_x, on_omega) = normal.split_last().map(|(w, x)| (x, *w))?;
+        if on_x.len() != self.full_index.len() || normal.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let mut row = self.truncation.on_kept_blocks(on_x, self.set.n_blocks())?;
+        row.push(on_omega);
+        let mut full = vec![0.0; self.problem.model.n_dofs() * self.set.n_blocks() + 1];
+        for (&i, &w) in self.full_index.iter().zip(on_x) {
+            full[i] = w;
+        }
+        *full.last_mut()? = on_omega;
+        Some((row, full))
     }
 
     /// The estimate at the converged point `x` (full coefficients, harmonic-major) solved at
     /// ω = `omega` (rad/s): one residual and Jacobian of the extended system, factorised once
     /// for both Newton steps (truncation: its own residual; sampling: the residual at twice
-    /// the samples on the kept harmonics).
-    pub fn estimate(&mut self, x: &[f64], omega: f64) -> PointAccuracy {
+    /// the samples on the kept harmonics). With the path's `normal` (in the run operator's
+    /// unknowns then ω, as [`crate::numerics::Observer::accepted`] gives it) the steps are
+    /// bordered with it (across the path), else at the fixed frequency; a bordered matrix
+    /// that cannot be factorised falls back to the fixed frequency.
+    pub fn estimate(&mut self, x: &[f64], omega: f64, path: Option<PathPlace>) -> PointAccuracy {
         let n = self.problem.model.n_dofs();
         let base = amplitudes(self.problem, &self.set, x);
-        let nan = || vec![f64::NAN; base.len()];
+        let nan = || PointAccuracy {
+            truncation: vec![f64::NAN; base.len()],
+            sampling: vec![f64::NAN; base.len()],
+            across_path: false,
+            path_normal: None,
+            both_truncation: None,
+            slide_and_step: (f64::NAN, f64::NAN),
+        };
         let xr = self.truncation.padded(n, x);
         let dim = xr.len();
         let mut r = vec![0.0; dim];
@@ -258,10 +378,7 @@ impl<'p> ErrorEstimator<'p> {
             .residual_and_jacobian(&xr, omega, &mut r, &mut self.truncation.jacobian, &mut dr)
             .is_err()
         {
-            return PointAccuracy {
-                truncation: nan(),
-                sampling: nan(),
-            };
+            return nan();
         }
         // The sampling residual on the base set, moved onto the extended unknowns.
         let xs = self.sampling.restrict(x);
@@ -275,26 +392,124 @@ impl<'p> ErrorEstimator<'p> {
         if let Some(s) = &sampling_rhs {
             rhs.push(s);
         }
-        let Ok(deltas) = self.truncation.jacobian.solve_many(&rhs) else {
-            return PointAccuracy {
-                truncation: nan(),
-                sampling: nan(),
-            };
+        let border = path.and_then(|p| self.border(p.normal));
+        let mut path_normal = None;
+        let mut deltas = None;
+        let mut fixed_deltas = None;
+        let mut slide = f64::NAN;
+        if let Some((row, full)) = border {
+            // The path's direction of the extended system, z with row · z = 1: the
+            // fixed-frequency steps are the across-path ones slid along z back onto ω.
+            let dim_x = dr.len();
+            let mut along = vec![0.0; dim_x];
+            along.push(1.0);
+            let mut with_along = rhs.clone();
+            let along_x = along[..dim_x].to_vec();
+            with_along.push(&along_x);
+            if let Ok(mut d) = self.bordered_steps(&dr, &row, &with_along) {
+                let z = d.pop().expect("the path direction was solved");
+                let z_omega = z[dim_x];
+                let fixed: Vec<Vec<f64>> = d
+                    .iter()
+                    .map(|step| {
+                        let s = step[dim_x] / z_omega;
+                        step.iter().zip(&z).map(|(a, b)| a - s * b).collect()
+                    })
+                    .collect();
+                // z has a unit component along the unit tangent of the scaled space, so the
+                // slide is an arc length of that space.
+                slide = (d[0][dim_x] / z_omega).abs();
+                deltas = Some(d);
+                fixed_deltas = Some(fixed);
+                path_normal = Some(full);
+            }
+        }
+        let deltas = match deltas {
+            Some(d) => d,
+            None => match self.truncation.jacobian.solve_many(&rhs) {
+                // At a fixed frequency: δω = 0.
+                Ok(d) => d
+                    .into_iter()
+                    .map(|mut v| {
+                        v.push(0.0);
+                        v
+                    })
+                    .collect(),
+                Err(_) => return nan(),
+            },
         };
         let ext = self.truncation.operator.unknowns().clone();
-        let mut change = |delta: &[f64]| match self.truncation.stepped(&xr, delta, omega) {
-            Some(full) => relative_changes(&amplitudes(self.problem, &ext, &full), &base),
-            None => nan(),
+        let nan_values = vec![f64::NAN; base.len()];
+        let mut change = |delta: &[f64]| {
+            let (d_omega, d_x) = delta.split_last().expect("a step has a frequency part");
+            match self.truncation.stepped(&xr, d_x, omega - d_omega) {
+                Some(full) => relative_changes(&amplitudes(self.problem, &ext, &full), &base),
+                None => nan_values.clone(),
+            }
         };
         let truncation = change(&deltas[0]);
         let sampling = match deltas.get(1) {
             Some(d) => change(d),
-            None => nan(),
+            None => nan_values.clone(),
         };
+        let step = path.map_or(f64::NAN, |p| p.step);
+        let Some(fixed) = fixed_deltas else {
+            return PointAccuracy {
+                truncation,
+                sampling,
+                across_path: false,
+                path_normal: None,
+                both_truncation: None,
+                slide_and_step: (f64::NAN, step),
+            };
+        };
+        let fixed_truncation = change(&fixed[0]);
+        let fixed_sampling = match fixed.get(1) {
+            Some(d) => change(d),
+            None => nan_values.clone(),
+        };
+        let across = PathSwitch::across(slide, step);
         PointAccuracy {
-            truncation,
-            sampling,
+            truncation: if across {
+                truncation.clone()
+            } else {
+                fixed_truncation.clone()
+            },
+            sampling: if across { sampling } else { fixed_sampling },
+            across_path: across,
+            path_normal,
+            both_truncation: Some((fixed_truncation, truncation)),
+            slide_and_step: (slide, step),
         }
+    }
+
+    /// The bordered Newton steps (δx, δω) of [[J, ∂R/∂ω], [row]] (δx, δω) = (r, 0) for each
+    /// residual r of `rhs`, with one factorisation (the Jacobian last evaluated by the
+    /// truncation operator, `dr` its ∂R/∂ω).
+    /// The last right-hand side takes 1 in the border row instead of 0: its solution is the
+    /// path's direction.
+    fn bordered_steps(
+        &mut self,
+        dr: &[f64],
+        row: &[f64],
+        rhs: &[&[f64]],
+    ) -> Result<Vec<Vec<f64>>, LinearSolveError> {
+        let ones = vec![1.0; dr.len()];
+        let factor = self.truncation.jacobian.factor_bordered(&ones, dr, row)?;
+        let last = rhs.len() - 1;
+        rhs.iter()
+            .enumerate()
+            .map(|(k, r)| {
+                let mut b = r.to_vec();
+                b.push(if k == last { 1.0 } else { 0.0 });
+                let step = factor.solve(&b)?;
+                if step.iter().all(|v| v.is_finite()) {
+                    Ok(step)
+                } else {
+                    Err(LinearSolveError::NonFinite)
+                }
+            })
+            .collect()
     }
 }
 
@@ -470,6 +685,10 @@ mod tests {
         PointAccuracy {
             truncation: vec![t],
             sampling: vec![s],
+            across_path: false,
+            path_normal: None,
+            both_truncation: None,
+            slide_and_step: (f64::NAN, f64::NAN),
         }
     }
 

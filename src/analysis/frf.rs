@@ -4,7 +4,7 @@
 use std::f64::consts::PI;
 use std::time::Instant;
 
-use crate::analysis::error_estimate::{ErrorEstimator, EstimateProblems, PointAccuracy};
+use crate::analysis::error_estimate::{ErrorEstimator, EstimateProblems, PathPlace, PointAccuracy};
 use crate::analysis::linear;
 use crate::analysis::monodromy::point_monodromy;
 use crate::analysis::stability::{point_stability, PointStability, StabilityError};
@@ -469,7 +469,7 @@ fn with_stability(
 }
 
 impl<O: FrfObserver> Observer<HbmOperator<'_>> for Adapter<'_, '_, O> {
-    fn accepted(&mut self, system: &mut HbmOperator<'_>, p: &PathPoint) {
+    fn accepted(&mut self, system: &mut HbmOperator<'_>, p: &PathPoint, normal: Option<&[f64]>) {
         let mut point =
             match full_point(system, p).and_then(|point| with_stability(system, point, p.omega)) {
                 Ok(point) => point,
@@ -479,7 +479,11 @@ impl<O: FrfObserver> Observer<HbmOperator<'_>> for Adapter<'_, '_, O> {
                 }
             };
         if let Some(estimator) = &mut self.estimator {
-            point.accuracy = Some(estimator.estimate(&point.coefficients, p.omega));
+            let place = normal.map(|normal| PathPlace {
+                normal,
+                step: p.step,
+            });
+            point.accuracy = Some(estimator.estimate(&point.coefficients, p.omega, place));
         }
         self.observer.point(&point);
         self.points.push(point);
@@ -615,6 +619,7 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
             freq_hz,
             highest,
             (budget / 2).min(FILL_POINTS),
+            &mut adapter.estimator,
         );
         if let Some(summary) = &summary {
             run.turning_points.extend(&summary.turning_points);
@@ -640,7 +645,7 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
                     .max_points
                     .saturating_sub(adapter.points.len() + fill.len())
                     / 2;
-                branching.bridge(&mut system, &top, &bottom, budget)
+                branching.bridge(&mut system, &top, &bottom, budget, &mut adapter.estimator)
             }
             _ => Vec::new(),
         };
@@ -662,9 +667,11 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
             run.jumps.push(jump);
             for mut p in branch {
                 reached = reached.max(p.freq_hz);
-                if let Some(estimator) = &mut adapter.estimator {
+                // Points followed on a branch have their estimate (across the path) already;
+                // the others (solved at a fixed frequency) take it at their frequency.
+                if let (Some(estimator), None) = (&mut adapter.estimator, &p.accuracy) {
                     let omega = 2.0 * PI * p.freq_hz;
-                    p.accuracy = Some(estimator.estimate(&p.coefficients, omega));
+                    p.accuracy = Some(estimator.estimate(&p.coefficients, omega, None));
                 }
                 adapter.observer.point(&p);
                 adapter.points.push(p);
@@ -703,14 +710,17 @@ impl Branching<'_> {
     /// Follows the path silently from `x` (the operator's unknowns, converged at `from_hz`)
     /// toward `to_hz` (below or above) with at most `max_points` points. Returns the points in
     /// path order (the first is the start point) and the summary, None when the continuation
-    /// failed (its points up to the failure are kept).
-    fn follow(
+    /// failed (its points up to the failure are kept). With an `estimator`, each point gets
+    /// its error estimate across the path as it is accepted (the estimator is lent to the
+    /// branch's observer and given back).
+    fn follow<'e>(
         &self,
         system: &mut HbmOperator<'_>,
         x: &[f64],
         from_hz: f64,
         to_hz: f64,
         max_points: usize,
+        estimator: &mut Option<ErrorEstimator<'e>>,
     ) -> (Vec<FrfPoint>, Option<crate::numerics::PathSummary>) {
         let settings = ContinuationSettings {
             freq_start_hz: from_hz,
@@ -722,12 +732,13 @@ impl Branching<'_> {
             observer: &mut Silent,
             points: Vec::new(),
             failure: None,
-            estimator: None,
+            estimator: estimator.take(),
         };
         let mut continuation = Continuation::new(settings, self.x_scale.to_vec())
             .with_adaptive_scale(self.adaptive.clone())
             .with_amplitude_steps(self.amplitude_groups.to_vec());
         let summary = continuation.run(system, x, &mut collect).ok();
+        *estimator = collect.estimator.take();
         (collect.points, summary)
     }
 
@@ -742,12 +753,13 @@ impl Branching<'_> {
     /// is bridged in turn, up to [`MAX_BRIDGES`] branches and `budget` points. Returns the
     /// branches found, each in path order from its lowest point up, sorted by their lowest
     /// frequency.
-    fn bridge(
+    fn bridge<'e>(
         &self,
         system: &mut HbmOperator<'_>,
         below: &FrfPoint,
         above: &FrfPoint,
         budget: usize,
+        estimator: &mut Option<ErrorEstimator<'e>>,
     ) -> Vec<Vec<FrfPoint>> {
         let mut branches: Vec<Vec<FrfPoint>> = Vec::new();
         let mut gaps = vec![(below.clone(), above.clone())];
@@ -761,8 +773,8 @@ impl Branching<'_> {
                 continue;
             };
             let per_side = BRIDGE_POINTS.min((budget - used) / 2);
-            let (mut down, _) = self.follow(system, &x, freq_hz, lo.freq_hz, per_side);
-            let (up, _) = self.follow(system, &x, freq_hz, hi.freq_hz, per_side);
+            let (mut down, _) = self.follow(system, &x, freq_hz, lo.freq_hz, per_side, estimator);
+            let (up, _) = self.follow(system, &x, freq_hz, hi.freq_hz, per_side, estimator);
             down.reverse();
             // Both directions start with the point at `freq_hz`: keep one.
             let branch: Vec<FrfPoint> = down.into_iter().chain(up.into_iter().skip(1)).collect();
@@ -1100,6 +1112,67 @@ pub fn amplitude_on_path(points: &[FrfPoint], freq_hz: f64) -> Option<f64> {
     Some(lo.amplitudes[0] + t * (hi.amplitudes[0] - lo.amplitudes[0]))
 }
 
+/// The first-harmonic amplitude of output `output` (index into the problem's outputs) on a
+/// reference path where it crosses the hyperplane through `point` normal to `point`'s own path,
+/// and the frequency there (Hz): the reference's counterpart of the point at the same place
+/// along the path, against which a bordered error estimate (see
+/// [`crate::analysis::error_estimate`]) is compared. `normal` is the hyperplane as
+/// [`PointAccuracy::path_normal`] holds it (a covector on `point`'s full coefficients on
+/// `set`, then on ω in rad/s); the reference's coefficients on `reference_set` enter on the
+/// blocks of `set` (the hyperplane does not see the others). Each segment of the reference
+/// within a branch (not across a jump) whose ends lie on either side is a crossing,
+/// interpolated linearly; the one nearest the point in relative frequency and amplitude is
+/// returned. None when the reference does not cross the hyperplane.
+pub fn amplitude_across_path(
+    reference: &FrfRun,
+    reference_set: &HarmonicSet,
+    point: &FrfPoint,
+    set: &HarmonicSet,
+    normal: &[f64],
+    output: usize,
+) -> Option<(f64, f64)> {
+    let blocks = set.n_blocks();
+    let n = point.coefficients.len() / blocks.max(1);
+    if normal.len() != n * blocks + 1 {
+        return None;
+    }
+    let block_in_reference: Vec<Option<usize>> = set
+        .blocks()
+        .iter()
+        .map(|b| reference_set.blocks().iter().position(|c| c == b))
+        .collect();
+    let side = |q: &FrfPoint| -> f64 {
+        let mut g = normal[n * blocks] * 2.0 * PI * (q.freq_hz - point.freq_hz);
+        for (j, jr) in block_in_reference.iter().enumerate() {
+            for i in 0..n {
+                let on_reference = jr.map_or(0.0, |jr| q.coefficients[jr * n + i]);
+                g += normal[j * n + i] * (on_reference - point.coefficients[j * n + i]);
+            }
+        }
+        g
+    };
+    let sides: Vec<f64> = reference.points.iter().map(side).collect();
+    let starts = reference.branch_starts();
+    let a0 = point.amplitudes[output];
+    let mut best: Option<(f64, (f64, f64))> = None;
+    for k in 0..reference.points.len().saturating_sub(1) {
+        let (ga, gb) = (sides[k], sides[k + 1]);
+        if starts.contains(&(k + 1)) || ga * gb > 0.0 || (ga == 0.0 && gb == 0.0) {
+            continue;
+        }
+        let t = ga / (ga - gb);
+        let (p, q) = (&reference.points[k], &reference.points[k + 1]);
+        let freq_hz = p.freq_hz + t * (q.freq_hz - p.freq_hz);
+        let amplitude = p.amplitudes[output] + t * (q.amplitudes[output] - p.amplitudes[output]);
+        let distance =
+            ((freq_hz - point.freq_hz) / point.freq_hz).powi(2) + ((amplitude - a0) / a0).powi(2);
+        if best.is_none_or(|(d, _)| distance < d) {
+            best = Some((distance, (amplitude, freq_hz)));
+        }
+    }
+    best.map(|(_, found)| found)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1114,6 +1187,64 @@ mod tests {
             end: PathEnd::EndFrequency,
             elapsed_s: 0.0,
         }
+    }
+
+    fn line_point(freq_hz: f64, c1: f64, c3: f64) -> FrfPoint {
+        FrfPoint {
+            freq_hz,
+            amplitudes: vec![c1.abs()],
+            peaks: vec![0.0],
+            states: Vec::new(),
+            newton_iterations: 1,
+            residual: 0.0,
+            coefficients: vec![c1, 0.0, c3, 0.0],
+            accuracy: None,
+            stability: None,
+        }
+    }
+
+    /// The reference path c₁ = 1 + (f − 100) (one DOF, harmonics 1 and 3) crosses the
+    /// hyperplane through (100.5 Hz, c₁ = 1.3) normal to the direction (1 Hz, 1) at 100.4 Hz,
+    /// c₁ = 1.4 (the 3rd harmonic, which the point's set lacks, does not enter); the segment
+    /// across a jump to another branch, which crosses it too, is not a crossing.
+    #[test]
+    fn the_reference_is_read_where_it_crosses_the_hyperplane_normal_to_the_path() {
+        let mut points: Vec<FrfPoint> = (0..=10)
+            .map(|k| {
+                let f = 100.0 + 0.1 * k as f64;
+                line_point(f, 1.0 + (f - 100.0), 7.0)
+            })
+            .collect();
+        // The far branch: c1 = −5 at 99 Hz and 97 Hz, on one side of the hyperplane; the
+        // jump's segment from (101 Hz, 2) to (99 Hz, −5) crosses it.
+        points.push(line_point(99.0, -5.0, 0.0));
+        points.push(line_point(97.0, -5.0, 0.0));
+        let mut reference = run_with_jumps(vec![Jump {
+            from_hz: 101.0,
+            to_hz: 97.0,
+            first_point: 11,
+            kind: JumpKind::PastFold,
+        }]);
+        reference.points = points;
+        let point = FrfPoint {
+            coefficients: vec![1.3, 0.0],
+            ..line_point(100.5, 1.3, 0.0)
+        };
+        let set = HarmonicSet::new(vec![1]);
+        let reference_set = HarmonicSet::new(vec![1, 3]);
+        // Unit weight per Hz of frequency (ω in rad/s) and per unit of c1.
+        let normal = [1.0, 0.0, 1.0 / (2.0 * PI)];
+        let (amplitude, freq_hz) =
+            amplitude_across_path(&reference, &reference_set, &point, &set, &normal, 0).unwrap();
+        assert!((amplitude - 1.4).abs() < 1e-12, "{amplitude}");
+        assert!((freq_hz - 100.4).abs() < 1e-12, "{freq_hz}");
+        // Without the line but its last point, only the jump's segment crosses: none.
+        reference.points.drain(..10);
+        reference.jumps[0].first_point = 1;
+        assert_eq!(
+            amplitude_across_path(&reference, &reference_set, &point, &set, &normal, 0),
+            None
+        );
     }
 
     /// A path that reached the end frequency but jumped over a stretch at a fold that no branch

@@ -225,6 +225,22 @@ impl Continuation {
         *self.carried.borrow_mut() = None;
     }
 
+    /// The hyperplane normal to the path of the unit tangent `t` (scaled space), as a covector
+    /// on the unknowns (x, ω in rad/s): tᵢ / x_scaleᵢ and t_ω / 2π (see
+    /// [`Observer::accepted`]).
+    fn path_normal(&self, t: &[f64]) -> Vec<f64> {
+        let n = self.x_scale.len();
+        (0..=n)
+            .map(|i| {
+                if i < n {
+                    t[i] / self.x_scale[i]
+                } else {
+                    t[n] / OMEGA_SCALE
+                }
+            })
+            .collect()
+    }
+
     /// Keeps the chord corrector's last factorisation for the tangent at its point.
     fn keep_factor(&self, factor: Option<BorderedFactor>, tangent: &[f64]) {
         *self.last_factor.borrow_mut() = factor.map(|f| (tangent.to_vec(), f));
@@ -840,7 +856,7 @@ impl Continuation {
             summary.turning_points.push(point.freq_hz());
             observer.turning_point(point.freq_hz());
         }
-        observer.accepted(system, &point);
+        observer.accepted(system, &point, Some(&self.path_normal(&t_new)));
         let left = self.left_range(&point);
         *tangent = t_new;
         self.adapt_scale(&point.x, tangent);
@@ -868,13 +884,14 @@ impl Continuation {
                 freq_hz: a.freq_start_hz,
                 reason,
             })?;
-        observer.accepted(system, &first);
         let mut tangent =
             self.tangent(system, &first, None)
                 .map_err(|reason| ContinuationError::Start {
                     freq_hz: a.freq_start_hz,
                     reason,
                 })?;
+        // The tangent evaluated the operator at the first point, as the observer expects.
+        observer.accepted(system, &first, Some(&self.path_normal(&tangent)));
         let mut summary = PathSummary {
             points: vec![first],
             turning_points: Vec::new(),
@@ -925,7 +942,7 @@ impl Continuation {
                 match self.solve_fixed(system, &guess, omega_end) {
                     Ok(mut p) => {
                         p.step = ds * frac;
-                        observer.accepted(system, &p);
+                        observer.accepted(system, &p, None);
                         summary.points.push(p);
                         summary.end = PathEnd::EndFrequency;
                         return Ok(summary);

@@ -106,7 +106,15 @@ impl PathPoint {
 /// Receives continuation events; writing results as they come is an observer's job.
 pub trait Observer<S: ParametricResidual> {
     /// A point converged. The operator was last evaluated at this point.
-    fn accepted(&mut self, _system: &mut S, _point: &PathPoint) {}
+    ///
+    /// `normal` (length dim + 1), when the path's tangent at the point is known, is the
+    /// hyperplane normal to the path there, as a covector on (x, ω): the points y = (x, ω) with
+    /// Σᵢ normalᵢ (xᵢ − x_pᵢ) + normalₙ (ω − ω_p) = 0, ω in rad/s. It is the unit tangent t of
+    /// the continuation's scaled space (x / x_scale, ω / 2π) divided by the scales, so that the
+    /// hyperplane is the one orthogonal to the path in the arc length's own metric (the
+    /// corrector's hyperplane of Eq. 9). None at points solved at a fixed frequency (the end
+    /// frequency of a path).
+    fn accepted(&mut self, _system: &mut S, _point: &PathPoint, _normal: Option<&[f64]>) {}
     /// A step was rejected and will be retried with `new_step`.
     fn rejected(&mut self, _freq_hz: f64, _step: f64, _new_step: f64, _reason: &NewtonFailure) {}
     /// dω/ds changed sign between the previous and this point.
