@@ -33,7 +33,8 @@
 //! thread; the QZ of the pencil
 //! was tried first: on the paper system at H = 3 it took seconds per point against milliseconds). A singular mass matrix is
 //! refused. The cost grows as (2·unknowns)³: models with more than [`MAX_HILL_UNKNOWNS`]
-//! unknowns are refused at the scene check (field `analysis.stability`).
+//! unknowns are refused at the scene check (field `analysis.stability`); the sparse
+//! shift-invert solve of [`crate::analysis::stability_sparse`] is the start of their path.
 //!
 //! # Picking the Floquet exponents
 //!
@@ -70,9 +71,10 @@ use crate::contact::ContactState;
 use crate::hbm::{HbmError, HbmSystem};
 use crate::model::LinearModel;
 
-/// Most harmonic-balance unknowns (DOFs × coefficient blocks) for which a scene may ask for
-/// Hill stability: the dense QZ of the 2·unknowns companion pencil costs about
-/// 30·(2·unknowns)³ flops (≈ 0.3 s at 300 unknowns on the development machine).
+/// Most harmonic-balance unknowns (DOFs × coefficient blocks) solved by the dense eigen solve
+/// of the 2·unknowns companion matrix, about 30·(2·unknowns)³ flops; scenes above it are
+/// refused (the sparse shift-invert solve, [`crate::analysis::stability_sparse`], is not yet
+/// trusted for runs).
 pub const MAX_HILL_UNKNOWNS: usize = 600;
 
 /// Largest real part of the leading Floquet exponent, relative to ω, of a point still
@@ -376,7 +378,7 @@ fn sequential_eigen(
 /// the eigenvector p (harmonic-major real-coefficient blocks of `n` DOFs): 0 for content
 /// centred on the 0th component (including a real mode split evenly between k = ±1, the
 /// saddle-node mode at a fold), ±1 for its copies shifted by one harmonic.
-fn content_centroid(set: &HarmonicSet, n: usize, p: faer::ColRef<'_, c64>) -> f64 {
+pub(crate) fn content_centroid(set: &HarmonicSet, n: usize, p: faer::ColRef<'_, c64>) -> f64 {
     let i = c64::new(0.0, 1.0);
     let (mut moment, mut total) = (0.0, 0.0);
     for (jb, block) in set.blocks().iter().enumerate() {
@@ -433,7 +435,9 @@ pub fn verdict(exponents: &[c64], omega: f64) -> PointStability {
 /// The stability of the converged point with full coefficients `x` at ω (rad/s) of `system`:
 /// its Jacobian (the system's strategy, analytic by default) in dense form, the Floquet
 /// exponents and the verdict, `reliable` from the contact states at the point
-/// ([`hill_reliable`]). The system's contact states are left as they were.
+/// ([`hill_reliable`]). The system's contact states are left as they were. The whole Hill
+/// spectrum is solved densely; [`crate::analysis::stability_sparse::point_stability_with`]
+/// can use the sparse shift-invert solve instead (not yet used by runs).
 pub fn point_stability(
     system: &mut HbmSystem<'_>,
     x: &[f64],
