@@ -85,8 +85,11 @@ pub const STABILITY_TOLERANCE: f64 = 1e-6;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum VerdictSource {
-    /// Hill's method (this module).
+    /// Hill's method (this module), the whole spectrum by the dense eigen solve.
     Hill,
+    /// Hill's method by the sparse shift-invert solve of the exponents near the estimated
+    /// ones ([`crate::analysis::stability_sparse`]).
+    HillSparse,
     /// The monodromy of the time integration's periodic orbit
     /// ([`crate::analysis::monodromy`]).
     Monodromy,
@@ -100,6 +103,7 @@ impl VerdictSource {
     pub fn label(self) -> &'static str {
         match self {
             VerdictSource::Hill => "hill",
+            VerdictSource::HillSparse => "hill-sparse",
             VerdictSource::Monodromy => "monodromy",
             VerdictSource::Failed => "failed",
         }
@@ -174,7 +178,7 @@ pub fn methods_text<'a>(verdicts: impl IntoIterator<Item = &'a PointStability>) 
     let (mut hill, mut hill_unreliable, mut monodromy) = (false, false, false);
     for v in verdicts {
         match v.method {
-            VerdictSource::Hill => {
+            VerdictSource::Hill | VerdictSource::HillSparse => {
                 hill = true;
                 hill_unreliable |= !v.reliable;
             }
@@ -379,8 +383,17 @@ fn sequential_eigen(
 /// centred on the 0th component (including a real mode split evenly between k = ±1, the
 /// saddle-node mode at a fold), ±1 for its copies shifted by one harmonic.
 pub(crate) fn content_centroid(set: &HarmonicSet, n: usize, p: faer::ColRef<'_, c64>) -> f64 {
+    content_profile(set, n, p).0
+}
+
+/// The centroid k̄ of [`content_centroid`] and the fraction of the content at the truncation
+/// edge |k| = H (0 when H = 0). A spurious eigenvalue of the truncated Hill matrix can have
+/// its content split between k = +H and k = −H, hence k̄ ≈ 0: the edge fraction tells it apart
+/// from a centred copy.
+pub fn content_profile(set: &HarmonicSet, n: usize, p: faer::ColRef<'_, c64>) -> (f64, f64) {
+    let h_max = set.harmonics().last().copied().unwrap_or(0);
     let i = c64::new(0.0, 1.0);
-    let (mut moment, mut total) = (0.0, 0.0);
+    let (mut moment, mut total, mut edge) = (0.0, 0.0, 0.0);
     for (jb, block) in set.blocks().iter().enumerate() {
         match block {
             Block::Constant => {
@@ -398,14 +411,17 @@ pub(crate) fn content_centroid(set: &HarmonicSet, n: usize, p: faer::ColRef<'_, 
                 }
                 moment += *h as f64 * (plus - minus);
                 total += plus + minus;
+                if *h == h_max {
+                    edge += plus + minus;
+                }
             }
             Block::Sin(_) => {}
         }
     }
     if total > 0.0 {
-        moment / total
+        (moment / total, edge / total)
     } else {
-        0.0
+        (0.0, 0.0)
     }
 }
 

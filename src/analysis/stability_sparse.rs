@@ -71,30 +71,32 @@ use faer::prelude::Solve;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{c64, Mat};
 
-#[allow(unused_imports)]
-use super::stability::MAX_HILL_UNKNOWNS;
 use super::stability::{
-    content_centroid, floquet_exponents, harmonics_supported, hill_reliable, verdict,
-    PointStability, StabilityError,
+    content_profile, floquet_exponents, harmonics_supported, hill_reliable, verdict,
+    PointStability, StabilityError, VerdictSource, MAX_HILL_UNKNOWNS,
 };
 use crate::contact::harmonic::{Block, HarmonicSet};
 use crate::hbm::HbmSystem;
-use crate::model::LinearModel;
+use crate::model::{HillSolve, LinearModel};
 
 /// Shifts and sizes of the shift-invert solve.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ShiftInvertSettings {
-    /// Shifts as fractions of the excitation frequency on the imaginary axis: σ = i·f (in
-    /// s = λ/ω; λ = i f ω). `None`: spread evenly over [0, 1/2], as many as needed for every
-    /// exponent ([`automatic_shifts`]).
+    /// Explicit shifts σ = i·f as fractions f of the excitation frequency (s = λ/ω; a shift at
+    /// f = 2.5 sits at 2.5 times the excitation frequency on the imaginary axis), replacing
+    /// the automatic placement at the estimated exponents ([`exponent_estimates`]); coverage
+    /// is then judged against the same estimates.
     pub shifts: Option<Vec<f64>>,
-    /// Eigenvalues wanted per shift (the nearest to it).
-    pub per_shift: usize,
-    /// Krylov space dimension per shift (at least `per_shift` + 1; capped at 2·unknowns).
+    /// Highest frequency (Hz) of the estimated exponents that must be covered; `None`: all of
+    /// them (every mode of the model).
+    pub max_freq_hz: Option<f64>,
+    /// Krylov space dimension per shift (capped at 2·unknowns).
     pub krylov: usize,
-    /// Relative residual of the quadratic problem below which an eigenpair is accepted (the
-    /// real parts that decide the verdict are 10⁻³-10⁻⁴ of |λ| for light damping, so a
-    /// backward error of 10⁻⁸ moved them by 20 % on the paper system: hence 10⁻¹²).
+    /// Arnoldi's residual of a Ritz pair of the shift-invert operator, relative to its
+    /// eigenvalue μ = 1/(s − σ), below which the pair counts as converged: the eigenvalue's
+    /// error is then about tolerance·|s − σ| (times its condition number). A backward error
+    /// on the quadratic problem relative to ‖J‖ was tried first: with contact springs
+    /// dominating ‖J‖ it let through unconverged Ritz values of mixed harmonic content.
     pub tolerance: f64,
 }
 
@@ -102,12 +104,17 @@ impl Default for ShiftInvertSettings {
     fn default() -> Self {
         Self {
             shifts: None,
-            per_shift: 12,
+            max_freq_hz: None,
             krylov: 60,
-            tolerance: 1e-12,
+            tolerance: 1e-10,
         }
     }
 }
+
+/// Backward error of an accepted eigenpair on the quadratic problem itself, a guard against
+/// a Krylov basis that lost orthogonality (the convergence test proper is Arnoldi's residual,
+/// [`ShiftInvertSettings::tolerance`]).
+const QUADRATIC_BACKWARD_ERROR: f64 = 1e-8;
 
 /// A sparse real matrix as (row, col, value) triplets.
 type Triplets = Vec<(usize, usize, f64)>;
@@ -115,33 +122,87 @@ type Triplets = Vec<(usize, usize, f64)>;
 /// The found exponents and what the solve did.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ShiftInvertExponents {
-    /// Floquet exponents λ (1/s), each as its most centred copy, merged over shifts.
+    /// Floquet exponents λ (1/s) with Im λ ≥ 0 (the conjugates are exponents too): the centred
+    /// Hill eigenvalues (|k̄| ≤ 1/2) inside the covered discs.
     pub exponents: Vec<c64>,
+    /// Per exponent: its eigenvector's content centroid k̄ and the fraction of its content at
+    /// the truncation edge |k| = H ([`super::stability::content_profile`]).
+    pub content: Vec<(f64, f64)>,
     /// Ritz pairs dropped by the residual check.
     pub rejected: usize,
-    /// Shifts used (fractions of ω on the imaginary axis).
-    pub shifts: Vec<f64>,
-    /// Whether every exponent was found: the found ones, counted with their conjugates, number
-    /// at least 2·DOFs (the count of Floquet exponents). Only then is the leading one known.
+    /// Shifts used, in s = λ/ω (complex: placed at the estimates).
+    pub shifts: Vec<c64>,
+    /// Radii (in s) of the discs around the shifts inside which every Hill eigenvalue was
+    /// found: the distance of the farthest of the consecutive nearest Ritz values that passed
+    /// the residual check (0 when the nearest one failed).
+    pub radii: Vec<f64>,
+    /// The estimated exponents (1/s, Im ≥ 0, up to the frequency limit) that had to be
+    /// covered, and how many of them no disc covers.
+    pub estimates: Vec<c64>,
+    /// Estimates outside every disc.
+    pub uncovered: usize,
+    /// Whether some disc covers every estimate (and s = 0): only then is the leading
+    /// exponent taken as known.
     pub complete: bool,
 }
 
-/// Shifts spread evenly over [0, 1/2] (fractions of ω on the imaginary axis; the spectrum is
-/// symmetric about the real axis, so the lower half of the strip adds nothing): the strip
-/// Im s ∈ [0, 1/2] holds about `n_dofs` eigenvalues, one copy of each exponent with Im ≥ 0,
-/// and each shift is asked for `per_shift` of them, about half of which lie below the shift
-/// or are conjugates of others near s = 0: 3·n_dofs/per_shift + 1 shifts (at least 3: 0, 1/4,
-/// 1/2) leave overlap between neighbours.
-pub fn automatic_shifts(n_dofs: usize, per_shift: usize) -> Vec<f64> {
-    let count = ((3.0 * n_dofs as f64 / per_shift.max(1) as f64).ceil() as usize + 1).max(3);
-    (0..count)
-        .map(|k| 0.5 * k as f64 / (count - 1) as f64)
-        .collect()
+/// Exponents an eigenvalue with Im ≥ 0 stands for: 1 if real, 2 with its conjugate.
+fn pair_count(e: c64) -> usize {
+    if e.im.abs() > 1e-9 * e.norm() {
+        2
+    } else {
+        1
+    }
 }
 
-/// The Floquet exponents nearest the shifts of `settings` (see the module doc) of a point with
-/// harmonic-balance Jacobian `jacobian` (triplets, duplicates summed, harmonic-major, all DOFs
-/// of `model`, blocks of `set`) at ω (rad/s).
+/// Most DOFs for the dense estimate of the exponents ([`exponent_estimates`]), a 2·DOFs
+/// nonsymmetric eigen solve: (2H + 1)³ times cheaper than the dense Hill solve it replaces,
+/// still about 30·(2·DOFs)³ flops.
+pub const MAX_ESTIMATE_DOFS: usize = 1000;
+
+/// Estimates of the Floquet exponents (1/s) with Im ≥ 0: the damped eigenvalues of
+/// λ²M + λC + K̄, K̄ = J₀₀ the harmonic-balance Jacobian's 0th-harmonic block (the structure's
+/// stiffness plus the period-mean contact stiffness at the point: kt for a stuck contact, 0
+/// for an open one). For a linear system these are the exponents themselves; with contacts
+/// they sit near them. `jacobian`: triplets, harmonic-major (the 0th harmonic block first).
+pub fn exponent_estimates(
+    model: &LinearModel,
+    jacobian: &[(usize, usize, f64)],
+) -> Result<Vec<c64>, StabilityError> {
+    use faer::linalg::solvers::DenseSolveCore;
+    let n = model.n_dofs();
+    let (m, c) = (model.mass.to_dense(), model.damping.to_dense());
+    let mut k = Mat::<f64>::zeros(n, n);
+    for &(i, j, v) in jacobian {
+        if i < n && j < n {
+            k[(i, j)] += v;
+        }
+    }
+    let minv = m.as_ref().partial_piv_lu().inverse();
+    if !minv.as_ref().is_all_finite() {
+        return Err(StabilityError::SingularMass);
+    }
+    let (mk, mc) = (&minv * &k, &minv * &c);
+    let a = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+        (true, true) => 0.0,
+        (true, false) => f64::from(u8::from(j - n == i)),
+        (false, true) => -mk[(i - n, j)],
+        (false, false) => -mc[(i - n, j - n)],
+    });
+    let values = a
+        .eigenvalues()
+        .map_err(|_| StabilityError::EigenSolve { size: 2 * n })?;
+    let mut upper: Vec<c64> = values
+        .into_iter()
+        .filter(|v| v.re.is_finite() && v.im.is_finite() && v.im >= 0.0)
+        .collect();
+    upper.sort_by(|a, b| a.im.total_cmp(&b.im));
+    Ok(upper)
+}
+
+/// The Floquet exponents of a point with harmonic-balance Jacobian `jacobian` (triplets,
+/// duplicates summed, harmonic-major, all DOFs of `model`, blocks of `set`) at ω (rad/s), by
+/// shift-invert Arnoldi with shifts placed at the estimated exponents (see the module doc).
 pub fn floquet_exponents_shift_invert(
     model: &LinearModel,
     set: &HarmonicSet,
@@ -164,15 +225,49 @@ pub fn floquet_exponents_shift_invert(
         rows.into_iter().fold(0.0, f64::max)
     };
     let (nj, n1, n2) = (norm(jacobian), norm(&a1), norm(&a2));
-    let mut found: Vec<c64> = Vec::new();
-    let mut rejected = 0;
-    let h_max = set.harmonics().last().copied().unwrap_or(0) as f64;
-    let shifts = settings
+    let limit = settings
+        .max_freq_hz
+        .map_or(f64::INFINITY, |f| 2.0 * std::f64::consts::PI * f);
+    let estimates: Vec<c64> = exponent_estimates(model, jacobian)?
+        .into_iter()
+        .filter(|e| e.im <= limit)
+        .collect();
+    // Targets in s = λ/ω: s = 0 first (a fold's real exponent, whatever the estimates say;
+    // a little off the axis so that Q(σ) = J stays regular at the fold itself), then the
+    // estimates in order of frequency.
+    let mut targets: Vec<c64> = vec![c64::new(0.0, 1e-2)];
+    targets.extend(estimates.iter().map(|e| e / omega));
+    let explicit: Option<Vec<c64>> = settings
         .shifts
-        .clone()
-        .unwrap_or_else(|| automatic_shifts(n, settings.per_shift));
-    for &f in &shifts {
-        let sigma = c64::new(0.0, f);
+        .as_ref()
+        .map(|f| f.iter().map(|&f| c64::new(0.0, f)).collect());
+    let mut found: Vec<c64> = Vec::new();
+    let mut content: Vec<(f64, f64)> = Vec::new();
+    let (mut shifts, mut radii) = (Vec::new(), Vec::new());
+    let mut rejected = 0;
+    let mut covered = vec![false; targets.len()];
+    let mut next = 0;
+    loop {
+        // The next shift: the explicit list, or the first target no disc covers yet.
+        let sigma = match &explicit {
+            Some(list) => match list.get(shifts.len()) {
+                Some(s) => *s,
+                None => break,
+            },
+            None => {
+                while next < targets.len() && covered[next] {
+                    next += 1;
+                }
+                if next == targets.len() {
+                    break;
+                }
+                next += 1;
+                // Just off the estimate: for a linear system the estimate is an exact
+                // eigenvalue, where Q(σ) would be singular.
+                let t = targets[next - 1];
+                c64::new(t.re, t.im + 1e-4 * (1.0 + t.norm()))
+            }
+        };
         let q = complex_pencil(dim, jacobian, &a1, &a2, sigma)?;
         let lu = q
             .sp_lu()
@@ -193,8 +288,8 @@ pub fn floquet_exponents_shift_invert(
             out.extend((0..dim).map(|i| x[i] + sigma * u[(i, 0)]));
             out
         };
-        let m = settings.krylov.max(settings.per_shift + 1).min(2 * dim);
-        let (basis, hess) = arnoldi(&apply, 2 * dim, m);
+        let m = settings.krylov.max(2).min(2 * dim);
+        let (basis, hess, beta) = arnoldi(&apply, 2 * dim, m);
         let k = hess.ncols();
         let small = Mat::from_fn(k, k, |i, j| hess[(i, j)]);
         let eig = small
@@ -203,7 +298,10 @@ pub fn floquet_exponents_shift_invert(
         let (vals, vecs) = (eig.S(), eig.U());
         let mut order: Vec<usize> = (0..k).filter(|&j| vals[j].norm() > 0.0).collect();
         order.sort_by(|&a, &b| vals[b].norm().total_cmp(&vals[a].norm()));
-        for &j in order.iter().take(settings.per_shift) {
+        // Walk the Ritz values from the nearest to the shift outwards while they pass the
+        // residual check: the disc up to the last one holds every Hill eigenvalue found.
+        let mut radius = 0.0;
+        for &j in &order {
             let s = sigma + c64::new(1.0, 0.0) / vals[j];
             // Ritz vector's upper half p = V[..dim] y.
             let mut p = vec![c64::new(0.0, 0.0); dim];
@@ -216,7 +314,15 @@ pub fn floquet_exponents_shift_invert(
             let pn = p.iter().map(|v| v.norm_sqr()).sum::<f64>().sqrt();
             if !(s.re.is_finite() && s.im.is_finite()) || pn == 0.0 {
                 rejected += 1;
-                continue;
+                break;
+            }
+            // Arnoldi's residual of the Ritz pair of the shift-invert operator,
+            // ‖(L − σI)⁻¹z − μz‖ = β·|y_last| / ‖y‖: converged when below tol·|μ|.
+            let y_norm = (0..k).map(|c| vecs[(c, j)].norm_sqr()).sum::<f64>().sqrt();
+            let ritz_residual = beta * vecs[(k - 1, j)].norm() / y_norm;
+            if ritz_residual > settings.tolerance * vals[j].norm() {
+                rejected += 1;
+                break;
             }
             let mut r = vec![c64::new(0.0, 0.0); dim];
             for &(i, jj, a) in jacobian {
@@ -230,35 +336,63 @@ pub fn floquet_exponents_shift_invert(
             }
             let rn = r.iter().map(|v| v.norm_sqr()).sum::<f64>().sqrt();
             let scale = (nj + s.norm() * n1 + s.norm_sqr() * n2) * pn;
-            if rn > settings.tolerance * scale {
+            if rn > QUADRATIC_BACKWARD_ERROR * scale {
                 rejected += 1;
+                break;
+            }
+            radius = (s - sigma).norm();
+            let pm = Mat::from_fn(dim, 1, |i, _| p[i]);
+            let (centroid, edge) = content_profile(set, n, pm.col(0));
+            if centroid.abs() > 0.5 {
                 continue;
             }
-            let pm = Mat::from_fn(dim, 1, |i, _| p[i]);
-            let centroid = content_centroid(set, n, pm.col(0));
-            let shift = centroid.round().clamp(-h_max, h_max);
-            let lambda = (s + c64::new(0.0, shift)) * omega;
-            let same = |a: &c64, b: c64| (a - b).norm() <= 1e-6 * (b.norm() + omega);
-            if !found
-                .iter()
-                .any(|e| same(e, lambda) || same(e, lambda.conj()))
-            {
+            // Exponents are kept with Im ≥ 0 (their conjugates are exponents too).
+            let lambda = if s.im < 0.0 { s.conj() } else { s } * omega;
+            let same = |a: &c64| (a - lambda).norm() <= 1e-8 * (lambda.norm() + omega);
+            if !found.iter().any(same) {
                 found.push(lambda);
+                content.push((centroid, edge));
             }
         }
+        for (t, c) in targets.iter().zip(covered.iter_mut()) {
+            // A disc covers a target, or its conjugate (the spectrum is symmetric).
+            *c |= (t - sigma).norm() < radius || (t.conj() - sigma).norm() < radius;
+        }
+        shifts.push(sigma);
+        radii.push(radius);
     }
     if found.is_empty() {
         return Err(StabilityError::NoFiniteExponent);
     }
-    let counted: usize = found
-        .iter()
-        .map(|e| if e.im.abs() > 1e-9 * e.norm() { 2 } else { 1 })
-        .sum();
+    // The dense rule on what was found: as many exponents as the estimates count (2·DOFs
+    // without a frequency limit, conjugates counted), those with the most centred content.
+    // Candidates beyond that count mix the 0th harmonic with others (at a stuck point the
+    // initial slider state couples every harmonic into the 0th-harmonic force).
+    let wanted: usize = estimates.iter().map(|e| pair_count(*e)).sum();
+    let mut order: Vec<usize> = (0..found.len()).collect();
+    order.sort_by(|&a, &b| content[a].0.abs().total_cmp(&content[b].0.abs()));
+    let mut kept = Vec::new();
+    let mut counted = 0;
+    for i in order {
+        if counted >= wanted {
+            break;
+        }
+        counted += pair_count(found[i]);
+        kept.push(i);
+    }
+    kept.sort_unstable();
+    let found: Vec<c64> = kept.iter().map(|&i| found[i]).collect();
+    let content: Vec<(f64, f64)> = kept.iter().map(|&i| content[i]).collect();
+    let uncovered = covered.iter().filter(|c| !**c).count();
     Ok(ShiftInvertExponents {
         exponents: found,
+        content,
         rejected,
         shifts,
-        complete: counted >= 2 * n,
+        radii,
+        estimates,
+        uncovered,
+        complete: uncovered == 0,
     })
 }
 
@@ -271,6 +405,26 @@ pub enum HillSolver {
     /// The exponents nearest a few shifts on the imaginary axis by the sparse shift-invert
     /// Arnoldi solve (this module).
     ShiftInvert(ShiftInvertSettings),
+}
+
+/// Whether the scene's choice `analysis.hill_solver` runs the shift-invert solve for a problem
+/// of `unknowns` harmonic-balance unknowns (`auto`: above [`MAX_HILL_UNKNOWNS`]).
+pub fn uses_shift_invert(choice: HillSolve, unknowns: usize) -> bool {
+    match choice {
+        HillSolve::Auto => unknowns > MAX_HILL_UNKNOWNS,
+        HillSolve::Dense => false,
+        HillSolve::ShiftInvert => true,
+    }
+}
+
+/// The Hill solver of a problem with the scene's choice `analysis.hill_solver` (default
+/// settings for the shift-invert solve).
+pub fn hill_solver_for(choice: HillSolve, unknowns: usize) -> HillSolver {
+    if uses_shift_invert(choice, unknowns) {
+        HillSolver::ShiftInvert(ShiftInvertSettings::default())
+    } else {
+        HillSolver::Dense
+    }
 }
 
 /// [`super::stability::point_stability`] with the Hill solver chosen by the caller. The shift-invert solve
@@ -302,6 +456,10 @@ pub fn point_stability_with(
     }
     evaluated?;
     let mut complete = true;
+    let method = match solver {
+        HillSolver::Dense => VerdictSource::Hill,
+        HillSolver::ShiftInvert(_) => VerdictSource::HillSparse,
+    };
     let exponents = match solver {
         HillSolver::Dense => {
             let dense = jacobian.to_dense();
@@ -326,6 +484,7 @@ pub fn point_stability_with(
     };
     Ok(PointStability {
         reliable: reliable && complete,
+        method,
         ..verdict(&exponents, omega)
     })
 }
@@ -388,7 +547,11 @@ fn complex_pencil(
 /// m steps of Arnoldi on `apply` (size `size`) from a fixed start vector: the orthonormal
 /// basis (m vectors, fewer on a lucky breakdown) and the square Hessenberg matrix of the
 /// steps taken. Gram-Schmidt is applied twice per step.
-fn arnoldi(apply: &dyn Fn(&[c64]) -> Vec<c64>, size: usize, m: usize) -> (Vec<Vec<c64>>, Mat<c64>) {
+fn arnoldi(
+    apply: &dyn Fn(&[c64]) -> Vec<c64>,
+    size: usize,
+    m: usize,
+) -> (Vec<Vec<c64>>, Mat<c64>, f64) {
     // A fixed start with every component non-zero and no structure the harmonics share.
     let mut v0: Vec<c64> = (0..size)
         .map(|i| {
@@ -401,6 +564,7 @@ fn arnoldi(apply: &dyn Fn(&[c64]) -> Vec<c64>, size: usize, m: usize) -> (Vec<Ve
     let mut basis = vec![v0];
     let mut hess = Mat::<c64>::zeros(m + 1, m);
     let mut steps = m;
+    let mut last_beta = 0.0;
     for j in 0..m {
         let mut w = apply(&basis[j]);
         for _pass in 0..2 {
@@ -412,8 +576,10 @@ fn arnoldi(apply: &dyn Fn(&[c64]) -> Vec<c64>, size: usize, m: usize) -> (Vec<Ve
         }
         let beta = w.iter().map(|v| v.norm_sqr()).sum::<f64>().sqrt();
         hess[(j + 1, j)] = c64::new(beta, 0.0);
+        last_beta = beta;
         if beta <= 1e-14 * (0..=j).map(|i| hess[(i, j)].norm()).fold(0.0, f64::max) {
             steps = j + 1;
+            last_beta = 0.0;
             break;
         }
         if j + 1 < m {
@@ -423,5 +589,5 @@ fn arnoldi(apply: &dyn Fn(&[c64]) -> Vec<c64>, size: usize, m: usize) -> (Vec<Ve
     }
     basis.truncate(steps);
     let h = Mat::from_fn(steps, steps, |i, j| hess[(i, j)]);
-    (basis, h)
+    (basis, h, last_beta)
 }
