@@ -33,8 +33,8 @@
 //! thread; the QZ of the pencil
 //! was tried first: on the paper system at H = 3 it took seconds per point against milliseconds). A singular mass matrix is
 //! refused. The cost grows as (2·unknowns)³: models with more than [`MAX_HILL_UNKNOWNS`]
-//! unknowns are refused at the scene check (field `analysis.stability`); the sparse
-//! shift-invert solve of [`crate::analysis::stability_sparse`] is the start of their path.
+//! unknowns use the sparse shift-invert solve of [`crate::analysis::stability_sparse`]
+//! instead (scene field `analysis.hill_solver`, default `auto`).
 //!
 //! # Picking the Floquet exponents
 //!
@@ -72,9 +72,9 @@ use crate::hbm::{HbmError, HbmSystem};
 use crate::model::LinearModel;
 
 /// Most harmonic-balance unknowns (DOFs × coefficient blocks) solved by the dense eigen solve
-/// of the 2·unknowns companion matrix, about 30·(2·unknowns)³ flops; scenes above it are
-/// refused (the sparse shift-invert solve, [`crate::analysis::stability_sparse`], is not yet
-/// trusted for runs).
+/// of the 2·unknowns companion matrix, about 30·(2·unknowns)³ flops; above it runs use the
+/// sparse shift-invert solve ([`crate::analysis::stability_sparse`]) unless the scene asks for
+/// `analysis.hill_solver = "dense"`, which is then refused.
 pub const MAX_HILL_UNKNOWNS: usize = 600;
 
 /// Largest real part of the leading Floquet exponent, relative to ω, of a point still
@@ -453,7 +453,7 @@ pub fn verdict(exponents: &[c64], omega: f64) -> PointStability {
 /// exponents and the verdict, `reliable` from the contact states at the point
 /// ([`hill_reliable`]). The system's contact states are left as they were. The whole Hill
 /// spectrum is solved densely; [`crate::analysis::stability_sparse::point_stability_with`]
-/// can use the sparse shift-invert solve instead (not yet used by runs).
+/// can use the sparse shift-invert solve instead (what runs do above the dense limit).
 pub fn point_stability(
     system: &mut HbmSystem<'_>,
     x: &[f64],

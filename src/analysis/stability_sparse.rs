@@ -1,7 +1,9 @@
-//! Hill stability for models above the dense limit ([`super::stability::MAX_HILL_UNKNOWNS`]),
-//! **not yet used by runs** (see "Status" below): the Floquet exponents nearest chosen points of the imaginary axis, by a shift-invert
-//! Arnoldi iteration on the companion form of the Hill quadratic eigenvalue problem, with the
-//! sparse harmonic-balance Jacobian and a complex sparse LU (faer 0.24) per shift.
+//! Hill stability for models above the dense limit ([`super::stability::MAX_HILL_UNKNOWNS`],
+//! or on request): the Floquet exponents near estimates of them, by a shift-invert Arnoldi
+//! iteration on the companion form of the Hill quadratic eigenvalue problem, with the sparse
+//! harmonic-balance Jacobian and a complex sparse LU (faer 0.24) per shift. Runs use it through
+//! the scene field `analysis.hill_solver` (`auto`: above the dense limit; `shift-invert`:
+//! always); its verdicts carry `stability_method = hill-sparse`.
 //!
 //! # The operator
 //!
@@ -16,56 +18,70 @@
 //! u = Q(σ)⁻¹ [ −A₂ y − (A₁ + σA₂) x ],   w = x + σ u,   (L − σI)⁻¹ [x; y] = [u; w].
 //! ```
 //!
-//! Q(σ) = J + σA₁ + σ²A₂ is complex for a shift off the real axis, so it is factored by faer's
-//! sparse LU in complex arithmetic (a real shift could not separate exponents by their
-//! imaginary parts, which is what the shifts along the axis are for). One factorisation per
-//! shift; each Arnoldi step is one forward/back solve.
+//! Q(σ) = J + σA₁ + σ²A₂ is complex, factored once per shift by faer's sparse LU; each Arnoldi
+//! step is one forward/back solve. No well-kept Rust crate offered a shift-invert Arnoldi
+//! (ARPACK-style) over faer's complex sparse LU at the time of writing (the reduction crate's
+//! block Lanczos is for the symmetric K, M pencil), hence this one.
 //!
-//! # The iteration
+//! # Where the shifts go
 //!
-//! Plain Arnoldi with classical Gram-Schmidt twice (no restart): a Krylov space of
-//! [`ShiftInvertSettings::krylov`] vectors, then the Ritz pairs of the Hessenberg matrix
-//! (faer's dense complex eigen solve). The [`ShiftInvertSettings::per_shift`] Ritz values of
-//! largest |μ| (nearest the shift) are kept if the eigenpair they give passes a residual check
-//! on the quadratic problem itself, ‖Q(s) p‖ ≤ tol · (‖J‖ + |s|‖A₁‖ + |s|²‖A₂‖) ‖p‖ (∞-norms of
-//! the matrices); a pair that fails is dropped and counted. No well-kept Rust crate offered a
-//! shift-invert Arnoldi (ARPACK-style) over faer's complex sparse LU at the time of writing
-//! (the reduction crate's block Lanczos is for the symmetric K, M pencil), hence this one.
+//! Every exponent λ appears 2H + 1 times in the Hill spectrum, as λ + ikω; the dense path keeps
+//! the **most centred** copy (content centroid k̄ ≈ 0, [`super::stability`]), and that copy
+//! sits near the physical frequencies of the linearised structure (e.g. 490 Hz on the paper
+//! system excited at 150 Hz), not in the strip Im λ ∈ (−ω/2, ω/2]. A first version put its
+//! shifts in that strip: it found copies shifted by several harmonics toward the truncation
+//! edge, poorly resolved in the truncated Hill matrix, and reported −0.148 1/s where the
+//! dense path gives −0.175 1/s. So the shifts are placed at **estimates** of the centred
+//! exponents ([`exponent_estimates`]): the damped eigenvalues of λ²M + λC + K̄ with K̄ = J₀₀, the
+//! Jacobian's 0th-harmonic block (the structure's stiffness plus the period-mean contact
+//! stiffness at the point), a dense 2·DOFs eigen solve ((2H + 1)³ times cheaper than the dense
+//! Hill solve). For a linear system, and at points where every contact is stuck or open, these
+//! estimates are the exponents themselves; at stick-slip points they are nearby. The shifts
+//! start at s = 0.01i (a fold's real exponent near 0, whatever the estimates say) and then go
+//! to the first estimate (by frequency) that no earlier shift's disc covers, just off it
+//! (σ = ŝ + 10⁻⁴(1 + |ŝ|)i, since at an exact eigenvalue Q(σ) is singular), until every
+//! estimate up to [`ShiftInvertSettings::max_freq_hz`] (default: all) is covered.
 //!
-//! # Which exponents, and the selection rule
+//! # Convergence, selection and coverage
 //!
-//! Every exponent λ appears as λ + ikω (k = −H..H); the strip Im λ ∈ (−ω/2, ω/2] holds one
-//! copy of each, and by the real problem's symmetry its half Im λ ∈ [0, ω/2] one of each
-//! conjugate pair. The shifts are spread over that half ([`automatic_shifts`]: 0, ω/4, ω/2
-//! for a few DOFs, more for more DOFs), so that together they find one copy of every
-//! exponent. Shifts only at 0 and ±ω/4 with a handful of eigenvalues each were tried first and
-//! missed the leading exponent on the paper system at 150 Hz (a 490 Hz mode, whose copy in the
-//! strip sits near ω/2): the eigenvalues nearest a shift are those nearest in imaginary part,
-//! not those with the largest real part. The same centroid rule as the dense path then
-//! names each found eigenvalue: its eigenvector's content centroid k̄ (see
-//! [`super::stability`]) says by how many harmonics it is shifted from the most centred copy,
-//! and the exponent reported is λ + i·round(k̄)·ω (the real part, which decides the verdict, is
-//! that of the copy found). Eigenvalues found from two shifts, or both copies of one exponent,
-//! are merged.
+//! Per shift, a Krylov space of [`ShiftInvertSettings::krylov`] vectors (classical
+//! Gram-Schmidt twice, no restart) and the Ritz pairs of its Hessenberg matrix (faer's dense
+//! complex eigen solve), walked from the nearest to the shift outwards while each is
+//! converged: Arnoldi's residual β|y_m|/‖y‖ ≤ [`ShiftInvertSettings::tolerance`]·|μ| (so the
+//! eigenvalue's error is about tolerance·|s − σ|), plus a backward error on the quadratic
+//! problem below 10⁻⁸ of (‖J‖ + |s|‖A₁‖ + |s|²‖A₂‖)‖p‖ as a guard. The walk stops at the first
+//! unconverged pair: the shift's disc |s − σ| ≤ r, r the distance of the farthest converged
+//! pair, is taken to hold every Hill eigenvalue in it (up to the usual Krylov caveat: an
+//! eigenvector with no component in the start vector is never seen).
 //!
-//! **Coverage.** The verdict covers only the exponents found. The solve counts them (with
-//! their conjugates) against the 2·DOFs exponents the problem has and reports
-//! [`ShiftInvertExponents::complete`]; an incomplete solve's verdict is marked not reliable
-//! (`stability_reliable = false`) by [`point_stability_with`]. The cost is
-//! one complex sparse LU of the Hill size per shift, and the shifts grow with the DOFs: this
-//! pays off against the dense (2·unknowns)³ solve through sparsity, not through asking for
-//! few exponents.
+//! Candidates are the found eigenvalues with |k̄| ≤ 1/2 (conjugates merged, kept with
+//! Im ≥ 0); then the dense rule: as many as the estimates count (2·DOFs with conjugates,
+//! without a frequency limit), those with the smallest |k̄|. The count matters: at a stuck
+//! point the initial slider state (T(τ_ini) = mμN(τ_ini)) couples every harmonic into the
+//! 0th-harmonic force, and the Hill matrix has further eigenvalues with k̄ between 0 and 1/2
+//! that are not exponents of the stuck system (measured on the paper system at 150 Hz: five
+//! such, e.g. −0.148 1/s at 1603 Hz, k̄ = 0.26, while the stuck system's six exponents come
+//! with k̄ below 10⁻²²).
 //!
-//! # Status
+//! **Coverage statement.** The solve guarantees (up to the Krylov caveat) the centred
+//! exponents inside the union of the discs; [`ShiftInvertExponents::complete`] says whether
+//! that union covers s = 0 and every estimate. The verdict is marked not reliable
+//! (`stability_reliable = false`) when it does not ([`point_stability_with`]), as well as on
+//! stick-slip points (as the dense path). The exponents that decide the verdict are the least
+//! damped: for Rayleigh or modal damping the lowest modes, which the estimates list first, so
+//! the first shifts target them; an exponent that contact nonlinearity moves far from every
+//! estimate (beyond the disc of the nearest shift) is not guaranteed to be found.
 //!
-//! Not validated: on a 12-mass chain whose one contact has μ = 0 the exponents found at 8 Hz
-//! are 0.58 1/s from the damped eigenvalues of M, C, K (fixture or solve: not resolved), and
-//! only 10 of 12 pairs were found with 30 Ritz values per shift (`complete` said so). On the paper
-//! system at H = 3 (150 Hz, contacts stuck) the solve, with a residual below 10⁻¹², reports
-//! an exponent with real part −0.148 1/s at a mapped 255 Hz while the dense path's leading one
-//! is −0.175 1/s at 490 Hz: the centroid mapping or the dense path's count-based selection
-//! differs there, not yet explained; on a 90-mass chain (630 unknowns) the automatic shifts
-//! did not find every exponent. Until both are resolved, scenes keep the dense limit.
+//! # Checks and cost
+//!
+//! `tests/stability_sparse.rs`: on a 12-mass linear chain the 12 exponent pairs are the damped
+//! eigenvalues of M, C, K to 10⁻⁹ at 8, 17.3 and 30 Hz; on the paper system (H = 3) the leading
+//! exponent, its frequency and the verdict are the dense path's at 13 points of 150-235 Hz,
+//! stuck and stick-slip (to 10⁻⁶ relative; the printed digits agree); above the dense limit (90
+//! masses, 630 unknowns) the dense path's at a point and a run fills every point's verdict. The
+//! cost is one complex sparse LU of the Hill size per shift, and the shifts grow with the
+//! number of modes to cover: a table per point against the dense solve is printed by
+//! `cargo run --release --example hill_sparse_cost` (README, section Stability).
 
 use faer::prelude::Solve;
 use faer::sparse::{SparseColMat, Triplet};
@@ -289,77 +305,90 @@ pub fn floquet_exponents_shift_invert(
             out
         };
         let m = settings.krylov.max(2).min(2 * dim);
-        let (basis, hess, beta) = arnoldi(&apply, 2 * dim, m);
-        let k = hess.ncols();
-        let small = Mat::from_fn(k, k, |i, j| hess[(i, j)]);
-        let eig = small
-            .eigen()
-            .map_err(|_| StabilityError::EigenSolve { size: 2 * dim })?;
-        let (vals, vecs) = (eig.S(), eig.U());
-        let mut order: Vec<usize> = (0..k).filter(|&j| vals[j].norm() > 0.0).collect();
-        order.sort_by(|&a, &b| vals[b].norm().total_cmp(&vals[a].norm()));
-        // Walk the Ritz values from the nearest to the shift outwards while they pass the
-        // residual check: the disc up to the last one holds every Hill eigenvalue found.
-        let mut radius = 0.0;
-        for &j in &order {
-            let s = sigma + c64::new(1.0, 0.0) / vals[j];
-            // Ritz vector's upper half p = V[..dim] y.
-            let mut p = vec![c64::new(0.0, 0.0); dim];
-            for (c, col) in basis.iter().enumerate().take(k) {
-                let yc = vecs[(c, j)];
-                for i in 0..dim {
-                    p[i] += col[i] * yc;
+        // The space is doubled once when the nearest Ritz pairs did not converge far enough
+        // to cover the shift's own target (clustered modes).
+        for attempt in 0..2 {
+            let m = if attempt == 0 {
+                m
+            } else {
+                (2 * m).min(2 * dim)
+            };
+            let (basis, hess, beta) = arnoldi(&apply, 2 * dim, m);
+            let k = hess.ncols();
+            let small = Mat::from_fn(k, k, |i, j| hess[(i, j)]);
+            let eig = small
+                .eigen()
+                .map_err(|_| StabilityError::EigenSolve { size: 2 * dim })?;
+            let (vals, vecs) = (eig.S(), eig.U());
+            let mut order: Vec<usize> = (0..k).filter(|&j| vals[j].norm() > 0.0).collect();
+            order.sort_by(|&a, &b| vals[b].norm().total_cmp(&vals[a].norm()));
+            // Walk the Ritz values from the nearest to the shift outwards while they pass the
+            // residual check: the disc up to the last one holds every Hill eigenvalue found.
+            let mut radius = 0.0;
+            for &j in &order {
+                let s = sigma + c64::new(1.0, 0.0) / vals[j];
+                // Ritz vector's upper half p = V[..dim] y.
+                let mut p = vec![c64::new(0.0, 0.0); dim];
+                for (c, col) in basis.iter().enumerate().take(k) {
+                    let yc = vecs[(c, j)];
+                    for i in 0..dim {
+                        p[i] += col[i] * yc;
+                    }
+                }
+                let pn = p.iter().map(|v| v.norm_sqr()).sum::<f64>().sqrt();
+                if !(s.re.is_finite() && s.im.is_finite()) || pn == 0.0 {
+                    rejected += 1;
+                    break;
+                }
+                // Arnoldi's residual of the Ritz pair of the shift-invert operator,
+                // ‖(L − σI)⁻¹z − μz‖ = β·|y_last| / ‖y‖: converged when below tol·|μ|.
+                let y_norm = (0..k).map(|c| vecs[(c, j)].norm_sqr()).sum::<f64>().sqrt();
+                let ritz_residual = beta * vecs[(k - 1, j)].norm() / y_norm;
+                if ritz_residual > settings.tolerance * vals[j].norm() {
+                    rejected += 1;
+                    break;
+                }
+                let mut r = vec![c64::new(0.0, 0.0); dim];
+                for &(i, jj, a) in jacobian {
+                    r[i] += p[jj] * a;
+                }
+                for &(i, jj, a) in &a1 {
+                    r[i] += p[jj] * (s * a);
+                }
+                for &(i, jj, a) in &a2 {
+                    r[i] += p[jj] * (s * s * a);
+                }
+                let rn = r.iter().map(|v| v.norm_sqr()).sum::<f64>().sqrt();
+                let scale = (nj + s.norm() * n1 + s.norm_sqr() * n2) * pn;
+                if rn > QUADRATIC_BACKWARD_ERROR * scale {
+                    rejected += 1;
+                    break;
+                }
+                radius = (s - sigma).norm();
+                let pm = Mat::from_fn(dim, 1, |i, _| p[i]);
+                let (centroid, edge) = content_profile(set, n, pm.col(0));
+                if centroid.abs() > 0.5 {
+                    continue;
+                }
+                // Exponents are kept with Im ≥ 0 (their conjugates are exponents too).
+                let lambda = if s.im < 0.0 { s.conj() } else { s } * omega;
+                let same = |a: &c64| (a - lambda).norm() <= 1e-8 * (lambda.norm() + omega);
+                if !found.iter().any(same) {
+                    found.push(lambda);
+                    content.push((centroid, edge));
                 }
             }
-            let pn = p.iter().map(|v| v.norm_sqr()).sum::<f64>().sqrt();
-            if !(s.re.is_finite() && s.im.is_finite()) || pn == 0.0 {
-                rejected += 1;
+            for (t, c) in targets.iter().zip(covered.iter_mut()) {
+                // A disc covers a target, or its conjugate (the spectrum is symmetric).
+                *c |= (t - sigma).norm() < radius || (t.conj() - sigma).norm() < radius;
+            }
+            let own_covered = explicit.is_some() || covered[next - 1];
+            if own_covered || attempt == 1 || m == 2 * dim {
+                shifts.push(sigma);
+                radii.push(radius);
                 break;
-            }
-            // Arnoldi's residual of the Ritz pair of the shift-invert operator,
-            // ‖(L − σI)⁻¹z − μz‖ = β·|y_last| / ‖y‖: converged when below tol·|μ|.
-            let y_norm = (0..k).map(|c| vecs[(c, j)].norm_sqr()).sum::<f64>().sqrt();
-            let ritz_residual = beta * vecs[(k - 1, j)].norm() / y_norm;
-            if ritz_residual > settings.tolerance * vals[j].norm() {
-                rejected += 1;
-                break;
-            }
-            let mut r = vec![c64::new(0.0, 0.0); dim];
-            for &(i, jj, a) in jacobian {
-                r[i] += p[jj] * a;
-            }
-            for &(i, jj, a) in &a1 {
-                r[i] += p[jj] * (s * a);
-            }
-            for &(i, jj, a) in &a2 {
-                r[i] += p[jj] * (s * s * a);
-            }
-            let rn = r.iter().map(|v| v.norm_sqr()).sum::<f64>().sqrt();
-            let scale = (nj + s.norm() * n1 + s.norm_sqr() * n2) * pn;
-            if rn > QUADRATIC_BACKWARD_ERROR * scale {
-                rejected += 1;
-                break;
-            }
-            radius = (s - sigma).norm();
-            let pm = Mat::from_fn(dim, 1, |i, _| p[i]);
-            let (centroid, edge) = content_profile(set, n, pm.col(0));
-            if centroid.abs() > 0.5 {
-                continue;
-            }
-            // Exponents are kept with Im ≥ 0 (their conjugates are exponents too).
-            let lambda = if s.im < 0.0 { s.conj() } else { s } * omega;
-            let same = |a: &c64| (a - lambda).norm() <= 1e-8 * (lambda.norm() + omega);
-            if !found.iter().any(same) {
-                found.push(lambda);
-                content.push((centroid, edge));
             }
         }
-        for (t, c) in targets.iter().zip(covered.iter_mut()) {
-            // A disc covers a target, or its conjugate (the spectrum is symmetric).
-            *c |= (t - sigma).norm() < radius || (t.conj() - sigma).norm() < radius;
-        }
-        shifts.push(sigma);
-        radii.push(radius);
     }
     if found.is_empty() {
         return Err(StabilityError::NoFiniteExponent);
