@@ -128,9 +128,10 @@ fn stability_off_adds_no_columns_and_on_adds_five() {
 #[test]
 fn scenes_hill_does_not_suit_are_refused_naming_the_field() {
     let dir = tempfile::tempdir().unwrap();
-    for (overrides, reason) in [
+    for (overrides, field, reason) in [
         (
             vec!["analysis.stability=true", "effects.coupling=uncoupled"],
+            "analysis.stability",
             "0th harmonic",
         ),
         (
@@ -139,18 +140,29 @@ fn scenes_hill_does_not_suit_are_refused_naming_the_field() {
                 "harmonics.max=",
                 "harmonics.list=[0, 1, 3]",
             ],
+            "analysis.stability",
             "without gaps",
         ),
         (
-            vec!["analysis.stability=true", "harmonics.max=60"],
+            vec![
+                "analysis.stability=true",
+                "analysis.hill_solver=dense",
+                "harmonics.max=60",
+            ],
+            "analysis.hill_solver",
             "exceed the 600",
+        ),
+        (
+            vec!["analysis.hill_solver=shift-invert"],
+            "analysis.hill_solver",
+            "analysis.stability is off",
         ),
     ] {
         let out = run_scene(&scene("full-range.toml"), dir.path(), &overrides);
         assert_eq!(out.status.code(), Some(1), "{overrides:?}");
         let err = text(&out.stderr);
         assert!(
-            err.contains("analysis.stability") && err.contains(reason),
+            err.contains(field) && err.contains(reason),
             "{overrides:?}: {err}"
         );
     }

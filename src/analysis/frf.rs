@@ -7,7 +7,8 @@ use std::time::Instant;
 use crate::analysis::error_estimate::{ErrorEstimator, EstimateProblems, PathPlace, PointAccuracy};
 use crate::analysis::linear;
 use crate::analysis::monodromy::point_monodromy;
-use crate::analysis::stability::{point_stability, PointStability, StabilityError};
+use crate::analysis::stability::{PointStability, StabilityError};
+use crate::analysis::stability_sparse::{hill_solver_for, point_stability_with};
 use crate::contact::harmonic::{Block, HarmonicSet};
 use crate::contact::ContactState;
 use crate::hbm::operator::HbmOperator;
@@ -437,7 +438,13 @@ fn with_stability(
     let mut verdict = None;
     if method.uses_hill() {
         verdict = Some(
-            point_stability(system.full(), &point.coefficients, omega).map_err(|e| match e {
+            {
+                let full = system.full();
+                let unknowns = full.problem().model.n_dofs() * full.unknowns().n_blocks();
+                let solver = hill_solver_for(analysis.hill_solver, unknowns);
+                point_stability_with(full, &point.coefficients, omega, &solver)
+            }
+            .map_err(|e| match e {
                 StabilityError::Hbm(e) => e,
                 other => HbmError::Stability(other.to_string()),
             })?,

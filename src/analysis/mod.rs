@@ -41,6 +41,9 @@
 //! - [`stability::point_stability`]: Hill stability of a converged point (Floquet exponents
 //!   from the quadratic Hill eigenvalue problem, [`stability::PointStability`]); computed on
 //!   every FRF point when the scene sets `analysis.stability`.
+//! - [`stability_sparse::floquet_exponents_shift_invert`]: the exponents near their estimates
+//!   by shift-invert Arnoldi on the sparse Hill pencil, with a coverage statement; used by runs
+//!   above the dense limit (`analysis.hill_solver`, [`stability_sparse::point_stability_with`]).
 //! - [`verify::verify_point`]: time integration (Newmark, implicit contact return mapping) from
 //!   a harmonic-balance point to its steady state, with a dt check ([`verify::PointVerification`]).
 //! - [`monodromy::monodromy_stability`]: Floquet multipliers of the time integration's periodic
@@ -55,4 +58,5 @@ pub mod modes;
 pub mod monodromy;
 pub mod peaks;
 pub mod stability;
+pub mod stability_sparse;
 pub mod verify;

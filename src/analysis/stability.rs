@@ -33,7 +33,8 @@
 //! thread; the QZ of the pencil
 //! was tried first: on the paper system at H = 3 it took seconds per point against milliseconds). A singular mass matrix is
 //! refused. The cost grows as (2·unknowns)³: models with more than [`MAX_HILL_UNKNOWNS`]
-//! unknowns are refused at the scene check (field `analysis.stability`).
+//! unknowns use the sparse shift-invert solve of [`crate::analysis::stability_sparse`]
+//! instead (scene field `analysis.hill_solver`, default `auto`).
 //!
 //! # Picking the Floquet exponents
 //!
@@ -70,9 +71,10 @@ use crate::contact::ContactState;
 use crate::hbm::{HbmError, HbmSystem};
 use crate::model::LinearModel;
 
-/// Most harmonic-balance unknowns (DOFs × coefficient blocks) for which a scene may ask for
-/// Hill stability: the dense QZ of the 2·unknowns companion pencil costs about
-/// 30·(2·unknowns)³ flops (≈ 0.3 s at 300 unknowns on the development machine).
+/// Most harmonic-balance unknowns (DOFs × coefficient blocks) solved by the dense eigen solve
+/// of the 2·unknowns companion matrix, about 30·(2·unknowns)³ flops; above it runs use the
+/// sparse shift-invert solve ([`crate::analysis::stability_sparse`]) unless the scene asks for
+/// `analysis.hill_solver = "dense"`, which is then refused.
 pub const MAX_HILL_UNKNOWNS: usize = 600;
 
 /// Largest real part of the leading Floquet exponent, relative to ω, of a point still
@@ -83,8 +85,11 @@ pub const STABILITY_TOLERANCE: f64 = 1e-6;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum VerdictSource {
-    /// Hill's method (this module).
+    /// Hill's method (this module), the whole spectrum by the dense eigen solve.
     Hill,
+    /// Hill's method by the sparse shift-invert solve of the exponents near the estimated
+    /// ones ([`crate::analysis::stability_sparse`]).
+    HillSparse,
     /// The monodromy of the time integration's periodic orbit
     /// ([`crate::analysis::monodromy`]).
     Monodromy,
@@ -98,6 +103,7 @@ impl VerdictSource {
     pub fn label(self) -> &'static str {
         match self {
             VerdictSource::Hill => "hill",
+            VerdictSource::HillSparse => "hill-sparse",
             VerdictSource::Monodromy => "monodromy",
             VerdictSource::Failed => "failed",
         }
@@ -172,7 +178,7 @@ pub fn methods_text<'a>(verdicts: impl IntoIterator<Item = &'a PointStability>) 
     let (mut hill, mut hill_unreliable, mut monodromy) = (false, false, false);
     for v in verdicts {
         match v.method {
-            VerdictSource::Hill => {
+            VerdictSource::Hill | VerdictSource::HillSparse => {
                 hill = true;
                 hill_unreliable |= !v.reliable;
             }
@@ -376,9 +382,18 @@ fn sequential_eigen(
 /// the eigenvector p (harmonic-major real-coefficient blocks of `n` DOFs): 0 for content
 /// centred on the 0th component (including a real mode split evenly between k = ±1, the
 /// saddle-node mode at a fold), ±1 for its copies shifted by one harmonic.
-fn content_centroid(set: &HarmonicSet, n: usize, p: faer::ColRef<'_, c64>) -> f64 {
+pub(crate) fn content_centroid(set: &HarmonicSet, n: usize, p: faer::ColRef<'_, c64>) -> f64 {
+    content_profile(set, n, p).0
+}
+
+/// The centroid k̄ of [`content_centroid`] and the fraction of the content at the truncation
+/// edge |k| = H (0 when H = 0). A spurious eigenvalue of the truncated Hill matrix can have
+/// its content split between k = +H and k = −H, hence k̄ ≈ 0: the edge fraction tells it apart
+/// from a centred copy.
+pub fn content_profile(set: &HarmonicSet, n: usize, p: faer::ColRef<'_, c64>) -> (f64, f64) {
+    let h_max = set.harmonics().last().copied().unwrap_or(0);
     let i = c64::new(0.0, 1.0);
-    let (mut moment, mut total) = (0.0, 0.0);
+    let (mut moment, mut total, mut edge) = (0.0, 0.0, 0.0);
     for (jb, block) in set.blocks().iter().enumerate() {
         match block {
             Block::Constant => {
@@ -396,14 +411,17 @@ fn content_centroid(set: &HarmonicSet, n: usize, p: faer::ColRef<'_, c64>) -> f6
                 }
                 moment += *h as f64 * (plus - minus);
                 total += plus + minus;
+                if *h == h_max {
+                    edge += plus + minus;
+                }
             }
             Block::Sin(_) => {}
         }
     }
     if total > 0.0 {
-        moment / total
+        (moment / total, edge / total)
     } else {
-        0.0
+        (0.0, 0.0)
     }
 }
 
@@ -433,7 +451,9 @@ pub fn verdict(exponents: &[c64], omega: f64) -> PointStability {
 /// The stability of the converged point with full coefficients `x` at ω (rad/s) of `system`:
 /// its Jacobian (the system's strategy, analytic by default) in dense form, the Floquet
 /// exponents and the verdict, `reliable` from the contact states at the point
-/// ([`hill_reliable`]). The system's contact states are left as they were.
+/// ([`hill_reliable`]). The system's contact states are left as they were. The whole Hill
+/// spectrum is solved densely; [`crate::analysis::stability_sparse::point_stability_with`]
+/// can use the sparse shift-invert solve instead (what runs do above the dense limit).
 pub fn point_stability(
     system: &mut HbmSystem<'_>,
     x: &[f64],

@@ -16,5 +16,6 @@ pub mod reduce;
 
 pub use problem::{
     Analysis, Coupling, DofSplit, Effects, ErrorEstimateSettings, FeOrigin, Formulation,
-    HarmonicLoad, JacobianStrategy, LinearModel, Problem, StabilityMethod, CHORD_MIN_UNKNOWNS,
+    HarmonicLoad, HillSolve, JacobianStrategy, LinearModel, Problem, StabilityMethod,
+    CHORD_MIN_UNKNOWNS,
 };

@@ -149,6 +149,24 @@ impl StabilityMethod {
     }
 }
 
+/// How Hill's eigenvalue problem is solved (scene field `analysis.hill_solver`; see
+/// [`crate::analysis::stability`] and [`crate::analysis::stability_sparse`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+pub enum HillSolve {
+    /// The dense solve of the whole spectrum up to
+    /// [`crate::analysis::stability::MAX_HILL_UNKNOWNS`] unknowns, the sparse shift-invert
+    /// solve above it (default).
+    #[default]
+    #[serde(rename = "auto")]
+    Auto,
+    /// The dense solve of the whole spectrum (refused above the limit).
+    #[serde(rename = "dense")]
+    Dense,
+    /// The sparse shift-invert solve at every size.
+    #[serde(rename = "shift-invert")]
+    ShiftInvert,
+}
+
 /// Settings of a frequency-response analysis: the continuation over the range (frequencies in
 /// Hz; arc-length steps in the scaled space where a unit of frequency is 1 Hz, see
 /// [`crate::numerics::continuation`]) and how the harmonic balance is formed and stored.
@@ -170,6 +188,8 @@ pub struct Analysis {
     /// Newmark steps per period of the monodromy's time integration (0: 256·H, the default of
     /// `fricbound verify`).
     pub monodromy_steps_per_period: usize,
+    /// How Hill's eigenvalue problem is solved when Hill's method runs.
+    pub hill_solver: HillSolve,
     /// The a-posteriori error estimate on every converged point (scene table `[accuracy]`).
     pub error_estimate: ErrorEstimateSettings,
 }

@@ -365,6 +365,39 @@ impl AssembledJacobian {
         }
     }
 
+    /// The stored non-zero entries of J as (row, col, value) triplets: the pattern's entries in
+    /// sparse storage, the non-zero values in dense storage, and in the implicit storage every
+    /// entry formed one by one (n² calls: for checks, or after switching to sparse storage).
+    pub fn triplets(&self) -> Vec<(usize, usize, f64)> {
+        match (&self.pattern, self.storage) {
+            (Some(p), Storage::Sparse) => {
+                let col_ptr = p.col_ptr();
+                let rows = p.row_idx();
+                let mut out = Vec::with_capacity(self.values.len());
+                for j in 0..self.n {
+                    for k in col_ptr[j]..col_ptr[j + 1] {
+                        if self.values[k] != 0.0 {
+                            out.push((rows[k], j, self.values[k]));
+                        }
+                    }
+                }
+                out
+            }
+            _ => {
+                let mut out = Vec::new();
+                for j in 0..self.n {
+                    for i in 0..self.n {
+                        let v = self.get(i, j);
+                        if v != 0.0 {
+                            out.push((i, j, v));
+                        }
+                    }
+                }
+                out
+            }
+        }
+    }
+
     /// Dense copy of J (for checks and small problems).
     pub fn to_dense(&self) -> Mat<f64> {
         Mat::from_fn(self.n, self.n, |i, j| self.get(i, j))

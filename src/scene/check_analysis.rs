@@ -4,8 +4,10 @@
 //! and the `[output]` table into the response DOFs.
 
 use crate::analysis::stability::{harmonics_supported, MAX_HILL_UNKNOWNS};
+use crate::analysis::stability_sparse::{uses_shift_invert, MAX_ESTIMATE_DOFS};
 use crate::analysis::verify::{MAX_MONODROMY_STEPS, MAX_VERIFY_DOFS, MIN_MONODROMY_STEPS};
 use crate::contact::{ContactPoint, NormalLoad};
+use crate::model::HillSolve;
 use crate::model::{
     Analysis, Coupling, ErrorEstimateSettings, LinearModel, Problem, CHORD_MIN_UNKNOWNS,
 };
@@ -131,6 +133,18 @@ pub(super) fn analysis(a: &AnalysisSpec, ck: &Checker) -> Result<Analysis, Scene
             "chooses how stability is computed, but analysis.stability is off: set analysis.stability = true",
         ));
     }
+    if a.hill_solver.is_some() && !a.stability_method.unwrap_or_default().uses_hill() {
+        return Err(ck.err(
+            "analysis.hill_solver",
+            "chooses how Hill's eigenvalue problem is solved, but Hill's method does not run: set analysis.stability = true with analysis.stability_method = \"hill\" or \"hill+monodromy\"",
+        ));
+    }
+    if a.hill_solver.is_some() && !a.stability {
+        return Err(ck.err(
+            "analysis.hill_solver",
+            "chooses how Hill's eigenvalue problem is solved, but analysis.stability is off: set analysis.stability = true",
+        ));
+    }
     if let Some(steps) = a.monodromy_steps_per_period {
         if !a.stability_method.is_some_and(|m| m.uses_monodromy()) {
             return Err(ck.err(
@@ -169,6 +183,7 @@ pub(super) fn analysis(a: &AnalysisSpec, ck: &Checker) -> Result<Analysis, Scene
         stability: a.stability,
         stability_method: a.stability_method.unwrap_or_default(),
         monodromy_steps_per_period: a.monodromy_steps_per_period.unwrap_or(0),
+        hill_solver: a.hill_solver.unwrap_or_default(),
         error_estimate: ErrorEstimateSettings::default(),
     })
 }
@@ -192,8 +207,10 @@ pub(super) fn error_estimate(
 }
 
 /// With `analysis.stability` on: Hill's method needs the 0th harmonic among the unknowns
-/// (a coupled scene) and the harmonics 0..H without gaps, and its dense eigen solve at most
-/// [`MAX_HILL_UNKNOWNS`] unknowns (DOFs × coefficient blocks, after any reduction).
+/// (a coupled scene) and the harmonics 0..H without gaps; its dense eigen solve
+/// (`analysis.hill_solver = "dense"`) at most [`MAX_HILL_UNKNOWNS`] unknowns (DOFs ×
+/// coefficient blocks, after any reduction), its shift-invert solve (`"auto"` above that
+/// size, or `"shift-invert"`) at most [`MAX_ESTIMATE_DOFS`] DOFs.
 ///
 /// With a method that uses the monodromy (`analysis.stability_method`): the time integration
 /// needs variable normal load and a dense model of at most [`MAX_VERIFY_DOFS`] DOFs; the
@@ -241,13 +258,26 @@ pub(super) fn check_stability(ck: &Checker, problem: &Problem) -> Result<(), Sce
         ));
     }
     let unknowns = problem.model.n_dofs() * set.n_blocks();
-    if method.uses_hill() && unknowns > MAX_HILL_UNKNOWNS {
+    let solver = problem.analysis.hill_solver;
+    if method.uses_hill() && solver == HillSolve::Dense && unknowns > MAX_HILL_UNKNOWNS {
+        return Err(ck.err(
+            "analysis.hill_solver",
+            format!(
+                "{unknowns} harmonic-balance unknowns ({} DOFs × {} blocks) exceed the {MAX_HILL_UNKNOWNS} of the dense Hill eigen solve: use \"auto\" or \"shift-invert\", lower harmonics.max, or reduce the model",
+                problem.model.n_dofs(),
+                set.n_blocks()
+            ),
+        ));
+    }
+    if method.uses_hill()
+        && uses_shift_invert(solver, unknowns)
+        && problem.model.n_dofs() > MAX_ESTIMATE_DOFS
+    {
         return Err(ck.err(
             field,
             format!(
-                "{unknowns} harmonic-balance unknowns ({} DOFs × {} blocks) exceed the {MAX_HILL_UNKNOWNS} of the dense Hill eigen solve: lower harmonics.max, reduce the model, or turn stability off",
-                problem.model.n_dofs(),
-                set.n_blocks()
+                "the shift-invert Hill solve places its shifts by a dense eigen solve of the {} DOFs, above its {MAX_ESTIMATE_DOFS}: reduce the model (Craig-Bampton) or turn stability off",
+                problem.model.n_dofs()
             ),
         ));
     }

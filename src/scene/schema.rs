@@ -312,6 +312,10 @@ pub struct AnalysisSpec {
     /// Newmark steps per period of the monodromy's time integration (default 256·H).
     #[serde(default)]
     pub monodromy_steps_per_period: Option<usize>,
+    /// How Hill's eigenvalue problem is solved: `auto` (default: dense up to 600 unknowns,
+    /// sparse shift-invert above), `dense` or `shift-invert`; needs `stability = true`.
+    #[serde(default)]
+    pub hill_solver: Option<crate::model::HillSolve>,
 }
 
 /// Default most continuation points.
