@@ -26,7 +26,16 @@
 //! from the Newton update w ← w + (I − A)⁻¹(Φ(w) − w) of the fixed-point equation Φ(w) = w,
 //! falling back to the plain update w ← Φ(w) whenever the Newton step does not reduce the
 //! mismatch. The march ends when a period started at w ends within the periodicity tolerance of
-//! w, as the 1D one does; its forces are the steady-state forces.
+//! w, as the 1D one does; its forces are the steady-state forces. The tolerance is relative to
+//! the point's own motion scale or, when larger, to the problem's force scale over kₜ
+//! ([`MarchSettings::length_scale`]), so that a barely loaded point is not held to a drift
+//! below round-off of the problem.
+//!
+//! Known limit: a point whose slip runs along one direction has a *degenerate* fixed point.
+//! Each slip contracts the slider's offset across the slip direction by μN/|T*| =
+//! 1 − O(offset²), so the offset decays like n^(−1/2) over n periods and the drift per period
+//! like n^(−3/2); I − A is singular at the fixed point, so Newton restarts are refused there,
+//! and such a march can end with [`AftError::NotSettled`] however the tolerance is scaled.
 //!
 //! # Analytic Jacobian
 //!
