@@ -114,3 +114,47 @@ fn a_short_frf_of_the_3d_scene_completes_with_vtu_output() {
     }
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// On the rising flank of the first bending pair, 885.4-885.7 Hz, contact points change state
+/// (`right-7` closes into stick-slip with lift-off); a 840-900 Hz run
+/// turned back at a corner there (measured: benches/README.md, "3D blade pair with 2D
+/// friction"). Followed on its own with the window's step sizes, the path crosses it without a
+/// step cut, monotonically in frequency, and the run ends `complete` at 885.7 Hz.
+#[test]
+fn the_3d_frf_crosses_contact_transitions_on_the_bending_flank() {
+    let out = std::env::temp_dir().join(format!("fricbound-blade-3d-flank-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let run = support::run_scene(
+        SCENE,
+        &out,
+        &[
+            "analysis.freq_start_hz=885.4",
+            "analysis.freq_end_hz=885.7",
+            "analysis.linear_points=3",
+            "accuracy.estimate=false",
+        ],
+    );
+    assert!(run.status.success(), "{}", support::text(&run.stderr));
+    let (header, rows) = support::csv(&out.join("frf.csv"));
+    let columns: Vec<&str> = header.split(',').collect();
+    let state = |name: &str| {
+        columns
+            .iter()
+            .position(|c| *c == format!("{name}_state"))
+            .unwrap()
+    };
+    let freqs: Vec<f64> = rows.iter().map(|r| r[0].parse().unwrap()).collect();
+    assert!(
+        freqs.windows(2).all(|w| w[1] > w[0]),
+        "not monotone: {freqs:?}"
+    );
+    assert!((freqs.last().unwrap() - 885.7).abs() < 1e-6);
+    let first = &rows[0];
+    let last = rows.last().unwrap();
+    assert_eq!(first[state("right-7")], "open");
+    assert_eq!(last[state("right-7")], "stick-slip-liftoff");
+    let solution = std::fs::read_to_string(out.join("solution.json")).unwrap();
+    assert!(solution.contains("\"status\": \"complete\""), "status");
+    assert!(solution.contains("\"step_cuts\": []"), "step cuts");
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -42,9 +42,26 @@ use crate::contact::{ContactEffects, ContactState, JenkinsLaw, NormalLoad};
 pub struct MarchSettings {
     /// Most periods marched before giving up (≥ 2).
     pub max_periods: usize,
-    /// Relative tolerance on the slider position repeating, scaled by the range of u plus
-    /// the largest μN/kₜ.
+    /// Relative tolerance on the slider position repeating, scaled by
+    /// [`MarchSettings::length_scale`].
     pub periodicity_tolerance: f64,
+    /// Force scale of the whole problem (N), e.g. the norm of its loads; 0 for none. The
+    /// periodicity tolerance is never scaled by less than `force_scale / kₜ`: a slider drift
+    /// whose spring force kₜ·drift is round-off against the loads on the structure is periodic,
+    /// even on a point whose own motion is tiny (a barely loaded, barely slipping point of a
+    /// 3D damper, whose 2D march otherwise creeps for thousands of periods).
+    pub force_scale: f64,
+}
+
+impl MarchSettings {
+    /// The length (m) the periodicity tolerance is relative to, for a point whose own motion
+    /// scale is `own_scale` (m: its tangential path's extent plus μ N_max / kₜ): the larger of
+    /// that and the problem's, `force_scale / kₜ`. The 1D and the 2D march both use it; the
+    /// test of a slip by mere rounding keeps the point's own scale.
+    pub fn length_scale(&self, own_scale: f64, kt: f64) -> f64 {
+        let problem = if kt > 0.0 { self.force_scale / kt } else { 0.0 };
+        own_scale.max(problem)
+    }
 }
 
 impl Default for MarchSettings {
@@ -52,6 +69,7 @@ impl Default for MarchSettings {
         Self {
             max_periods: 64,
             periodicity_tolerance: 1e-12,
+            force_scale: 0.0,
         }
     }
 }
@@ -313,7 +331,7 @@ impl AftWorkspace {
             });
         let nmax = self.n.iter().fold(0.0_f64, |a, &x| a.max(x.abs()));
         let scale = (umax - umin) + law.mu * nmax / law.kt + f64::MIN_POSITIVE;
-        let tol = self.settings.periodicity_tolerance * scale;
+        let tol = self.settings.periodicity_tolerance * self.settings.length_scale(scale, law.kt);
 
         // Initial condition: T(0) = m μ N(0), i.e. w = u₀ − m μ N₀ / kₜ.
         let limit0 = law.mu * self.n[0].max(0.0);

@@ -111,6 +111,21 @@ impl<'p> HbmSystem<'p> {
                 excitation[j * n + load.dof] += load.sin;
             }
         }
+        // The periodicity tolerance of both marches is never finer than round-off against the
+        // loads on the structure (`MarchSettings::force_scale`): the total force applied, the
+        // static loads' and the harmonic amplitudes' magnitudes summed (N). A sum, not a norm:
+        // a load shared over many nodes (a pre-load distributed by mass) counts in full.
+        let force_scale = problem.static_load.iter().map(|x| x.abs()).sum::<f64>()
+            + problem
+                .harmonic_loads
+                .iter()
+                .map(|l| l.cos.hypot(l.sin))
+                .sum::<f64>();
+        aft.settings.force_scale = force_scale;
+        let aft2d = aft2d.map(|mut w| {
+            w.settings.force_scale = force_scale;
+            w
+        });
         let static_offset = match problem.effects.coupling {
             Coupling::Coupled => vec![0.0; n],
             Coupling::Uncoupled => static_solve(problem)?,
