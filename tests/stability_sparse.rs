@@ -218,6 +218,65 @@ fn above_the_dense_limit_it_runs_and_says_whether_it_found_every_exponent() {
         (hill.floquet_re - dense.floquet_re).abs() <= 1e-6 * dense.floquet_re.abs() + 1e-9 * omega
     );
     assert!((hill.floquet_freq_hz - dense.floquet_freq_hz).abs() <= 1e-6 * dense.floquet_freq_hz);
+
+    // With the coverage limited to exponents below twice the leading one's frequency
+    // (`analysis.hill_max_freq_hz`), fewer shifts find the same leading exponent.
+    let limit = 2.0 * dense.floquet_freq_hz.max(freq_hz);
+    let t3 = Instant::now();
+    let limited = point_stability_with(
+        solver.system(),
+        &point.coefficients,
+        omega,
+        &HillSolver::ShiftInvert(ShiftInvertSettings {
+            max_freq_hz: Some(limit),
+            ..ShiftInvertSettings::default()
+        }),
+    )
+    .unwrap();
+    println!(
+        "limited to {limit:.2} Hz: {} {:.6} 1/s {:.3} Hz reliable {} in {:.1} ms",
+        limited.stable,
+        limited.floquet_re,
+        limited.floquet_freq_hz,
+        limited.reliable,
+        t3.elapsed().as_secs_f64() * 1e3
+    );
+    assert!(limited.reliable);
+    assert_eq!(limited.stable, dense.stable);
+    assert!(
+        (limited.floquet_re - dense.floquet_re).abs()
+            <= 1e-6 * dense.floquet_re.abs() + 1e-9 * omega
+    );
+}
+
+#[test]
+fn the_coverage_limit_is_checked_at_the_door() {
+    let text = chain_scene(12, 1, 3);
+    let refused = |o: &[&str]| {
+        let o: Vec<String> = o.iter().map(|s| s.to_string()).collect();
+        let err = scene::parse(&text, "case", &o)
+            .unwrap()
+            .validate("case")
+            .expect_err("refused")
+            .to_string();
+        assert!(err.contains("analysis.hill_max_freq_hz"), "{err}");
+    };
+    refused(&["analysis.stability=true", "analysis.hill_max_freq_hz=-5"]);
+    refused(&["analysis.hill_max_freq_hz=50"]);
+    refused(&[
+        "analysis.stability=true",
+        "analysis.hill_solver=dense",
+        "analysis.hill_max_freq_hz=50",
+    ]);
+    let ok = problem(
+        &text,
+        &[
+            "analysis.stability=true".into(),
+            "analysis.hill_solver=shift-invert".into(),
+            "analysis.hill_max_freq_hz=50".into(),
+        ],
+    );
+    assert_eq!(ok.analysis.hill_max_freq_hz, Some(50.0));
 }
 
 #[test]

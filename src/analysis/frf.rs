@@ -441,7 +441,8 @@ fn with_stability(
             {
                 let full = system.full();
                 let unknowns = full.problem().model.n_dofs() * full.unknowns().n_blocks();
-                let solver = hill_solver_for(analysis.hill_solver, unknowns);
+                let solver =
+                    hill_solver_for(analysis.hill_solver, unknowns, analysis.hill_max_freq_hz);
                 point_stability_with(full, &point.coefficients, omega, &solver)
             }
             .map_err(|e| match e {

@@ -447,10 +447,14 @@ pub fn uses_shift_invert(choice: HillSolve, unknowns: usize) -> bool {
 }
 
 /// The Hill solver of a problem with the scene's choice `analysis.hill_solver` (default
-/// settings for the shift-invert solve).
-pub fn hill_solver_for(choice: HillSolve, unknowns: usize) -> HillSolver {
+/// settings for the shift-invert solve, with the coverage limit `analysis.hill_max_freq_hz`
+/// in Hz, `None` for every mode).
+pub fn hill_solver_for(choice: HillSolve, unknowns: usize, max_freq_hz: Option<f64>) -> HillSolver {
     if uses_shift_invert(choice, unknowns) {
-        HillSolver::ShiftInvert(ShiftInvertSettings::default())
+        HillSolver::ShiftInvert(ShiftInvertSettings {
+            max_freq_hz,
+            ..ShiftInvertSettings::default()
+        })
     } else {
         HillSolver::Dense
     }

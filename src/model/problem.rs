@@ -190,6 +190,10 @@ pub struct Analysis {
     pub monodromy_steps_per_period: usize,
     /// How Hill's eigenvalue problem is solved when Hill's method runs.
     pub hill_solver: HillSolve,
+    /// Highest frequency (Hz) of the exponents the shift-invert Hill solve must cover (`None`:
+    /// every mode of the model); exponents above it are not sought and the verdict says
+    /// nothing about them.
+    pub hill_max_freq_hz: Option<f64>,
     /// The a-posteriori error estimate on every converged point (scene table `[accuracy]`).
     pub error_estimate: ErrorEstimateSettings,
 }

@@ -145,6 +145,25 @@ pub(super) fn analysis(a: &AnalysisSpec, ck: &Checker) -> Result<Analysis, Scene
             "chooses how Hill's eigenvalue problem is solved, but analysis.stability is off: set analysis.stability = true",
         ));
     }
+    if let Some(f) = a.hill_max_freq_hz {
+        let field = "analysis.hill_max_freq_hz";
+        ck.finite(field, f)?;
+        if f <= 0.0 {
+            return Err(ck.err(field, format!("must be positive (Hz), got {f}")));
+        }
+        if !a.stability || !a.stability_method.unwrap_or_default().uses_hill() {
+            return Err(ck.err(
+                field,
+                "limits the shift-invert Hill solve, but Hill's method does not run: set analysis.stability = true with analysis.stability_method = \"hill\" or \"hill+monodromy\"",
+            ));
+        }
+        if a.hill_solver == Some(HillSolve::Dense) {
+            return Err(ck.err(
+                field,
+                "limits the shift-invert Hill solve, but analysis.hill_solver = \"dense\" solves the whole spectrum: use \"auto\" or \"shift-invert\"",
+            ));
+        }
+    }
     if let Some(steps) = a.monodromy_steps_per_period {
         if !a.stability_method.is_some_and(|m| m.uses_monodromy()) {
             return Err(ck.err(
@@ -184,6 +203,7 @@ pub(super) fn analysis(a: &AnalysisSpec, ck: &Checker) -> Result<Analysis, Scene
         stability_method: a.stability_method.unwrap_or_default(),
         monodromy_steps_per_period: a.monodromy_steps_per_period.unwrap_or(0),
         hill_solver: a.hill_solver.unwrap_or_default(),
+        hill_max_freq_hz: a.hill_max_freq_hz,
         error_estimate: ErrorEstimateSettings::default(),
     })
 }

@@ -316,6 +316,10 @@ pub struct AnalysisSpec {
     /// sparse shift-invert above), `dense` or `shift-invert`; needs `stability = true`.
     #[serde(default)]
     pub hill_solver: Option<crate::model::HillSolve>,
+    /// Highest frequency (Hz) of the exponents the shift-invert Hill solve must find; default:
+    /// every mode of the model. Applies to the shift-invert solve only.
+    #[serde(default)]
+    pub hill_max_freq_hz: Option<f64>,
 }
 
 /// Default most continuation points.
