@@ -7,7 +7,6 @@
 use std::f64::consts::PI;
 use std::time::Instant;
 
-use faer::linalg::solvers::DenseSolveCore;
 use faer::{c64, Mat};
 use fricbound::analysis::frf::{self, PointSolver, Silent};
 use fricbound::analysis::stability::{VerdictSource, MAX_HILL_UNKNOWNS};
@@ -28,21 +27,12 @@ fn problem(text: &str, overrides: &[String]) -> Problem {
 
 /// The damped eigenvalues of λ²M + λC + K (first-order form).
 fn damped_eigenvalues(problem: &Problem) -> Vec<c64> {
-    let n = problem.model.n_dofs();
     let (m, c, k) = (
         problem.model.mass.to_dense(),
         problem.model.damping.to_dense(),
         problem.model.stiffness.to_dense(),
     );
-    let minv = m.as_ref().partial_piv_lu().inverse();
-    let (mk, mc) = (&minv * &k, &minv * &c);
-    let a = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
-        (true, true) => 0.0,
-        (true, false) => f64::from(u8::from(j - n == i)),
-        (false, true) => -mk[(i - n, j)],
-        (false, false) => -mc[(i - n, j - n)],
-    });
-    a.eigenvalues().unwrap()
+    fricbound::analysis::stability::damped_eigenvalues(m.as_ref(), c.as_ref(), k.as_ref()).unwrap()
 }
 
 #[test]

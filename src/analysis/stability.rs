@@ -521,6 +521,31 @@ pub fn stretches_text(stretches: &[[f64; 2]]) -> String {
         .join(", ")
 }
 
+/// The damped eigenvalues λ (1/s) of λ²M + λC + K (all 2n, conjugate pairs included), by the
+/// eigen solve of the first-order matrix [[0, I], [−M⁻¹K, −M⁻¹C]]: for a linear system these are
+/// its Floquet exponents, and the shift-invert solve places its shifts at them
+/// ([`super::stability_sparse::exponent_estimates`]). A singular M is refused.
+pub fn damped_eigenvalues(
+    mass: MatRef<'_, f64>,
+    damping: MatRef<'_, f64>,
+    stiffness: MatRef<'_, f64>,
+) -> Result<Vec<c64>, StabilityError> {
+    let n = mass.nrows();
+    let minv = mass.partial_piv_lu().inverse();
+    if !minv.as_ref().is_all_finite() {
+        return Err(StabilityError::SingularMass);
+    }
+    let (mk, mc) = (&minv * stiffness, &minv * damping);
+    let a = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+        (true, true) => 0.0,
+        (true, false) => f64::from(u8::from(j - n == i)),
+        (false, true) => -mk[(i - n, j)],
+        (false, false) => -mc[(i - n, j - n)],
+    });
+    a.eigenvalues()
+        .map_err(|_| StabilityError::EigenSolve { size: 2 * n })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -585,23 +610,14 @@ mod tests {
         j
     }
 
-    /// The damped eigenvalues of λ²M + λC + K by the 2n first-order form.
     fn damped_eigenvalues(model: &LinearModel) -> Vec<c64> {
-        let n = model.n_dofs();
         let (m, c, k) = (
             model.mass.to_dense(),
             model.damping.to_dense(),
             model.stiffness.to_dense(),
         );
-        let minv = m.as_ref().partial_piv_lu().inverse();
-        let (mk, mc) = (&minv * &k, &minv * &c);
-        let a = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
-            (true, true) => 0.0,
-            (true, false) => f64::from(u8::from(j - n == i)),
-            (false, true) => -mk[(i - n, j)],
-            (false, false) => -mc[(i - n, j - n)],
-        });
-        a.eigenvalues().expect("a small eigen solve converges")
+        super::damped_eigenvalues(m.as_ref(), c.as_ref(), k.as_ref())
+            .expect("a small eigen solve converges")
     }
 
     fn sorted(mut v: Vec<c64>) -> Vec<c64> {

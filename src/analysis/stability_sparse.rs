@@ -88,8 +88,8 @@ use faer::sparse::{SparseColMat, Triplet};
 use faer::{c64, Mat};
 
 use super::stability::{
-    content_profile, floquet_exponents, harmonics_supported, hill_reliable, verdict,
-    PointStability, StabilityError, VerdictSource, MAX_HILL_UNKNOWNS,
+    content_profile, damped_eigenvalues, floquet_exponents, harmonics_supported, hill_reliable,
+    verdict, PointStability, StabilityError, VerdictSource, MAX_HILL_UNKNOWNS,
 };
 use crate::contact::harmonic::{Block, HarmonicSet};
 use crate::hbm::HbmSystem;
@@ -185,29 +185,18 @@ pub fn exponent_estimates(
     model: &LinearModel,
     jacobian: &[(usize, usize, f64)],
 ) -> Result<Vec<c64>, StabilityError> {
-    use faer::linalg::solvers::DenseSolveCore;
     let n = model.n_dofs();
-    let (m, c) = (model.mass.to_dense(), model.damping.to_dense());
     let mut k = Mat::<f64>::zeros(n, n);
     for &(i, j, v) in jacobian {
         if i < n && j < n {
             k[(i, j)] += v;
         }
     }
-    let minv = m.as_ref().partial_piv_lu().inverse();
-    if !minv.as_ref().is_all_finite() {
-        return Err(StabilityError::SingularMass);
-    }
-    let (mk, mc) = (&minv * &k, &minv * &c);
-    let a = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
-        (true, true) => 0.0,
-        (true, false) => f64::from(u8::from(j - n == i)),
-        (false, true) => -mk[(i - n, j)],
-        (false, false) => -mc[(i - n, j - n)],
-    });
-    let values = a
-        .eigenvalues()
-        .map_err(|_| StabilityError::EigenSolve { size: 2 * n })?;
+    let values = damped_eigenvalues(
+        model.mass.to_dense().as_ref(),
+        model.damping.to_dense().as_ref(),
+        k.as_ref(),
+    )?;
     let mut upper: Vec<c64> = values
         .into_iter()
         .filter(|v| v.re.is_finite() && v.im.is_finite() && v.im >= 0.0)

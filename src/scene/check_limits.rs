@@ -120,18 +120,21 @@ pub(super) fn limit_settings(
                 "give m for at least one damper side (`sides`) or contact (`contacts`)",
             ));
         }
-        let mut side_states = Vec::new();
-        for (name, &m) in &c.sides {
-            let field = format!("{}.{name}", f("sides"));
-            let side = side_names.iter().position(|s| s == name).ok_or_else(|| {
+        let side_index = |field: &str, name: &str| {
+            side_names.iter().position(|s| s == name).ok_or_else(|| {
                 ck.err(
-                    field.clone(),
+                    field,
                     format!(
                         "unknown damper side `{name}` (the scene has {})",
                         side_names.join(", ")
                     ),
                 )
-            })?;
+            })
+        };
+        let mut side_states = Vec::new();
+        for (name, &m) in &c.sides {
+            let field = format!("{}.{name}", f("sides"));
+            let side = side_index(&field, name)?;
             side_states.push((side, check_m(field, m)?));
         }
         let mut contact_states = Vec::new();
@@ -163,15 +166,7 @@ pub(super) fn limit_settings(
         let mut side_states2 = Vec::new();
         for (name, &m2) in &c.sides2 {
             let field = format!("{}.{name}", f("sides2"));
-            let side = side_names.iter().position(|s| s == name).ok_or_else(|| {
-                ck.err(
-                    field.clone(),
-                    format!(
-                        "unknown damper side `{name}` (the scene has {})",
-                        side_names.join(", ")
-                    ),
-                )
-            })?;
+            let side = side_index(&field, name)?;
             let m2 = check_m(field.clone(), m2)?;
             // m₁ of each 2D point of the side: the case's for the side, or the point's own.
             let mut firsts: Vec<f64> = scene
