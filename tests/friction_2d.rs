@@ -2,8 +2,7 @@
 //! version of the paper's lumped system with the out-of-plane motion constrained equals the
 //! planar 1D result; with out-of-plane excitation (slip directions that rotate) the dense,
 //! sparse and condensed formulations agree and the assembled analytic Jacobian matches central
-//! differences of the residual; inconsistent frames and unsupported uses are refused with the
-//! field named.
+//! differences of the residual; inconsistent frames are refused with the field named.
 
 use fricbound::analysis::frf::{self, PointSolver, Silent};
 use fricbound::analysis::limits::{self, LimitCase};
@@ -318,13 +317,7 @@ fn inconsistent_2d_frames_and_states_are_refused() {
 }
 
 #[test]
-fn unsupported_paths_refuse_2d_points() {
-    let p = problem(SPATIAL, &["effects.coupling=uncoupled"]);
-    let err = HbmSystem::new(&p)
-        .err()
-        .expect("the static pre-solve refuses 2D points");
-    assert!(err.to_string().contains("2D friction"), "{err}");
-    // The schur formulation counts 3 relative coordinates per 2D point.
+fn schur_counts_three_relative_coordinates_per_2d_point() {
     let p = problem(SPATIAL, &[]);
     assert_eq!(p.relative_coordinate_count(), 6);
 }

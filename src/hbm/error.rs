@@ -25,16 +25,6 @@ pub enum HbmError {
     /// The Hill stability of a converged point could not be computed (the eigen solve).
     #[error("Hill stability: {0}")]
     Stability(String),
-    /// An evaluation that handles 1D-friction points only met a 2D-friction point.
-    #[error(
-        "contact `{contact}` has 2D friction (jenkins-2d): {evaluation} handles 1D points only"
-    )]
-    TwoDimensionalFriction {
-        /// The first 2D point.
-        contact: String,
-        /// What refused it.
-        evaluation: &'static str,
-    },
     /// The static pre-solve of the uncoupled mode did not converge.
     #[error("static pre-solve did not converge in {iterations} iterations (relative residual {residual:.3e})")]
     StaticNotConverged {

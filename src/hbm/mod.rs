@@ -13,7 +13,7 @@
 //! | [`schur`] | `RelativeCoordinates`, `SchurJacobian` | all DOFs, each linear solve reduced to the relative contact coordinates |
 //! | [`operator`] | `HbmOperator` | the operator a run solves, dispatching to the formulation |
 //! | [`cost`] | `CostEstimate`, `estimate` | size of the unknowns, memory of one Newton iteration and time per point, estimated before anything is allocated |
-//! | [`statics`] | [`static_solve`] | the static pre-solve of the uncoupled mode |
+//! | [`statics`] | [`static_solve`], [`statics::StaticSystem`], [`statics::static_point_2d`] | the static pre-solve of the uncoupled mode (1D and 2D friction points from rest) |
 //! | [`error`] | [`HbmError`] | evaluation and solve errors |
 
 pub mod condensed;
