@@ -18,16 +18,8 @@ use fricbound::contact::ContactState;
 use fricbound::model::{HarmonicLoad, Problem};
 use fricbound::scene;
 
-const PLANAR: &str = include_str!("../meshes/paper-wedge/fig13-3rd.toml");
-const SPATIAL: &str = include_str!("../meshes/paper-wedge-3d/fig13-3rd-3d.toml");
-
-fn problem(text: &str, overrides: &[&str]) -> Problem {
-    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    scene::parse(text, "scene", &o)
-        .unwrap()
-        .validate("scene")
-        .unwrap()
-}
+mod common;
+use common::{problem, PLANAR, SPATIAL};
 
 #[test]
 fn the_disc_map_is_one_to_one_and_its_jacobian_matches_central_differences() {

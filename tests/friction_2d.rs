@@ -14,33 +14,8 @@ use fricbound::numerics::derivatives::check_operator_jacobian;
 use fricbound::numerics::jacobian::Storage;
 use fricbound::scene;
 
-const PLANAR: &str = include_str!("../meshes/paper-wedge/fig13-3rd.toml");
-const SPATIAL: &str = include_str!("../meshes/paper-wedge-3d/fig13-3rd-3d.toml");
-
-/// In-plane DOFs of the 3D scene, in the order of the planar scene's DOFs.
-const IN_PLANE: [usize; 6] = [0, 1, 3, 4, 6, 7];
-/// Out-of-plane DOFs of the 3D scene.
-const OUT_OF_PLANE: [usize; 3] = [2, 5, 8];
-
-fn problem(text: &str, overrides: &[&str]) -> Problem {
-    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    scene::parse(text, "scene", &o)
-        .unwrap()
-        .validate("scene")
-        .unwrap()
-}
-
-/// Planar coefficients (6 DOFs per block) placed on the 3D layout (9 DOFs per block, z = 0).
-fn to_spatial(x: &[f64]) -> Vec<f64> {
-    let blocks = x.len() / 6;
-    let mut out = vec![0.0; 9 * blocks];
-    for j in 0..blocks {
-        for (k, &d) in IN_PLANE.iter().enumerate() {
-            out[9 * j + d] = x[6 * j + k];
-        }
-    }
-    out
-}
+mod common;
+use common::{assert_spatial_equals_planar, problem, to_spatial, PLANAR, SPATIAL};
 
 #[test]
 fn the_3d_paper_system_with_2d_friction_equals_the_planar_one() {
@@ -61,21 +36,13 @@ fn the_3d_paper_system_with_2d_friction_equals_the_planar_one() {
         let guess = frf::interpolate_on_path(&run.points, f).unwrap();
         let a = flat.solve(&guess, f).unwrap();
         let b = solid.solve(&to_spatial(&guess), f).unwrap();
-        let scale = a.coefficients.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        let blocks = a.coefficients.len() / 6;
-        for j in 0..blocks {
-            for (k, &d) in IN_PLANE.iter().enumerate() {
-                let diff = (a.coefficients[6 * j + k] - b.coefficients[9 * j + d]).abs();
-                largest = largest.max(diff / scale);
-                assert!(
-                    diff <= 1e-8 * scale,
-                    "{f:.3} Hz, block {j}, DOF {d}: {diff:.3e} (scale {scale:.3e})"
-                );
-            }
-            for &d in &OUT_OF_PLANE {
-                assert!(b.coefficients[9 * j + d].abs() <= 1e-12 * scale);
-            }
-        }
+        let what = format!("{f:.3} Hz");
+        largest = largest.max(assert_spatial_equals_planar(
+            &a.coefficients,
+            &b.coefficients,
+            1e-8,
+            &what,
+        ));
         assert_eq!(a.states, b.states, "{f:.3} Hz");
         assert!((a.amplitudes[0] - b.amplitudes[0]).abs() <= 1e-8 * a.amplitudes[0]);
         if a.states.iter().any(|s| *s != ContactState::Stuck) {

@@ -11,25 +11,14 @@ use fricbound::contact::Jenkins2dLaw;
 use fricbound::hbm::statics::{static_point_2d, static_solve, StaticSystem};
 use fricbound::hbm::{check_jacobian, HbmSystem};
 use fricbound::model::{Formulation, HarmonicLoad, Problem};
-use fricbound::scene;
 
-const PLANAR: &str = include_str!("../meshes/paper-wedge/fig13-3rd.toml");
-const SPATIAL: &str = include_str!("../meshes/paper-wedge-3d/fig13-3rd-3d.toml");
+mod common;
+use common::{
+    assert_spatial_equals_planar, problem, to_spatial, IN_PLANE, OUT_OF_PLANE, PLANAR, SPATIAL,
+};
 
-/// In-plane DOFs of the 3D scene, in the order of the planar scene's DOFs.
-const IN_PLANE: [usize; 6] = [0, 1, 3, 4, 6, 7];
-/// Out-of-plane DOFs of the 3D scene.
-const OUT_OF_PLANE: [usize; 3] = [2, 5, 8];
 /// The damper's out-of-plane DOF (zD) in the 3D scene.
 const Z_DAMPER: usize = 8;
-
-fn problem(text: &str, overrides: &[&str]) -> Problem {
-    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    scene::parse(text, "scene", &o)
-        .unwrap()
-        .validate("scene")
-        .unwrap()
-}
 
 const LAW: Jenkins2dLaw = Jenkins2dLaw {
     kt: 3.0e5,
@@ -226,29 +215,15 @@ fn uncoupled_3d_paper_system_equals_the_planar_one() {
     for i in 1..8 {
         let f = 200.0 + 35.0 * i as f64 / 8.0;
         let guess = frf::interpolate_on_path(&run.points, f).unwrap();
-        let blocks = guess.len() / 6;
-        let mut spatial_guess = vec![0.0; 9 * blocks];
-        for j in 0..blocks {
-            for (k, &d) in IN_PLANE.iter().enumerate() {
-                spatial_guess[9 * j + d] = guess[6 * j + k];
-            }
-        }
         let a = flat.solve(&guess, f).unwrap();
-        let b = solid.solve(&spatial_guess, f).unwrap();
-        let scale = a.coefficients.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        for j in 0..blocks {
-            for (k, &d) in IN_PLANE.iter().enumerate() {
-                let diff = (a.coefficients[6 * j + k] - b.coefficients[9 * j + d]).abs();
-                largest = largest.max(diff / scale);
-                assert!(
-                    diff <= 1e-10 * scale,
-                    "{f:.3} Hz, block {j}, DOF {d}: {diff:.3e}"
-                );
-            }
-            for &d in &OUT_OF_PLANE {
-                assert!(b.coefficients[9 * j + d].abs() <= 1e-12 * scale);
-            }
-        }
+        let b = solid.solve(&to_spatial(&guess), f).unwrap();
+        let what = format!("{f:.3} Hz");
+        largest = largest.max(assert_spatial_equals_planar(
+            &a.coefficients,
+            &b.coefficients,
+            1e-10,
+            &what,
+        ));
         assert_eq!(a.states, b.states, "{f:.3} Hz");
         if a.states.iter().any(|s| s.is_unique()) {
             slipping += 1;

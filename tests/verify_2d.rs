@@ -15,21 +15,9 @@ use fricbound::analysis::verify::{self, VerifySettings};
 use fricbound::contact::harmonic::HarmonicSet;
 use fricbound::contact::ContactState;
 use fricbound::model::{HarmonicLoad, Problem};
-use fricbound::scene;
 
-const PLANAR: &str = include_str!("../meshes/paper-wedge/fig13-3rd.toml");
-const SPATIAL: &str = include_str!("../meshes/paper-wedge-3d/fig13-3rd-3d.toml");
-
-/// In-plane DOFs of the 3D scene, in the order of the planar scene's DOFs.
-const IN_PLANE: [usize; 6] = [0, 1, 3, 4, 6, 7];
-
-fn problem(text: &str, overrides: &[&str]) -> Problem {
-    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    scene::parse(text, "scene", &o)
-        .unwrap()
-        .validate("scene")
-        .unwrap()
-}
+mod common;
+use common::{problem, IN_PLANE, PLANAR, SPATIAL};
 
 /// The HBM point at `freq_hz` from the stuck linear guess: (harmonic set, coefficients,
 /// output amplitudes).
