@@ -149,15 +149,16 @@ fn quick_accuracy_study_of_a_limit_scene_covers_each_limit_curve() {
 /// each per-side case of a limit scene.
 #[test]
 fn study_curves_of_plain_and_limit_scenes() {
-    use fricbound::study::accuracy::study_curves;
+    use fricbound::study::accuracy::{study_curves, StudyPlan};
+    let parsed = |text: &str, label: &str| fricbound::scene::parse(text, label, &[]).unwrap();
     let plain = std::fs::read_to_string(scene("zoom-2nd.toml")).unwrap();
-    let curves = study_curves(&plain, "zoom-2nd.toml", &[]).unwrap();
+    let curves = study_curves(&parsed(&plain, "zoom-2nd.toml"), "zoom-2nd.toml").unwrap();
     assert_eq!(curves.len(), 1);
     assert_eq!(curves[0].name, "frf");
     assert!(curves[0].case.is_none());
     let limits = std::fs::read_to_string(scene("fig13-3rd.toml")).unwrap()
         + "\n[[limits.cases]]\nname = \"stuck-left\"\nsides = { left = 1.0, right = -1.0 }\n";
-    let curves = study_curves(&limits, "fig13-3rd.toml", &[]).unwrap();
+    let curves = study_curves(&parsed(&limits, "fig13-3rd.toml"), "fig13-3rd.toml").unwrap();
     let names: Vec<&str> = curves.iter().map(|c| c.name.as_str()).collect();
     assert_eq!(names, ["m+1", "m-1", "stuck-left"]);
     let states: Vec<Vec<f64>> = curves
@@ -166,10 +167,13 @@ fn study_curves_of_plain_and_limit_scenes() {
         .collect();
     assert_eq!(states, [vec![1.0, 1.0], vec![-1.0, -1.0], vec![1.0, -1.0]]);
     // A bad override is an error naming the field, not a panic.
-    let err = study_curves(
+    let err = StudyPlan::new(
         &limits,
         "fig13-3rd.toml",
         &["harmonics.max=zero".to_string()],
-    );
-    assert!(err.is_err());
+        true,
+    )
+    .expect_err("a bad override is refused")
+    .to_string();
+    assert!(err.contains("harmonics.max"), "{err}");
 }

@@ -192,32 +192,24 @@ fn curve_pareto_figure(
         .map(|&i| ([pairs[i].0], [pairs[i].1]))
         .collect();
     let mut series: Vec<Curve> = vec![
-        Curve {
-            label: "Pareto front",
-            x: &front_x,
-            y: &front_y,
-            color: RGBColor(200, 30, 30),
-            dashed: true,
-            markers: true,
-        },
-        Curve {
-            label: "other settings",
-            x: &others_x,
-            y: &others_y,
-            color: RGBColor(150, 150, 150),
-            dashed: false,
-            markers: true,
-        },
+        marked(
+            "Pareto front",
+            &front_x,
+            &front_y,
+            RGBColor(200, 30, 30),
+            true,
+        ),
+        marked(
+            "other settings",
+            &others_x,
+            &others_y,
+            RGBColor(150, 150, 150),
+            false,
+        ),
     ];
     for (k, (&i, (x, y))) in front.iter().zip(&fronts).enumerate() {
-        series.push(Curve {
-            label: study.results[i].setting.label.as_str(),
-            x: &x[..],
-            y: &y[..],
-            color: plot::palette(k + 1),
-            dashed: false,
-            markers: true,
-        });
+        let label = study.results[i].setting.label.as_str();
+        series.push(marked(label, x, y, plot::palette(k + 1), false));
     }
     pareto_plot(title, &series, dir, stem)
 }
@@ -251,24 +243,34 @@ fn curves_pareto_figure(
     let mut series: Vec<Curve> = Vec::new();
     for (k, d) in data.iter().enumerate() {
         let color = plot::palette(k);
-        series.push(Curve {
-            label: &d.front_label,
-            x: &d.front.0,
-            y: &d.front.1,
+        series.push(marked(&d.front_label, &d.front.0, &d.front.1, color, true));
+        series.push(marked(
+            &d.others_label,
+            &d.others.0,
+            &d.others.1,
             color,
-            dashed: true,
-            markers: true,
-        });
-        series.push(Curve {
-            label: &d.others_label,
-            x: &d.others.0,
-            y: &d.others.1,
-            color,
-            dashed: false,
-            markers: true,
-        });
+            false,
+        ));
     }
     pareto_plot(title, &series, dir, "accuracy_pareto")
+}
+
+/// A series of a Pareto figure: its points marked, joined by a dashed or a solid line.
+fn marked<'a>(
+    label: &'a str,
+    x: &'a [f64],
+    y: &'a [f64],
+    color: RGBColor,
+    dashed: bool,
+) -> Curve<'a> {
+    Curve {
+        label,
+        x,
+        y,
+        color,
+        dashed,
+        markers: true,
+    }
 }
 
 /// Draws error-against-time `series` (log-log) to `<dir>/<stem>.png` and `.svg`.

@@ -187,13 +187,9 @@ impl StudyCurve {
 /// The curves a study of the scene covers: the FRF for a scene without `[limits]`; for a limit
 /// scene, the two limit curves (m = +1, m = −1 on every point) and each case the scene gives per
 /// side or per point (`[[limits.cases]]`). The uniform intermediate curves
-/// (`limits.intermediate`) and the bound scan are not studied. `user` are the user's overrides.
-pub fn study_curves(
-    scene_text: &str,
-    label: &str,
-    user: &[String],
-) -> Result<Vec<StudyCurve>, SceneError> {
-    let scene = scene::parse(scene_text, label, user)?;
+/// (`limits.intermediate`) and the bound scan are not studied. `scene`: parsed with the user's
+/// overrides.
+pub fn study_curves(scene: &Scene, label: &str) -> Result<Vec<StudyCurve>, SceneError> {
     if scene.limits.is_none() {
         return Ok(vec![StudyCurve::frf()]);
     }
@@ -450,11 +446,23 @@ pub fn load(
     label: &str,
     user: &[String],
 ) -> Result<(Scene, Problem, Vec<String>), SceneError> {
-    let scene = scene::parse(scene_text, label, user)?;
-    let base = base_overrides(&scene, user);
+    let (scene, problem, base, _) = load_with_curves(scene_text, label, user)?;
+    Ok((scene, problem, base))
+}
+
+/// [`load`] and the curves the study covers ([`study_curves`]), from the same parse with the
+/// user's overrides.
+fn load_with_curves(
+    scene_text: &str,
+    label: &str,
+    user: &[String],
+) -> Result<(Scene, Problem, Vec<String>, Vec<StudyCurve>), SceneError> {
+    let user_scene = scene::parse(scene_text, label, user)?;
+    let curves = study_curves(&user_scene, label)?;
+    let base = base_overrides(&user_scene, user);
     let scene = scene::parse(scene_text, label, &base)?;
     let problem = scene.validate(label)?;
-    Ok((scene, problem, base))
+    Ok((scene, problem, base, curves))
 }
 
 /// Why a study could not be carried out.
@@ -557,8 +565,7 @@ impl StudyPlan {
     /// Plans the study of a scene (`text`, named `label`, with the user's `--set` overrides):
     /// `quick` uses the short setting lists.
     pub fn new(text: &str, label: &str, user: &[String], quick: bool) -> Result<Self, SceneError> {
-        let curves = study_curves(text, label, user)?;
-        let (scene, problem, base) = load(text, label, user)?;
+        let (scene, problem, base, curves) = load_with_curves(text, label, user)?;
         let (reference, check, settings) = settings(&scene, &problem, quick);
         Ok(Self {
             label: label.to_string(),
