@@ -88,7 +88,7 @@ use faer::sparse::{SparseColMat, Triplet};
 use faer::{c64, Mat};
 
 use super::stability::{
-    content_profile, damped_eigenvalues, floquet_exponents, harmonics_supported, hill_reliable,
+    content_profile, damped_eigenvalues, harmonics_supported, hill_reliable, point_stability,
     verdict, PointStability, StabilityError, VerdictSource, MAX_HILL_UNKNOWNS,
 };
 use crate::contact::harmonic::{Block, HarmonicSet};
@@ -460,10 +460,13 @@ pub fn point_stability_with(
     omega: f64,
     solver: &HillSolver,
 ) -> Result<PointStability, StabilityError> {
+    let settings = match solver {
+        HillSolver::Dense => return point_stability(system, x, omega),
+        HillSolver::ShiftInvert(settings) => settings,
+    };
     let dim = system.dim();
     let storage = system.storage();
-    let switch = matches!(solver, HillSolver::ShiftInvert(_))
-        && storage == crate::numerics::jacobian::Storage::Schur;
+    let switch = storage == crate::numerics::jacobian::Storage::Schur;
     if switch {
         system.set_storage(crate::numerics::jacobian::Storage::Sparse)?;
     }
@@ -477,37 +480,17 @@ pub fn point_stability_with(
         system.set_storage(storage)?;
     }
     evaluated?;
-    let mut complete = true;
-    let method = match solver {
-        HillSolver::Dense => VerdictSource::Hill,
-        HillSolver::ShiftInvert(_) => VerdictSource::HillSparse,
-    };
-    let exponents = match solver {
-        HillSolver::Dense => {
-            let dense = jacobian.to_dense();
-            floquet_exponents(
-                &system.problem().model,
-                system.unknowns(),
-                dense.as_ref(),
-                omega,
-            )?
-        }
-        HillSolver::ShiftInvert(settings) => {
-            let found = floquet_exponents_shift_invert(
-                &system.problem().model,
-                system.unknowns(),
-                &jacobian.triplets(),
-                omega,
-                settings,
-            )?;
-            complete = found.complete;
-            found.exponents
-        }
-    };
+    let found = floquet_exponents_shift_invert(
+        &system.problem().model,
+        system.unknowns(),
+        &jacobian.triplets(),
+        omega,
+        settings,
+    )?;
     Ok(PointStability {
-        reliable: reliable && complete,
-        method,
-        ..verdict(&exponents, omega)
+        reliable: reliable && found.complete,
+        method: VerdictSource::HillSparse,
+        ..verdict(&found.exponents, omega)
     })
 }
 

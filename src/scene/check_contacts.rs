@@ -57,17 +57,7 @@ pub(super) fn contact_set(
                 "only a `law = \"jenkins-2d\"` patch has a second initial-state component",
             ));
         }
-        let radius = p.initial_state.hypot(p.initial_state2);
-        if radius > 1.0 {
-            return Err(ck.err(
-                f("initial_state2"),
-                format!(
-                    "the initial state (initial_state, initial_state2) = ({}, {}) has length \
-                     {radius:.6} > 1: it must lie in the unit disc (T(0) = μN(0)·m)",
-                    p.initial_state, p.initial_state2
-                ),
-            ));
-        }
+        check_in_disc(ck, &f("initial_state2"), p.initial_state, p.initial_state2)?;
         let Some(structure) = fe else {
             return Err(ck.err(
                 format!("contact_patches[{pi}]"),
@@ -284,17 +274,7 @@ fn second_tangent(
         }
     };
     ck.finite(&f("initial_state2"), c.initial_state2)?;
-    let radius = c.initial_state.hypot(c.initial_state2);
-    if radius > 1.0 {
-        return Err(ck.err(
-            f("initial_state2"),
-            format!(
-                "the initial state (initial_state, initial_state2) = ({}, {}) has length \
-                 {radius:.6} > 1: it must lie in the unit disc (T(0) = μN(0)·m)",
-                c.initial_state, c.initial_state2
-            ),
-        ));
-    }
+    check_in_disc(ck, &f("initial_state2"), c.initial_state, c.initial_state2)?;
     Ok(Some(t2))
 }
 
@@ -424,6 +404,21 @@ pub(super) fn check_gap_scale(
                 ),
             ));
         }
+    }
+    Ok(())
+}
+
+/// Refuses a 2D initial state (m₁, m₂) outside the unit disc (T(0) = μN(0)·m), naming `field`.
+fn check_in_disc(ck: &Checker, field: &str, m1: f64, m2: f64) -> Result<(), SceneError> {
+    let radius = m1.hypot(m2);
+    if radius > 1.0 {
+        return Err(ck.err(
+            field,
+            format!(
+                "the initial state (initial_state, initial_state2) = ({m1}, {m2}) has length \
+                 {radius:.6} > 1: it must lie in the unit disc (T(0) = μN(0)·m)"
+            ),
+        ));
     }
     Ok(())
 }
