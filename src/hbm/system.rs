@@ -345,6 +345,17 @@ impl<'p> HbmSystem<'p> {
         jacobian: bool,
     ) -> Result<ContactState, HbmError> {
         self.contact_coefficients(c, x);
+        let state = self.march_contact(c, jacobian)?;
+        self.states[c] = state;
+        Ok(state)
+    }
+
+    /// Marches contact `c` from the coefficients û, û₂, v̂ in the system's buffers (filled by
+    /// [`Self::contact_coefficients`], v̂ including the gap) with the march its law needs: the
+    /// 2D workspace for a `jenkins-2d` point, the 1D one otherwise. The forces (and, with
+    /// `jacobian`, their derivatives) stay in that workspace. The one place that chooses
+    /// between the two marches.
+    fn march_contact(&mut self, c: usize, jacobian: bool) -> Result<ContactState, HbmError> {
         let law = self.law(c);
         let contact = &self.problem.contacts[c];
         let effects = self.problem.effects.contact;
@@ -364,7 +375,6 @@ impl<'p> HbmSystem<'p> {
             contact: contact.name.clone(),
             source,
         })?;
-        self.states[c] = report.state;
         Ok(report.state)
     }
 
@@ -731,42 +741,36 @@ impl<'p> HbmSystem<'p> {
 
     /// The force coefficients (AFT blocks) of contact `c` at given coordinate coefficients in
     /// force order: [T̂, N̂] from [û, v̂] for a 1D point, [T̂₁, T̂₂, N̂] from [û₁, û₂, v̂] for a 2D
-    /// point (v̂ including the gap).
+    /// point (v̂ including the gap). Overwrites the coefficient buffers of
+    /// [`Self::contact_coefficients`].
     fn contact_force_coefficients(
         &mut self,
         c: usize,
         coordinates: &[Vec<f64>],
     ) -> Result<Vec<Vec<f64>>, HbmError> {
-        let law = self.law(c);
-        let contact = &self.problem.contacts[c];
-        let effects = self.problem.effects.contact;
-        let error = |source| HbmError::Aft {
-            contact: contact.name.clone(),
-            source,
-        };
-        match (self.law_2d(c), self.aft2d.as_mut()) {
-            (Some(law), Some(aft)) => {
-                aft.evaluate(
-                    &law,
-                    effects,
-                    [&coordinates[0], &coordinates[1]],
-                    &coordinates[2],
-                    false,
-                )
-                .map_err(error)?;
-                Ok(vec![
+        let (normal, tangential) = coordinates
+            .split_last()
+            .expect("a normal and at least one tangential coordinate");
+        self.u_coef.copy_from_slice(&tangential[0]);
+        match tangential.get(1) {
+            Some(second) => self.u2_coef.copy_from_slice(second),
+            None => self.u2_coef.iter_mut().for_each(|v| *v = 0.0),
+        }
+        self.v_coef.copy_from_slice(normal);
+        self.march_contact(c, false)?;
+        Ok(
+            match (
+                &self.aft2d,
+                self.problem.contacts[c].second_tangent.is_some(),
+            ) {
+                (Some(aft), true) => vec![
                     aft.t_hat[0].clone(),
                     aft.t_hat[1].clone(),
                     aft.n_hat.clone(),
-                ])
-            }
-            _ => {
-                self.aft
-                    .evaluate(&law, effects, &coordinates[0], &coordinates[1], false)
-                    .map_err(error)?;
-                Ok(vec![self.aft.t_hat.clone(), self.aft.n_hat.clone()])
-            }
-        }
+                ],
+                _ => vec![self.aft.t_hat.clone(), self.aft.n_hat.clone()],
+            },
+        )
     }
 
     /// ∂R/∂x by forward or central differences (the strategy decides), given R at x.
