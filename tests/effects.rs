@@ -4,19 +4,14 @@
 use fricbound::analysis::frf::{self, Silent};
 use fricbound::hbm::{check_jacobian, HbmSystem};
 use fricbound::model::Problem;
-use fricbound::scene;
-use fricbound::scene::paper_wedge_scene;
+
+mod common;
+use common::scenes;
 
 fn paper(overrides: &[&str]) -> Problem {
-    let mut o: Vec<String> = vec![
-        "analysis.freq_start_hz=150.0".into(),
-        "analysis.freq_end_hz=230.0".into(),
-    ];
-    o.extend(overrides.iter().map(|s| s.to_string()));
-    scene::parse(paper_wedge_scene(), "paper", &o)
-        .unwrap()
-        .validate("paper")
-        .unwrap()
+    let mut o = vec!["analysis.freq_start_hz=150.0", "analysis.freq_end_hz=230.0"];
+    o.extend_from_slice(overrides);
+    scenes::paper(&o)
 }
 
 #[test]

@@ -3,11 +3,15 @@
 //! amplitudes in every contact regime, and the optimised envelope against a dense scan of
 //! m per side on the paper case (`meshes/paper-wedge/fig13-3rd.toml`).
 
+mod common;
 mod support;
+
+use common::envelope::limit_seeds;
+use common::scenes::load;
 
 use fricbound::analysis::frf::PointSolver;
 use fricbound::analysis::limits::{
-    self, amplitude_sensitivity, envelope_at, group_states, EnvelopeMode, EnvelopeSeeds, LimitCase,
+    self, amplitude_sensitivity, envelope_at, EnvelopeMode, EnvelopeSeeds, LimitCase,
 };
 use fricbound::contact::aft::AftWorkspace;
 use fricbound::contact::harmonic::HarmonicSet;
@@ -18,37 +22,7 @@ use std::path::Path;
 
 /// The scene of Figs. 13-14 (β = 120°, F0 = 120 N, 200-235 Hz), with overrides.
 fn fig13(extra: &[&str]) -> Problem {
-    let overrides: Vec<String> = extra.iter().map(|s| s.to_string()).collect();
-    fricbound::scene::load(Path::new("meshes/paper-wedge/fig13-3rd.toml"), &overrides)
-        .and_then(|s| s.validate("fig13-3rd"))
-        .unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// The two limit curves (m = ±1 on both sides) solved at the given frequencies: per frequency
-/// (m per side, full coefficients) of each curve that has a solution there.
-fn limit_states(problem: &Problem, freqs: &[f64]) -> Vec<Vec<(Vec<f64>, Vec<f64>)>> {
-    let (_, groups) = EnvelopeMode::Sides.groups(problem);
-    let cases = limits::two_point_cases(problem);
-    let per_case: Vec<Vec<limits::GridSolution>> = cases
-        .iter()
-        .map(|c| {
-            let curve = limits::solve_case(problem, c, None).unwrap_or_else(|e| panic!("{e}"));
-            limits::on_grid(problem, c, &curve.points, freqs).unwrap_or_else(|e| panic!("{e}"))
-        })
-        .collect();
-    (0..freqs.len())
-        .map(|g| {
-            cases
-                .iter()
-                .zip(&per_case)
-                .filter_map(|(c, sols)| {
-                    sols[g]
-                        .as_ref()
-                        .map(|(p, _)| (group_states(c, &groups), p.coefficients.clone()))
-                })
-                .collect()
-        })
-        .collect()
+    load("meshes/paper-wedge/fig13-3rd.toml", extra)
 }
 
 /// The case with m per side.
@@ -138,7 +112,7 @@ fn check_regime(
 fn sensitivity_matches_central_differences_in_every_regime() {
     let problem = fig13(&[]);
     let freqs = [205.0, 215.0, 222.0];
-    let seeds = limit_states(&problem, &freqs);
+    let seeds = limit_seeds(&problem, &freqs);
     // Stuck: both sides stuck at 205 Hz; m moves the static forces only, and the response of
     // the stuck (linear) system does not move.
     let (states, g) = check_regime(&problem, &seeds[0][1], &[-0.3, 0.4], 205.0);
@@ -151,7 +125,7 @@ fn sensitivity_matches_central_differences_in_every_regime() {
     // Slip and lift-off: a light pre-load (F0 = 15 N). At 204 Hz the left side slips and
     // lifts off, the right side slips; at 212 Hz the right side is open all period.
     let light = fig13(&["static_loads.0.value=-15"]);
-    let seeds = limit_states(&light, &[204.0, 212.0]);
+    let seeds = limit_seeds(&light, &[204.0, 212.0]);
     for (i, f) in [204.0, 212.0].into_iter().enumerate() {
         let (states, g) = check_regime(&light, &seeds[i][0], &[0.5, -0.5], f);
         assert!(!states.contains(&ContactState::Stuck), "{f} Hz: {states:?}");
@@ -219,7 +193,7 @@ fn optimised_envelope_equals_a_dense_scan_on_the_paper_case() {
     let problem = fig13(&[]);
     let (_, groups) = EnvelopeMode::Sides.groups(&problem);
     let freqs = [205.0, 213.0, 215.0, 220.0];
-    let seeds = limit_states(&problem, &freqs);
+    let seeds = limit_seeds(&problem, &freqs);
     for (f, s) in freqs.iter().zip(&seeds) {
         let point = envelope_at(
             &problem,
@@ -295,7 +269,7 @@ fn reused_solver_equals_a_fresh_solver_for_every_m() {
     let problem = fig13(&[]);
     let (_, groups) = EnvelopeMode::Sides.groups(&problem);
     let freqs = [213.0, 215.0];
-    let seeds = limit_states(&problem, &freqs);
+    let seeds = limit_seeds(&problem, &freqs);
     let mut reused = PointSolver::new(&problem).unwrap();
     let ms: [[f64; 2]; 5] = [
         [1.0, 1.0],

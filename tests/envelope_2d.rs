@@ -10,8 +10,7 @@ use std::f64::consts::PI;
 use fricbound::analysis::frf::PointSolver;
 use fricbound::analysis::limits::envelope::{disc_to_square, square_to_disc};
 use fricbound::analysis::limits::{
-    self, amplitude_sensitivity_of, envelope_at, group_states, EnvelopeMode, EnvelopeSeeds,
-    StateVariable,
+    self, amplitude_sensitivity_of, envelope_at, EnvelopeMode, EnvelopeSeeds, StateVariable,
 };
 use fricbound::analysis::linear;
 use fricbound::contact::ContactState;
@@ -19,6 +18,8 @@ use fricbound::model::{HarmonicLoad, Problem};
 use fricbound::scene;
 
 mod common;
+use common::blade_pair::coarse_blade_pair;
+use common::envelope::{as_seeds, limit_states, LimitState};
 use common::{problem, PLANAR, SPATIAL};
 
 #[test]
@@ -163,39 +164,6 @@ fn the_sensitivity_to_both_components_of_a_stuck_2d_point_matches_central_differ
     );
 }
 
-/// A solved limit state: m per side, full coefficients, first output's amplitude (m).
-type LimitState = (Vec<f64>, Vec<f64>, f64);
-
-/// The m = ±1 limit curves at the given frequencies: per frequency, each curve's state there.
-fn limit_states(problem: &Problem, freqs: &[f64]) -> Vec<Vec<LimitState>> {
-    let (_, groups) = EnvelopeMode::Sides.groups(problem);
-    let cases = limits::two_point_cases(problem);
-    let per_case: Vec<Vec<limits::GridSolution>> = cases
-        .iter()
-        .map(|c| {
-            let curve = limits::solve_case(problem, c, None).unwrap_or_else(|e| panic!("{e}"));
-            limits::on_grid(problem, c, &curve.points, freqs).unwrap_or_else(|e| panic!("{e}"))
-        })
-        .collect();
-    (0..freqs.len())
-        .map(|g| {
-            cases
-                .iter()
-                .zip(&per_case)
-                .filter_map(|(c, sols)| {
-                    sols[g].as_ref().map(|(p, _)| {
-                        (
-                            group_states(c, &groups),
-                            p.coefficients.clone(),
-                            p.amplitudes[0],
-                        )
-                    })
-                })
-                .collect()
-        })
-        .collect()
-}
-
 #[test]
 fn the_disc_envelope_of_the_constrained_3d_system_equals_the_planar_one() {
     let planar = problem(PLANAR, &[]);
@@ -213,10 +181,7 @@ fn the_disc_envelope_of_the_constrained_3d_system_equals_the_planar_one() {
                 groups,
                 f,
                 &EnvelopeSeeds {
-                    states: seeds
-                        .iter()
-                        .map(|(m, x, _)| (m.clone(), x.clone()))
-                        .collect(),
+                    states: as_seeds(seeds),
                     starts: Vec::new(),
                 },
                 &limits::envelope::search_settings(),
@@ -265,23 +230,7 @@ fn the_disc_envelope_of_the_constrained_3d_system_equals_the_planar_one() {
 /// The 3D blade pair scene (the generator's coarsest mesh, 2 node pairs per side) with the
 /// patch fields `extra` added after each patch's `tolerance`.
 fn blade_pair_3d(dir: &std::path::Path, extra: &str) -> Result<Problem, String> {
-    use fricbound::fe::blade_pair::{generate, BladePairParams};
-    use fricbound::fe::msh_write::{write_msh, MshFormat};
-    let mesh = generate(&BladePairParams {
-        three_d: true,
-        refine: 1,
-        contact_pairs: Some(2),
-        ..BladePairParams::default()
-    })
-    .unwrap();
-    let file = dir.join("blade-pair.msh");
-    write_msh(&file, &mesh, MshFormat::Binary).unwrap();
-    let text = fricbound::study::scaling::blade_pair_scene(&file, true, 1)
-        .replace("tolerance = 1e-6\n", &format!("tolerance = 1e-6\n{extra}"));
-    let label = dir.join("scene.toml").display().to_string();
-    scene::parse(&text, &label, &[])
-        .and_then(|s| s.validate(&label))
-        .map_err(|e| e.to_string())
+    coarse_blade_pair(dir, true, extra)
 }
 
 #[test]

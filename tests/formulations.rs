@@ -10,16 +10,9 @@ use fricbound::model::matrix::StructuralMatrix;
 use fricbound::model::{Formulation, HarmonicLoad, JacobianStrategy, Problem};
 use fricbound::numerics::derivatives::check_operator_jacobian;
 use fricbound::numerics::jacobian::Storage;
-use fricbound::scene;
-use fricbound::scene::paper_wedge_scene;
 
-fn paper(overrides: &[&str]) -> Problem {
-    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    scene::parse(paper_wedge_scene(), "paper", &o)
-        .unwrap()
-        .validate("paper")
-        .unwrap()
-}
+mod common;
+use common::scenes::{paper, problem};
 
 /// The paper system with a flexible tip on each blade DOF: tip masses (0.3 kg) tied to the
 /// blade DOFs by springs (4e5 N/m), damped (5 N s/m), excited and observed at the tips. The
@@ -377,9 +370,7 @@ fn chain_scene(n: usize, jenkins: usize) -> String {
 #[test]
 fn auto_picks_the_formulation_estimated_fastest() {
     let text = chain_scene(40, 10);
-    let chain = fricbound::scene::parse(&text, "chain", &[])
-        .and_then(|s| s.validate("chain"))
-        .expect("valid chain scene");
+    let chain = problem(&text, &[]);
     assert_eq!(chain.formulation(), Formulation::Sparse);
     let (_, why) = chain.auto_formulation();
     for f in ["dense", "sparse", "condensed"] {
@@ -395,9 +386,7 @@ fn auto_picks_the_formulation_estimated_fastest() {
 #[test]
 fn schur_handles_contacts_with_a_zero_normal_direction() {
     let text = chain_scene(12, 3);
-    let chain = fricbound::scene::parse(&text, "chain", &[])
-        .and_then(|s| s.validate("chain"))
-        .expect("valid chain scene");
+    let chain = problem(&text, &[]);
     let dense = with_formulation(chain.clone(), Formulation::Dense);
     let schur = with_formulation(chain, Formulation::Schur);
     // One coordinate per contact and coefficient block (H = 5: 11 blocks).

@@ -9,13 +9,16 @@ use fricbound::analysis::limits::{self, LimitCase};
 use fricbound::contact::{ContactState, FrictionLaw};
 use fricbound::hbm::operator::HbmOperator;
 use fricbound::hbm::{check_jacobian, HbmSystem};
-use fricbound::model::{Formulation, HarmonicLoad, JacobianStrategy, Problem};
+use fricbound::model::{Formulation, JacobianStrategy, Problem};
 use fricbound::numerics::derivatives::check_operator_jacobian;
 use fricbound::numerics::jacobian::Storage;
 use fricbound::scene;
 
 mod common;
-use common::{assert_spatial_equals_planar, problem, to_spatial, PLANAR, SPATIAL};
+use common::blade_pair::coarse_blade_pair;
+use common::{
+    compare_on_planar_path, excited_out_of_plane, problem, OUT_OF_PLANE_RUN, PLANAR, SPATIAL,
+};
 
 #[test]
 fn the_3d_paper_system_with_2d_friction_equals_the_planar_one() {
@@ -26,25 +29,14 @@ fn the_3d_paper_system_with_2d_friction_equals_the_planar_one() {
         .contacts
         .iter()
         .all(|c| c.friction_law() == FrictionLaw::Jenkins2d));
-    let run = frf::solve(&planar, &mut Silent).unwrap();
-    let mut flat = PointSolver::new(&planar).unwrap();
-    let mut solid = PointSolver::new(&spatial).unwrap();
+    let (largest, pairs) = compare_on_planar_path(&planar, &spatial, (200.0, 235.0), 12, 1e-8);
     let mut slipping = 0;
-    let mut largest = 0.0_f64;
-    for i in 1..12 {
-        let f = 200.0 + 35.0 * i as f64 / 12.0;
-        let guess = frf::interpolate_on_path(&run.points, f).unwrap();
-        let a = flat.solve(&guess, f).unwrap();
-        let b = solid.solve(&to_spatial(&guess), f).unwrap();
-        let what = format!("{f:.3} Hz");
-        largest = largest.max(assert_spatial_equals_planar(
-            &a.coefficients,
-            &b.coefficients,
-            1e-8,
-            &what,
-        ));
-        assert_eq!(a.states, b.states, "{f:.3} Hz");
-        assert!((a.amplitudes[0] - b.amplitudes[0]).abs() <= 1e-8 * a.amplitudes[0]);
+    for (a, b) in &pairs {
+        assert!(
+            (a.amplitudes[0] - b.amplitudes[0]).abs() <= 1e-8 * a.amplitudes[0],
+            "{:.3} Hz",
+            a.freq_hz
+        );
         if a.states.iter().any(|s| *s != ContactState::Stuck) {
             slipping += 1;
         }
@@ -78,23 +70,7 @@ fn the_3d_paper_system_with_2d_friction_equals_the_planar_one() {
 /// 2000-period budget (slider drift 1.3e-10 m, a grazing path; see README "2D tangential
 /// friction").
 fn out_of_plane(formulation: Formulation) -> Problem {
-    let mut p = problem(
-        SPATIAL,
-        &[
-            "analysis.freq_start_hz=150",
-            "analysis.freq_end_hz=185",
-            "harmonics.max=3",
-            "harmonics.samples=128",
-        ],
-    );
-    p.harmonic_loads.push(HarmonicLoad {
-        dof: 2,
-        harmonic: 1,
-        cos: 10.0,
-        sin: 0.0,
-    });
-    p.analysis.formulation = formulation;
-    p
+    excited_out_of_plane(problem(SPATIAL, &OUT_OF_PLANE_RUN), formulation)
 }
 
 #[test]
@@ -289,29 +265,10 @@ fn schur_counts_three_relative_coordinates_per_2d_point() {
     assert_eq!(p.relative_coordinate_count(), 6);
 }
 
-/// A 3D blade pair (the generator's coarsest mesh, 2 node pairs per side) with 2D friction on
+/// A blade pair (the generator's coarsest mesh, 2 node pairs per side) with 2D friction on
 /// its contact patches.
 fn blade_pair_3d(dir: &std::path::Path, three_d: bool) -> Result<Problem, String> {
-    use fricbound::fe::blade_pair::{generate, BladePairParams};
-    use fricbound::fe::msh_write::{write_msh, MshFormat};
-    let mesh = generate(&BladePairParams {
-        three_d,
-        refine: 1,
-        contact_pairs: Some(2),
-        ..BladePairParams::default()
-    })
-    .unwrap();
-    let file = dir.join("blade-pair.msh");
-    write_msh(&file, &mesh, MshFormat::Binary).unwrap();
-    let text = fricbound::study::scaling::blade_pair_scene(&file, three_d, 1).replace(
-        "tolerance = 1e-6\n",
-        "tolerance = 1e-6\nlaw = \"jenkins-2d\"\n",
-    );
-    assert_eq!(text.matches("jenkins-2d").count(), 2);
-    let label = dir.join("scene.toml").display().to_string();
-    scene::parse(&text, &label, &[])
-        .and_then(|s| s.validate(&label))
-        .map_err(|e| e.to_string())
+    coarse_blade_pair(dir, three_d, "law = \"jenkins-2d\"\n")
 }
 
 #[test]

@@ -14,29 +14,17 @@ use fricbound::analysis::stability;
 use fricbound::analysis::verify::{self, VerifySettings};
 use fricbound::model::matrix::StructuralMatrix;
 use fricbound::model::Problem;
-use fricbound::scene;
-use fricbound::scene::paper_wedge_scene;
+
+mod common;
+use common::linear::damped_eigenvalues;
+use common::scenes::{load, paper};
 
 fn paper_h1() -> Problem {
-    let o: Vec<String> = vec![
-        "analysis.freq_start_hz=150.0".into(),
-        "analysis.freq_end_hz=230.0".into(),
-        "harmonics.max=1".into(),
-    ];
-    scene::parse(paper_wedge_scene(), "paper", &o)
-        .unwrap()
-        .validate("paper")
-        .unwrap()
-}
-
-/// The damped eigenvalues of λ²M + λC + K (first-order form).
-fn damped_eigenvalues(problem: &Problem) -> Vec<c64> {
-    let (m, c, k) = (
-        problem.model.mass.to_dense(),
-        problem.model.damping.to_dense(),
-        problem.model.stiffness.to_dense(),
-    );
-    fricbound::analysis::stability::damped_eigenvalues(m.as_ref(), c.as_ref(), k.as_ref()).unwrap()
+    paper(&[
+        "analysis.freq_start_hz=150.0",
+        "analysis.freq_end_hz=230.0",
+        "harmonics.max=1",
+    ])
 }
 
 #[test]
@@ -137,12 +125,7 @@ fn linear_multipliers_are_the_trapezoidal_images_of_the_damped_eigenvalues() {
 }
 
 fn fold_problem() -> Problem {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/liftoff-fold.toml");
-    let text = std::fs::read_to_string(path).unwrap();
-    scene::parse(&text, "liftoff-fold", &[])
-        .unwrap()
-        .validate("liftoff-fold")
-        .unwrap()
+    load("tests/data/liftoff-fold.toml", &[])
 }
 
 #[test]

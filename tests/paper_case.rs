@@ -6,16 +6,9 @@ use fricbound::analysis::linear::{self, LinearCase};
 use fricbound::contact::ContactState;
 use fricbound::hbm::{check_jacobian, HbmSystem};
 use fricbound::model::Problem;
-use fricbound::scene;
-use fricbound::scene::paper_wedge_scene;
 
-fn paper(overrides: &[&str]) -> Problem {
-    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    scene::parse(paper_wedge_scene(), "paper", &o)
-        .unwrap()
-        .validate("paper")
-        .unwrap()
-}
+mod common;
+use common::scenes::paper;
 
 /// The paper structure with the damper also grounded (so that it is not a free body when
 /// contacts are open), no pre-load, and contacts forced open (large gap) or stuck (interference

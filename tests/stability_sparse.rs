@@ -18,33 +18,19 @@ use fricbound::model::Problem;
 use fricbound::scene;
 use fricbound::study::jacobian::chain_scene;
 
-fn problem(text: &str, overrides: &[String]) -> Problem {
-    scene::parse(text, "case", overrides)
-        .unwrap()
-        .validate("case")
-        .unwrap()
-}
-
-/// The damped eigenvalues of λ²M + λC + K (first-order form).
-fn damped_eigenvalues(problem: &Problem) -> Vec<c64> {
-    let (m, c, k) = (
-        problem.model.mass.to_dense(),
-        problem.model.damping.to_dense(),
-        problem.model.stiffness.to_dense(),
-    );
-    fricbound::analysis::stability::damped_eigenvalues(m.as_ref(), c.as_ref(), k.as_ref()).unwrap()
-}
+mod common;
+use common::linear::damped_eigenvalues;
+use common::scenes::{paper, problem};
 
 #[test]
 fn below_the_dense_limit_shift_invert_gives_the_dense_leading_exponent_and_verdict() {
     // The paper system at H = 3 (6 DOFs × 7 blocks = 42 unknowns) over its 2nd and 3rd
     // resonances: stuck and stick-slip points.
-    let o: Vec<String> = vec![
-        "analysis.freq_start_hz=150.0".into(),
-        "analysis.freq_end_hz=235.0".into(),
-        "harmonics.max=3".into(),
-    ];
-    let problem = problem(scene::paper_wedge_scene(), &o);
+    let problem = paper(&[
+        "analysis.freq_start_hz=150.0",
+        "analysis.freq_end_hz=235.0",
+        "harmonics.max=3",
+    ]);
     let run = frf::solve(&problem, &mut Silent).unwrap();
     let mut solver = PointSolver::new(&problem).unwrap();
     let settings = HillSolver::ShiftInvert(ShiftInvertSettings::default());
@@ -261,9 +247,9 @@ fn the_coverage_limit_is_checked_at_the_door() {
     let ok = problem(
         &text,
         &[
-            "analysis.stability=true".into(),
-            "analysis.hill_solver=shift-invert".into(),
-            "analysis.hill_max_freq_hz=50".into(),
+            "analysis.stability=true",
+            "analysis.hill_solver=shift-invert",
+            "analysis.hill_max_freq_hz=50",
         ],
     );
     assert_eq!(ok.analysis.hill_max_freq_hz, Some(50.0));
@@ -274,12 +260,14 @@ fn a_run_above_the_dense_limit_fills_the_stability_columns_by_shift_invert() {
     // 90 masses, 4 Jenkins elements, H = 3 (630 unknowns): the scene check no longer refuses
     // stability; the run's points get Hill verdicts by the shift-invert solve, checked against
     // the dense solve at one point.
-    let o: Vec<String> = vec![
-        "analysis.stability=true".into(),
-        "analysis.freq_start_hz=5.0".into(),
-        "analysis.freq_end_hz=5.3".into(),
-    ];
-    let problem = problem(&chain_scene(90, 4, 3), &o);
+    let problem = problem(
+        &chain_scene(90, 4, 3),
+        &[
+            "analysis.stability=true",
+            "analysis.freq_start_hz=5.0",
+            "analysis.freq_end_hz=5.3",
+        ],
+    );
     let set = problem.unknown_harmonics();
     assert!(problem.model.n_dofs() * set.n_blocks() > MAX_HILL_UNKNOWNS);
     let run = frf::solve(&problem, &mut Silent).unwrap();

@@ -10,11 +10,12 @@ use fricbound::analysis::frf::{self, PointSolver, Silent};
 use fricbound::contact::Jenkins2dLaw;
 use fricbound::hbm::statics::{static_point_2d, static_solve, StaticSystem};
 use fricbound::hbm::{check_jacobian, HbmSystem};
-use fricbound::model::{Formulation, HarmonicLoad, Problem};
+use fricbound::model::{Formulation, Problem};
 
 mod common;
 use common::{
-    assert_spatial_equals_planar, problem, to_spatial, IN_PLANE, OUT_OF_PLANE, PLANAR, SPATIAL,
+    compare_on_planar_path, excited_out_of_plane, problem, IN_PLANE, OUT_OF_PLANE,
+    OUT_OF_PLANE_RUN, PLANAR, SPATIAL,
 };
 
 /// The damper's out-of-plane DOF (zD) in the 3D scene.
@@ -207,28 +208,11 @@ fn uncoupled_3d_paper_system_equals_the_planar_one() {
         assert_eq!(b[d], 0.0);
     }
     // FRF points from the same guesses (harmonics ≥ 1 only in the uncoupled mode).
-    let run = frf::solve(&planar, &mut Silent).unwrap();
-    let mut flat = PointSolver::new(&planar).unwrap();
-    let mut solid = PointSolver::new(&spatial).unwrap();
-    let mut largest = 0.0_f64;
-    let mut slipping = 0;
-    for i in 1..8 {
-        let f = 200.0 + 35.0 * i as f64 / 8.0;
-        let guess = frf::interpolate_on_path(&run.points, f).unwrap();
-        let a = flat.solve(&guess, f).unwrap();
-        let b = solid.solve(&to_spatial(&guess), f).unwrap();
-        let what = format!("{f:.3} Hz");
-        largest = largest.max(assert_spatial_equals_planar(
-            &a.coefficients,
-            &b.coefficients,
-            1e-10,
-            &what,
-        ));
-        assert_eq!(a.states, b.states, "{f:.3} Hz");
-        if a.states.iter().any(|s| s.is_unique()) {
-            slipping += 1;
-        }
-    }
+    let (largest, pairs) = compare_on_planar_path(&planar, &spatial, (200.0, 235.0), 8, 1e-10);
+    let slipping = pairs
+        .iter()
+        .filter(|(a, _)| a.states.iter().any(|s| s.is_unique()))
+        .count();
     println!("largest in-plane FRF difference / scale: {largest:.3e}, {slipping} points with slip");
     assert!(slipping >= 3, "only {slipping} points with slip compared");
 }
@@ -305,23 +289,10 @@ fn out_of_plane_static_load_slips_a_point_off_t1() {
 #[test]
 fn uncoupled_frf_with_2d_points_agrees_across_formulations() {
     let build = |formulation: Formulation| {
-        let mut p = with_out_of_plane_static_load(
-            40.0,
-            &[
-                "analysis.freq_start_hz=150",
-                "analysis.freq_end_hz=185",
-                "harmonics.max=3",
-                "harmonics.samples=128",
-            ],
-        );
-        p.harmonic_loads.push(HarmonicLoad {
-            dof: 2,
-            harmonic: 1,
-            cos: 10.0,
-            sin: 0.0,
-        });
-        p.analysis.formulation = formulation;
-        p
+        excited_out_of_plane(
+            with_out_of_plane_static_load(40.0, &OUT_OF_PLANE_RUN),
+            formulation,
+        )
     };
     let dense = build(Formulation::Dense);
     let run = frf::solve(&dense, &mut Silent).unwrap();

@@ -4,22 +4,14 @@
 //! most modes of the list, and the error of the modes rows falls as the modes grow.
 
 use fricbound::study::accuracy::{self, StudyCurve};
-use fricbound::study::scaling::{self, ModelSize};
+
+mod common;
+use common::blade_pair::reduced_blade_pair_2d;
 
 #[test]
 fn modes_rows_vary_the_interior_modes_and_their_error_falls() {
     let dir = tempfile::tempdir().unwrap();
-    let size = ModelSize {
-        contact_pairs: Some(2),
-        ..ModelSize::uniform(false, 1)
-    };
-    // Writes the mesh `blade-pair-2d-r1-p2.msh` into the folder.
-    scaling::full_problem(size, 1, dir.path()).unwrap();
-    let mesh = dir.path().join("blade-pair-2d-r1-p2.msh");
-    let text = format!(
-        "{}\n[reduction]\nmodes = 8\nmodal_damping = 0.002\n",
-        scaling::blade_pair_scene(&mesh, false, 1)
-    );
+    let text = reduced_blade_pair_2d(dir.path());
     let label = dir.path().join("blade-pair.toml").display().to_string();
 
     // The full study's list: a quarter, half, once and twice the scene's modes; the reference

@@ -1,10 +1,9 @@
-//! Helpers shared by the test crates that compare the 3D paper scene (`jenkins-2d` friction,
-//! out-of-plane motion constrained) with the planar one: the two scenes, the DOF maps between
-//! them, and the comparison of their harmonic coefficients. Each test crate uses a part of it.
-#![allow(dead_code)]
+//! The 3D paper scene (`jenkins-2d` friction, out-of-plane motion constrained) against the
+//! planar one: the two scenes, the DOF maps between them, and the comparison of their harmonic
+//! coefficients and FRF points.
 
-use fricbound::model::Problem;
-use fricbound::scene;
+use fricbound::analysis::frf::{self, FrfPoint, PointSolver, Silent};
+use fricbound::model::{Formulation, HarmonicLoad, Problem};
 
 /// The planar paper scene (Fig. 13, 3rd resonance).
 pub const PLANAR: &str = include_str!("../../meshes/paper-wedge/fig13-3rd.toml");
@@ -15,15 +14,6 @@ pub const SPATIAL: &str = include_str!("../../meshes/paper-wedge-3d/fig13-3rd-3d
 pub const IN_PLANE: [usize; 6] = [0, 1, 3, 4, 6, 7];
 /// Out-of-plane DOFs of the 3D scene.
 pub const OUT_OF_PLANE: [usize; 3] = [2, 5, 8];
-
-/// A validated scene with `--set`-style overrides.
-pub fn problem(text: &str, overrides: &[&str]) -> Problem {
-    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    scene::parse(text, "scene", &o)
-        .unwrap()
-        .validate("scene")
-        .unwrap()
-}
 
 /// Planar coefficients (6 DOFs per block) placed on the 3D layout (9 DOFs per block, z = 0).
 pub fn to_spatial(x: &[f64]) -> Vec<f64> {
@@ -66,4 +56,60 @@ pub fn assert_spatial_equals_planar(
         }
     }
     largest
+}
+
+/// Solves the planar and the 3D problem at `count − 1` frequencies evenly inside (lo, hi) (Hz),
+/// each from the same guess on the planar FRF path, and asserts that the 3D coefficients equal
+/// the planar ones to `tolerance` ([`assert_spatial_equals_planar`]) and the contact states
+/// agree. Returns the largest in-plane difference relative to the scale and the solution
+/// pairs (planar, 3D).
+pub fn compare_on_planar_path(
+    planar: &Problem,
+    spatial: &Problem,
+    (lo, hi): (f64, f64),
+    count: usize,
+    tolerance: f64,
+) -> (f64, Vec<(FrfPoint, FrfPoint)>) {
+    let run = frf::solve(planar, &mut Silent).unwrap();
+    let mut flat = PointSolver::new(planar).unwrap();
+    let mut solid = PointSolver::new(spatial).unwrap();
+    let mut largest = 0.0_f64;
+    let mut pairs = Vec::new();
+    for i in 1..count {
+        let f = lo + (hi - lo) * i as f64 / count as f64;
+        let guess = frf::interpolate_on_path(&run.points, f).unwrap();
+        let a = flat.solve(&guess, f).unwrap();
+        let b = solid.solve(&to_spatial(&guess), f).unwrap();
+        let what = format!("{f:.3} Hz");
+        largest = largest.max(assert_spatial_equals_planar(
+            &a.coefficients,
+            &b.coefficients,
+            tolerance,
+            &what,
+        ));
+        assert_eq!(a.states, b.states, "{what}");
+        pairs.push((a, b));
+    }
+    (largest, pairs)
+}
+
+/// Overrides of the 3D cases with out-of-plane excitation: 150-185 Hz, H = 3, 128 samples.
+pub const OUT_OF_PLANE_RUN: [&str; 4] = [
+    "analysis.freq_start_hz=150",
+    "analysis.freq_end_hz=185",
+    "harmonics.max=3",
+    "harmonics.samples=128",
+];
+
+/// `p` (the 3D scene) with an out-of-plane load on blade 1 (10 N cos ωt on z₁, DOF 2), which
+/// takes the contact paths off the t₁ direction, solved with `formulation`.
+pub fn excited_out_of_plane(mut p: Problem, formulation: Formulation) -> Problem {
+    p.harmonic_loads.push(HarmonicLoad {
+        dof: 2,
+        harmonic: 1,
+        cos: 10.0,
+        sin: 0.0,
+    });
+    p.analysis.formulation = formulation;
+    p
 }

@@ -1,0 +1,30 @@
+//! Scenes into validated problems, with `--set`-style overrides; any error panics with its
+//! message (file, field and reason).
+
+use fricbound::model::Problem;
+use fricbound::scene;
+use std::path::Path;
+
+/// A validated problem from scene text with `--set`-style overrides.
+pub fn problem(text: &str, overrides: &[&str]) -> Problem {
+    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    scene::parse(text, "scene", &o)
+        .and_then(|s| s.validate("scene"))
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The paper's lumped wedge-damper scene ([`scene::paper_wedge_scene`]) with overrides.
+pub fn paper(overrides: &[&str]) -> Problem {
+    problem(scene::paper_wedge_scene(), overrides)
+}
+
+/// A validated problem from the scene file at `path` (relative to the crate's folder, e.g.
+/// `meshes/paper-wedge/fig13-3rd.toml`) with overrides; a mesh the scene names is read
+/// relative to the scene file.
+pub fn load(path: &str, overrides: &[&str]) -> Problem {
+    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
+    scene::load_problem(&path, &o)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .1
+}
