@@ -8,7 +8,8 @@
 //! (linear part and every contact's AFT march), the residual with the analytic Jacobian (the
 //! marches with their derivatives, and their scatter into the Jacobian's storage), the
 //! factorisation of the bordered Jacobian (for the schur formulation: the per-harmonic
-//! elimination of the non-contact coordinates and the LU of the reduced matrix), one solve
+//! elimination of the non-contact coordinates, reused at a repeated ω as here, and the LU of
+//! the reduced matrix; the schur rows also time it at a new ω every call), one solve
 //! with it; then each contact point's march alone, with and without its Jacobian, and how many
 //! periods it marched. Wall and process CPU time (all threads) per call, in ms; the CPU time
 //! comes from `/proc/self/stat` (Linux). The numbers are the machine's of the moment: run it
