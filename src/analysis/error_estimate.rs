@@ -610,6 +610,15 @@ fn bands(points: &[(f64, &PointAccuracy)], outputs: usize, threshold: f64) -> Ve
     found
 }
 
+/// The relative truncation estimate above which a warning says the size is not to be read:
+/// the estimate is one Newton step of the extended system, and a step that changes the
+/// amplitude by more than the amplitude itself is outside the reach of the linearisation it
+/// comes from. Measured on the reduced blade pair at H = 1 (docs/accuracy.md, "The larger
+/// blade pair at H = 1, on its small folds"): its points with estimates of 560-8907 % have no
+/// state nearby at H = 3, 5 or 7 (Newton from the padded point does not converge at the
+/// point's frequency), and the nearest one across the path is 33-39 % away.
+pub const BEYOND_LINEAR: f64 = 1.0;
+
 /// The warning line of a band: where, how large, and which field to raise. `h_max` is the
 /// highest balanced harmonic, `samples` the samples per period, `output` the DOF's name.
 pub fn warning_text(w: &AccuracyWarning, output: &str, h_max: usize, samples: usize) -> String {
@@ -619,6 +628,17 @@ pub fn warning_text(w: &AccuracyWarning, output: &str, h_max: usize, samples: us
         format!("is estimated at up to {:.2} %", 100.0 * w.largest)
     };
     let (what, advice) = match w.kind {
+        EstimateKind::Truncation if w.largest > BEYOND_LINEAR => (
+            "harmonic truncation",
+            format!(
+                "harmonics.max > {h_max} needed; an estimate above {:.0} % is beyond what a \
+                 first-order step can size: these points may lie on a branch of the truncated \
+                 model that has no counterpart at H = {} (read them as wrong, not as off by that \
+                 much, and solve the band at the higher H)",
+                100.0 * BEYOND_LINEAR,
+                extended_harmonic(h_max)
+            ),
+        ),
         EstimateKind::Truncation => (
             "harmonic truncation",
             format!(
@@ -723,6 +743,15 @@ mod tests {
         let text = warning_text(&w[0], "y2", 1, 256);
         assert!(text.contains("harmonics.max > 1"), "{text}");
         assert!(text.contains("101.0000 and 104.0000 Hz"), "{text}");
+        assert!(!text.contains("no counterpart"), "{text}");
+        // Above 100 % the size is beyond a first-order step: the warning says so.
+        let huge = AccuracyWarning {
+            largest: 89.07,
+            ..w[0].clone()
+        };
+        let text = warning_text(&huge, "y2", 1, 256);
+        assert!(text.contains("8907.00 %"), "{text}");
+        assert!(text.contains("no counterpart at H = 3"), "{text}");
     }
 
     #[test]
