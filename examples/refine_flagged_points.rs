@@ -81,6 +81,7 @@ fn main() {
         let n = refined.model.n_dofs();
         let blocks = refined.unknown_harmonics().n_blocks();
         let mut solver = frf::PointSolver::new(&refined).expect("point solver");
+        // Zero padding onto 0..H_REF (the blocks of 0..H are a prefix of those of 0..H_REF).
         let pad = |p: &FrfPoint| -> FrfPoint {
             let mut q = p.clone();
             q.coefficients.resize(n * blocks, 0.0);
@@ -103,7 +104,7 @@ fn main() {
                 slide / step,
                 acc.across_path
             );
-            match solver.solve(&p.coefficients_padded(n * blocks), p.freq_hz) {
+            match solver.solve(&pad(p).coefficients, p.freq_hz) {
                 Ok(q) => println!(
                     "   H {h_ref} fixed frequency: amp {:.5e} [{}], true error {:.3e}",
                     q.amplitudes[0],
@@ -134,19 +135,5 @@ fn main() {
                 }
             }
         }
-    }
-}
-
-/// Zero-padding of a point's coefficients onto a larger harmonic set 0..H' (the blocks of
-/// 0..H are a prefix of those of 0..H').
-trait Padded {
-    fn coefficients_padded(&self, len: usize) -> Vec<f64>;
-}
-
-impl Padded for FrfPoint {
-    fn coefficients_padded(&self, len: usize) -> Vec<f64> {
-        let mut x = self.coefficients.clone();
-        x.resize(len, 0.0);
-        x
     }
 }
