@@ -969,6 +969,22 @@ mod tests {
     }
 
     #[test]
+    fn tail_test_extends_slow_tails_and_stuck_contacts_only() {
+        // Lower half changes the amplitude by 1e-2, the upper half by 1e-3: r = 0.1, tail
+        // 1.1e-4, far below half of the 1.1e-2 estimate.
+        assert!(!TailTest::extend(1.0, 1.01, 1.011, false));
+        // The upper half changes it by as much as the lower one: r = 1, unbounded tail.
+        assert!(TailTest::extend(1.0, 1.01, 1.02, false));
+        // r = 0.6: tail 0.6/0.4 · 6e-3 = 9e-3 > half of 1.6e-2.
+        assert!(TailTest::extend(1.0, 1.01, 1.016, false));
+        // A stuck contact extends any estimate that is not negligible ...
+        assert!(TailTest::extend(1.0, 1.01, 1.011, true));
+        // ... and none that is (all stuck: linear, no truncation error), nor a NaN.
+        assert!(!TailTest::extend(1.0, 1.0, 1.0 + 1e-9, true));
+        assert!(!TailTest::extend(1.0, f64::NAN, f64::NAN, true));
+    }
+
+    #[test]
     fn largest_ignores_unformed_estimates() {
         let a = [acc(0.01, f64::NAN), acc(0.03, 0.002)];
         let refs: Vec<&PointAccuracy> = a.iter().collect();
