@@ -16,6 +16,12 @@
 //! estimate of an output is |A(x + δ) − A(x)| / A(x), A the first-harmonic amplitude
 //! √(c₁² + s₁²).
 //!
+//! Where the harmonics beyond 2H + 1 may matter ([`TailTest`]: a contact stuck all period,
+//! whose mean force holds every harmonic of u(τ = 0), or an extension whose upper half of
+//! harmonics still changes the estimate as much as its lower half) the point is estimated
+//! again in the same way on the wider set H+1 … 4H+3 ([`wider_harmonic`]) and reports that
+//! estimate ([`PointAccuracy::estimate_harmonic`] says which).
+//!
 //! # Sampling
 //!
 //! The same point put into the harmonic balance of the same harmonic set at twice the samples
@@ -57,6 +63,7 @@
 //! border by blocks).
 
 use crate::contact::harmonic::HarmonicSet;
+use crate::contact::point::ContactState;
 use crate::hbm::operator::HbmOperator;
 use crate::hbm::HbmError;
 use crate::model::{Formulation, Problem};
@@ -92,6 +99,10 @@ pub struct PointAccuracy {
     /// it, and the continuation step that reached the point; NaN elsewhere.
     #[serde(skip)]
     pub slide_and_step: (f64, f64),
+    /// Highest harmonic of the extended set the reported truncation estimate comes from:
+    /// 2H + 1, or the wider set's 4H + 3 where the first extension had not converged in its
+    /// own harmonics ([`TailTest`]); 0 where no estimate was formed.
+    pub estimate_harmonic: usize,
 }
 
 /// Where the path is at a converged point, for the estimate across it: the hyperplane normal
@@ -135,8 +146,11 @@ impl PathSwitch {
 /// and the same set at twice the samples. Built once per run (see [`ErrorEstimator`]).
 #[derive(Debug, Clone)]
 pub struct EstimateProblems {
-    /// The problem on the extended harmonic set.
+    /// The problem on the extended harmonic set (up to 2H + 1).
     pub truncation: Problem,
+    /// The problem on the wider set (up to [`wider_harmonic`], 4H + 3), for the points whose
+    /// first extension has not converged in its own harmonics ([`TailTest`]).
+    pub wider: Problem,
     /// The problem at twice the samples per period.
     pub sampling: Problem,
 }
@@ -148,24 +162,27 @@ impl EstimateProblems {
             return None;
         }
         let h = problem.harmonics.iter().copied().max().unwrap_or(1);
-        let top = extended_harmonic(h);
-        let mut truncation = problem.clone();
-        truncation.harmonics = problem
-            .harmonics
-            .iter()
-            .copied()
-            .chain(h + 1..=top)
-            .collect();
-        truncation.harmonics.sort_unstable();
-        truncation.harmonics.dedup();
-        while truncation.samples <= 2 * top {
-            truncation.samples *= 2;
-        }
-        truncation.analysis.formulation = extended_formulation(problem, &truncation);
+        let extended_to = |top: usize| {
+            let mut extended = problem.clone();
+            extended.harmonics = problem
+                .harmonics
+                .iter()
+                .copied()
+                .chain(h + 1..=top)
+                .collect();
+            extended.harmonics.sort_unstable();
+            extended.harmonics.dedup();
+            while extended.samples <= 2 * top {
+                extended.samples *= 2;
+            }
+            extended.analysis.formulation = extended_formulation(problem, &extended);
+            extended
+        };
         let mut sampling = problem.clone();
         sampling.samples = 2 * problem.samples;
         Some(Self {
-            truncation,
+            truncation: extended_to(extended_harmonic(h)),
+            wider: extended_to(wider_harmonic(h)),
             sampling,
         })
     }
@@ -196,6 +213,66 @@ fn extended_formulation(problem: &Problem, extended: &Problem) -> Formulation {
 /// reach the 3rd harmonic for the estimate to see what matters.
 pub fn extended_harmonic(h: usize) -> usize {
     2 * h + 1
+}
+
+/// The highest harmonic of the wider set, the cap of the adaptive extension: the first
+/// extension applied twice, 2(2H + 1) + 1 = 4H + 3 (7 at H = 1, where the upper branch of the
+/// blade pair holds its error in harmonics 6-7: docs/accuracy.md).
+pub fn wider_harmonic(h: usize) -> usize {
+    extended_harmonic(extended_harmonic(h))
+}
+
+/// Whether the estimate on 2H + 1 may be missing what lies beyond 2H + 1, so that the point is
+/// estimated again on the wider set (4H + 3), which it then reports. Two reasons, either
+/// suffices (and neither where the estimate is negligible, [`Self::NEGLIGIBLE`]):
+///
+/// - **A contact stuck all period.** Its tangential force keeps the march's initial condition
+///   T(0) = m μ N(0), so its mean force is kₜ (ū − u(0)) + m μ N(0): it holds u and N at τ = 0,
+///   sums of every cosine harmonic with weight one. The harmonic content such a contact feeds
+///   back does not decay with the harmonic number as slip-driven forces do, and the error can
+///   sit far above 2H + 1 (on the small blade pair's upper branch at H = 1 it sits in the
+///   harmonics 6-7: docs/accuracy.md). Where every contact is stuck the model is linear and
+///   the estimate negligible, so only points mixing stuck and moving contacts pay.
+/// - **The extension has not converged in its own harmonics.** Two estimates come from the
+///   same factorisation: the step from the residual on the lower half of the new harmonics
+///   alone (H+1 … ⌈3H/2⌉) changes the amplitude by d₁, the step from all of them by
+///   d₁ + d₂. If each further half of harmonics changes it by r = |d₂|/|d₁| times the previous
+///   one (a geometric tail), the harmonics above 2H + 1 add at most |d₂| r/(1 − r) (unbounded
+///   for r ≥ 1). Where that exceeds [`Self::FRACTION`] of the estimate |d₁ + d₂|, the point is
+///   extended.
+///
+/// The fraction: the issue's criterion holds an estimate to a factor 3 of the true error; a
+/// tail of at most half the estimate leaves the reported value within a factor 1.5 of the
+/// extension's limit, half of the allowed band (in log scale), the other half left for the
+/// first-order step itself.
+pub struct TailTest;
+
+impl TailTest {
+    /// Largest projected tail, relative to the estimate, that the 2H + 1 estimate is kept with.
+    pub const FRACTION: f64 = 0.5;
+    /// Relative estimates below this are kept without testing their tail (round-off of the
+    /// amplitude, far below the no-warning level 1e-4 of the issue).
+    pub const NEGLIGIBLE: f64 = 1e-7;
+
+    /// True when the estimate needs the wider set: `base` the point's amplitude, `low` and
+    /// `full` the amplitudes after the lower-half and the full steps, `stuck_contact` whether
+    /// a contact of the point is stuck all period.
+    pub fn extend(base: f64, low: f64, full: f64, stuck_contact: bool) -> bool {
+        let d1 = (low - base).abs();
+        let d2 = (full - low).abs();
+        let estimate = (full - base).abs();
+        if estimate.partial_cmp(&(Self::NEGLIGIBLE * base.abs()))
+            != Some(std::cmp::Ordering::Greater)
+        {
+            // Negligible, or not a number (then the wider set cannot do better).
+            return false;
+        }
+        if stuck_contact || d2 >= d1 {
+            return true;
+        }
+        let r = d2 / d1;
+        d2 * r / (1.0 - r) > Self::FRACTION * estimate
+    }
 }
 
 /// One refined operator and a Jacobian in its storage (pattern built once).
@@ -257,6 +334,21 @@ impl<'p> Refined<'p> {
         Some(out)
     }
 
+    /// `r` (in this operator's unknowns) with the blocks of the upper half of the harmonics
+    /// above `h` (above ⌈3h/2⌉) set to zero.
+    fn lower_half(&self, r: &[f64], h: usize) -> Vec<f64> {
+        let set = self.operator.unknowns();
+        let size = r.len() / set.n_blocks().max(1);
+        let split = (3 * h).div_ceil(2);
+        let mut low = r.to_vec();
+        for (j, block) in set.blocks().iter().enumerate() {
+            if block.harmonic() > split {
+                low[j * size..(j + 1) * size].fill(0.0);
+            }
+        }
+        low
+    }
+
     /// Full coefficients of `xr − δ` (refined unknowns); None when not finite.
     fn stepped(&mut self, xr: &[f64], delta: &[f64], omega: f64) -> Option<Vec<f64>> {
         let stepped: Vec<f64> = xr.iter().zip(delta).map(|(a, d)| a - d).collect();
@@ -302,6 +394,10 @@ pub struct ErrorEstimator<'p> {
     problem: &'p Problem,
     set: HarmonicSet,
     truncation: Refined<'p>,
+    /// The wider set (4H + 3), for points whose first extension has not converged.
+    wider: Refined<'p>,
+    /// The problem's highest harmonic H.
+    h_max: usize,
     /// The operator at twice the samples (residuals only).
     sampling: HbmOperator<'p>,
     /// For each of the run's unknowns, its index among the full coefficients (the run's
@@ -326,6 +422,8 @@ impl<'p> ErrorEstimator<'p> {
         Ok(Self {
             problem,
             truncation: Refined::new(&refined.truncation, &set)?,
+            wider: Refined::new(&refined.wider, &set)?,
+            h_max: problem.harmonics.iter().copied().max().unwrap_or(1),
             sampling,
             set,
             full_index,
@@ -357,7 +455,17 @@ impl<'p> ErrorEstimator<'p> {
     /// unknowns then ω, as [`crate::numerics::Observer::accepted`] gives it) the steps are
     /// bordered with it (across the path), else at the fixed frequency; a bordered matrix
     /// that cannot be factorised falls back to the fixed frequency.
-    pub fn estimate(&mut self, x: &[f64], omega: f64, path: Option<PathPlace>) -> PointAccuracy {
+    ///
+    /// `states` are the point's contact states: a contact stuck all period sends the point on
+    /// to the wider set when its estimate is not negligible ([`TailTest`]).
+    pub fn estimate(
+        &mut self,
+        x: &[f64],
+        omega: f64,
+        path: Option<PathPlace>,
+        states: &[ContactState],
+    ) -> PointAccuracy {
+        let stuck_contact = states.contains(&ContactState::Stuck);
         let n = self.problem.model.n_dofs();
         let base = amplitudes(self.problem, &self.set, x);
         let nan = || PointAccuracy {
@@ -367,6 +475,7 @@ impl<'p> ErrorEstimator<'p> {
             path_normal: None,
             both_truncation: None,
             slide_and_step: (f64::NAN, f64::NAN),
+            estimate_harmonic: 0,
         };
         let xr = self.truncation.padded(n, x);
         let dim = xr.len();
@@ -388,7 +497,10 @@ impl<'p> ErrorEstimator<'p> {
             .residual(&xs, omega, &mut rs)
             .ok()
             .and_then(|()| self.truncation.on_kept_blocks(&rs, self.set.n_blocks()));
-        let mut rhs: Vec<&[f64]> = vec![&r];
+        // The truncation residual on the lower half of the new harmonics alone, for the
+        // extension's own convergence ([`TailTest`]).
+        let r_low = self.truncation.lower_half(&r, self.h_max);
+        let mut rhs: Vec<&[f64]> = vec![&r, &r_low];
         if let Some(s) = &sampling_rhs {
             rhs.push(s);
         }
@@ -440,20 +552,41 @@ impl<'p> ErrorEstimator<'p> {
         };
         let ext = self.truncation.operator.unknowns().clone();
         let nan_values = vec![f64::NAN; base.len()];
-        let mut change = |delta: &[f64]| {
+        let mut amplitudes_after = |delta: &[f64]| {
             let (d_omega, d_x) = delta.split_last().expect("a step has a frequency part");
             match self.truncation.stepped(&xr, d_x, omega - d_omega) {
-                Some(full) => relative_changes(&amplitudes(self.problem, &ext, &full), &base),
+                Some(full) => amplitudes(self.problem, &ext, &full),
                 None => nan_values.clone(),
             }
         };
-        let truncation = change(&deltas[0]);
-        let sampling = match deltas.get(1) {
-            Some(d) => change(d),
-            None => nan_values.clone(),
+        // Per reported step set (across the path or at the fixed frequency): the truncation
+        // estimate, whether its tail needs the wider set, and the sampling estimate.
+        let mut assess = |steps: &[Vec<f64>]| {
+            let full = amplitudes_after(&steps[0]);
+            let low = amplitudes_after(&steps[1]);
+            let needs_wider = base
+                .iter()
+                .zip(&low)
+                .zip(&full)
+                .any(|((&b, &l), &f)| TailTest::extend(b, l, f, stuck_contact));
+            let sampling = match steps.get(2) {
+                Some(d) => relative_changes(&amplitudes_after(d), &base),
+                None => nan_values.clone(),
+            };
+            (relative_changes(&full, &base), needs_wider, sampling)
         };
+        let top = extended_harmonic(self.h_max);
+        let (truncation, across_needs_wider, sampling) = assess(&deltas);
         let step = path.map_or(f64::NAN, |p| p.step);
         let Some(fixed) = fixed_deltas else {
+            let (truncation, estimate_harmonic) = if across_needs_wider {
+                match self.wider_truncation(x, omega, None, &base) {
+                    Some((fixed, _)) => (fixed, wider_harmonic(self.h_max)),
+                    None => (truncation, top),
+                }
+            } else {
+                (truncation, top)
+            };
             return PointAccuracy {
                 truncation,
                 sampling,
@@ -461,26 +594,104 @@ impl<'p> ErrorEstimator<'p> {
                 path_normal: None,
                 both_truncation: None,
                 slide_and_step: (f64::NAN, step),
+                estimate_harmonic,
             };
         };
-        let fixed_truncation = change(&fixed[0]);
-        let fixed_sampling = match fixed.get(1) {
-            Some(d) => change(d),
-            None => nan_values.clone(),
-        };
+        let (fixed_truncation, fixed_needs_wider, fixed_sampling) = assess(&fixed);
         let across = PathSwitch::across(slide, step);
+        let needs_wider = if across {
+            across_needs_wider
+        } else {
+            fixed_needs_wider
+        };
+        let mut both = (fixed_truncation, truncation);
+        let mut estimate_harmonic = top;
+        if needs_wider {
+            let normal = path.map(|p| p.normal);
+            if let Some((wider_fixed, wider_across)) =
+                self.wider_truncation(x, omega, normal, &base)
+            {
+                if let Some(a) = wider_across {
+                    both = (wider_fixed, a);
+                    estimate_harmonic = wider_harmonic(self.h_max);
+                } else if !across {
+                    both.0 = wider_fixed;
+                    estimate_harmonic = wider_harmonic(self.h_max);
+                }
+            }
+        }
         PointAccuracy {
             truncation: if across {
-                truncation.clone()
+                both.1.clone()
             } else {
-                fixed_truncation.clone()
+                both.0.clone()
             },
             sampling: if across { sampling } else { fixed_sampling },
             across_path: across,
             path_normal,
-            both_truncation: Some((fixed_truncation, truncation)),
+            both_truncation: Some(both),
             slide_and_step: (slide, step),
+            estimate_harmonic,
         }
+    }
+
+    /// The truncation estimate of the point `x` at `omega` on the wider set (4H + 3): at the
+    /// fixed frequency, and across the path when the path's `normal` (run unknowns, then ω) is
+    /// given and the bordered matrix factorises; None when the estimate cannot be formed.
+    #[allow(clippy::type_complexity)]
+    fn wider_truncation(
+        &mut self,
+        x: &[f64],
+        omega: f64,
+        normal: Option<&[f64]>,
+        base: &[f64],
+    ) -> Option<(Vec<f64>, Option<Vec<f64>>)> {
+        let n = self.problem.model.n_dofs();
+        let wider = &mut self.wider;
+        let xr = wider.padded(n, x);
+        let dim = xr.len();
+        let mut r = vec![0.0; dim];
+        let mut dr = vec![0.0; dim];
+        wider
+            .operator
+            .residual_and_jacobian(&xr, omega, &mut r, &mut wider.jacobian, &mut dr)
+            .ok()?;
+        let ext = wider.operator.unknowns().clone();
+        let row = normal.and_then(|normal| {
+            let (on_omega, on_x) = normal.split_last()?;
+            if on_x.len() != self.full_index.len() || normal.iter().any(|v| !v.is_finite()) {
+                return None;
+            }
+            let mut row = wider.on_kept_blocks(on_x, self.set.n_blocks())?;
+            row.push(*on_omega);
+            Some(row)
+        });
+        let problem = self.problem;
+        let change = |w: &mut Refined, delta: &[f64], d_omega: f64| {
+            w.stepped(&xr, delta, omega - d_omega)
+                .map(|full| relative_changes(&amplitudes(problem, &ext, &full), base))
+        };
+        if let Some(row) = row {
+            let ones = vec![1.0; dim];
+            if let Ok(factor) = wider.jacobian.factor_bordered(&ones, &dr, &row) {
+                let mut b = r.clone();
+                b.push(0.0);
+                let mut along = vec![0.0; dim];
+                along.push(1.0);
+                if let (Ok(step), Ok(z)) = (factor.solve(&b), factor.solve(&along)) {
+                    let (d_omega, z_omega) = (step[dim], z[dim]);
+                    let s = d_omega / z_omega;
+                    let fixed: Vec<f64> = step.iter().zip(&z).map(|(a, b)| a - s * b).collect();
+                    let across = change(wider, &step[..dim], d_omega);
+                    let fixed = change(wider, &fixed[..dim], fixed[dim]);
+                    if let (Some(f), Some(a)) = (fixed, across) {
+                        return Some((f, Some(a)));
+                    }
+                }
+            }
+        }
+        let step = wider.jacobian.solve_many(&[&r]).ok()?.pop()?;
+        change(wider, &step, 0.0).map(|f| (f, None))
     }
 
     /// The bordered Newton steps (δx, δω) of [[J, ∂R/∂ω], [row]] (δx, δω) = (r, 0) for each
@@ -610,6 +821,15 @@ fn bands(points: &[(f64, &PointAccuracy)], outputs: usize, threshold: f64) -> Ve
     found
 }
 
+/// The relative truncation estimate above which a warning says the size is not to be read:
+/// the estimate is one Newton step of the extended system, and a step that changes the
+/// amplitude by more than the amplitude itself is outside the reach of the linearisation it
+/// comes from. Measured on the reduced blade pair at H = 1 (docs/accuracy.md, "The larger
+/// blade pair at H = 1, on its small folds"): its points with estimates of 560-8907 % have no
+/// state nearby at H = 3, 5 or 7 (Newton from the padded point does not converge at the
+/// point's frequency), and the nearest one across the path is 33-39 % away.
+pub const BEYOND_LINEAR: f64 = 1.0;
+
 /// The warning line of a band: where, how large, and which field to raise. `h_max` is the
 /// highest balanced harmonic, `samples` the samples per period, `output` the DOF's name.
 pub fn warning_text(w: &AccuracyWarning, output: &str, h_max: usize, samples: usize) -> String {
@@ -619,11 +839,24 @@ pub fn warning_text(w: &AccuracyWarning, output: &str, h_max: usize, samples: us
         format!("is estimated at up to {:.2} %", 100.0 * w.largest)
     };
     let (what, advice) = match w.kind {
+        EstimateKind::Truncation if w.largest > BEYOND_LINEAR => (
+            "harmonic truncation",
+            format!(
+                "harmonics.max > {h_max} needed; an estimate above {:.0} % is beyond what a \
+                 first-order step can size: these points may lie on a branch of the truncated \
+                 model that has no counterpart at H = {} (read them as wrong, not as off by that \
+                 much, and solve the band at the higher H)",
+                100.0 * BEYOND_LINEAR,
+                extended_harmonic(h_max)
+            ),
+        ),
         EstimateKind::Truncation => (
             "harmonic truncation",
             format!(
-                "harmonics.max > {h_max} needed (the estimate compares with H = {})",
-                extended_harmonic(h_max)
+                "harmonics.max > {h_max} needed (the estimate compares with H = {}, or {} where \
+                 contacts stay stuck or the harmonics decay slowly)",
+                extended_harmonic(h_max),
+                wider_harmonic(h_max)
             ),
         ),
         EstimateKind::Sampling => (
@@ -689,6 +922,7 @@ mod tests {
             path_normal: None,
             both_truncation: None,
             slide_and_step: (f64::NAN, f64::NAN),
+            estimate_harmonic: 3,
         }
     }
 
@@ -723,6 +957,31 @@ mod tests {
         let text = warning_text(&w[0], "y2", 1, 256);
         assert!(text.contains("harmonics.max > 1"), "{text}");
         assert!(text.contains("101.0000 and 104.0000 Hz"), "{text}");
+        assert!(!text.contains("no counterpart"), "{text}");
+        // Above 100 % the size is beyond a first-order step: the warning says so.
+        let huge = AccuracyWarning {
+            largest: 89.07,
+            ..w[0].clone()
+        };
+        let text = warning_text(&huge, "y2", 1, 256);
+        assert!(text.contains("8907.00 %"), "{text}");
+        assert!(text.contains("no counterpart at H = 3"), "{text}");
+    }
+
+    #[test]
+    fn tail_test_extends_slow_tails_and_stuck_contacts_only() {
+        // Lower half changes the amplitude by 1e-2, the upper half by 1e-3: r = 0.1, tail
+        // 1.1e-4, far below half of the 1.1e-2 estimate.
+        assert!(!TailTest::extend(1.0, 1.01, 1.011, false));
+        // The upper half changes it by as much as the lower one: r = 1, unbounded tail.
+        assert!(TailTest::extend(1.0, 1.01, 1.02, false));
+        // r = 0.6: tail 0.6/0.4 · 6e-3 = 9e-3 > half of 1.6e-2.
+        assert!(TailTest::extend(1.0, 1.01, 1.016, false));
+        // A stuck contact extends any estimate that is not negligible ...
+        assert!(TailTest::extend(1.0, 1.01, 1.011, true));
+        // ... and none that is (all stuck: linear, no truncation error), nor a NaN.
+        assert!(!TailTest::extend(1.0, 1.0, 1.0 + 1e-9, true));
+        assert!(!TailTest::extend(1.0, f64::NAN, f64::NAN, true));
     }
 
     #[test]

@@ -491,7 +491,8 @@ impl<O: FrfObserver> Observer<HbmOperator<'_>> for Adapter<'_, '_, O> {
                 normal,
                 step: p.step,
             });
-            point.accuracy = Some(estimator.estimate(&point.coefficients, p.omega, place));
+            point.accuracy =
+                Some(estimator.estimate(&point.coefficients, p.omega, place, &point.states));
         }
         self.observer.point(&point);
         self.points.push(point);
@@ -679,7 +680,7 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
                 // the others (solved at a fixed frequency) take it at their frequency.
                 if let (Some(estimator), None) = (&mut adapter.estimator, &p.accuracy) {
                     let omega = 2.0 * PI * p.freq_hz;
-                    p.accuracy = Some(estimator.estimate(&p.coefficients, omega, None));
+                    p.accuracy = Some(estimator.estimate(&p.coefficients, omega, None, &p.states));
                 }
                 adapter.observer.point(&p);
                 adapter.points.push(p);
