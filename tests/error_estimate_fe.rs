@@ -9,10 +9,11 @@
 //! period (`error_estimate::TailTest`). Which points a truncation estimate cannot size is
 //! computed, not listed: those where a contact's regime differs from the reference point's.
 
+mod common;
+
 use fricbound::analysis::frf::{self, FrfRun, Silent};
 use fricbound::model::Problem;
 use fricbound::scene;
-use fricbound::study::scaling::{self, ModelSize};
 
 /// The first output's amplitude on the branch of `run` at `freq_hz` nearest to `near` (every
 /// segment of a branch that brackets the frequency), with the segment's index and the index
@@ -62,16 +63,7 @@ fn problem(dir: &std::path::Path, overrides: &[String]) -> Problem {
 #[test]
 fn truncation_estimate_tracks_the_true_error_on_the_blade_pair() {
     let dir = tempfile::tempdir().unwrap();
-    let size = ModelSize {
-        contact_pairs: Some(2),
-        ..ModelSize::uniform(false, 1)
-    };
-    scaling::full_problem(size, 1, dir.path()).unwrap();
-    let mesh = dir.path().join("blade-pair-2d-r1-p2.msh");
-    let text = format!(
-        "{}\n[reduction]\nmodes = 8\nmodal_damping = 0.002\n",
-        scaling::blade_pair_scene(&mesh, false, 1)
-    );
+    let text = common::blade_pair::reduced_blade_pair_2d(dir.path());
     std::fs::write(dir.path().join("blade-pair.toml"), text).unwrap();
     let range = [
         "analysis.freq_start_hz=928".to_string(),
@@ -197,8 +189,10 @@ fn truncation_estimate_tracks_the_true_error_on_the_blade_pair() {
     // extension's upper harmonics still matter: the H = 1 upper branch is now within 3× (it
     // was 5-8× below), but 6 of 64 points at H = 1 and 5 of 72 at H = 3 (same regimes) miss
     // the factor 3, at points whose neighbours' estimates differ by factors of 3-50 (why is
-    // not established: docs/accuracy.md, "Not covered yet"). The test asserts that misses stay
-    // under a tenth of the measured points per H, and prints each one.
+    // not established: docs/accuracy.md, "Not covered yet"), so the criterion does not
+    // hold at those points. Until it does, the test only guards against it failing more often:
+    // misses stay under a tenth of the measured points per H (a regression bound on a known
+    // failure, not the criterion), and each one is printed.
     let mut failures = Vec::new();
     let mut large = [0_usize; 2];
     let mut small = 0;

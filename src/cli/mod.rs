@@ -878,12 +878,13 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
         s,
         "accuracy     {}",
         if estimate.enabled {
+            let h_max = problem.harmonics.iter().copied().max().unwrap_or(1);
             format!(
-                "error estimate on every point (truncation to H = {}, sampling at {} \
-                 samples), warning above {} %",
-                crate::analysis::error_estimate::extended_harmonic(
-                    problem.harmonics.iter().copied().max().unwrap_or(1)
-                ),
+                "error estimate on every point (truncation to H = {}, or {} where contacts \
+                 stay stuck or the harmonics decay slowly; sampling at {} samples), warning \
+                 above {} %",
+                crate::analysis::error_estimate::extended_harmonic(h_max),
+                crate::analysis::error_estimate::wider_harmonic(h_max),
                 2 * problem.samples,
                 100.0 * estimate.warn_threshold
             )
