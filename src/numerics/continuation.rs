@@ -674,12 +674,10 @@ impl Continuation {
 
     /// Tries to continue past a spot where the corrector fails at every step down to the
     /// minimum: predictions [`LEAPS`] of the largest step ahead along the tangent, each
-    /// corrected to full tolerance on the hyperplane normal to the tangent, or where that fails
-    /// by Newton at the predicted frequency; the first that lies ahead of `y`, within the leap
-    /// of its prediction and off the path already followed (`recent`, as in
-    /// [`Continuation::runs_back_along`]) is returned with its tangent, oriented along the
-    /// chord from `y`. Steps that land beyond the end frequency are not tried (the end point is
-    /// solved separately).
+    /// corrected to full tolerance; the first whose correction stays within the leap, whose
+    /// tangent keeps the direction of travel and which lies off the path already followed
+    /// (`recent`, as in [`Continuation::runs_back_along`]) is returned with its tangent. Steps
+    /// that land beyond the end frequency are not tried (the end point is solved separately).
     fn leap<S: ParametricResidual>(
         &self,
         system: &mut S,
@@ -694,36 +692,11 @@ impl Continuation {
             if self.past_end(&predicted) {
                 continue;
             }
-            // On the hyperplane normal to the tangent, else at the predicted frequency (Newton
-            // from the predicted x): near a contact transition the one can cycle between the
-            // pieces of the residual where the other converges.
-            let corrected = self.correct(system, &predicted, tangent).or_else(|_| {
-                let x: Vec<f64> = (0..n).map(|j| predicted[j] * self.x_scale[j]).collect();
-                self.solve_fixed(system, &x, predicted[n] * OMEGA_SCALE)
-                    .map(|p| {
-                        let yc: Vec<f64> =
-                            p.x.iter()
-                                .zip(&self.x_scale)
-                                .map(|(v, s)| v / s)
-                                .chain(std::iter::once(predicted[n]))
-                                .collect();
-                        (yc, p.iterations, p.residual)
-                    })
-            });
-            let Ok((yc, it, rel)) = corrected else {
+            let Ok((yc, it, rel)) = self.correct(system, &predicted, tangent) else {
                 continue;
             };
-            // Past a gap the tangent is oriented away from where the path leapt from (along
-            // the chord from `y`), not by the tangent before the gap: the piece reached may run
-            // back toward the incoming branch one way and on the other.
-            let chord: Vec<f64> = yc.iter().zip(y).map(|(a, b)| a - b).collect();
-            let length = norm(&chord);
-            if length == 0.0 || dot(&chord, tangent) <= 0.0 {
-                continue;
-            }
-            let chord: Vec<f64> = chord.iter().map(|v| v / length).collect();
             let Ok((point, t_new, _, _)) =
-                self.corrected_point(system, &yc, it, rel, ds, &predicted, &chord)
+                self.corrected_point(system, &yc, it, rel, ds, &predicted, tangent)
             else {
                 continue;
             };
@@ -736,7 +709,7 @@ impl Continuation {
             let reach = norm(&yc.iter().zip(y).map(|(a, b)| a - b).collect::<Vec<_>>());
             let on_path =
                 distance_to_polyline(&yc, &self.scaled_points(recent)) <= RETRACE_FRACTION * reach;
-            if distance <= ds && !on_path {
+            if distance <= ds && dot(&t_new, tangent) > 0.0 && !on_path {
                 return Ok(Some((point, t_new)));
             }
         }
