@@ -158,3 +158,49 @@ fn the_3d_frf_crosses_contact_transitions_on_the_bending_flank() {
     assert!(solution.contains("\"step_cuts\": []"), "step cuts");
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// At 886.685 Hz, on the rising flank of the first bending pair, `left-25` closes into
+/// stick-slip with lift-off; a 840-900 Hz run failed there at every step and its corner search
+/// resumed the path on the incoming branch, which it then retraced downwards (benches/README.md,
+/// "FRF across the bending pair"). Started below it, the path crosses it: every point at a
+/// higher frequency than the one before (no point repeats the way up going down), the run
+/// `complete` at the end frequency, and `left-25` open at the start and touching at the end.
+#[test]
+fn the_3d_frf_crosses_the_transition_at_886_685_hz_without_turning_back() {
+    let out = std::env::temp_dir().join(format!("fricbound-blade-3d-886-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let run = support::run_scene(
+        SCENE,
+        &out,
+        &[
+            "analysis.freq_start_hz=886.6",
+            "analysis.freq_end_hz=886.75",
+            "analysis.max_step=0.02",
+            "analysis.linear_points=3",
+            "accuracy.estimate=false",
+        ],
+    );
+    assert!(run.status.success(), "{}", support::text(&run.stderr));
+    let (header, rows) = support::csv(&out.join("frf.csv"));
+    let columns: Vec<&str> = header.split(',').collect();
+    let state = |name: &str| {
+        columns
+            .iter()
+            .position(|c| *c == format!("{name}_state"))
+            .unwrap()
+    };
+    let freqs: Vec<f64> = rows.iter().map(|r| r[0].parse().unwrap()).collect();
+    println!("{} points: {freqs:?}", freqs.len());
+    assert!(
+        freqs.windows(2).all(|w| w[1] > w[0]),
+        "not monotone: {freqs:?}"
+    );
+    assert!(freqs[0] < 886.685 && (freqs.last().unwrap() - 886.75).abs() < 1e-6);
+    assert_ne!(
+        rows[0][state("left-25")],
+        rows.last().unwrap()[state("left-25")]
+    );
+    let solution = std::fs::read_to_string(out.join("solution.json")).unwrap();
+    assert!(solution.contains("\"status\": \"complete\""), "status");
+    let _ = std::fs::remove_dir_all(&out);
+}
