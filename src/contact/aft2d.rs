@@ -375,8 +375,9 @@ impl Aft2dWorkspace {
                 );
             }
             if let Some(t) = trial.take() {
-                // Sufficient decrease of the mismatch (the negation also rejects NaN).
-                if !(drift < (1.0 - 1e-4 * t.fraction) * t.base_drift) {
+                // Sufficient decrease of the mismatch (false for NaN, which is rejected).
+                let decreased = drift < (1.0 - 1e-4 * t.fraction) * t.base_drift;
+                if !decreased {
                     let fraction = 0.5 * t.fraction;
                     if fraction >= MIN_STEP_FRACTION {
                         start = [
@@ -475,7 +476,8 @@ impl Aft2dWorkspace {
                 let new_drift = change[0].hypot(change[1]);
                 let still_slipping = again.any_slip || again.open_samples > 0;
                 let keeps_condition = !well || well_conditioned(again.period_map_derivative);
-                if !(new_drift <= drift) || !still_slipping || !keeps_condition {
+                let not_worse = new_drift <= drift;
+                if !not_worse || !still_slipping || !keeps_condition {
                     marched_last = false;
                     break;
                 }
