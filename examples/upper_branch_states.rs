@@ -28,29 +28,19 @@ const PROBES: [f64; 9] = [
 
 fn problem(dir: &std::path::Path, overrides: &[String]) -> Problem {
     let path = dir.join("blade-pair.toml");
-    scene::load(&path, overrides)
-        .expect("scene loads")
-        .validate("blade-pair")
+    scene::load_problem(&path, overrides)
         .expect("scene is valid")
+        .1
 }
 
 /// Every crossing of `freq_hz` by the path of `run`: (interpolated amplitude, index of the path
 /// point nearest in frequency on that segment).
 fn crossings(run: &FrfRun, freq_hz: f64) -> Vec<(f64, usize)> {
-    let starts = run.branch_starts();
-    let mut out = Vec::new();
-    for k in 0..run.points.len().saturating_sub(1) {
-        if starts.contains(&(k + 1)) {
-            continue;
-        }
-        let (p, q) = (&run.points[k], &run.points[k + 1]);
-        if (p.freq_hz - freq_hz) * (q.freq_hz - freq_hz) > 0.0 || p.freq_hz == q.freq_hz {
-            continue;
-        }
-        let t = (freq_hz - p.freq_hz) / (q.freq_hz - p.freq_hz);
-        let a = p.amplitudes[0] + t * (q.amplitudes[0] - p.amplitudes[0]);
-        out.push((a, if t < 0.5 { k } else { k + 1 }));
-    }
+    let mut out: Vec<(f64, usize)> = run
+        .crossings(freq_hz, 0)
+        .into_iter()
+        .map(|c| (c.amplitude, c.nearest_point))
+        .collect();
     out.sort_by(|a, b| a.0.total_cmp(&b.0));
     out
 }

@@ -115,6 +115,36 @@ fn a_short_frf_of_the_3d_scene_completes_with_vtu_output() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
+/// A narrow FRF of the 3D scene run by the CLI with the `--set` overrides: its frequencies
+/// (Hz) in path order, the state of `contact` at the first and at the last point, and the
+/// text of `solution.json`.
+struct NarrowFrf {
+    freqs: Vec<f64>,
+    first_state: String,
+    last_state: String,
+    solution: String,
+}
+
+fn narrow_frf(tag: &str, contact: &str, overrides: &[&str]) -> NarrowFrf {
+    let out = std::env::temp_dir().join(format!("fricbound-blade-3d-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let run = support::run_scene(SCENE, &out, overrides);
+    assert!(run.status.success(), "{}", support::text(&run.stderr));
+    let (header, rows) = support::csv(&out.join("frf.csv"));
+    let state = header
+        .split(',')
+        .position(|c| c == format!("{contact}_state"))
+        .unwrap();
+    let frf = NarrowFrf {
+        freqs: rows.iter().map(|r| r[0].parse().unwrap()).collect(),
+        first_state: rows[0][state].clone(),
+        last_state: rows.last().unwrap()[state].clone(),
+        solution: std::fs::read_to_string(out.join("solution.json")).unwrap(),
+    };
+    let _ = std::fs::remove_dir_all(&out);
+    frf
+}
+
 /// On the rising flank of the first bending pair, 885.4-885.7 Hz, contact points change state
 /// (`right-7` closes into stick-slip with lift-off); a 840-900 Hz run
 /// turned back at a corner there (measured: benches/README.md, "3D blade pair with 2D
@@ -122,11 +152,9 @@ fn a_short_frf_of_the_3d_scene_completes_with_vtu_output() {
 /// step cut, monotonically in frequency, and the run ends `complete` at 885.7 Hz.
 #[test]
 fn the_3d_frf_crosses_contact_transitions_on_the_bending_flank() {
-    let out = std::env::temp_dir().join(format!("fricbound-blade-3d-flank-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out);
-    let run = support::run_scene(
-        SCENE,
-        &out,
+    let frf = narrow_frf(
+        "flank",
+        "right-7",
         &[
             "analysis.freq_start_hz=885.4",
             "analysis.freq_end_hz=885.7",
@@ -134,29 +162,16 @@ fn the_3d_frf_crosses_contact_transitions_on_the_bending_flank() {
             "accuracy.estimate=false",
         ],
     );
-    assert!(run.status.success(), "{}", support::text(&run.stderr));
-    let (header, rows) = support::csv(&out.join("frf.csv"));
-    let columns: Vec<&str> = header.split(',').collect();
-    let state = |name: &str| {
-        columns
-            .iter()
-            .position(|c| *c == format!("{name}_state"))
-            .unwrap()
-    };
-    let freqs: Vec<f64> = rows.iter().map(|r| r[0].parse().unwrap()).collect();
+    let freqs = &frf.freqs;
     assert!(
         freqs.windows(2).all(|w| w[1] > w[0]),
         "not monotone: {freqs:?}"
     );
     assert!((freqs.last().unwrap() - 885.7).abs() < 1e-6);
-    let first = &rows[0];
-    let last = rows.last().unwrap();
-    assert_eq!(first[state("right-7")], "open");
-    assert_eq!(last[state("right-7")], "stick-slip-liftoff");
-    let solution = std::fs::read_to_string(out.join("solution.json")).unwrap();
-    assert!(solution.contains("\"status\": \"complete\""), "status");
-    assert!(solution.contains("\"step_cuts\": []"), "step cuts");
-    let _ = std::fs::remove_dir_all(&out);
+    assert_eq!(frf.first_state, "open");
+    assert_eq!(frf.last_state, "stick-slip-liftoff");
+    assert!(frf.solution.contains("\"status\": \"complete\""), "status");
+    assert!(frf.solution.contains("\"step_cuts\": []"), "step cuts");
 }
 
 /// At 886.685 Hz, on the rising flank of the first bending pair, `left-25` closes into
@@ -167,11 +182,9 @@ fn the_3d_frf_crosses_contact_transitions_on_the_bending_flank() {
 /// `complete` at the end frequency, and `left-25` open at the start and touching at the end.
 #[test]
 fn the_3d_frf_crosses_the_transition_at_886_685_hz_without_turning_back() {
-    let out = std::env::temp_dir().join(format!("fricbound-blade-3d-886-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out);
-    let run = support::run_scene(
-        SCENE,
-        &out,
+    let frf = narrow_frf(
+        "886",
+        "left-25",
         &[
             "analysis.freq_start_hz=886.6",
             "analysis.freq_end_hz=886.75",
@@ -180,27 +193,13 @@ fn the_3d_frf_crosses_the_transition_at_886_685_hz_without_turning_back() {
             "accuracy.estimate=false",
         ],
     );
-    assert!(run.status.success(), "{}", support::text(&run.stderr));
-    let (header, rows) = support::csv(&out.join("frf.csv"));
-    let columns: Vec<&str> = header.split(',').collect();
-    let state = |name: &str| {
-        columns
-            .iter()
-            .position(|c| *c == format!("{name}_state"))
-            .unwrap()
-    };
-    let freqs: Vec<f64> = rows.iter().map(|r| r[0].parse().unwrap()).collect();
+    let freqs = &frf.freqs;
     println!("{} points: {freqs:?}", freqs.len());
     assert!(
         freqs.windows(2).all(|w| w[1] > w[0]),
         "not monotone: {freqs:?}"
     );
     assert!(freqs[0] < 886.685 && (freqs.last().unwrap() - 886.75).abs() < 1e-6);
-    assert_ne!(
-        rows[0][state("left-25")],
-        rows.last().unwrap()[state("left-25")]
-    );
-    let solution = std::fs::read_to_string(out.join("solution.json")).unwrap();
-    assert!(solution.contains("\"status\": \"complete\""), "status");
-    let _ = std::fs::remove_dir_all(&out);
+    assert_ne!(frf.first_state, frf.last_state);
+    assert!(frf.solution.contains("\"status\": \"complete\""), "status");
 }

@@ -19,23 +19,14 @@ use fricbound::scene;
 /// segment of a branch that brackets the frequency), with the segment's index and the index
 /// of its point nearer in frequency (the reference point the comparison is made with).
 fn amplitude_near(run: &FrfRun, freq_hz: f64, near: f64) -> Option<(f64, usize, usize)> {
-    let starts = run.branch_starts();
-    let mut best: Option<(f64, usize, usize)> = None;
-    for k in 0..run.points.len().saturating_sub(1) {
-        if starts.contains(&(k + 1)) {
-            continue;
-        }
-        let (p, q) = (&run.points[k], &run.points[k + 1]);
-        if (p.freq_hz - freq_hz) * (q.freq_hz - freq_hz) > 0.0 || p.freq_hz == q.freq_hz {
-            continue;
-        }
-        let t = (freq_hz - p.freq_hz) / (q.freq_hz - p.freq_hz);
-        let a = p.amplitudes[0] + t * (q.amplitudes[0] - p.amplitudes[0]);
-        if best.is_none_or(|(b, _, _)| (a - near).abs() < (b - near).abs()) {
-            best = Some((a, k, if t < 0.5 { k } else { k + 1 }));
-        }
-    }
-    best
+    run.crossings(freq_hz, 0)
+        .into_iter()
+        .min_by(|x, y| {
+            (x.amplitude - near)
+                .abs()
+                .total_cmp(&(y.amplitude - near).abs())
+        })
+        .map(|c| (c.amplitude, c.segment, c.nearest_point))
 }
 
 /// One compared point: its harmonic count, frequency (Hz), true error (against the
@@ -54,10 +45,9 @@ struct Compared {
 
 fn problem(dir: &std::path::Path, overrides: &[String]) -> Problem {
     let path = dir.join("blade-pair.toml");
-    scene::load(&path, overrides)
-        .expect("scene loads")
-        .validate("blade-pair")
+    scene::load_problem(&path, overrides)
         .expect("scene is valid")
+        .1
 }
 
 #[test]

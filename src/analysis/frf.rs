@@ -137,10 +137,47 @@ pub struct FrfRun {
     pub elapsed_s: f64,
 }
 
+/// One crossing of a frequency by a path ([`FrfRun::crossings`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathCrossing {
+    /// Amplitude of the output there, interpolated along the segment (m).
+    pub amplitude: f64,
+    /// Index of the segment's first point.
+    pub segment: usize,
+    /// Index of the segment's point nearer in frequency.
+    pub nearest_point: usize,
+}
+
 impl FrfRun {
     /// Indices of the points where a branch reached by a jump starts.
     pub fn branch_starts(&self) -> Vec<usize> {
         self.jumps.iter().map(|j| j.first_point).collect()
+    }
+
+    /// Every place where the path crosses `freq_hz` (Hz) within a branch (a segment between
+    /// consecutive points bracketing it, not across a jump), in path order: the linearly
+    /// interpolated amplitude of output `output` there (m), the segment's first point index,
+    /// and the index of its point nearer in frequency. A folded path crosses a frequency more
+    /// than once, which is why a comparison between paths picks among these.
+    pub fn crossings(&self, freq_hz: f64, output: usize) -> Vec<PathCrossing> {
+        let starts = self.branch_starts();
+        let mut out = Vec::new();
+        for k in 0..self.points.len().saturating_sub(1) {
+            if starts.contains(&(k + 1)) {
+                continue;
+            }
+            let (p, q) = (&self.points[k], &self.points[k + 1]);
+            if (p.freq_hz - freq_hz) * (q.freq_hz - freq_hz) > 0.0 || p.freq_hz == q.freq_hz {
+                continue;
+            }
+            let t = (freq_hz - p.freq_hz) / (q.freq_hz - p.freq_hz);
+            out.push(PathCrossing {
+                amplitude: p.amplitudes[output] + t * (q.amplitudes[output] - p.amplitudes[output]),
+                segment: k,
+                nearest_point: if t < 0.5 { k } else { k + 1 },
+            });
+        }
+        out
     }
 
     /// Whether the run covers the range: the path reached the end frequency, and every
