@@ -17,7 +17,8 @@ use fricbound::scene;
 mod common;
 use common::blade_pair::coarse_blade_pair;
 use common::{
-    compare_on_planar_path, excited_out_of_plane, problem, OUT_OF_PLANE_RUN, PLANAR, SPATIAL,
+    assert_formulations_agree, compare_on_planar_path, excited_out_of_plane, problem,
+    OUT_OF_PLANE_RUN, PLANAR, SPATIAL,
 };
 
 #[test]
@@ -84,7 +85,7 @@ fn formulations_agree_and_jacobians_match_central_differences_with_out_of_plane_
         ("schur", out_of_plane(Formulation::Schur)),
     ];
     let mut rotating = 0;
-    for (i, p) in run.points.iter().enumerate().step_by(run.points.len() / 8) {
+    for p in run.points.iter().step_by(run.points.len() / 8) {
         let f = p.freq_hz;
         let omega = 2.0 * std::f64::consts::PI * f;
         let z = p
@@ -97,24 +98,7 @@ fn formulations_agree_and_jacobians_match_central_differences_with_out_of_plane_
             rotating += 1;
         }
         // Same solutions from the same guess.
-        let a = reference.solve(&p.coefficients, f).unwrap();
-        let scale = a.coefficients.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        for (name, variant) in &variants {
-            let b = PointSolver::new(variant)
-                .unwrap()
-                .solve(&p.coefficients, f)
-                .unwrap();
-            let diff = a
-                .coefficients
-                .iter()
-                .zip(&b.coefficients)
-                .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
-            assert!(
-                diff <= 1e-8 * scale,
-                "{name}, point {i} at {f:.3} Hz: {diff:.3e} (scale {scale:.3e})"
-            );
-            assert_eq!(a.states, b.states, "{name} at {f:.3} Hz");
-        }
+        assert_formulations_agree(&mut reference, &variants, &p.coefficients, f);
         // Analytic Jacobians against central differences of the residual.
         let mut s = HbmSystem::new(&dense).unwrap();
         let check = check_jacobian(&mut s, &p.coefficients, omega, 1e-7).unwrap();

@@ -14,8 +14,8 @@ use fricbound::model::{Formulation, Problem};
 
 mod common;
 use common::{
-    compare_on_planar_path, excited_out_of_plane, problem, IN_PLANE, OUT_OF_PLANE,
-    OUT_OF_PLANE_RUN, PLANAR, SPATIAL,
+    assert_formulations_agree, compare_on_planar_path, excited_out_of_plane, problem, IN_PLANE,
+    OUT_OF_PLANE, OUT_OF_PLANE_RUN, PLANAR, SPATIAL,
 };
 
 /// The damper's out-of-plane DOF (zD) in the 3D scene.
@@ -306,21 +306,7 @@ fn uncoupled_frf_with_2d_points_agrees_across_formulations() {
     let mut slipping = 0;
     for p in run.points.iter().step_by((run.points.len() / 10).max(1)) {
         let f = p.freq_hz;
-        let a = reference.solve(&p.coefficients, f).unwrap();
-        let scale = a.coefficients.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        for (name, variant) in &variants {
-            let b = PointSolver::new(variant)
-                .unwrap()
-                .solve(&p.coefficients, f)
-                .unwrap();
-            let diff = a
-                .coefficients
-                .iter()
-                .zip(&b.coefficients)
-                .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
-            assert!(diff <= 1e-8 * scale, "{name} at {f:.3} Hz: {diff:.3e}");
-            assert_eq!(a.states, b.states, "{name} at {f:.3} Hz");
-        }
+        let a = assert_formulations_agree(&mut reference, &variants, &p.coefficients, f);
         compared += 1;
         if a.states.iter().any(|s| s.is_unique()) {
             slipping += 1;

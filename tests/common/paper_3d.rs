@@ -113,3 +113,34 @@ pub fn excited_out_of_plane(mut p: Problem, formulation: Formulation) -> Problem
     p.analysis.formulation = formulation;
     p
 }
+
+/// Solves a point at `freq_hz` from `guess` with the `reference` solver and with a solver of
+/// every variant (the same scene in other formulations), and asserts that each gives the
+/// reference's coefficients to 1e-8 of their largest and the same contact states. Returns the
+/// reference's solution.
+pub fn assert_formulations_agree(
+    reference: &mut PointSolver,
+    variants: &[(&str, Problem)],
+    guess: &[f64],
+    freq_hz: f64,
+) -> FrfPoint {
+    let a = reference.solve(guess, freq_hz).unwrap();
+    let scale = a.coefficients.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    for (name, variant) in variants {
+        let b = PointSolver::new(variant)
+            .unwrap()
+            .solve(guess, freq_hz)
+            .unwrap();
+        let diff = a
+            .coefficients
+            .iter()
+            .zip(&b.coefficients)
+            .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+        assert!(
+            diff <= 1e-8 * scale,
+            "{name} at {freq_hz:.3} Hz: {diff:.3e} (scale {scale:.3e})"
+        );
+        assert_eq!(a.states, b.states, "{name} at {freq_hz:.3} Hz");
+    }
+    a
+}
