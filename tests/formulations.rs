@@ -12,6 +12,7 @@ use fricbound::numerics::derivatives::check_operator_jacobian;
 use fricbound::numerics::jacobian::Storage;
 
 mod common;
+use common::points::assert_same_point;
 use common::scenes::{paper, problem};
 
 /// The paper system with a flexible tip on each blade DOF: tip masses (0.3 kg) tied to the
@@ -88,17 +89,7 @@ fn assert_variants_agree(base: &Problem, variants: &[(&str, Problem)]) {
             let (Ok(a), Ok(b)) = (reference.solve(&guess, f), solver.solve(&guess, f)) else {
                 continue;
             };
-            let scale = a.coefficients.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-            let diff = a
-                .coefficients
-                .iter()
-                .zip(&b.coefficients)
-                .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
-            assert!(
-                diff <= 1e-8 * scale,
-                "{name} at {f:.3} Hz: coefficients differ by {diff:.3e} (scale {scale:.3e})"
-            );
-            assert_eq!(a.states, b.states, "{name} at {f:.3} Hz");
+            assert_same_point(&a, &b, &format!("{name} at {f:.3} Hz"));
             compared += 1;
         }
         assert!(compared >= 30, "{name}: only {compared} points compared");

@@ -125,22 +125,12 @@ pub fn assert_formulations_agree(
     freq_hz: f64,
 ) -> FrfPoint {
     let a = reference.solve(guess, freq_hz).unwrap();
-    let scale = a.coefficients.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     for (name, variant) in variants {
         let b = PointSolver::new(variant)
             .unwrap()
             .solve(guess, freq_hz)
             .unwrap();
-        let diff = a
-            .coefficients
-            .iter()
-            .zip(&b.coefficients)
-            .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
-        assert!(
-            diff <= 1e-8 * scale,
-            "{name} at {freq_hz:.3} Hz: {diff:.3e} (scale {scale:.3e})"
-        );
-        assert_eq!(a.states, b.states, "{name} at {freq_hz:.3} Hz");
+        super::points::assert_same_point(&a, &b, &format!("{name} at {freq_hz:.3} Hz"));
     }
     a
 }
