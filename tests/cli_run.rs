@@ -21,17 +21,29 @@ fn run_writes_all_results() {
     let mut lines = frf.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "freq_hz,y2_amp,y2_peak,left_state,right_state,newton_iters,y2_trunc_err,y2_sampling_err"
+        "freq_hz,y2_amp,y2_peak,left_state,right_state,newton_iters,y2_trunc_err,y2_sampling_err,\
+         estimate_harmonic,estimate_method"
     );
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert!(rows.len() > 20);
+    let mut extensions = std::collections::BTreeSet::new();
+    let mut methods = std::collections::BTreeMap::new();
     for r in &rows {
-        assert_eq!(r.len(), 8);
+        assert_eq!(r.len(), 10);
         // The error estimate: relative, finite, non-negative.
         for e in &r[6..8] {
             let e: f64 = e.parse().unwrap();
             assert!(e.is_finite() && e >= 0.0, "{e}");
         }
+        // The extension it comes from at H = 1: 2H + 1 = 3, or 4H + 3 = 7 where widened.
+        let top: usize = r[8].parse().unwrap();
+        assert!(top == 3 || top == 7, "{top}");
+        extensions.insert(top);
+        assert!(["step", "solved", "unsized"].contains(&r[9]), "{}", r[9]);
+        *methods.entry(r[9]).or_insert(0_usize) += 1;
+    }
+    println!("estimate_harmonic values: {extensions:?}, estimate_method counts: {methods:?}");
+    for r in &rows {
         let f: f64 = r[0].parse().unwrap();
         assert!((150.0..=175.0 + 1e-9).contains(&f));
         let amp: f64 = r[1].parse().unwrap();
@@ -62,6 +74,19 @@ fn run_writes_all_results() {
     // has it, and a run that is not quiet says so on stderr (a quiet one writes nothing there).
     let largest = json["accuracy"]["max_trunc_err"][0].as_f64().unwrap();
     assert!(largest > 0.05, "{largest}");
+    // The largest extension any point used is the largest of the CSV column.
+    assert_eq!(
+        json["accuracy"]["max_estimate_harmonic"].as_u64(),
+        extensions.last().map(|&h| h as u64)
+    );
+    // ... and the counts of solved and unsized rows are the CSV's.
+    for (key, label) in [("solved_points", "solved"), ("unsized_points", "unsized")] {
+        assert_eq!(
+            json["accuracy"][key].as_u64(),
+            Some(methods.get(label).copied().unwrap_or(0) as u64),
+            "{key}"
+        );
+    }
     assert!(o.stderr.is_empty(), "{}", text(&o.stderr));
     let loud = support::fricbound(&[
         "run",

@@ -11,6 +11,7 @@
 
 mod common;
 
+use fricbound::analysis::error_estimate::EstimateMethod;
 use fricbound::analysis::frf::{self, FrfRun, Silent};
 use fricbound::model::Problem;
 use fricbound::scene;
@@ -41,6 +42,10 @@ struct Compared {
     estimate_harmonic: usize,
     convergence: f64,
     regime_change: bool,
+    /// How the estimate was formed (one step, solved, not sizeable) and the step's
+    /// contraction of the extended residual.
+    method: EstimateMethod,
+    contraction: f64,
 }
 
 fn problem(dir: &std::path::Path, overrides: &[String]) -> Problem {
@@ -142,13 +147,15 @@ fn truncation_estimate_tracks_the_true_error_on_the_blade_pair() {
             if truth > 1e-4 || acc.across_path {
                 println!(
                     "H = {h} {:.5} Hz: amp {:.5e}, true {truth:.3e}, estimate {est:.3e} to \
-                     H = {} (across {}, slide {:.1} steps), reference converged to \
-                     {convergence:.1e}, regime change {regime_change}",
+                     H = {} (across {}, slide {:.1} steps, {:?}, contraction {:.2e}), \
+                     reference converged to {convergence:.1e}, regime change {regime_change}",
                     p.freq_hz,
                     p.amplitudes[0],
                     acc.estimate_harmonic,
                     acc.across_path,
-                    slide / step
+                    slide / step,
+                    acc.method,
+                    acc.contraction
                 );
             }
             compared.push(Compared {
@@ -159,6 +166,8 @@ fn truncation_estimate_tracks_the_true_error_on_the_blade_pair() {
                 estimate_harmonic: acc.estimate_harmonic,
                 convergence,
                 regime_change,
+                method: acc.method,
+                contraction: acc.contraction,
             });
         }
     }
@@ -168,41 +177,57 @@ fn truncation_estimate_tracks_the_true_error_on_the_blade_pair() {
     );
     // The issue's criteria where the reference measures the true error: above 1e-3 (with the
     // reference converged to a third of it) the estimate within a factor 3; below 1e-4 (with
-    // the reference converged to 1e-4) no warning. Points where a contact's regime differs
-    // from the reference point they are compared with (a contact stuck at one and slipping at
-    // the other, ...) are outside what a truncation estimate can size: a step on the point's
-    // own regime cannot see another regime. They are counted and printed, not asserted (at
-    // H = 3 on 924.3-924.5 Hz the estimate there, 0.19-0.24 %, does not even warn of the 31 %:
-    // docs/accuracy.md).
+    // the reference converged to 1e-4) no warning. Two kinds of points are outside what a
+    // truncation estimate can size, and are flagged, counted and printed instead:
     //
-    // Measured with the estimate extended to 4H + 3 where a contact stays stuck or the
-    // extension's upper harmonics still matter: the H = 1 upper branch is now within 3× (it
-    // was 5-8× below), but 6 of 64 points at H = 1 and 5 of 72 at H = 3 (same regimes) miss
-    // the factor 3, at points whose neighbours' estimates differ by factors of 3-50 (why is
-    // not established: docs/accuracy.md, "Not covered yet"), so the issue's criterion does not
-    // hold at those points. Until it does, the test only guards against it failing more often:
-    // misses stay under a tenth of the measured points per H (a regression bound on a known
-    // failure, not the criterion), and each one is printed.
+    // - points the estimate itself reports as not sizeable (`EstimateMethod::Unsized`: its
+    //   Newton step left its linear range and the extended system has no converged solution
+    //   at the point's frequency; the run warns there);
+    // - points where a contact's regime differs from the reference point they are compared
+    //   with (a contact stuck at one and slipping at the other, ...): a step on the point's
+    //   own regime cannot see another regime.
+    //
+    // Where the estimate's one Newton step leaves its linear range (a stuck contact at its
+    // friction limit at the point and stuck with a margin on the extended set, below
+    // 929.5 Hz: docs/accuracy.md) the point is solved on the extended set to convergence
+    // (`EstimateMethod::Solved`); with that, the criterion holds at every other point.
     let mut failures = Vec::new();
     let mut large = [0_usize; 2];
     let mut small = 0;
     let mut unmeasured = 0;
     let mut extended = [0_usize; 2];
+    let mut solved = [0_usize; 2];
     let mut regime = Vec::new();
+    let mut not_sized = Vec::new();
     let mut ratios = [(f64::INFINITY, 0.0_f64); 2];
-    let mut misses = [0_usize; 2];
     let mut missed = Vec::new();
+    // Largest contraction of a kept step, smallest of a solved one, per H.
+    let mut contractions = [(0.0_f64, f64::INFINITY); 2];
     for c in &compared {
         let (h, f, truth, est) = (c.h, c.freq_hz, c.truth, c.estimate);
         let i = usize::from(h == 3);
         if c.estimate_harmonic > 2 * h + 1 {
             extended[i] += 1;
         }
+        match c.method {
+            EstimateMethod::Step => contractions[i].0 = contractions[i].0.max(c.contraction),
+            EstimateMethod::Solved => {
+                solved[i] += 1;
+                contractions[i].1 = contractions[i].1.min(c.contraction);
+            }
+            _ => {}
+        }
+        let line = format!(
+            "H = {h}, {f:.4} Hz: true {truth:.3e}, estimate {est:.3e} (to H = {}, {:?}, \
+             contraction {:.2e})",
+            c.estimate_harmonic, c.method, c.contraction
+        );
+        if c.method == EstimateMethod::Unsized {
+            not_sized.push(line);
+            continue;
+        }
         if c.regime_change {
-            regime.push(format!(
-                "H = {h}, {f:.4} Hz: true {truth:.3e}, estimate {est:.3e} (to H = {})",
-                c.estimate_harmonic
-            ));
+            regime.push(line);
             continue;
         }
         if truth > 1e-3 && c.convergence <= truth / 3.0 {
@@ -210,18 +235,12 @@ fn truncation_estimate_tracks_the_true_error_on_the_blade_pair() {
             let ratio = est / truth;
             ratios[i] = (ratios[i].0.min(ratio), ratios[i].1.max(ratio));
             if !(1.0 / 3.0..=3.0).contains(&ratio) {
-                misses[i] += 1;
-                missed.push(format!(
-                    "H = {h}, {f:.4} Hz: true {truth:.3e}, estimate {est:.3e} (to H = {})",
-                    c.estimate_harmonic
-                ));
+                missed.push(line);
             }
         } else if truth < 1e-4 && c.convergence < 1e-4 {
             small += 1;
             if est > 0.01 {
-                failures.push(format!(
-                    "H = {h}, {f:.4} Hz: true {truth:.3e}, estimate {est:.3e} warns"
-                ));
+                failures.push(format!("{line} warns"));
             }
         } else if truth > 1e-4 {
             unmeasured += 1;
@@ -231,8 +250,9 @@ fn truncation_estimate_tracks_the_true_error_on_the_blade_pair() {
         "true error > 1e-3 measured, same regimes: H = 1 {} points (estimate / true \
          {:.2}-{:.2}), H = 3 {} points ({:.2}-{:.2}); {small} below 1e-4; {unmeasured} above \
          1e-4 where the reference is not converged to a third of it; estimates extended to \
-         4H + 3: H = 1 {}, H = 3 {}; {} points where a contact's regime differs from the \
-         reference",
+         4H + 3: H = 1 {}, H = 3 {}; solved on the extended set: H = 1 {}, H = 3 {}; \
+         contraction of kept steps up to {:.2e} / {:.2e}, of solved ones from {:.2e} / {:.2e}; \
+         {} points not sizeable; {} points where a contact's regime differs from the reference",
         large[0],
         ratios[0].0,
         ratios[0].1,
@@ -241,24 +261,26 @@ fn truncation_estimate_tracks_the_true_error_on_the_blade_pair() {
         ratios[1].1,
         extended[0],
         extended[1],
+        solved[0],
+        solved[1],
+        contractions[0].0,
+        contractions[1].0,
+        contractions[0].1,
+        contractions[1].1,
+        not_sized.len(),
         regime.len()
     );
+    for r in &not_sized {
+        println!("not sizeable: {r}");
+    }
     for r in &regime {
         println!("regime change: {r}");
     }
     for m in &missed {
         println!("miss: {m}");
     }
-    println!(
-        "misses (same regimes): H = 1 {}, H = 3 {}",
-        misses[0], misses[1]
-    );
     assert!(failures.is_empty(), "{}", failures.join("\n"));
-    assert!(
-        misses.iter().zip(&large).all(|(&m, &n)| 10 * m <= n),
-        "misses {misses:?} of {large:?}:\n{}",
-        missed.join("\n")
-    );
+    assert!(missed.is_empty(), "misses:\n{}", missed.join("\n"));
     assert!(small > 20, "{small}");
     // Both runs apply the criterion above 1e-3 on the points of both branches.
     assert!(large.iter().all(|&n| n > 20), "{large:?}");

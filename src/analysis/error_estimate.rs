@@ -67,6 +67,7 @@ use crate::contact::point::ContactState;
 use crate::hbm::operator::HbmOperator;
 use crate::hbm::HbmError;
 use crate::model::{Formulation, Problem};
+use crate::numerics::continuation::Continuation;
 use crate::numerics::jacobian::AssembledJacobian;
 use crate::numerics::linalg::LinearSolveError;
 use crate::numerics::ParametricResidual;
@@ -103,6 +104,26 @@ pub struct PointAccuracy {
     /// 2H + 1, or the wider set's 4H + 3 where the first extension had not converged in its
     /// own harmonics ([`TailTest`]); 0 where no estimate was formed.
     pub estimate_harmonic: usize,
+    /// The reported kind of truncation estimate (across the path or at the fixed frequency)
+    /// on the first extension (2H + 1) alone, per output, whether or not the point was
+    /// widened; empty where no estimate was formed. For measuring the widening's gate.
+    #[serde(skip)]
+    pub first_truncation: Vec<f64>,
+    /// Whether the geometric-tail reason of [`TailTest`] alone (without the stuck-contact
+    /// reason) asks for the wider set.
+    #[serde(skip)]
+    pub tail_asks_wider: bool,
+    /// Whether a contact's regime at the point moved by the reported truncation step (on the
+    /// first extension) differs from the point's own: the step crosses a stick-slip or
+    /// lift-off transition, outside the range where its linearisation holds.
+    pub step_changes_regime: bool,
+    /// The reported truncation step's contraction of the extended residual
+    /// ([`LinearRange`]); NaN where not formed.
+    #[serde(skip)]
+    pub contraction: f64,
+    /// How the truncation estimate was formed: one Newton step, the extended system solved to
+    /// convergence, or not sizeable ([`EstimateMethod`]).
+    pub method: EstimateMethod,
 }
 
 /// Where the path is at a converged point, for the estimate across it: the hyperplane normal
@@ -349,6 +370,23 @@ impl<'p> Refined<'p> {
         low
     }
 
+    /// The contact states of `xr − δ` at ω and the norm of the residual there (one residual
+    /// evaluation); None when it fails.
+    fn after_step(
+        &mut self,
+        xr: &[f64],
+        delta: &[f64],
+        omega: f64,
+    ) -> Option<(Vec<ContactState>, f64)> {
+        let stepped: Vec<f64> = xr.iter().zip(delta).map(|(a, d)| a - d).collect();
+        let mut r = vec![0.0; stepped.len()];
+        self.operator.residual(&stepped, omega, &mut r).ok()?;
+        Some((
+            self.operator.states().to_vec(),
+            crate::numerics::linalg::norm(&r),
+        ))
+    }
+
     /// Full coefficients of `xr − δ` (refined unknowns); None when not finite.
     fn stepped(&mut self, xr: &[f64], delta: &[f64], omega: f64) -> Option<Vec<f64>> {
         let stepped: Vec<f64> = xr.iter().zip(delta).map(|(a, d)| a - d).collect();
@@ -386,6 +424,88 @@ fn relative_changes(refined: &[f64], base: &[f64]) -> Vec<f64> {
             }
         })
         .collect()
+}
+
+/// The truncation estimate on the wider set (4H + 3).
+struct Wider {
+    /// At the fixed frequency, per output.
+    fixed: Vec<f64>,
+    /// The fixed-frequency step's contraction ([`LinearRange`]).
+    fixed_contraction: f64,
+    /// Across the path (per output) and that step's contraction, where the path's normal was
+    /// given and the bordered matrix factorised.
+    across: Option<(Vec<f64>, f64)>,
+}
+
+/// Whether the one Newton step of the extended system stays in the range where its
+/// linearisation holds: its contraction, the norm of the extended residual after the step
+/// relative to the norm before it (the residual on the new harmonics), is at most
+/// [`Self::MAX_CONTRACTION`]. Within its linear range a Newton step leaves a residual of
+/// second order in the step, far below the first.
+///
+/// Measured on the small blade pair (`examples/estimate_misses.rs`, docs/accuracy.md, "Why
+/// the estimate missed on the small blade pair"): below 929.5 Hz a stuck contact of the point
+/// sits at its friction limit at an instant of the period (it slipped by a hair, so its mean
+/// force is set by that slip), while on the extended set it stays stuck from the march's
+/// initial condition with a margin of 1-3 % of μN; the step linearised on the first regime
+/// lands far from the extended solution (at H = 1, 928.77 Hz: step 0.27 %, converged extended
+/// solution 6.4 %, true error 6.6 %), and its estimate jumps by factors 3-50 between
+/// neighbouring points while the converged extended solutions change smoothly. Where the
+/// contraction exceeds the bound the point is solved on the extended set to convergence at
+/// its frequency ([`EstimateMethod::Solved`]), or, where that fails or the point reports the
+/// step across the path, reported as not sizeable ([`EstimateMethod::Unsized`]).
+pub struct LinearRange;
+
+impl LinearRange {
+    /// Largest contraction of the residual by the estimate's Newton step that keeps the step.
+    pub const MAX_CONTRACTION: f64 = 0.05;
+}
+
+/// How a point's truncation estimate was formed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EstimateMethod {
+    /// One Newton step of the extended system (the default, within its linear range).
+    Step,
+    /// The extended system solved to convergence at the point's frequency (the step left its
+    /// linear range, [`LinearRange`]).
+    Solved,
+    /// Not sizeable: the step left its linear range and the extended system has no converged
+    /// solution at the point's frequency (or the point reports the across-path step, for
+    /// which no converged solve is done). The estimate is the step's and is not to be read
+    /// as a size: the run warns.
+    Unsized,
+    /// No estimate formed (NaN).
+    None,
+}
+
+impl EstimateMethod {
+    /// The label written in the output files.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Step => "step",
+            Self::Solved => "solved",
+            Self::Unsized => "unsized",
+            Self::None => "none",
+        }
+    }
+}
+
+/// What one set of Newton steps (across the path or at the fixed frequency) gives on the
+/// first extension.
+struct Assessed {
+    /// Truncation estimate per output.
+    truncation: Vec<f64>,
+    /// Whether [`TailTest`] sends the point to the wider set.
+    needs_wider: bool,
+    /// Whether its geometric-tail reason alone would.
+    tail_asks: bool,
+    /// Whether the truncation step changes a contact's regime.
+    changes_regime: bool,
+    /// The truncation step's contraction ([`LinearRange`]).
+    contraction: f64,
+    /// Sampling estimate per output.
+    sampling: Vec<f64>,
 }
 
 /// Estimates the truncation and sampling errors of converged points of one problem, reusing
@@ -476,6 +596,11 @@ impl<'p> ErrorEstimator<'p> {
             both_truncation: None,
             slide_and_step: (f64::NAN, f64::NAN),
             estimate_harmonic: 0,
+            first_truncation: Vec::new(),
+            tail_asks_wider: false,
+            step_changes_regime: false,
+            contraction: f64::NAN,
+            method: EstimateMethod::None,
         };
         let xr = self.truncation.padded(n, x);
         let dim = xr.len();
@@ -552,100 +677,188 @@ impl<'p> ErrorEstimator<'p> {
         };
         let ext = self.truncation.operator.unknowns().clone();
         let nan_values = vec![f64::NAN; base.len()];
-        let mut amplitudes_after = |delta: &[f64]| {
+        let r_norm = crate::numerics::linalg::norm(&r);
+        let mut amplitudes_after = |delta: &[f64], with_states: bool| {
             let (d_omega, d_x) = delta.split_last().expect("a step has a frequency part");
-            match self.truncation.stepped(&xr, d_x, omega - d_omega) {
+            let values = match self.truncation.stepped(&xr, d_x, omega - d_omega) {
                 Some(full) => amplitudes(self.problem, &ext, &full),
                 None => nan_values.clone(),
-            }
+            };
+            let moved = with_states
+                .then(|| self.truncation.after_step(&xr, d_x, omega - d_omega))
+                .flatten();
+            (values, moved)
         };
         // Per reported step set (across the path or at the fixed frequency): the truncation
-        // estimate, whether its tail needs the wider set, and the sampling estimate.
+        // estimate, whether its tail needs the wider set (and whether the tail alone asks
+        // for it), whether the step changes a contact's regime, and the sampling estimate.
         let mut assess = |steps: &[Vec<f64>]| {
-            let full = amplitudes_after(&steps[0]);
-            let low = amplitudes_after(&steps[1]);
+            let (full, moved) = amplitudes_after(&steps[0], true);
+            let (low, _) = amplitudes_after(&steps[1], false);
             let needs_wider = base
                 .iter()
                 .zip(&low)
                 .zip(&full)
                 .any(|((&b, &l), &f)| TailTest::extend(b, l, f, stuck_contact));
+            let tail_asks = base
+                .iter()
+                .zip(&low)
+                .zip(&full)
+                .any(|((&b, &l), &f)| TailTest::extend(b, l, f, false));
+            let changes_regime = moved.as_ref().is_some_and(|m| m.0.as_slice() != states);
+            let contraction = moved.map_or(f64::NAN, |m| m.1 / r_norm);
             let sampling = match steps.get(2) {
-                Some(d) => relative_changes(&amplitudes_after(d), &base),
+                Some(d) => relative_changes(&amplitudes_after(d, false).0, &base),
                 None => nan_values.clone(),
             };
-            (relative_changes(&full, &base), needs_wider, sampling)
+            Assessed {
+                truncation: relative_changes(&full, &base),
+                needs_wider,
+                tail_asks,
+                changes_regime,
+                contraction,
+                sampling,
+            }
         };
         let top = extended_harmonic(self.h_max);
-        let (truncation, across_needs_wider, sampling) = assess(&deltas);
+        let first = assess(&deltas);
         let step = path.map_or(f64::NAN, |p| p.step);
         let Some(fixed) = fixed_deltas else {
-            let (truncation, estimate_harmonic) = if across_needs_wider {
-                match self.wider_truncation(x, omega, None, &base) {
-                    Some((fixed, _)) => (fixed, wider_harmonic(self.h_max)),
-                    None => (truncation, top),
+            let mut truncation = first.truncation.clone();
+            let mut estimate_harmonic = top;
+            let mut contraction = first.contraction;
+            if first.needs_wider {
+                if let Some(w) = self.wider_truncation(x, omega, None, &base) {
+                    truncation = w.fixed;
+                    contraction = w.fixed_contraction;
+                    estimate_harmonic = wider_harmonic(self.h_max);
                 }
-            } else {
-                (truncation, top)
-            };
+            }
+            let method = self.settle(
+                x,
+                omega,
+                &base,
+                (&mut truncation, estimate_harmonic, contraction),
+                false,
+            );
             return PointAccuracy {
                 truncation,
-                sampling,
+                sampling: first.sampling,
                 across_path: false,
                 path_normal: None,
                 both_truncation: None,
                 slide_and_step: (f64::NAN, step),
                 estimate_harmonic,
+                first_truncation: first.truncation,
+                tail_asks_wider: first.tail_asks,
+                step_changes_regime: first.changes_regime,
+                contraction,
+                method,
             };
         };
-        let (fixed_truncation, fixed_needs_wider, fixed_sampling) = assess(&fixed);
+        let fixed = assess(&fixed);
         let across = PathSwitch::across(slide, step);
-        let needs_wider = if across {
-            across_needs_wider
-        } else {
-            fixed_needs_wider
-        };
-        let mut both = (fixed_truncation, truncation);
+        let reported = if across { &first } else { &fixed };
+        let mut both = (fixed.truncation.clone(), first.truncation.clone());
+        let mut contractions = (fixed.contraction, first.contraction);
         let mut estimate_harmonic = top;
-        if needs_wider {
+        if reported.needs_wider {
             let normal = path.map(|p| p.normal);
-            if let Some((wider_fixed, wider_across)) =
-                self.wider_truncation(x, omega, normal, &base)
-            {
-                if let Some(a) = wider_across {
-                    both = (wider_fixed, a);
+            if let Some(w) = self.wider_truncation(x, omega, normal, &base) {
+                if let Some((a, a_contraction)) = w.across {
+                    both = (w.fixed, a);
+                    contractions = (w.fixed_contraction, a_contraction);
                     estimate_harmonic = wider_harmonic(self.h_max);
                 } else if !across {
-                    both.0 = wider_fixed;
+                    both.0 = w.fixed;
+                    contractions.0 = w.fixed_contraction;
                     estimate_harmonic = wider_harmonic(self.h_max);
                 }
             }
         }
+        let contraction = if across {
+            contractions.1
+        } else {
+            contractions.0
+        };
+        let mut truncation = if across {
+            both.1.clone()
+        } else {
+            both.0.clone()
+        };
+        let method = self.settle(
+            x,
+            omega,
+            &base,
+            (&mut truncation, estimate_harmonic, contraction),
+            across,
+        );
+        if !across && method == EstimateMethod::Solved {
+            both.0 = truncation.clone();
+        }
         PointAccuracy {
-            truncation: if across {
-                both.1.clone()
+            truncation,
+            sampling: if across {
+                first.sampling.clone()
             } else {
-                both.0.clone()
+                fixed.sampling.clone()
             },
-            sampling: if across { sampling } else { fixed_sampling },
             across_path: across,
             path_normal,
             both_truncation: Some(both),
             slide_and_step: (slide, step),
             estimate_harmonic,
+            first_truncation: reported.truncation.clone(),
+            tail_asks_wider: reported.tail_asks,
+            step_changes_regime: reported.changes_regime,
+            contraction,
+            method,
+        }
+    }
+
+    /// How the reported truncation estimate stands ([`LinearRange`]): `truncation` (per
+    /// output, replaced by the converged extended solution's change where that is solved),
+    /// the extension it comes from and its step's contraction; `across` when the point
+    /// reports the step across the path.
+    fn settle(
+        &mut self,
+        x: &[f64],
+        omega: f64,
+        base: &[f64],
+        (truncation, estimate_harmonic, contraction): (&mut Vec<f64>, usize, f64),
+        across: bool,
+    ) -> EstimateMethod {
+        if truncation.iter().any(|v| v.is_nan()) {
+            return EstimateMethod::None;
+        }
+        // A contraction that is not a number (the residual after the step failed) counts as
+        // beyond the linear range.
+        if contraction <= LinearRange::MAX_CONTRACTION {
+            return EstimateMethod::Step;
+        }
+        if across {
+            return EstimateMethod::Unsized;
+        }
+        let wider = estimate_harmonic == wider_harmonic(self.h_max);
+        match self.converged_truncation(x, omega, wider, base) {
+            Some(solved) => {
+                *truncation = solved;
+                EstimateMethod::Solved
+            }
+            None => EstimateMethod::Unsized,
         }
     }
 
     /// The truncation estimate of the point `x` at `omega` on the wider set (4H + 3): at the
     /// fixed frequency, and across the path when the path's `normal` (run unknowns, then ω) is
     /// given and the bordered matrix factorises; None when the estimate cannot be formed.
-    #[allow(clippy::type_complexity)]
     fn wider_truncation(
         &mut self,
         x: &[f64],
         omega: f64,
         normal: Option<&[f64]>,
         base: &[f64],
-    ) -> Option<(Vec<f64>, Option<Vec<f64>>)> {
+    ) -> Option<Wider> {
         let n = self.problem.model.n_dofs();
         let wider = &mut self.wider;
         let xr = wider.padded(n, x);
@@ -667,9 +880,18 @@ impl<'p> ErrorEstimator<'p> {
             Some(row)
         });
         let problem = self.problem;
+        let r_norm = crate::numerics::linalg::norm(&r);
+        // The change of each output and the step's contraction ([`LinearRange`]).
         let change = |w: &mut Refined, delta: &[f64], d_omega: f64| {
-            w.stepped(&xr, delta, omega - d_omega)
-                .map(|full| relative_changes(&amplitudes(problem, &ext, &full), base))
+            let contraction = w
+                .after_step(&xr, delta, omega - d_omega)
+                .map_or(f64::NAN, |(_, after)| after / r_norm);
+            w.stepped(&xr, delta, omega - d_omega).map(|full| {
+                (
+                    relative_changes(&amplitudes(problem, &ext, &full), base),
+                    contraction,
+                )
+            })
         };
         if let Some(row) = row {
             let ones = vec![1.0; dim];
@@ -685,13 +907,51 @@ impl<'p> ErrorEstimator<'p> {
                     let across = change(wider, &step[..dim], d_omega);
                     let fixed = change(wider, &fixed[..dim], fixed[dim]);
                     if let (Some(f), Some(a)) = (fixed, across) {
-                        return Some((f, Some(a)));
+                        return Some(Wider {
+                            fixed: f.0,
+                            fixed_contraction: f.1,
+                            across: Some(a),
+                        });
                     }
                 }
             }
         }
         let step = wider.jacobian.solve_many(&[&r]).ok()?.pop()?;
-        change(wider, &step, 0.0).map(|f| (f, None))
+        change(wider, &step, 0.0).map(|f| Wider {
+            fixed: f.0,
+            fixed_contraction: f.1,
+            across: None,
+        })
+    }
+
+    /// The converged solution of the extended system (the wider one when `wider`) at the
+    /// fixed ω (rad/s), by Newton from the point `x` padded with zeros, as the relative change
+    /// of each output's amplitude from `base`; None when Newton does not converge. What the
+    /// one Newton step of [`Self::estimate`] approximates, for the points where that step
+    /// leaves its linear range ([`LinearRange`]).
+    fn converged_truncation(
+        &mut self,
+        x: &[f64],
+        omega: f64,
+        wider: bool,
+        base: &[f64],
+    ) -> Option<Vec<f64>> {
+        let n = self.problem.model.n_dofs();
+        let refined = if wider {
+            &mut self.wider
+        } else {
+            &mut self.truncation
+        };
+        let xr = refined.padded(n, x);
+        // The step tolerance is relative to the point's largest coefficient.
+        let scale = xr.iter().fold(0.0_f64, |m, v| m.max(v.abs())).max(1e-300);
+        let newton = Continuation::new(self.problem.analysis.continuation, vec![scale; xr.len()]);
+        let solved = newton.solve_fixed(&mut refined.operator, &xr, omega).ok()?;
+        let ext = refined.operator.unknowns().clone();
+        let full = refined.operator.expand(&solved.x, omega).ok()?;
+        full.iter()
+            .all(|v| v.is_finite())
+            .then(|| relative_changes(&amplitudes(self.problem, &ext, &full), base))
     }
 
     /// The bordered Newton steps (δx, δω) of [[J, ∂R/∂ω], [row]] (δx, δω) = (r, 0) for each
@@ -746,6 +1006,9 @@ pub enum EstimateKind {
     Truncation,
     /// AFT sampling.
     Sampling,
+    /// Points whose truncation error could not be sized ([`EstimateMethod::Unsized`]): the
+    /// band holds them whatever their estimate.
+    Unsized,
 }
 
 /// Bands of consecutive points (in path order) where an estimate exceeds `threshold`, per
@@ -789,16 +1052,27 @@ pub const MERGE_FRACTION: f64 = 0.02;
 /// The bands of [`warnings`] before merging.
 fn bands(points: &[(f64, &PointAccuracy)], outputs: usize, threshold: f64) -> Vec<AccuracyWarning> {
     let mut found = Vec::new();
-    for kind in [EstimateKind::Truncation, EstimateKind::Sampling] {
+    for kind in [
+        EstimateKind::Truncation,
+        EstimateKind::Sampling,
+        EstimateKind::Unsized,
+    ] {
         for output in 0..outputs {
             let mut band: Option<AccuracyWarning> = None;
             for &(freq_hz, acc) in points {
                 let values = match kind {
-                    EstimateKind::Truncation => &acc.truncation,
+                    EstimateKind::Truncation | EstimateKind::Unsized => &acc.truncation,
                     EstimateKind::Sampling => &acc.sampling,
                 };
                 let e = values.get(output).copied().unwrap_or(f64::NAN);
-                if e > threshold || e.is_nan() {
+                let not_sized = acc.method == EstimateMethod::Unsized;
+                let inside = match kind {
+                    // Unsized points warn in their own band, not as a size.
+                    EstimateKind::Truncation => !not_sized && (e > threshold || e.is_nan()),
+                    EstimateKind::Sampling => e > threshold || e.is_nan(),
+                    EstimateKind::Unsized => not_sized,
+                };
+                if inside {
                     let b = band.get_or_insert(AccuracyWarning {
                         kind,
                         output,
@@ -863,6 +1137,19 @@ pub fn warning_text(w: &AccuracyWarning, output: &str, h_max: usize, samples: us
             "AFT sampling",
             format!("harmonics.samples > {samples} needed (try {})", 2 * samples),
         ),
+        EstimateKind::Unsized => {
+            return format!(
+                "accuracy: the harmonic truncation error of {output}'s amplitude could not be \
+                 sized between {:.4} and {:.4} Hz: the estimate's Newton step leaves its linear \
+                 range there (a contact changes regime with more harmonics) and the system on \
+                 H = {} (or {}) has no converged solution at those frequencies; solve the band \
+                 at harmonics.max > {h_max} and compare",
+                w.from_hz,
+                w.to_hz,
+                extended_harmonic(h_max),
+                wider_harmonic(h_max)
+            );
+        }
     };
     format!(
         "accuracy: the {what} error of {output}'s amplitude {size} between {:.4} and {:.4} Hz: \
@@ -923,6 +1210,11 @@ mod tests {
             both_truncation: None,
             slide_and_step: (f64::NAN, f64::NAN),
             estimate_harmonic: 3,
+            first_truncation: vec![t],
+            tail_asks_wider: false,
+            step_changes_regime: false,
+            contraction: 0.0,
+            method: EstimateMethod::Step,
         }
     }
 

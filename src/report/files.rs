@@ -14,6 +14,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use crate::analysis::error_estimate::EstimateMethod;
 use crate::analysis::frf::{FrfObserver, FrfPoint, Jump};
 use crate::analysis::linear::LinearCurve;
 use crate::analysis::peaks::{ExtremumKind, PathExtremum};
@@ -86,13 +87,21 @@ pub fn frf_row(point: &FrfPoint) -> String {
 /// The error-estimate columns of `frf.csv` and `curve_*.csv`, when the scene asks for the
 /// estimate (`[accuracy].estimate`): `<dof>_trunc_err` and `<dof>_sampling_err` per output,
 /// the estimated relative error of the first-harmonic amplitude due to harmonic truncation and
-/// AFT sampling ([`crate::analysis::error_estimate`]).
+/// AFT sampling ([`crate::analysis::error_estimate`]), then `estimate_harmonic`, the highest
+/// harmonic of the extended set the point's truncation estimate comes from (2H + 1, or 4H + 3
+/// where the estimate was widened; 0 where it could not be formed:
+/// [`crate::analysis::error_estimate::PointAccuracy::estimate_harmonic`]), and
+/// `estimate_method`, how the truncation estimate was formed: `step` (one Newton step of the
+/// extended system), `solved` (the extended system solved to convergence, where the step left
+/// its linear range), `unsized` (not sizeable: the run warns) or `none` (not formed:
+/// [`crate::analysis::error_estimate::EstimateMethod`]).
 pub fn accuracy_header(problem: &Problem, h: &mut String) {
     if problem.analysis.error_estimate.enabled {
         for &d in &problem.outputs {
             let name = &problem.model.dof_names[d];
             let _ = write!(h, ",{name}_trunc_err,{name}_sampling_err");
         }
+        h.push_str(",estimate_harmonic,estimate_method");
     }
 }
 
@@ -103,6 +112,7 @@ pub fn accuracy_cells(point: &FrfPoint, r: &mut String) {
         for (t, s) in acc.truncation.iter().zip(&acc.sampling) {
             let _ = write!(r, ",{t:.3e},{s:.3e}");
         }
+        let _ = write!(r, ",{},{}", acc.estimate_harmonic, acc.method.label());
     }
 }
 
@@ -121,6 +131,14 @@ pub struct AccuracySummary {
     pub max_sampling_err_hz: Vec<f64>,
     /// Points whose estimate could not be formed (NaN cells).
     pub unformed_points: usize,
+    /// Highest harmonic any point's truncation estimate extended to (the largest
+    /// `estimate_harmonic` of the CSV rows: 2H + 1, or 4H + 3 when some point was widened).
+    pub max_estimate_harmonic: usize,
+    /// Points whose truncation estimate is the extended system solved to convergence
+    /// (`estimate_method` `solved`).
+    pub solved_points: usize,
+    /// Points whose truncation error could not be sized (`estimate_method` `unsized`).
+    pub unsized_points: usize,
     /// The warning threshold of the scene (relative).
     pub threshold: f64,
 }
@@ -146,12 +164,21 @@ pub fn accuracy_summary(
         max_trunc_err_hz: vec![f64::NAN; k],
         max_sampling_err_hz: vec![f64::NAN; k],
         unformed_points: 0,
+        max_estimate_harmonic: 0,
+        solved_points: 0,
+        unsized_points: 0,
         threshold,
     };
     for (f, a) in with {
         let values = a.truncation.iter().chain(&a.sampling);
         if values.clone().any(|v| v.is_nan()) {
             s.unformed_points += 1;
+        }
+        s.max_estimate_harmonic = s.max_estimate_harmonic.max(a.estimate_harmonic);
+        match a.method {
+            EstimateMethod::Solved => s.solved_points += 1,
+            EstimateMethod::Unsized => s.unsized_points += 1,
+            EstimateMethod::Step | EstimateMethod::None => {}
         }
         for o in 0..k.min(a.truncation.len()) {
             if a.truncation[o] > s.max_trunc_err[o] {
