@@ -6,8 +6,10 @@
 //! depend on the harmonic count through N and u at τ = 0, and converge slowly with H: H = 5 is
 //! 1-7 % off there, H = 7 up to 0.8 %, H = 9 up to 0.16 % (docs/accuracy.md), hence H = 11.
 //! The estimate reaches those harmonics by its extension to 4H + 3 where a contact is stuck all
-//! period (`error_estimate::TailTest`). Which points a truncation estimate cannot size is
-//! computed, not listed: those where a contact's regime differs from the reference point's.
+//! period (`error_estimate::TailTest`), and solves the extended system to convergence where its
+//! Newton step leaves its linear range (`error_estimate::LinearRange`). Which points a
+//! truncation estimate cannot size is computed, not listed: those the estimate reports as not
+//! sizeable, and those where a contact's regime differs from the reference point's.
 
 mod common;
 

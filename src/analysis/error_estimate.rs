@@ -22,6 +22,17 @@
 //! again in the same way on the wider set H+1 … 4H+3 ([`wider_harmonic`]) and reports that
 //! estimate ([`PointAccuracy::estimate_harmonic`] says which).
 //!
+//! # Where the step leaves its linear range
+//!
+//! The extended residual is evaluated once more at the stepped point. Where it is more than
+//! [`LinearRange::MAX_CONTRACTION`] of the residual before the step, the step is outside the
+//! range where its linearisation holds (a contact whose regime differs between the point and
+//! the extended solution: docs/accuracy.md, "Why the estimate missed on the small blade
+//! pair"), and the point is solved on the extended set to convergence at its frequency, which
+//! it then reports ([`EstimateMethod::Solved`]); where that does not converge, or the point
+//! reports the step across the path, it is not sizeable ([`EstimateMethod::Unsized`], warned
+//! in a band of its own).
+//!
 //! # Sampling
 //!
 //! The same point put into the harmonic balance of the same harmonic set at twice the samples
