@@ -1288,6 +1288,36 @@ mod tests {
     }
 
     #[test]
+    fn unsized_points_warn_in_their_own_band() {
+        // Two points not sizeable with small estimates between sized ones, one of them above
+        // the threshold: the unsized ones form their own band and do not count as a size.
+        let mut a = [
+            acc(0.001, 0.0),
+            acc(0.002, 0.0),
+            acc(0.003, 0.0),
+            acc(0.05, 0.0),
+        ];
+        a[1].method = EstimateMethod::Unsized;
+        a[2].method = EstimateMethod::Unsized;
+        let points: Vec<(f64, &PointAccuracy)> =
+            [100.0, 110.0, 120.0, 200.0].into_iter().zip(&a).collect();
+        let w = warnings(&points, 1, 0.01);
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert_eq!(w[0].kind, EstimateKind::Truncation);
+        assert_eq!((w[0].from_hz, w[0].to_hz), (200.0, 200.0));
+        assert_eq!(w[1].kind, EstimateKind::Unsized);
+        assert_eq!((w[1].from_hz, w[1].to_hz), (110.0, 120.0));
+        let text = warning_text(&w[1], "y2", 3, 256);
+        assert!(
+            text.contains("could not be sized between 110.0000 and 120.0000 Hz"),
+            "{text}"
+        );
+        assert!(text.contains("H = 7 (or 15)"), "{text}");
+        assert!(text.contains("harmonics.max > 3"), "{text}");
+        assert_eq!(EstimateMethod::Unsized.label(), "unsized");
+    }
+
+    #[test]
     fn largest_ignores_unformed_estimates() {
         let a = [acc(0.01, f64::NAN), acc(0.03, 0.002)];
         let refs: Vec<&PointAccuracy> = a.iter().collect();
