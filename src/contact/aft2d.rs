@@ -318,8 +318,9 @@ impl Aft2dWorkspace {
     }
 
     /// One attempt of [`Self::march`]. Returns None when Newton restarts were used and the
-    /// settled state needs the plain history for its derivative (its final period does not
-    /// slip: a transient slip, then stuck).
+    /// settled state is a function of the march's history (its final period does not slip
+    /// beyond rounding nor lift off: a transient slip, then stuck), which only plain periods
+    /// make continuous in the coefficients and differentiable.
     ///
     /// With `allow_newton`, each period's start is a safeguarded Newton update of the
     /// fixed-point equation Φ(w) = w: the full step (I − A)⁻¹(Φ(w) − w), shortened to the
@@ -454,6 +455,27 @@ impl Aft2dWorkspace {
         let scale = self.march_scale;
         let slipped = outcome.any_slip || outcome.open_samples > 0;
         let well = well_conditioned(outcome.period_map_derivative);
+        if !slips_beyond_rounding(&outcome) {
+            // Stuck throughout the final period (at most touching the friction circle by
+            // rounding): the slider rests where the transient left it, one of a continuum of
+            // periodic states (every point of the stuck set is one), so the state is a function
+            // of the march's history. A history with Newton restarts is not a continuous
+            // function of the coefficients (a step can land on another part of the stuck
+            // set's boundary: measured on a grazing circle, two corners 60 samples apart for
+            // coefficients 10⁻¹¹ m apart), so such a state is marched again with plain periods.
+            if used_newton {
+                return Ok(None);
+            }
+        }
+        if !well && !slips_beyond_rounding(&outcome) {
+            // Touching along (nearly) one direction only: the position along the stuck set's
+            // boundary is the transient's, whose derivative only the history gives. (Touching
+            // in two directions apart, a corner of the stuck set, I − A is well conditioned and
+            // the corner is the fixed point the plain march converges to.)
+            let report = self.report(&outcome, period);
+            self.slider_start = start;
+            return Ok(Some((report, StartOrigin::History { periods: period })));
+        }
         let mut drift = mismatch[0].hypot(mismatch[1]);
         let mut resolved = quadratic;
         if slipped && (well || used_newton) {
@@ -474,7 +496,13 @@ impl Aft2dWorkspace {
                     again.slider_end[1] - polished[1],
                 ];
                 let new_drift = change[0].hypot(change[1]);
-                let still_slipping = again.any_slip || again.open_samples > 0;
+                // A polished period must still be one whose start solves Φ(w) = w: slipping
+                // (beyond rounding, unless I − A is well conditioned) or lifting off.
+                let still_slipping = if well {
+                    again.any_slip || again.open_samples > 0
+                } else {
+                    slips_beyond_rounding(&again)
+                };
                 let keeps_condition = !well || well_conditioned(again.period_map_derivative);
                 let not_worse = new_drift <= drift;
                 if !not_worse || !still_slipping || !keeps_condition {
@@ -494,13 +522,15 @@ impl Aft2dWorkspace {
                 outcome = self.march_period(law, start, false, scale);
             }
         }
-        let origin = if !slipped {
+        let origin = if well_conditioned(outcome.period_map_derivative) {
+            StartOrigin::FixedPoint
+        } else if !slips_beyond_rounding(&outcome) {
+            // The polish keeps only periods that slip beyond rounding here, but should the
+            // accepted period be stuck after all, the same rule as above holds.
             if used_newton {
                 return Ok(None);
             }
             StartOrigin::History { periods: period }
-        } else if well_conditioned(outcome.period_map_derivative) {
-            StartOrigin::FixedPoint
         } else if !used_newton {
             StartOrigin::History { periods: period }
         } else if resolved {
@@ -509,8 +539,12 @@ impl Aft2dWorkspace {
             StartOrigin::DegenerateFixedPoint
         };
         self.slider_start = start;
-        let ns = self.n_samples;
-        let state = if outcome.open_samples == ns {
+        Ok(Some((self.report(&outcome, period), origin)))
+    }
+
+    /// The march's report for a final period `outcome` reached at period `period`.
+    fn report(&self, outcome: &PeriodOutcome, period: usize) -> MarchReport {
+        let state = if outcome.open_samples == self.n_samples {
             ContactState::Open
         } else if outcome.open_samples > 0 {
             ContactState::StickSlipLiftoff
@@ -519,11 +553,10 @@ impl Aft2dWorkspace {
         } else {
             ContactState::Stuck
         };
-        let report = MarchReport {
+        MarchReport {
             state,
             periods: period,
-        };
-        Ok(Some((report, origin)))
+        }
     }
 
     /// Marches one period from the slider position `start`, filling the force samples and
@@ -850,6 +883,13 @@ fn step_derivative(
             }
         }
     }
+}
+
+/// Whether a period slips by more than rounding at some sample or lifts off: where it does
+/// not, the slider stays put over the period (it at most touches the friction circle) and its
+/// position is whatever the transient left, not the solution of a fixed-point equation.
+fn slips_beyond_rounding(outcome: &PeriodOutcome) -> bool {
+    outcome.margin_slips > 0 || outcome.open_samples > 0
 }
 
 /// Whether I − A is safely invertible: the period map attracts in every direction (a
