@@ -306,14 +306,22 @@ impl Aft2dWorkspace {
         } else {
             u0
         };
-        match self.march_from_initial(law, self.newton_restarts)? {
+        match self.march_from_initial(law, self.newton_restarts, false)? {
             Some(result) => Ok(result),
-            None => self
-                .march_from_initial(law, false)?
-                .ok_or(AftError::NotSettled {
-                    periods: self.settings.max_periods.max(2),
-                    drift: f64::NAN,
-                }),
+            None => match self.march_from_initial(law, false, false) {
+                Ok(Some(result)) => Ok(result),
+                // The plain march creeps towards its stuck state without settling: keep the
+                // stuck state the Newton restarts reached (a periodic state as valid as any of
+                // the stuck set, though not the one the plain transient would choose), with
+                // the slider held where I − A is singular (`DegenerateFixedPoint`).
+                Ok(None) | Err(AftError::NotSettled { .. }) => self
+                    .march_from_initial(law, true, true)?
+                    .ok_or(AftError::NotSettled {
+                        periods: self.settings.max_periods.max(2),
+                        drift: f64::NAN,
+                    }),
+                Err(error) => Err(error),
+            },
         }
     }
 
@@ -335,6 +343,7 @@ impl Aft2dWorkspace {
         &mut self,
         law: &Jenkins2dLaw,
         allow_newton: bool,
+        keep_newton_stuck_state: bool,
     ) -> Result<Option<(MarchReport, StartOrigin)>, AftError> {
         let scale = self.march_scale;
         let tol = self.settings.periodicity_tolerance * self.tolerance_scale;
@@ -373,6 +382,7 @@ impl Aft2dWorkspace {
                     used_newton,
                     quadratic,
                     period,
+                    keep_newton_stuck_state,
                 );
             }
             if let Some(t) = trial.take() {
@@ -451,6 +461,7 @@ impl Aft2dWorkspace {
         used_newton: bool,
         quadratic: bool,
         period: usize,
+        keep_newton_stuck_state: bool,
     ) -> Result<Option<(MarchReport, StartOrigin)>, AftError> {
         let scale = self.march_scale;
         let slipped = outcome.any_slip || outcome.open_samples > 0;
@@ -463,6 +474,15 @@ impl Aft2dWorkspace {
             // function of the coefficients (a step can land on another part of the stuck
             // set's boundary: measured on a grazing circle, two corners 60 samples apart for
             // coefficients 10⁻¹¹ m apart), so such a state is marched again with plain periods.
+            if used_newton && keep_newton_stuck_state {
+                let origin = if well {
+                    StartOrigin::FixedPoint
+                } else {
+                    StartOrigin::DegenerateFixedPoint
+                };
+                self.slider_start = start;
+                return Ok(Some((self.report(&outcome, period), origin)));
+            }
             if used_newton {
                 return Ok(None);
             }
