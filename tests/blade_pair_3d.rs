@@ -2,8 +2,8 @@
 //! the scene validates into a Craig-Bampton-reduced model whose 56 patch contact points all
 //! carry the `jenkins-2d` law; fixed-frequency solves near the first bending pair, where
 //! contacts stick, slip and lift off, give the same solutions in the schur (`auto`) and dense
-//! formulations; and `fricbound run` of a narrow window completes with its result files and
-//! VTU output.
+//! formulations; `fricbound run` of a narrow window completes with its result files and
+//! VTU output; and the m = +1 limit curve crosses its former stall at 852.78 Hz.
 
 mod support;
 
@@ -203,3 +203,48 @@ fn the_3d_frf_crosses_the_transition_at_886_685_hz_without_turning_back() {
     assert_ne!(frf.first_state, frf.last_state);
     assert!(frf.solution.contains("\"status\": \"complete\""), "status");
 }
+
+/// The m = +1 limit curve of `blade-pair-3d-limits.toml` used to stall at 852.78 Hz: point
+/// `left-17` slips essentially along one direction there, and its 2D march crept towards a
+/// degenerate fixed point without settling in 2000 periods (benches/README.md, "3D blade pair
+/// with 2D friction"). With the 2D march's safeguarded Newton restarts the curve crosses that
+/// frequency on a narrow window and ends `complete`.
+#[test]
+fn the_m_plus_1_limit_curve_passes_its_former_stall_at_852_78_hz() {
+    use fricbound::analysis::limits::case::two_point_cases;
+    use fricbound::analysis::limits::curve::attempt_case;
+    let (start, end) = (LIMIT_WINDOW_HZ[0], LIMIT_WINDOW_HZ[1]);
+    let o = [
+        format!("analysis.freq_start_hz={start}"),
+        format!("analysis.freq_end_hz={end}"),
+        "accuracy.estimate=false".to_string(),
+    ];
+    let problem = scene::load_problem(Path::new(LIMITS_SCENE), &o).unwrap().1;
+    let case = two_point_cases(&problem)
+        .into_iter()
+        .find(|c| c.name == "m+1")
+        .unwrap();
+    let curve = attempt_case(&problem, &case, None);
+    let reached = curve
+        .points
+        .iter()
+        .map(|p| p.freq_hz)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let iterations: usize = curve.points.iter().map(|p| p.newton_iterations).sum();
+    println!(
+        "m = +1 over {start}-{end} Hz: {} ({} points, {iterations} Newton iterations, reached \
+         {reached:.4} Hz)",
+        curve.status.text(),
+        curve.points.len()
+    );
+    assert!(curve.status.is_complete(), "{}", curve.status.text());
+    assert!(
+        reached > 852.78 && (reached - end).abs() < 1e-6,
+        "{reached}"
+    );
+}
+
+const LIMITS_SCENE: &str = "meshes/blade-pair/blade-pair-3d-limits.toml";
+
+/// A window across the former stall of the m = +1 limit curve (Hz).
+const LIMIT_WINDOW_HZ: [f64; 2] = [852.5, 853.2];
