@@ -20,7 +20,11 @@
 //! ahead), never on the path already followed: a point found behind the incoming direction
 //! is kept only when a look-ahead step from it leaves that path (a sharp fold), since at a
 //! contact transition such a point can lead straight back onto the incoming branch, which the
-//! path would then retrace. The last point is solved at exactly the end frequency. A path runs down in
+//! path would then retrace (and loop: back along the followed path and on again through the
+//! same corners). When neither is found the run ends with [`PathEnd::DeadEnd`] where a way
+//! back along the followed path was refused or below the highest frequency reached (the caller
+//! goes on past the highest frequency, as after a path that wandered without progress), and
+//! with [`ContinuationError::Stalled`] otherwise. The last point is solved at exactly the end frequency. A path runs down in
 //! frequency when the end frequency is below the start (e.g. to fill in, back toward a fold, a
 //! branch found past it).
 //!
@@ -684,6 +688,7 @@ impl Continuation {
         y: &[f64],
         tangent: &[f64],
         recent: &[PathPoint],
+        refused_retrace: &mut bool,
     ) -> Result<Option<(PathPoint, Vec<f64>)>, ContinuationError> {
         let n = y.len() - 1;
         for &fraction in LEAPS {
@@ -709,8 +714,11 @@ impl Continuation {
             let reach = norm(&yc.iter().zip(y).map(|(a, b)| a - b).collect::<Vec<_>>());
             let on_path =
                 distance_to_polyline(&yc, &self.scaled_points(recent)) <= RETRACE_FRACTION * reach;
-            if distance <= ds && dot(&t_new, tangent) > 0.0 && !on_path {
-                return Ok(Some((point, t_new)));
+            if distance <= ds && dot(&t_new, tangent) > 0.0 {
+                if !on_path {
+                    return Ok(Some((point, t_new)));
+                }
+                *refused_retrace = true;
             }
         }
         Ok(None)
@@ -752,6 +760,7 @@ impl Continuation {
         y: &[f64],
         tangent: &[f64],
         recent: &[PathPoint],
+        refused_retrace: &mut bool,
     ) -> Result<Option<(PathPoint, Vec<f64>)>, ContinuationError> {
         let n = y.len() - 1;
         for &multiple in CORNER_STEPS {
@@ -807,6 +816,7 @@ impl Continuation {
                 if dot(&chord, tangent) < 0.0
                     && self.runs_back_along(system, (&yc, &t_new), y, recent)
                 {
+                    *refused_retrace = true;
                     continue;
                 }
                 return Ok(Some((point, t_new)));
@@ -1116,10 +1126,18 @@ impl Continuation {
                         let from = last.freq_hz();
                         let recent =
                             &summary.points[summary.points.len().saturating_sub(RETRACE_HISTORY)..];
-                        let resumed = match self.corner(system, &y, &tangent, recent)? {
+                        let mut refused_retrace = false;
+                        let resumed = match self.corner(
+                            system,
+                            &y,
+                            &tangent,
+                            recent,
+                            &mut refused_retrace,
+                        )? {
                             Some(found) => Some(found),
                             None => {
-                                let leapt = self.leap(system, &y, &tangent, recent)?;
+                                let leapt =
+                                    self.leap(system, &y, &tangent, recent, &mut refused_retrace)?;
                                 if let Some((point, _)) = &leapt {
                                     observer.leap(from, point.freq_hz());
                                     summary.leaps.push((from, point.freq_hz()));
@@ -1128,6 +1146,16 @@ impl Continuation {
                             }
                         };
                         let Some((point, t_new)) = resumed else {
+                            // Where the only way on found was back along the path already
+                            // followed (refused: the path would retrace itself and loop through
+                            // the same corners until `stagnation_points` ended it), or behind
+                            // the highest frequency reached (the path turned back at a fold),
+                            // the path ends for the caller to go on past the highest frequency
+                            // reached, as it would after that loop. Otherwise it is a stall.
+                            if refused_retrace || dir * from < furthest.0 - a.min_step {
+                                summary.end = PathEnd::DeadEnd;
+                                return Ok(summary);
+                            }
                             return Err(ContinuationError::Stalled {
                                 freq_hz: from,
                                 step: ds,
@@ -1360,17 +1388,11 @@ mod tests {
     /// At the dead end the corrector fails at every step; the corner search must not resume on
     /// the incoming branch backwards (it used to: a point 0.1 back on it, whose tangent differs
     /// from the incoming one by 2°, was taken and the path ran back down below its start). With
-    /// nothing ahead, the run stops there with `Stalled`, every point on the incoming branch
-    /// in rising frequency.
+    /// nothing ahead but the way back (refused), the path ends there as [`PathEnd::DeadEnd`]
+    /// (for the FRF to go on past it), every point on the incoming branch in rising frequency.
     #[test]
     fn a_corner_never_resumes_on_the_incoming_branch_backwards() {
         let mut points = Vec::new();
-        struct Collect<'a>(&'a mut Vec<PathPoint>);
-        impl<S: ParametricResidual> Observer<S> for Collect<'_> {
-            fn accepted(&mut self, _: &mut S, p: &PathPoint, _: Option<&[f64]>) {
-                self.0.push(p.clone());
-            }
-        }
         let mut c = Continuation::new(settings(12.0, 20.0), vec![1.0, 1.0]);
         let outcome = c.run(&mut DeadEnd, &[0.4, 1.8], &mut Collect(&mut points));
         let freqs: Vec<f64> = points.iter().map(|p| p.freq_hz()).collect();
@@ -1380,14 +1402,237 @@ mod tests {
             &freqs[freqs.len().saturating_sub(8)..]
         );
         match outcome {
-            Err(ContinuationError::Stalled { freq_hz, .. }) => {
-                assert!((freq_hz - 15.0).abs() < 1e-3, "stalled at {freq_hz} Hz");
+            Ok(summary) => {
+                assert_eq!(summary.end, PathEnd::DeadEnd);
+                let last = freqs.last().unwrap();
+                assert!((last - 15.0).abs() < 1e-3, "ended at {last} Hz");
             }
-            other => panic!("expected a stall at the dead end, got {other:?}"),
+            other => panic!("expected the path to end at the dead end, got {other:?}"),
         }
         for p in &points {
             assert!(p.x[0] <= 1.0 && (p.freq_hz() - 10.0 - 5.0 * p.x[0]).abs() < 1e-9);
         }
+    }
+
+    /// Collects the accepted points of a run.
+    struct Collect<'a>(&'a mut Vec<PathPoint>);
+
+    impl<S: ParametricResidual> Observer<S> for Collect<'_> {
+        fn accepted(&mut self, _: &mut S, p: &PathPoint, _: Option<&[f64]>) {
+            self.0.push(p.clone());
+        }
+    }
+
+    /// The dead end of [`DeadEnd`] met behind a fold, as the 1D paths of the sampled contact
+    /// law meet theirs (`tests/hard_cases.rs` at F₀ = 1 N, 18.78 Hz, and
+    /// `tests/data/liftoff-fold.toml`, 32.52 Hz, both below a fold they turned back at): the
+    /// frequency 15 − 5(x₁ − 1)² rises to a smooth fold at 15 Hz (x₁ = 1) and falls to 10 Hz at
+    /// x₁ = 2, where the path ends (R₂ = x₂ − 5(x₁ − 2)² up to x₁ = 2, 1 + |x₂| beyond, which
+    /// has no zero).
+    struct FoldThenDeadEnd;
+
+    impl FoldThenDeadEnd {
+        fn second(x: &[f64]) -> (f64, f64, f64) {
+            if x[0] <= 2.0 {
+                let d = x[0] - 2.0;
+                (x[1] - 5.0 * d * d, -10.0 * d, 1.0)
+            } else {
+                (1.0 + x[1].abs(), 0.0, if x[1] < 0.0 { -1.0 } else { 1.0 })
+            }
+        }
+
+        fn freq_hz(x: &[f64]) -> f64 {
+            15.0 - 5.0 * (x[0] - 1.0) * (x[0] - 1.0)
+        }
+    }
+
+    impl ParametricResidual for FoldThenDeadEnd {
+        type Error = Never;
+        fn dim(&self) -> usize {
+            2
+        }
+        fn residual_scale(&self) -> f64 {
+            1.0
+        }
+        fn residual(&mut self, x: &[f64], omega: f64, r: &mut [f64]) -> Result<(), Never> {
+            r[0] = omega / OMEGA_SCALE - Self::freq_hz(x);
+            r[1] = Self::second(x).0;
+            Ok(())
+        }
+        fn new_jacobian(&mut self) -> AssembledJacobian {
+            AssembledJacobian::dense(2)
+        }
+        fn residual_and_jacobian(
+            &mut self,
+            x: &[f64],
+            omega: f64,
+            r: &mut [f64],
+            jac: &mut AssembledJacobian,
+            dr: &mut [f64],
+        ) -> Result<(), Never> {
+            self.residual(x, omega, r)?;
+            let (_, d1, d2) = Self::second(x);
+            jac.clear();
+            let slot = jac.slot(0, 0);
+            jac.add_at(slot, 10.0 * (x[0] - 1.0));
+            let slot = jac.slot(1, 0);
+            jac.add_at(slot, d1);
+            let slot = jac.slot(1, 1);
+            jac.add_at(slot, d2);
+            dr[0] = 1.0 / OMEGA_SCALE;
+            dr[1] = 0.0;
+            Ok(())
+        }
+    }
+
+    /// Behind the highest frequency reached, a dead end past which only the path already
+    /// followed lies ends the path as [`PathEnd::DeadEnd`] (for the FRF to go on past the
+    /// fold), not as a stall: the path rises to the fold, turns once and runs down to the dead
+    /// end at 10 Hz, never back up along itself, every point on the path.
+    #[test]
+    fn a_dead_end_behind_a_fold_ends_the_path_for_the_caller_to_jump() {
+        let mut points = Vec::new();
+        let mut c = Continuation::new(settings(14.0, 30.0), vec![1.0, 1.0]);
+        let summary = c
+            .run(
+                &mut FoldThenDeadEnd,
+                &[0.55, 10.5],
+                &mut Collect(&mut points),
+            )
+            .expect("the dead end behind the fold is not a stall");
+        assert_eq!(summary.end, PathEnd::DeadEnd);
+        assert_eq!(
+            summary.turning_points.len(),
+            1,
+            "{:?}",
+            summary.turning_points
+        );
+        assert!((summary.turning_points[0] - 15.0).abs() < 0.01);
+        let freqs: Vec<f64> = points.iter().map(|p| p.freq_hz()).collect();
+        let top = freqs
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(k, _)| k)
+            .unwrap();
+        assert!(freqs[..=top].windows(2).all(|w| w[1] > w[0]));
+        assert!(
+            freqs[top..].windows(2).all(|w| w[1] < w[0]),
+            "the path turned back up: {:?}",
+            &freqs[freqs.len().saturating_sub(8)..]
+        );
+        let last = points.last().unwrap();
+        assert!(
+            (last.freq_hz() - 10.0).abs() < 1e-3,
+            "ended at {} Hz",
+            last.freq_hz()
+        );
+        for p in &points {
+            let mut r = [0.0; 2];
+            FoldThenDeadEnd.residual(&p.x, p.omega, &mut r).unwrap();
+            assert!(
+                p.x[0] <= 2.0 && r[0].abs() < 1e-9 && r[1].abs() < 1e-9,
+                "{p:?}"
+            );
+        }
+    }
+
+    /// A corner in the response coefficients whose outgoing piece leaves behind the incoming
+    /// direction while the frequency keeps rising (as at the 3D blade pair's contact transitions
+    /// at 882-885 Hz): y = (x₁, x₂, ω/2π) runs along piece A, c + s·(1, 0, 0.1) for s ≤ 0, then
+    /// along piece B, c + s·(−0.5, 1, 0.1) for s > 0, with c = (1, 0, 10.1) (their chords make a
+    /// cosine of −0.35). R = L±·(y − c), piecewise linear and continuous across the plane
+    /// x₁ + x₂ = 1: L⁻ has null vector A's direction, L⁺ = L⁻ + a·(1, 1, 0)ᵀ that of B.
+    struct CoefficientCorner;
+
+    impl CoefficientCorner {
+        const CORNER: [f64; 3] = [1.0, 0.0, 10.1];
+
+        fn operator(x: &[f64]) -> [[f64; 3]; 2] {
+            if x[0] + x[1] <= 1.0 {
+                [[-0.1, 0.0, 1.0], [0.0, 1.0, 0.0]]
+            } else {
+                [[-0.4, -0.3, 1.0], [-2.0, -1.0, 0.0]]
+            }
+        }
+    }
+
+    impl ParametricResidual for CoefficientCorner {
+        type Error = Never;
+        fn dim(&self) -> usize {
+            2
+        }
+        fn residual_scale(&self) -> f64 {
+            1.0
+        }
+        fn residual(&mut self, x: &[f64], omega: f64, r: &mut [f64]) -> Result<(), Never> {
+            let y = [x[0], x[1], omega / OMEGA_SCALE];
+            for (ri, row) in r.iter_mut().zip(Self::operator(x)) {
+                *ri = (0..3).map(|j| row[j] * (y[j] - Self::CORNER[j])).sum();
+            }
+            Ok(())
+        }
+        fn new_jacobian(&mut self) -> AssembledJacobian {
+            AssembledJacobian::dense(2)
+        }
+        fn residual_and_jacobian(
+            &mut self,
+            x: &[f64],
+            omega: f64,
+            r: &mut [f64],
+            jac: &mut AssembledJacobian,
+            dr: &mut [f64],
+        ) -> Result<(), Never> {
+            self.residual(x, omega, r)?;
+            jac.clear();
+            for (i, row) in Self::operator(x).iter().enumerate() {
+                for (j, value) in row[..2].iter().enumerate() {
+                    let slot = jac.slot(i, j);
+                    jac.add_at(slot, *value);
+                }
+                dr[i] = row[2] / OMEGA_SCALE;
+            }
+            Ok(())
+        }
+    }
+
+    /// The corner search keeps a genuine outgoing piece found behind the incoming direction:
+    /// the path turns from A onto B (no leap, no turning point), runs up to the end frequency
+    /// with every point on A or B, and never back along A.
+    #[test]
+    fn a_corner_keeps_an_outgoing_piece_behind_the_incoming_direction() {
+        let mut points = Vec::new();
+        let mut c = Continuation::new(settings(10.0, 11.0), vec![1.0, 1.0]);
+        let summary = c
+            .run(
+                &mut CoefficientCorner,
+                &[0.0, 0.0],
+                &mut Collect(&mut points),
+            )
+            .expect("the corner is turned");
+        assert_eq!(summary.end, PathEnd::EndFrequency);
+        assert!(
+            summary.turning_points.is_empty(),
+            "{:?}",
+            summary.turning_points
+        );
+        assert!(summary.leaps.is_empty(), "{:?}", summary.leaps);
+        let freqs: Vec<f64> = points.iter().map(|p| p.freq_hz()).collect();
+        assert!(freqs.windows(2).all(|w| w[1] > w[0]), "{freqs:?}");
+        for p in &points {
+            let f = p.freq_hz();
+            let on_a = p.x[0] <= 1.0 + 1e-9
+                && p.x[1].abs() < 1e-9
+                && (f - 10.0 - 0.1 * p.x[0]).abs() < 1e-9;
+            let s = p.x[1];
+            let on_b = s > 0.0
+                && (p.x[0] - 1.0 + 0.5 * s).abs() < 1e-9
+                && (f - 10.1 - 0.1 * s).abs() < 1e-9;
+            assert!(on_a || on_b, "off the path: {p:?}");
+        }
+        let last = points.last().unwrap();
+        assert!((last.freq_hz() - 11.0).abs() < 1e-12);
+        assert!((last.x[0] + 3.5).abs() < 1e-9 && (last.x[1] - 9.0).abs() < 1e-9);
     }
 
     /// The scale of a group grows with its norm along the path and the tangent is carried over
