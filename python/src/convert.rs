@@ -245,6 +245,7 @@ pub fn frf_dict<'py>(
             "kind",
             match j.kind {
                 fricbound::analysis::frf::JumpKind::PastFold => "past-fold",
+                fricbound::analysis::frf::JumpKind::PastDeadEnd => "past-dead-end",
                 fricbound::analysis::frf::JumpKind::Bridge => "bridge",
             },
         )?;

@@ -81,6 +81,10 @@ pub enum JumpKind {
     /// The path turned back at a fold and did not come back; the run went on on a branch
     /// solved just past the highest frequency reached.
     PastFold,
+    /// The path met a spot it could not pass where the only way on found led back along the
+    /// path already followed, or behind a fold ([`PathEnd::DeadEnd`]); the run went on on a
+    /// branch solved just past the highest frequency reached.
+    PastDeadEnd,
     /// A branch solved inside a stretch that the branches on either side of it did not reach
     /// (Newton from blends of the two ends' coefficients, then followed both ways).
     Bridge,
@@ -224,6 +228,11 @@ impl FrfRun {
             PathEnd::NoProgress => Some(format!(
                 "the path wandered back and forth below {highest:.4} Hz without getting \
                  higher (last point at {last:.4} Hz); frequencies above were never reached"
+            )),
+            PathEnd::DeadEnd => Some(format!(
+                "the path could not be followed past {last:.4} Hz (the only way on found led \
+                 back along the path already followed, or the path had turned back at a fold \
+                 below {highest:.4} Hz); frequencies above {highest:.4} Hz were never reached"
             )),
         }
     }
@@ -619,15 +628,20 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
                 run.leaps.extend(summary.leaps);
                 run.end = summary.end;
             }
-            // A stall is not a fold: the path goes on past it, but could not be followed.
+            // A stall is not a fold: the path goes on past it, but could not be followed. (A
+            // spot past which only the way back was found ends the summary as
+            // `PathEnd::DeadEnd` and is jumped past below.)
             Err(e) => return Err(e.into()),
         }
-        let turned_back = matches!(run.end, PathEnd::LeftRangeBelow | PathEnd::NoProgress);
+        let turned_back = matches!(
+            run.end,
+            PathEnd::LeftRangeBelow | PathEnd::NoProgress | PathEnd::DeadEnd
+        );
         let budget = settings.max_points.saturating_sub(adapter.points.len());
         let past_folds = run
             .jumps
             .iter()
-            .filter(|j| j.kind == JumpKind::PastFold)
+            .filter(|j| matches!(j.kind, JumpKind::PastFold | JumpKind::PastDeadEnd))
             .count();
         if !turned_back || past_folds >= MAX_JUMPS || budget < 2 {
             break;
@@ -696,7 +710,11 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
             _ => Vec::new(),
         };
         let mut reached = highest;
-        let mut kind = JumpKind::PastFold;
+        let mut kind = if run.end == PathEnd::DeadEnd {
+            JumpKind::PastDeadEnd
+        } else {
+            JumpKind::PastFold
+        };
         for branch in bridges.into_iter().chain([fill]) {
             let lowest = branch
                 .iter()

@@ -341,6 +341,11 @@ impl FrfObserver for RunObserver<'_> {
                  on a branch found past it, from {:.4} Hz{uncovered}",
                 jump.from_hz, jump.to_hz
             ),
+            JumpKind::PastDeadEnd => format!(
+                "the path could not be followed on below {:.4} Hz (only the way back was \
+                 found): it goes on on a branch found past it, from {:.4} Hz{uncovered}",
+                jump.from_hz, jump.to_hz
+            ),
             JumpKind::Bridge => format!(
                 "a branch solved between the fold's two sides goes on from {:.4} Hz (the \
                  previous branch reached {:.4} Hz){uncovered}",

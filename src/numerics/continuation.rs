@@ -14,7 +14,17 @@
 //! corrector (iteration limit, divergence, singular Jacobian, failed AFT) is not a result: the
 //! step is cut and the reason reported to the observer; below the minimum step the run ends
 //! with [`ContinuationError::Stalled`]. Turning points (sign changes of dω/ds) are reported and
-//! traversed. The last point is solved at exactly the end frequency. A path runs down in
+//! traversed. Where the corrector fails at every step down to the minimum (a contact sample
+//! changing state: the residual is only piecewise smooth), the path is resumed past the spot
+//! by [`Continuation::corner`] (along the outgoing piece) or [`Continuation::leap`] (further
+//! ahead), never on the path already followed: a point found behind the incoming direction
+//! is kept only when a look-ahead step from it leaves that path (a sharp fold), since at a
+//! contact transition such a point can lead straight back onto the incoming branch, which the
+//! path would then retrace (and loop: back along the followed path and on again through the
+//! same corners). When neither is found the run ends with [`PathEnd::DeadEnd`] where a way
+//! back along the followed path was refused or below the highest frequency reached (the caller
+//! goes on past the highest frequency, as after a path that wandered without progress), and
+//! with [`ContinuationError::Stalled`] otherwise. The last point is solved at exactly the end frequency. A path runs down in
 //! frequency when the end frequency is below the start (e.g. to fill in, back toward a fold, a
 //! branch found past it).
 //!
@@ -140,6 +150,17 @@ const MIN_STAGNATION_POINTS: usize = 200;
 const CORNER_BACKWARD_COSINE: f64 = 0.95;
 /// See [`CORNER_BACKWARD_COSINE`] (cos 0.5°).
 const CORNER_SAME_PIECE_COSINE: f64 = 0.999_96;
+/// Accepted points (the last ones of the path) that a corner point found behind the incoming
+/// direction is checked against (see [`Continuation::runs_back_along`]).
+const RETRACE_HISTORY: usize = 64;
+/// Look-ahead steps from a corner point found behind the incoming direction, as fractions of
+/// the first step (the initial step, at most half the extent of the checked points), tried in
+/// turn until one converges (see [`Continuation::runs_back_along`]).
+const RETRACE_LOOKAHEADS: &[f64] = &[1.0, 0.25, 0.0625];
+/// A look-ahead point closer to the path already followed than this fraction of its distance
+/// from the corner (about 3°) lies on it: the corner point would resume the incoming branch
+/// backwards (see [`Continuation::runs_back_along`]).
+const RETRACE_FRACTION: f64 = 0.05;
 /// Largest turn of the tangent in one step before the step is cut (unless it is a corner).
 const MAX_TURN_DEGREES: f64 = 45.0;
 /// Turn of the tangent per step the step length aims at: a step that turned the tangent by
@@ -657,14 +678,17 @@ impl Continuation {
 
     /// Tries to continue past a spot where the corrector fails at every step down to the
     /// minimum: predictions [`LEAPS`] of the largest step ahead along the tangent, each
-    /// corrected to full tolerance; the first whose correction stays within the leap and whose
-    /// tangent keeps the direction of travel is returned with its tangent. Steps that land
-    /// beyond the end frequency are not tried (the end point is solved separately).
+    /// corrected to full tolerance; the first whose correction stays within the leap, whose
+    /// tangent keeps the direction of travel and which lies off the path already followed
+    /// (`recent`, as in [`Continuation::runs_back_along`]) is returned with its tangent. Steps
+    /// that land beyond the end frequency are not tried (the end point is solved separately).
     fn leap<S: ParametricResidual>(
         &self,
         system: &mut S,
         y: &[f64],
         tangent: &[f64],
+        recent: &[PathPoint],
+        refused_retrace: &mut bool,
     ) -> Result<Option<(PathPoint, Vec<f64>)>, ContinuationError> {
         let n = y.len() - 1;
         for &fraction in LEAPS {
@@ -687,11 +711,31 @@ impl Continuation {
                     .map(|(a, b)| a - b)
                     .collect::<Vec<_>>(),
             );
+            let reach = norm(&yc.iter().zip(y).map(|(a, b)| a - b).collect::<Vec<_>>());
+            let on_path =
+                distance_to_polyline(&yc, &self.scaled_points(recent)) <= RETRACE_FRACTION * reach;
             if distance <= ds && dot(&t_new, tangent) > 0.0 {
-                return Ok(Some((point, t_new)));
+                if !on_path {
+                    return Ok(Some((point, t_new)));
+                }
+                *refused_retrace = true;
             }
         }
         Ok(None)
+    }
+
+    /// Points of the path in the scaled space (x / x_scale, ω / 2π).
+    fn scaled_points(&self, points: &[PathPoint]) -> Vec<Vec<f64>> {
+        points
+            .iter()
+            .map(|p| {
+                p.x.iter()
+                    .zip(&self.x_scale)
+                    .map(|(v, s)| v / s)
+                    .chain(std::iter::once(p.omega / OMEGA_SCALE))
+                    .collect()
+            })
+            .collect()
     }
 
     /// Tries to turn a corner of the piecewise-smooth path at `y`, where the corrector fails at
@@ -704,14 +748,19 @@ impl Continuation {
     /// Past the corner (at `y + ds·t_in`) the Jacobian is that of the outgoing piece; its null
     /// direction t_out is the outgoing tangent up to sign. Both signs are corrected on the
     /// hyperplane normal to them at `y ± ds·t_out`; a corrected point that lies back along the
-    /// incoming branch (its chord from `y` within [`CORNER_BACKWARD_COSINE`] of −t_in) or
-    /// further than the step from its prediction is rejected. Returns the point and its tangent
-    /// oriented along the chord from `y`.
+    /// incoming branch (its chord from `y` within [`CORNER_BACKWARD_COSINE`] of −t_in, with the
+    /// incoming tangent) or further than the step from its prediction is rejected, and so is
+    /// one behind the incoming direction (chord · t_in < 0) from which the path runs back onto
+    /// the `recent` points ([`Continuation::runs_back_along`]): only a sharp fold's outgoing
+    /// piece may leave a corner backwards. Returns the point and its tangent oriented along the
+    /// chord from `y`.
     fn corner<S: ParametricResidual>(
         &self,
         system: &mut S,
         y: &[f64],
         tangent: &[f64],
+        recent: &[PathPoint],
+        refused_retrace: &mut bool,
     ) -> Result<Option<(PathPoint, Vec<f64>)>, ContinuationError> {
         let n = y.len() - 1;
         for &multiple in CORNER_STEPS {
@@ -761,10 +810,66 @@ impl Continuation {
                 {
                     continue;
                 }
+                // Behind the incoming direction: a sharp fold's outgoing piece, or a piece that
+                // leads back onto the incoming branch (its tangent there need not be the
+                // incoming one, which the test above relies on). Look ahead along it.
+                if dot(&chord, tangent) < 0.0
+                    && self.runs_back_along(system, (&yc, &t_new), y, recent)
+                {
+                    *refused_retrace = true;
+                    continue;
+                }
                 return Ok(Some((point, t_new)));
             }
         }
         Ok(None)
+    }
+
+    /// Whether the path from a corner point `from` (scaled y) along its tangent `t` runs back
+    /// onto the path already followed (`recent`, the last accepted points, the corner `y`
+    /// last). One step is taken along `t` ([`RETRACE_LOOKAHEADS`] of the initial step, at most
+    /// half the extent of `recent` from `y`) and corrected; the point reached lies on the
+    /// followed path when its distance from the polyline through `recent` is below
+    /// [`RETRACE_FRACTION`] of its distance from `y`. At a contact transition of the sampled
+    /// contact law, a piece found behind the incoming direction can lead straight back onto the
+    /// incoming branch: the run would then retrace it downwards. A sharp fold's outgoing piece
+    /// leaves the followed path at an angle and is kept. When no look-ahead step converges
+    /// there is no evidence either way and the point is kept.
+    fn runs_back_along<S: ParametricResidual>(
+        &self,
+        system: &mut S,
+        (from, t): (&[f64], &[f64]),
+        y: &[f64],
+        recent: &[PathPoint],
+    ) -> bool {
+        let n = y.len() - 1;
+        let path = self.scaled_points(recent);
+        let distance = |a: &[f64], b: &[f64]| {
+            a.iter()
+                .zip(b)
+                .map(|(p, q)| (p - q) * (p - q))
+                .sum::<f64>()
+                .sqrt()
+        };
+        let extent = path.iter().map(|p| distance(p, y)).fold(0.0, f64::max);
+        let first = self.settings.initial_step.min(0.5 * extent);
+        if first <= 0.0 {
+            return false;
+        }
+        for &fraction in RETRACE_LOOKAHEADS {
+            let h = fraction * first;
+            let predicted: Vec<f64> = (0..=n).map(|j| from[j] + h * t[j]).collect();
+            let Ok((q, _, _)) = self.correct(system, &predicted, t) else {
+                continue;
+            };
+            if distance(&q, &predicted) > h {
+                continue;
+            }
+            let reach = distance(&q, y);
+            let off_path = distance_to_polyline(&q, &path);
+            return off_path <= RETRACE_FRACTION * reach;
+        }
+        false
     }
 
     /// The path point of a corrected y, its tangent, the distance of the correction relative
@@ -1019,10 +1124,20 @@ impl Continuation {
                         // the pieces of the sampled, piecewise-smooth contact law): try to land
                         // on it further on, with a fully converged point, before giving up.
                         let from = last.freq_hz();
-                        let resumed = match self.corner(system, &y, &tangent)? {
+                        let recent =
+                            &summary.points[summary.points.len().saturating_sub(RETRACE_HISTORY)..];
+                        let mut refused_retrace = false;
+                        let resumed = match self.corner(
+                            system,
+                            &y,
+                            &tangent,
+                            recent,
+                            &mut refused_retrace,
+                        )? {
                             Some(found) => Some(found),
                             None => {
-                                let leapt = self.leap(system, &y, &tangent)?;
+                                let leapt =
+                                    self.leap(system, &y, &tangent, recent, &mut refused_retrace)?;
                                 if let Some((point, _)) = &leapt {
                                     observer.leap(from, point.freq_hz());
                                     summary.leaps.push((from, point.freq_hz()));
@@ -1031,6 +1146,16 @@ impl Continuation {
                             }
                         };
                         let Some((point, t_new)) = resumed else {
+                            // Where the only way on found was back along the path already
+                            // followed (refused: the path would retrace itself and loop through
+                            // the same corners until `stagnation_points` ended it), or behind
+                            // the highest frequency reached (the path turned back at a fold),
+                            // the path ends for the caller to go on past the highest frequency
+                            // reached, as it would after that loop. Otherwise it is a stall.
+                            if refused_retrace || dir * from < furthest.0 - a.min_step {
+                                summary.end = PathEnd::DeadEnd;
+                                return Ok(summary);
+                            }
                             return Err(ContinuationError::Stalled {
                                 freq_hz: from,
                                 step: ds,
@@ -1050,6 +1175,34 @@ impl Continuation {
         }
         summary.end = PathEnd::MaxPoints;
         Ok(summary)
+    }
+}
+
+/// Euclidean distance from `q` to the polyline through `points` (to the point itself when
+/// there is one; infinite when there is none).
+fn distance_to_polyline(q: &[f64], points: &[Vec<f64>]) -> f64 {
+    let distance_to_segment = |a: &[f64], b: &[f64]| {
+        let ab: Vec<f64> = b.iter().zip(a).map(|(u, v)| u - v).collect();
+        let aq: Vec<f64> = q.iter().zip(a).map(|(u, v)| u - v).collect();
+        let length2 = dot(&ab, &ab);
+        let s = if length2 > 0.0 {
+            (dot(&aq, &ab) / length2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        aq.iter()
+            .zip(&ab)
+            .map(|(u, v)| (u - s * v) * (u - s * v))
+            .sum::<f64>()
+            .sqrt()
+    };
+    match points {
+        [] => f64::INFINITY,
+        [only] => distance_to_segment(only, only),
+        _ => points
+            .windows(2)
+            .map(|w| distance_to_segment(&w[0], &w[1]))
+            .fold(f64::INFINITY, f64::min),
     }
 }
 
@@ -1171,6 +1324,315 @@ mod tests {
         let last = summary.points.last().unwrap();
         assert_eq!(last.freq_hz(), 10.0);
         assert!(last.x[0].abs() < 1e-9);
+    }
+
+    /// A path that ends at a contact transition it cannot pass (a dead end of the sampled
+    /// contact law's piecewise-smooth residual): two unknowns, R₁ = ω/2π − 10 − 5x₁ and, up to
+    /// x₁ = 1 (15 Hz), R₂ = x₂ − 5(x₁ − 1)² (the incoming branch, curved in x₂), beyond it
+    /// R₂ = 1 + |x₂|, which has no zero. Past the end the Jacobian's null direction is the
+    /// incoming tangent, so the corner search's points behind the corner lie on the incoming
+    /// branch, where its curvature turns the tangent by more than the same-piece test allows
+    /// at the largest corner step.
+    struct DeadEnd;
+
+    impl DeadEnd {
+        fn second(x: &[f64]) -> (f64, f64, f64) {
+            if x[0] <= 1.0 {
+                let d = x[0] - 1.0;
+                (x[1] - 5.0 * d * d, -10.0 * d, 1.0)
+            } else {
+                (1.0 + x[1].abs(), 0.0, if x[1] < 0.0 { -1.0 } else { 1.0 })
+            }
+        }
+    }
+
+    impl ParametricResidual for DeadEnd {
+        type Error = Never;
+        fn dim(&self) -> usize {
+            2
+        }
+        fn residual_scale(&self) -> f64 {
+            1.0
+        }
+        fn residual(&mut self, x: &[f64], omega: f64, r: &mut [f64]) -> Result<(), Never> {
+            r[0] = omega / OMEGA_SCALE - 10.0 - 5.0 * x[0];
+            r[1] = Self::second(x).0;
+            Ok(())
+        }
+        fn new_jacobian(&mut self) -> AssembledJacobian {
+            AssembledJacobian::dense(2)
+        }
+        fn residual_and_jacobian(
+            &mut self,
+            x: &[f64],
+            omega: f64,
+            r: &mut [f64],
+            jac: &mut AssembledJacobian,
+            dr: &mut [f64],
+        ) -> Result<(), Never> {
+            self.residual(x, omega, r)?;
+            let (_, d1, d2) = Self::second(x);
+            jac.clear();
+            let slot = jac.slot(0, 0);
+            jac.add_at(slot, -5.0);
+            let slot = jac.slot(1, 0);
+            jac.add_at(slot, d1);
+            let slot = jac.slot(1, 1);
+            jac.add_at(slot, d2);
+            dr[0] = 1.0 / OMEGA_SCALE;
+            dr[1] = 0.0;
+            Ok(())
+        }
+    }
+
+    /// At the dead end the corrector fails at every step; the corner search must not resume on
+    /// the incoming branch backwards (it used to: a point 0.1 back on it, whose tangent differs
+    /// from the incoming one by 2°, was taken and the path ran back down below its start). With
+    /// nothing ahead but the way back (refused), the path ends there as [`PathEnd::DeadEnd`]
+    /// (for the FRF to go on past it), every point on the incoming branch in rising frequency.
+    #[test]
+    fn a_corner_never_resumes_on_the_incoming_branch_backwards() {
+        let mut points = Vec::new();
+        let mut c = Continuation::new(settings(12.0, 20.0), vec![1.0, 1.0]);
+        let outcome = c.run(&mut DeadEnd, &[0.4, 1.8], &mut Collect(&mut points));
+        let freqs: Vec<f64> = points.iter().map(|p| p.freq_hz()).collect();
+        assert!(
+            freqs.windows(2).all(|w| w[1] > w[0]),
+            "the path turned back: {:?}",
+            &freqs[freqs.len().saturating_sub(8)..]
+        );
+        match outcome {
+            Ok(summary) => {
+                assert_eq!(summary.end, PathEnd::DeadEnd);
+                let last = freqs.last().unwrap();
+                assert!((last - 15.0).abs() < 1e-3, "ended at {last} Hz");
+            }
+            other => panic!("expected the path to end at the dead end, got {other:?}"),
+        }
+        for p in &points {
+            assert!(p.x[0] <= 1.0 && (p.freq_hz() - 10.0 - 5.0 * p.x[0]).abs() < 1e-9);
+        }
+    }
+
+    /// Collects the accepted points of a run.
+    struct Collect<'a>(&'a mut Vec<PathPoint>);
+
+    impl<S: ParametricResidual> Observer<S> for Collect<'_> {
+        fn accepted(&mut self, _: &mut S, p: &PathPoint, _: Option<&[f64]>) {
+            self.0.push(p.clone());
+        }
+    }
+
+    /// The dead end of [`DeadEnd`] met behind a fold, as the 1D paths of the sampled contact
+    /// law meet theirs (`tests/hard_cases.rs` at F₀ = 1 N, 18.78 Hz, and
+    /// `tests/data/liftoff-fold.toml`, 32.52 Hz, both below a fold they turned back at): the
+    /// frequency 15 − 5(x₁ − 1)² rises to a smooth fold at 15 Hz (x₁ = 1) and falls to 10 Hz at
+    /// x₁ = 2, where the path ends (R₂ = x₂ − 5(x₁ − 2)² up to x₁ = 2, 1 + |x₂| beyond, which
+    /// has no zero).
+    struct FoldThenDeadEnd;
+
+    impl FoldThenDeadEnd {
+        fn second(x: &[f64]) -> (f64, f64, f64) {
+            if x[0] <= 2.0 {
+                let d = x[0] - 2.0;
+                (x[1] - 5.0 * d * d, -10.0 * d, 1.0)
+            } else {
+                (1.0 + x[1].abs(), 0.0, if x[1] < 0.0 { -1.0 } else { 1.0 })
+            }
+        }
+
+        fn freq_hz(x: &[f64]) -> f64 {
+            15.0 - 5.0 * (x[0] - 1.0) * (x[0] - 1.0)
+        }
+    }
+
+    impl ParametricResidual for FoldThenDeadEnd {
+        type Error = Never;
+        fn dim(&self) -> usize {
+            2
+        }
+        fn residual_scale(&self) -> f64 {
+            1.0
+        }
+        fn residual(&mut self, x: &[f64], omega: f64, r: &mut [f64]) -> Result<(), Never> {
+            r[0] = omega / OMEGA_SCALE - Self::freq_hz(x);
+            r[1] = Self::second(x).0;
+            Ok(())
+        }
+        fn new_jacobian(&mut self) -> AssembledJacobian {
+            AssembledJacobian::dense(2)
+        }
+        fn residual_and_jacobian(
+            &mut self,
+            x: &[f64],
+            omega: f64,
+            r: &mut [f64],
+            jac: &mut AssembledJacobian,
+            dr: &mut [f64],
+        ) -> Result<(), Never> {
+            self.residual(x, omega, r)?;
+            let (_, d1, d2) = Self::second(x);
+            jac.clear();
+            let slot = jac.slot(0, 0);
+            jac.add_at(slot, 10.0 * (x[0] - 1.0));
+            let slot = jac.slot(1, 0);
+            jac.add_at(slot, d1);
+            let slot = jac.slot(1, 1);
+            jac.add_at(slot, d2);
+            dr[0] = 1.0 / OMEGA_SCALE;
+            dr[1] = 0.0;
+            Ok(())
+        }
+    }
+
+    /// Behind the highest frequency reached, a dead end past which only the path already
+    /// followed lies ends the path as [`PathEnd::DeadEnd`] (for the FRF to go on past the
+    /// fold), not as a stall: the path rises to the fold, turns once and runs down to the dead
+    /// end at 10 Hz, never back up along itself, every point on the path.
+    #[test]
+    fn a_dead_end_behind_a_fold_ends_the_path_for_the_caller_to_jump() {
+        let mut points = Vec::new();
+        let mut c = Continuation::new(settings(14.0, 30.0), vec![1.0, 1.0]);
+        let summary = c
+            .run(
+                &mut FoldThenDeadEnd,
+                &[0.55, 10.5],
+                &mut Collect(&mut points),
+            )
+            .expect("the dead end behind the fold is not a stall");
+        assert_eq!(summary.end, PathEnd::DeadEnd);
+        assert_eq!(
+            summary.turning_points.len(),
+            1,
+            "{:?}",
+            summary.turning_points
+        );
+        assert!((summary.turning_points[0] - 15.0).abs() < 0.01);
+        let freqs: Vec<f64> = points.iter().map(|p| p.freq_hz()).collect();
+        let top = freqs
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(k, _)| k)
+            .unwrap();
+        assert!(freqs[..=top].windows(2).all(|w| w[1] > w[0]));
+        assert!(
+            freqs[top..].windows(2).all(|w| w[1] < w[0]),
+            "the path turned back up: {:?}",
+            &freqs[freqs.len().saturating_sub(8)..]
+        );
+        let last = points.last().unwrap();
+        assert!(
+            (last.freq_hz() - 10.0).abs() < 1e-3,
+            "ended at {} Hz",
+            last.freq_hz()
+        );
+        for p in &points {
+            let mut r = [0.0; 2];
+            FoldThenDeadEnd.residual(&p.x, p.omega, &mut r).unwrap();
+            assert!(
+                p.x[0] <= 2.0 && r[0].abs() < 1e-9 && r[1].abs() < 1e-9,
+                "{p:?}"
+            );
+        }
+    }
+
+    /// A corner in the response coefficients whose outgoing piece leaves behind the incoming
+    /// direction while the frequency keeps rising (as at the 3D blade pair's contact transitions
+    /// at 882-885 Hz): y = (x₁, x₂, ω/2π) runs along piece A, c + s·(1, 0, 0.1) for s ≤ 0, then
+    /// along piece B, c + s·(−0.5, 1, 0.1) for s > 0, with c = (1, 0, 10.1) (their chords make a
+    /// cosine of −0.35). R = L±·(y − c), piecewise linear and continuous across the plane
+    /// x₁ + x₂ = 1: L⁻ has null vector A's direction, L⁺ = L⁻ + a·(1, 1, 0)ᵀ that of B.
+    struct CoefficientCorner;
+
+    impl CoefficientCorner {
+        const CORNER: [f64; 3] = [1.0, 0.0, 10.1];
+
+        fn operator(x: &[f64]) -> [[f64; 3]; 2] {
+            if x[0] + x[1] <= 1.0 {
+                [[-0.1, 0.0, 1.0], [0.0, 1.0, 0.0]]
+            } else {
+                [[-0.4, -0.3, 1.0], [-2.0, -1.0, 0.0]]
+            }
+        }
+    }
+
+    impl ParametricResidual for CoefficientCorner {
+        type Error = Never;
+        fn dim(&self) -> usize {
+            2
+        }
+        fn residual_scale(&self) -> f64 {
+            1.0
+        }
+        fn residual(&mut self, x: &[f64], omega: f64, r: &mut [f64]) -> Result<(), Never> {
+            let y = [x[0], x[1], omega / OMEGA_SCALE];
+            for (ri, row) in r.iter_mut().zip(Self::operator(x)) {
+                *ri = (0..3).map(|j| row[j] * (y[j] - Self::CORNER[j])).sum();
+            }
+            Ok(())
+        }
+        fn new_jacobian(&mut self) -> AssembledJacobian {
+            AssembledJacobian::dense(2)
+        }
+        fn residual_and_jacobian(
+            &mut self,
+            x: &[f64],
+            omega: f64,
+            r: &mut [f64],
+            jac: &mut AssembledJacobian,
+            dr: &mut [f64],
+        ) -> Result<(), Never> {
+            self.residual(x, omega, r)?;
+            jac.clear();
+            for (i, row) in Self::operator(x).iter().enumerate() {
+                for (j, value) in row[..2].iter().enumerate() {
+                    let slot = jac.slot(i, j);
+                    jac.add_at(slot, *value);
+                }
+                dr[i] = row[2] / OMEGA_SCALE;
+            }
+            Ok(())
+        }
+    }
+
+    /// The corner search keeps a genuine outgoing piece found behind the incoming direction:
+    /// the path turns from A onto B (no leap, no turning point), runs up to the end frequency
+    /// with every point on A or B, and never back along A.
+    #[test]
+    fn a_corner_keeps_an_outgoing_piece_behind_the_incoming_direction() {
+        let mut points = Vec::new();
+        let mut c = Continuation::new(settings(10.0, 11.0), vec![1.0, 1.0]);
+        let summary = c
+            .run(
+                &mut CoefficientCorner,
+                &[0.0, 0.0],
+                &mut Collect(&mut points),
+            )
+            .expect("the corner is turned");
+        assert_eq!(summary.end, PathEnd::EndFrequency);
+        assert!(
+            summary.turning_points.is_empty(),
+            "{:?}",
+            summary.turning_points
+        );
+        assert!(summary.leaps.is_empty(), "{:?}", summary.leaps);
+        let freqs: Vec<f64> = points.iter().map(|p| p.freq_hz()).collect();
+        assert!(freqs.windows(2).all(|w| w[1] > w[0]), "{freqs:?}");
+        for p in &points {
+            let f = p.freq_hz();
+            let on_a = p.x[0] <= 1.0 + 1e-9
+                && p.x[1].abs() < 1e-9
+                && (f - 10.0 - 0.1 * p.x[0]).abs() < 1e-9;
+            let s = p.x[1];
+            let on_b = s > 0.0
+                && (p.x[0] - 1.0 + 0.5 * s).abs() < 1e-9
+                && (f - 10.1 - 0.1 * s).abs() < 1e-9;
+            assert!(on_a || on_b, "off the path: {p:?}");
+        }
+        let last = points.last().unwrap();
+        assert!((last.freq_hz() - 11.0).abs() < 1e-12);
+        assert!((last.x[0] + 3.5).abs() < 1e-9 && (last.x[1] - 9.0).abs() < 1e-9);
     }
 
     /// The scale of a group grows with its norm along the path and the tangent is carried over

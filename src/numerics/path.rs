@@ -156,4 +156,11 @@ pub enum PathEnd {
     /// `Continuation::stagnation_points` points (back and forth through folds of the sampled
     /// contact law): the range above was not covered.
     NoProgress,
+    /// The path met a spot it could not pass (the corrector failed at every step down to the
+    /// minimum, and neither the corner search nor a leap found a way on) where the only way on
+    /// found led back along the path already followed (a retrace, refused), or below the
+    /// highest frequency it had reached (it had turned back at a fold): the range above the
+    /// highest frequency was not covered. Anywhere else such a spot is a
+    /// [`ContinuationError::Stalled`].
+    DeadEnd,
 }

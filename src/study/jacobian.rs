@@ -524,6 +524,7 @@ fn measure_formulation(
         PathEnd::MaxPoints => format!("capped at {} points", budget.frf_points),
         PathEnd::LeftRangeBelow => "left the range below".to_string(),
         PathEnd::NoProgress => "no progress".to_string(),
+        PathEnd::DeadEnd => "dead end".to_string(),
     };
     if probe.is_none() {
         *probe = run
