@@ -376,6 +376,7 @@ mod tests {
             coefficients: Vec::new(),
             accuracy: None,
             stability: None,
+            sampling_floor: None,
         }
     }
 

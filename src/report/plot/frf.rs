@@ -224,6 +224,7 @@ mod tests {
             coefficients: Vec::new(),
             accuracy: None,
             stability: None,
+            sampling_floor: None,
         }
     }
 
