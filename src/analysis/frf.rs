@@ -48,7 +48,7 @@ pub struct FrfPoint {
     pub stability: Option<PointStability>,
     /// Relative sampling floor of the residual where Newton stagnated above the residual
     /// tolerance at a contact transition between AFT samples and the point was accepted at
-    /// `residual` ≤ 1/100 of this floor (see [`PathPoint::sampling_floor`]); None for a point
+    /// `residual` ≤ 10⁻⁴ of this floor (see [`PathPoint::sampling_floor`]); None for a point
     /// that met the tolerance.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sampling_floor: Option<f64>,

@@ -314,7 +314,7 @@ struct PointRecord<'a> {
     newton_iterations: usize,
     residual: f64,
     /// Only on a point accepted at the AFT's sampling floor (Newton stagnated above
-    /// `residual_tolerance` with `residual` ≤ 1/100 of this relative floor).
+    /// `residual_tolerance` with `residual` ≤ 10⁻⁴ of this relative floor).
     #[serde(skip_serializing_if = "Option::is_none")]
     sampling_floor: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
