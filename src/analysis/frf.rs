@@ -46,12 +46,6 @@ pub struct FrfPoint {
     /// Hill stability of the point, when the scene asks for it (`analysis.stability`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stability: Option<PointStability>,
-    /// Relative sampling floor of the residual where Newton stagnated above the residual
-    /// tolerance at a contact transition between AFT samples and the point was accepted at
-    /// `residual` ≤ 10⁻⁴ of this floor (see [`PathPoint::sampling_floor`]); None for a point
-    /// that met the tolerance.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub sampling_floor: Option<f64>,
 }
 
 /// The frequency (Hz) and error estimate of every point of `points` that has one, in order
@@ -457,7 +451,6 @@ fn full_point(system: &mut HbmOperator<'_>, p: &PathPoint) -> Result<FrfPoint, H
         coefficients,
         accuracy: None,
         stability: None,
-        sampling_floor: p.sampling_floor,
     })
 }
 
@@ -1116,7 +1109,6 @@ impl<'p> PointSolver<'p> {
             iterations,
             residual,
             step: 0.0,
-            sampling_floor: self.continuation.accepted_floor(),
         };
         let mut point = full_point(&mut self.system, &path_point)
             .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
@@ -1254,7 +1246,6 @@ mod tests {
             coefficients: vec![c1, 0.0, c3, 0.0],
             accuracy: None,
             stability: None,
-            sampling_floor: None,
         }
     }
 

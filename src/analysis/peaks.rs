@@ -376,7 +376,6 @@ mod tests {
             coefficients: Vec::new(),
             accuracy: None,
             stability: None,
-            sampling_floor: None,
         }
     }
 

@@ -99,15 +99,6 @@ impl ParametricResidual for HbmOperator<'_> {
         }
     }
 
-    fn sampling_floor(&mut self, x: &[f64], _lambda: f64) -> f64 {
-        match self {
-            HbmOperator::Full(s) => s.sampling_floor(x),
-            // The condensed residual lives on the contact DOFs after the elimination: no
-            // floor is claimed for it.
-            HbmOperator::Condensed(_) => 0.0,
-        }
-    }
-
     fn residual(&mut self, x: &[f64], lambda: f64, r: &mut [f64]) -> Result<(), HbmError> {
         match self {
             HbmOperator::Full(s) => s.residual(x, lambda, r),

@@ -448,45 +448,6 @@ impl<'p> HbmSystem<'p> {
         f64::EPSILON * sum.iter().map(|v| v * v).sum::<f64>().sqrt()
     }
 
-    /// Sampling floor of the residual at x (N): ‖f(x; 2N) − f(x; N)‖, the change of the
-    /// contact forces' harmonics (paper Eq. 10, the AFT) when the same iterate is marched with
-    /// twice the problem's time samples per period N. A stick-slip or lift-off transition is
-    /// located only to a sample, so this is the AFT's own error at x (the residual of the
-    /// sampling estimate of `analysis::error_estimate`, without its solve). ω does not enter
-    /// the contact forces. Builds the finer AFT workspaces on each call: continuation asks for
-    /// it only where Newton has stagnated. Returns 0 (no floor claimed) when either march
-    /// fails. The contact states of the last evaluation are kept.
-    pub fn sampling_floor(&mut self, x: &[f64]) -> f64 {
-        let samples = 2 * self.problem.samples;
-        let force_set = self.aft.harmonic_set().clone();
-        let mut fine = AftWorkspace::new(&force_set, samples);
-        fine.settings = self.aft.settings;
-        let mut fine_2d = self.aft2d.as_ref().map(|w| {
-            let mut f = Aft2dWorkspace::new(&force_set, samples);
-            f.settings = w.settings;
-            f
-        });
-        let states = self.states.clone();
-        let mut coarse = vec![0.0; self.dim()];
-        let coarse_ok = self.add_contact_terms(x, &mut coarse, None).is_ok();
-        std::mem::swap(&mut self.aft, &mut fine);
-        std::mem::swap(&mut self.aft2d, &mut fine_2d);
-        let mut refined = vec![0.0; self.dim()];
-        let refined_ok = self.add_contact_terms(x, &mut refined, None).is_ok();
-        std::mem::swap(&mut self.aft, &mut fine);
-        std::mem::swap(&mut self.aft2d, &mut fine_2d);
-        self.states = states;
-        if !(coarse_ok && refined_ok) {
-            return 0.0;
-        }
-        coarse
-            .iter()
-            .zip(&refined)
-            .map(|(a, b)| (a - b) * (a - b))
-            .sum::<f64>()
-            .sqrt()
-    }
-
     /// The block coupled to `b` through damping and the sign of that coupling: the cosine
     /// block of harmonic h gets +hωC q_sh, the sine block −hωC q_ch.
     fn partner(&self, b: Block) -> Option<(usize, f64)> {
@@ -835,9 +796,6 @@ impl ParametricResidual for HbmSystem<'_> {
     }
     fn round_off(&mut self, x: &[f64], lambda: f64) -> f64 {
         HbmSystem::round_off(self, x, lambda)
-    }
-    fn sampling_floor(&mut self, x: &[f64], _lambda: f64) -> f64 {
-        HbmSystem::sampling_floor(self, x)
     }
     fn residual(&mut self, x: &[f64], lambda: f64, r: &mut [f64]) -> Result<(), Self::Error> {
         HbmSystem::residual(self, x, lambda, r)

@@ -85,9 +85,6 @@ pub struct Continuation {
     /// Chord corrector only: the last factorisation made, and the points since it was made,
     /// for the next corrector to start from (storages whose border is eliminated by blocks).
     carried: std::cell::RefCell<Option<(BorderedFactor, usize)>>,
-    /// The sampling floor (relative) of the last corrected point when the corrector accepted
-    /// it at that floor, None when it met the tolerance (see [`Continuation::correct`]).
-    accepted_floor: std::cell::Cell<Option<f64>>,
     /// How the scale follows the response along the path, if it does.
     adaptive: Option<AdaptiveScale>,
     /// Groups of unknowns whose norm (an output's amplitude) the step length watches.
@@ -122,18 +119,6 @@ const ROUND_OFF_FACTOR: f64 = 4.0;
 /// Relative residual below which the round-off level is looked at; a level above it would be
 /// a badly scaled residual, not round-off.
 const ROUND_OFF_CHECK_BELOW: f64 = 1e-6;
-/// Newton stagnated above its tolerance accepts an iterate whose residual is at most this
-/// fraction of the operator's sampling floor ([`ParametricResidual::sampling_floor`], see
-/// `Continuation::floor_accepts`). The solution error a residual r leaves is about J⁻¹r, and
-/// the sampling error already in the solution about J⁻¹ times the floor, so at 10⁻⁴ the
-/// remaining Newton error is negligible next to an error the discretisation makes anyway.
-/// Measured (benches/README.md, "Newton at transitions between samples"): on the 2-pair blade
-/// pair at 128 samples the corrector stagnates at 6·10⁻⁹ against a floor of 9·10⁻⁵ (6.8·10⁻⁵
-/// of it) at 911.86 Hz; on the 3D blade pair near 882.6 Hz at 3·10⁻⁴-10⁻³ of floors of
-/// 2.5·10⁻⁶-2·10⁻⁵, and accepting those (with a fraction of 10⁻³) made its path cycle among
-/// them; with 10⁻² the 2-pair path also crept along dozens of points accepted just below the
-/// fraction.
-pub const SAMPLING_FLOOR_FRACTION: f64 = 1e-4;
 /// A chord iteration must cut the relative residual at least by this factor, else the
 /// Jacobian is recomputed and factorised at the current iterate.
 const CHORD_CONTRACTION: f64 = 0.5;
@@ -170,7 +155,6 @@ impl Continuation {
             x_scale,
             last_factor: std::cell::RefCell::new(None),
             carried: std::cell::RefCell::new(None),
-            accepted_floor: std::cell::Cell::new(None),
             adaptive: None,
             amplitudes: Vec::new(),
         }
@@ -286,33 +270,6 @@ impl Continuation {
         relative_residual <= tolerance && step <= self.settings.step_tolerance.max(1e-14)
     }
 
-    /// The relative sampling floor at the iterate (x, ω) when Newton, stagnated above its
-    /// tolerance at relative residual `rel`, may stop there: `rel` at most
-    /// [`SAMPLING_FLOOR_FRACTION`] of the operator's sampling floor
-    /// ([`ParametricResidual::sampling_floor`]), i.e. far below the change that a finer AFT
-    /// sampling alone makes to the residual at this iterate. A contact transition between two
-    /// time samples makes the sampled residual only piecewise smooth; Newton then cycles
-    /// between the pieces at a residual that no step lowers. Asked only after such a stall,
-    /// so it costs nothing where Newton converges.
-    fn floor_accepts<S: ParametricResidual>(
-        &self,
-        system: &mut S,
-        (x, omega): (&[f64], f64),
-        rel: f64,
-    ) -> Option<f64> {
-        if !rel.is_finite() {
-            return None;
-        }
-        let floor = system.sampling_floor(x, omega) / system.residual_scale();
-        (floor > 0.0 && rel <= SAMPLING_FLOOR_FRACTION * floor).then_some(floor)
-    }
-
-    /// The sampling floor at which the last corrector call accepted its point (None: the
-    /// point met the tolerance, or the last call failed).
-    pub fn accepted_floor(&self) -> Option<f64> {
-        self.accepted_floor.get()
-    }
-
     /// The residual at an iterate of a chord iteration, returned relative to the load: with a
     /// kept factorisation only the residual (unless `r_current` says r holds it already), and
     /// the factorisation dropped when the residual fell by less than CHORD_CONTRACTION from
@@ -371,8 +328,6 @@ impl Continuation {
         // Whether r holds the residual at x (the accepted trial of the previous step).
         let mut r_current = false;
         let mut rel = f64::INFINITY;
-        // Relative residual at each iterate, to tell a stagnated Newton from a slow one.
-        let mut history: Vec<f64> = Vec::new();
         for it in 1..=max_iter {
             let previous = rel;
             rel = self.chord_evaluate(
@@ -383,12 +338,9 @@ impl Continuation {
                 r_current,
                 previous,
             )?;
-            history.push(rel);
             let tolerance = self.tolerance_at(system, (&x, omega), rel);
             let at_tolerance = rel <= tolerance;
             let neg: Vec<f64> = r.iter().map(|v| -v).collect();
-            // Whether dx comes from the Jacobian evaluated at this iterate.
-            let fresh = factor.is_none();
             let dx = match &factor {
                 Some(f) => {
                     chord_steps += 1;
@@ -414,7 +366,6 @@ impl Continuation {
                 None => jac.solve(&neg)?,
             };
             let step_norm = scaled_norm(&dx, &self.x_scale);
-            let rel_here = rel;
             let mut alpha = 1.0;
             let improved = loop {
                 for i in 0..n {
@@ -431,14 +382,6 @@ impl Continuation {
                 }
                 alpha *= 0.5;
             };
-            // Above tolerance, no fraction of the step lowers the residual: Newton has
-            // stagnated (e.g. at a contact transition between two AFT samples). The point is
-            // kept if its residual is far below the sampling floor.
-            if !improved && !at_tolerance && fresh {
-                if let Some(floor) = self.floor_accepts(system, (&x, omega), rel_here) {
-                    return self.fixed_point(system, x, omega, it, Some(floor));
-                }
-            }
             // At tolerance, a step that does not lower the residual only moves through
             // round-off: keep the current point (see `correct`).
             let stalled_at_tolerance = at_tolerance && !improved;
@@ -453,45 +396,22 @@ impl Continuation {
                 it
             };
             if stalled_at_tolerance || self.converged(rel, alpha * step_norm, tolerance) {
-                return self.fixed_point(system, x, omega, it, None);
-            }
-        }
-        // Newton crept on without meeting the tolerance: the last iterate (r holds its
-        // residual) is kept if Newton has stagnated and it is far below the sampling floor.
-        if stagnated(&history, rel) {
-            if let Some(floor) = self.floor_accepts(system, (&x, omega), rel) {
-                return self.fixed_point(system, x, omega, max_iter, Some(floor));
+                // Leave the operator evaluated at the returned point.
+                system
+                    .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
+                    .map_err(eval_err)?;
+                return Ok(PathPoint {
+                    omega,
+                    x,
+                    iterations: it,
+                    residual: norm(&r) / scale,
+                    step: 0.0,
+                });
             }
         }
         Err(NewtonFailure::MaxIterations {
             iterations: max_iter,
             residual: rel,
-        })
-    }
-
-    /// The point that fixed-frequency Newton returns at x, with the operator left evaluated
-    /// (residual and Jacobian) there, and the sampling floor it was accepted at, if any.
-    fn fixed_point<S: ParametricResidual>(
-        &self,
-        system: &mut S,
-        x: Vec<f64>,
-        omega: f64,
-        iterations: usize,
-        sampling_floor: Option<f64>,
-    ) -> Result<PathPoint, NewtonFailure> {
-        let n = x.len();
-        let (mut r, mut dr) = (vec![0.0; n], vec![0.0; n]);
-        let mut jac = system.new_jacobian();
-        system
-            .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
-            .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
-        Ok(PathPoint {
-            omega,
-            residual: norm(&r) / system.residual_scale(),
-            x,
-            iterations,
-            step: 0.0,
-            sampling_floor,
         })
     }
 
@@ -569,8 +489,6 @@ impl Continuation {
         let mut trial = vec![0.0; n];
         let mut first = f64::NAN;
         let mut rel = f64::INFINITY;
-        // Relative residual at each iterate, to tell a stagnated Newton from a slow one.
-        let mut history: Vec<f64> = Vec::new();
         // Chord iterations on large problems: the factorised bordered matrix is reused while
         // the residual keeps falling fast enough (see the module docs).
         let chord = n >= self.settings.chord_min_unknowns;
@@ -584,7 +502,6 @@ impl Continuation {
         // previous step), so that a chord step need not evaluate it again.
         let mut r_current = false;
         let mut broyden = BroydenUpdates::default();
-        self.accepted_floor.set(None);
         if chord {
             let mut carried = self.carried.borrow_mut();
             if let Some((f, age)) = carried.as_mut() {
@@ -619,7 +536,6 @@ impl Continuation {
                 r_current,
                 previous,
             )?;
-            history.push(rel);
             let tolerance = self.tolerance_at(system, (&x, omega), rel);
             if first.is_nan() {
                 first = rel;
@@ -632,8 +548,6 @@ impl Continuation {
                     .map(|j| tangent[j] * (y[j] - predicted[j]))
                     .sum::<f64>(),
             );
-            // Whether dy comes from the Jacobian evaluated at this iterate.
-            let fresh = factor.is_none();
             let mut dy = match (&factor, chord) {
                 (Some(f), _) => {
                     chord_steps += 1;
@@ -684,16 +598,15 @@ impl Continuation {
                 // contact states). The arc-length equation is linear, so every fraction of
                 // the step keeps it.
                 let mut alpha = 1.0;
-                let improved = loop {
+                loop {
                     for j in 0..n {
                         trial[j] = (y[j] + alpha * dy[j]) * self.x_scale[j];
                     }
                     system
                         .residual(&trial, (y[n] + alpha * dy[n]) * OMEGA_SCALE, &mut r)
                         .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
-                    let improved = norm(&r) / scale < rel;
-                    if improved || alpha < 1e-3 {
-                        break improved;
+                    if norm(&r) / scale < rel || alpha < 1e-3 {
+                        break;
                     }
                     if from_carried {
                         // A factorisation carried from an earlier point that does not lower
@@ -702,21 +615,9 @@ impl Continuation {
                         alpha = 0.0;
                         factor = None;
                         from_carried = false;
-                        break false;
+                        break;
                     }
                     alpha *= 0.5;
-                };
-                // No fraction of a step from the Jacobian at this iterate lowers the residual
-                // above tolerance: Newton has stagnated (a contact transition between two AFT
-                // samples). The iterate is kept if its residual is far below the sampling
-                // floor. (A stale chord or Broyden step failing is no stall: the next
-                // iteration factorises afresh.)
-                if !improved && alpha > 0.0 && fresh {
-                    if let Some(floor) = self.floor_accepts(system, (&x, y[n] * OMEGA_SCALE), rel) {
-                        self.accepted_floor.set(Some(floor));
-                        self.keep_factor(factor.take(), tangent);
-                        return Ok((y, it, rel));
-                    }
                 }
                 // r now holds the residual at the accepted iterate (not after a rejected
                 // carried step, which leaves the iterate where it was).
@@ -747,31 +648,6 @@ impl Continuation {
                     return Ok((y, it, rel_new));
                 }
             }
-        }
-        // Newton crept on without meeting the tolerance: the last iterate is kept if its
-        // residual is far below the sampling floor.
-        for i in 0..n {
-            x[i] = y[i] * self.x_scale[i];
-        }
-        let omega = y[n] * OMEGA_SCALE;
-        system
-            .residual(&x, omega, &mut r)
-            .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
-        let rel_last = norm(&r) / scale;
-        let floor = if stagnated(&history, rel_last) {
-            self.floor_accepts(system, (&x, omega), rel_last)
-        } else {
-            None
-        };
-        if let Some(floor) = floor {
-            self.accepted_floor.set(Some(floor));
-            self.keep_factor(factor.take(), tangent);
-            let iterations = if chord {
-                effort(factorisations, chord_steps)
-            } else {
-                limit
-            };
-            return Ok((y, iterations, rel_last));
         }
         Err(NewtonFailure::MaxIterations {
             iterations: limit,
@@ -847,7 +723,6 @@ impl Continuation {
                 iterations: 0,
                 residual: f64::NAN,
                 step: ds,
-                sampling_floor: None,
             };
             let Ok(outgoing) = self.tangent(system, &probe, Some(tangent)) else {
                 continue;
@@ -922,7 +797,6 @@ impl Continuation {
             iterations,
             residual,
             step: ds,
-            sampling_floor: self.accepted_floor.get(),
         };
         let t_new = self.tangent(system, &point, Some(tangent))?;
         let degrees = dot(&t_new, tangent).clamp(-1.0, 1.0).acos().to_degrees();
@@ -1179,18 +1053,6 @@ impl Continuation {
     }
 }
 
-/// Whether Newton has stagnated rather than being slow: at least [`STAGNATION_ITERATIONS`]
-/// iterates, and the last relative residual `last` not below half of the residual that many
-/// iterations back (`history`: the residual at each iterate). A Newton that is merely cut
-/// short by the iteration limit (e.g. `max_iterations = 2`) is not stagnated.
-fn stagnated(history: &[f64], last: f64) -> bool {
-    history.len() >= STAGNATION_ITERATIONS
-        && last >= 0.5 * history[history.len() - STAGNATION_ITERATIONS]
-}
-
-/// Iterations over which a stagnated Newton has not halved its residual (see `stagnated`).
-const STAGNATION_ITERATIONS: usize = 4;
-
 /// Norm of v scaled per entry: ‖(vᵢ / sᵢ)‖.
 fn scaled_norm(v: &[f64], scale: &[f64]) -> f64 {
     v.iter()
@@ -1204,7 +1066,6 @@ fn scaled_norm(v: &[f64], scale: &[f64]) -> f64 {
 mod tests {
     use super::*;
     use crate::numerics::path::NoObserver;
-    use std::f64::consts::FRAC_1_SQRT_2;
 
     /// R(x, ω) = ω/2π − g(x): a path whose frequency is the piecewise-linear g of the single
     /// unknown x. g rises to 15 Hz at x = 1, falls steeply to 13 Hz at x = 1.2 and rises on:
@@ -1256,130 +1117,6 @@ mod tests {
             dr[0] = 1.0 / OMEGA_SCALE;
             Ok(())
         }
-    }
-
-    /// A sampled, piecewise-smooth residual R_N(x, ω) = x − ω/2π + a/N + h·H(x − x₀): a
-    /// smooth discretisation error a/N of the N samples (the floor, |R_2N − R_N| = a/2N) and a
-    /// jump h at x₀ (a contact transition moving past a sample), with the per-piece Jacobian
-    /// 1. Where the root falls inside the jump, no iterate brings |R| below h/2: Newton
-    /// stagnates there.
-    struct SampledStep {
-        samples: f64,
-        a: f64,
-        jump: f64,
-        x0: f64,
-        /// Whether the operator reports its sampling floor (else the trait's default 0).
-        claims_floor: bool,
-    }
-
-    impl SampledStep {
-        fn at(&self, samples: f64, x: f64, omega: f64) -> f64 {
-            let step = if x >= self.x0 { self.jump } else { 0.0 };
-            x - omega / OMEGA_SCALE + self.a / samples + step
-        }
-    }
-
-    impl ParametricResidual for SampledStep {
-        type Error = Never;
-        fn dim(&self) -> usize {
-            1
-        }
-        fn residual_scale(&self) -> f64 {
-            1.0
-        }
-        fn sampling_floor(&mut self, x: &[f64], omega: f64) -> f64 {
-            if !self.claims_floor {
-                return 0.0;
-            }
-            (self.at(2.0 * self.samples, x[0], omega) - self.at(self.samples, x[0], omega)).abs()
-        }
-        fn residual(&mut self, x: &[f64], omega: f64, r: &mut [f64]) -> Result<(), Never> {
-            r[0] = self.at(self.samples, x[0], omega);
-            Ok(())
-        }
-        fn new_jacobian(&mut self) -> AssembledJacobian {
-            AssembledJacobian::dense(1)
-        }
-        fn residual_and_jacobian(
-            &mut self,
-            x: &[f64],
-            omega: f64,
-            r: &mut [f64],
-            jac: &mut AssembledJacobian,
-            dr: &mut [f64],
-        ) -> Result<(), Never> {
-            self.residual(x, omega, r)?;
-            jac.clear();
-            let slot = jac.slot(0, 0);
-            jac.add_at(slot, 1.0);
-            dr[0] = -1.0 / OMEGA_SCALE;
-            Ok(())
-        }
-    }
-
-    /// The stagnating step with N = 128 samples, a = 1 (floor 1/256 ≈ 3.9·10⁻³) and jump h.
-    fn sampled_step(jump: f64, claims_floor: bool) -> SampledStep {
-        SampledStep {
-            samples: 128.0,
-            a: 1.0,
-            jump,
-            x0: 0.5,
-            claims_floor,
-        }
-    }
-
-    /// Fixed-frequency Newton with the root inside a jump of 10⁻⁸: stagnates above the
-    /// tolerance 10⁻¹² and fails without a floor; with the floor 3.9·10⁻³ it keeps the iterate
-    /// at the jump (residual ≤ 10⁻⁴ of the floor), marked with its floor. A jump of 10⁻⁴
-    /// (stagnation at ≥ 5·10⁻⁵, above 10⁻⁴ of the floor) still fails.
-    #[test]
-    fn fixed_newton_stagnated_far_below_the_sampling_floor_is_accepted_and_marked() {
-        let c = Continuation::new(settings(1.0, 2.0), vec![1.0]);
-        let solve = |system: &mut SampledStep| {
-            let f = system.x0 + system.a / system.samples + 0.5 * system.jump;
-            c.solve_fixed(system, &[0.0], OMEGA_SCALE * f)
-        };
-        assert!(matches!(
-            solve(&mut sampled_step(1e-8, false)),
-            Err(NewtonFailure::MaxIterations { .. })
-        ));
-        let p = solve(&mut sampled_step(1e-8, true)).unwrap();
-        let floor = p.sampling_floor.expect("accepted at the floor");
-        assert!((floor - 1.0 / 256.0).abs() < 1e-12, "{floor}");
-        assert!(p.residual > 1e-12 && p.residual <= SAMPLING_FLOOR_FRACTION * floor);
-        assert!((p.x[0] - 0.5).abs() <= 1e-8, "{}", p.x[0]);
-        assert!(solve(&mut sampled_step(1e-4, true)).is_err());
-    }
-
-    /// The arc-length corrector on a hyperplane through the jump: fails without a floor,
-    /// returns the stagnated iterate with the floor recorded when it is far below it, and
-    /// fails when the jump is not far below the floor. A point that meets the tolerance
-    /// records no floor.
-    #[test]
-    fn corrector_stagnated_far_below_the_sampling_floor_is_accepted_and_marked() {
-        let c = Continuation::new(settings(1.0, 2.0), vec![1.0]);
-        let t = [FRAC_1_SQRT_2, FRAC_1_SQRT_2];
-        // On t·(y − y_p) = 0, R = 2x − (f_p + x_p − a/N) + h·H(x − x₀): its root is at the
-        // jump when f_p + x_p − a/N = 2x₀ + h/2.
-        let correct = |system: &mut SampledStep| {
-            let xp = system.x0 - 0.05;
-            let fp = 2.0 * system.x0 + 0.5 * system.jump + system.a / system.samples - xp;
-            c.correct(system, &[xp, fp], &t)
-        };
-        assert!(correct(&mut sampled_step(1e-8, false)).is_err());
-        assert_eq!(c.accepted_floor(), None);
-        let (y, _, rel) = correct(&mut sampled_step(1e-8, true)).unwrap();
-        let floor = c.accepted_floor().expect("accepted at the floor");
-        assert!(
-            rel > 1e-12 && rel <= SAMPLING_FLOOR_FRACTION * floor,
-            "{rel} {floor}"
-        );
-        assert!((y[0] - 0.5).abs() <= 1e-8, "{}", y[0]);
-        assert!(correct(&mut sampled_step(1e-4, true)).is_err());
-        // Without a jump the corrector meets the tolerance: no floor.
-        let (_, _, rel) = correct(&mut sampled_step(0.0, true)).unwrap();
-        assert!(rel <= 1e-12);
-        assert_eq!(c.accepted_floor(), None);
     }
 
     fn settings(start: f64, end: f64) -> ContinuationSettings {

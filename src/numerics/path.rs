@@ -94,11 +94,6 @@ pub struct PathPoint {
     pub residual: f64,
     /// Arc-length step that reached this point (0 for the first).
     pub step: f64,
-    /// The relative sampling floor ([`ParametricResidual::sampling_floor`]) where Newton
-    /// stagnated above the residual tolerance and the point was accepted because its residual
-    /// is at most [`crate::numerics::continuation::SAMPLING_FLOOR_FRACTION`] of that floor;
-    /// None for a point that met the tolerance.
-    pub sampling_floor: Option<f64>,
 }
 
 impl PathPoint {

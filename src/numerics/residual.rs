@@ -22,16 +22,6 @@ pub trait ParametricResidual {
     fn round_off(&mut self, _x: &[f64], _lambda: f64) -> f64 {
         0.0
     }
-    /// Sampling floor of ‖R(x, λ)‖ (absolute, same norm as the residual): the change of the
-    /// residual at the same iterate when the operator is discretised more finely (for the
-    /// harmonic balance: the contact forces marched with twice the AFT time samples). It is the
-    /// operator's own discretisation error at x; a Newton residual far below it changes the
-    /// solution by much less than the discretisation already does. Continuation asks for it
-    /// only where Newton has stagnated above its tolerance
-    /// ([`crate::numerics::continuation`]). The default, 0, claims no such floor.
-    fn sampling_floor(&mut self, _x: &[f64], _lambda: f64) -> f64 {
-        0.0
-    }
     /// R(x, λ) into r.
     fn residual(&mut self, x: &[f64], lambda: f64, r: &mut [f64]) -> Result<(), Self::Error>;
     /// An empty Jacobian with the operator's storage and pattern.

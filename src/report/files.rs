@@ -313,10 +313,6 @@ struct PointRecord<'a> {
     states: &'a [crate::contact::ContactState],
     newton_iterations: usize,
     residual: f64,
-    /// Only on a point accepted at the AFT's sampling floor (Newton stagnated above
-    /// `residual_tolerance` with `residual` ≤ 10⁻⁴ of this relative floor).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    sampling_floor: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     coefficients: Option<&'a [f64]>,
     /// `stable`, `floquet_re`, `floquet_freq_hz` when the scene sets `analysis.stability`.
@@ -484,7 +480,6 @@ impl FrfWriter {
                     states: &p.states,
                     newton_iterations: p.newton_iterations,
                     residual: p.residual,
-                    sampling_floor: p.sampling_floor,
                     coefficients: inline.then_some(p.coefficients.as_slice()),
                     stability: p.stability.as_ref(),
                 })
@@ -648,7 +643,6 @@ mod tests {
             coefficients: vec![k as f64; 18],
             accuracy: None,
             stability: None,
-            sampling_floor: None,
         }
     }
 

@@ -685,7 +685,6 @@ mod tests {
             coefficients: Vec::new(),
             accuracy: None,
             stability: None,
-            sampling_floor: None,
         };
         let r: Vec<FrfPoint> = (0..=10).map(|k| point(k as f64, 1.0 + k as f64)).collect();
         let a: Vec<FrfPoint> = (0..=10)

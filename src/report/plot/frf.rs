@@ -224,7 +224,6 @@ mod tests {
             coefficients: Vec::new(),
             accuracy: None,
             stability: None,
-            sampling_floor: None,
         }
     }
 
