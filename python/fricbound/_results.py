@@ -51,6 +51,10 @@ class ContinuationPath(_Result):
       relative to the load norm;
     - ``trunc_err``, ``sampling_err`` (n, outputs) or None: estimated relative error of the
       amplitudes from harmonic truncation and AFT sampling (``[accuracy]``, on by default);
+      ``estimate_harmonic`` (n,) int: the highest harmonic of the extended set the truncation
+      estimate comes from (2H + 1, or 4H + 3 where widened; 0 where not formed), and
+      ``estimate_method`` (n,) str: ``step``, ``solved``, ``unsized`` (the error is not sized)
+      or ``none``, as the CLI's ``frf.csv``;
     - ``stable`` (n,) bool, ``floquet_re`` (n,) 1/s, ``floquet_freq_hz`` (n,) or None: the
       stability verdict, when the scene sets ``analysis.stability = true``;
       ``stability_method`` (n,) str: which method gave it (``hill``, ``monodromy``, or
@@ -61,6 +65,8 @@ class ContinuationPath(_Result):
 
     trunc_err: Optional[np.ndarray] = None
     sampling_err: Optional[np.ndarray] = None
+    estimate_harmonic: Optional[np.ndarray] = None
+    estimate_method: Optional[List[str]] = None
     stable: Optional[np.ndarray] = None
     floquet_re: Optional[np.ndarray] = None
     floquet_freq_hz: Optional[np.ndarray] = None
@@ -95,7 +101,8 @@ class ContinuationPath(_Result):
     def to_pandas(self):
         """A DataFrame with the columns of the CLI's ``frf.csv``: ``freq_hz``,
         ``<dof>_amp``, ``<dof>_peak`` per output, ``<contact>_state`` per contact,
-        ``newton_iters``, then ``<dof>_trunc_err``, ``<dof>_sampling_err`` and ``stable``,
+        ``newton_iters``, then ``<dof>_trunc_err``, ``<dof>_sampling_err``,
+        ``estimate_harmonic``, ``estimate_method`` and ``stable``,
         ``floquet_re``, ``floquet_freq_hz``, ``stability_method``, ``stability_reliable``
         when present."""
         pd = _pandas()
@@ -110,6 +117,8 @@ class ContinuationPath(_Result):
             for k, name in enumerate(self.outputs):
                 cols[f"{name}_trunc_err"] = self.trunc_err[:, k]
                 cols[f"{name}_sampling_err"] = self.sampling_err[:, k]
+            cols["estimate_harmonic"] = self.estimate_harmonic
+            cols["estimate_method"] = self.estimate_method
         if self.stable is not None:
             cols["stable"] = self.stable
             cols["floquet_re"] = self.floquet_re
@@ -129,6 +138,8 @@ _PATH_KEYS = (
     "residual",
     "trunc_err",
     "sampling_err",
+    "estimate_harmonic",
+    "estimate_method",
     "stable",
     "floquet_re",
     "floquet_freq_hz",

@@ -132,8 +132,9 @@ pub fn problem_names(d: &Bound<'_, PyDict>, problem: &Problem) -> PyResult<()> {
 /// The per-point arrays of a path: `freq_hz` (n), `amplitudes` and `peaks` (n × outputs),
 /// `states` (n lists of contact-state labels), `newton_iterations`, `residual`,
 /// `coefficients` (n × DOFs·blocks, harmonic-major), `trunc_err` and `sampling_err`
-/// (n × outputs, NaN where not estimated; absent when the scene does not ask for the
-/// estimate), `stable`, `floquet_re`, `floquet_freq_hz`, `stability_method`,
+/// (n × outputs, NaN where not estimated), `estimate_harmonic` (n) and `estimate_method` (n
+/// labels: `step`, `solved`, `unsized`, `none`) (all four absent when the scene does not ask
+/// for the estimate), `stable`, `floquet_re`, `floquet_freq_hz`, `stability_method`,
 /// `stability_reliable` (absent without `analysis.stability`).
 pub fn points_dict<'py>(py: Python<'py>, points: &[FrfPoint]) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
@@ -185,6 +186,25 @@ pub fn points_dict<'py>(py: Python<'py>, points: &[FrfPoint]) -> PyResult<Bound<
         };
         d.set_item("trunc_err", est(&|a| &a.truncation)?)?;
         d.set_item("sampling_err", est(&|a| &a.sampling)?)?;
+        let harmonic: Vec<i64> = points
+            .iter()
+            .map(|p| {
+                p.accuracy
+                    .as_ref()
+                    .map_or(0, |a| a.estimate_harmonic as i64)
+            })
+            .collect();
+        d.set_item("estimate_harmonic", PyArray1::from_vec(py, harmonic))?;
+        let method: Vec<&str> = points
+            .iter()
+            .map(|p| {
+                p.accuracy.as_ref().map_or(
+                    fricbound::analysis::error_estimate::EstimateMethod::None.label(),
+                    |a| a.method.label(),
+                )
+            })
+            .collect();
+        d.set_item("estimate_method", method)?;
     }
     if points.iter().any(|p| p.stability.is_some()) {
         let stable: Vec<bool> = points
