@@ -115,15 +115,6 @@ pub struct PointAccuracy {
     /// 2H + 1, or the wider set's 4H + 3 where the first extension had not converged in its
     /// own harmonics ([`TailTest`]); 0 where no estimate was formed.
     pub estimate_harmonic: usize,
-    /// The reported kind of truncation estimate (across the path or at the fixed frequency)
-    /// on the first extension (2H + 1) alone, per output, whether or not the point was
-    /// widened; empty where no estimate was formed. For measuring the widening's gate.
-    #[serde(skip)]
-    pub first_truncation: Vec<f64>,
-    /// Whether the geometric-tail reason of [`TailTest`] alone (without the stuck-contact
-    /// reason) asks for the wider set.
-    #[serde(skip)]
-    pub tail_asks_wider: bool,
     /// Whether a contact's regime at the point moved by the reported truncation step (on the
     /// first extension) differs from the point's own: the step crosses a stick-slip or
     /// lift-off transition, outside the range where its linearisation holds.
@@ -509,8 +500,6 @@ struct Assessed {
     truncation: Vec<f64>,
     /// Whether [`TailTest`] sends the point to the wider set.
     needs_wider: bool,
-    /// Whether its geometric-tail reason alone would.
-    tail_asks: bool,
     /// Whether the truncation step changes a contact's regime.
     changes_regime: bool,
     /// The truncation step's contraction ([`LinearRange`]).
@@ -607,8 +596,6 @@ impl<'p> ErrorEstimator<'p> {
             both_truncation: None,
             slide_and_step: (f64::NAN, f64::NAN),
             estimate_harmonic: 0,
-            first_truncation: Vec::new(),
-            tail_asks_wider: false,
             step_changes_regime: false,
             contraction: f64::NAN,
             method: EstimateMethod::None,
@@ -701,8 +688,8 @@ impl<'p> ErrorEstimator<'p> {
             (values, moved)
         };
         // Per reported step set (across the path or at the fixed frequency): the truncation
-        // estimate, whether its tail needs the wider set (and whether the tail alone asks
-        // for it), whether the step changes a contact's regime, and the sampling estimate.
+        // estimate, whether its tail needs the wider set, whether the step changes a contact's
+        // regime, and the sampling estimate.
         let mut assess = |steps: &[Vec<f64>]| {
             let (full, moved) = amplitudes_after(&steps[0], true);
             let (low, _) = amplitudes_after(&steps[1], false);
@@ -711,11 +698,6 @@ impl<'p> ErrorEstimator<'p> {
                 .zip(&low)
                 .zip(&full)
                 .any(|((&b, &l), &f)| TailTest::extend(b, l, f, stuck_contact));
-            let tail_asks = base
-                .iter()
-                .zip(&low)
-                .zip(&full)
-                .any(|((&b, &l), &f)| TailTest::extend(b, l, f, false));
             let changes_regime = moved.as_ref().is_some_and(|m| m.0.as_slice() != states);
             let contraction = moved.map_or(f64::NAN, |m| m.1 / r_norm);
             let sampling = match steps.get(2) {
@@ -725,7 +707,6 @@ impl<'p> ErrorEstimator<'p> {
             Assessed {
                 truncation: relative_changes(&full, &base),
                 needs_wider,
-                tail_asks,
                 changes_regime,
                 contraction,
                 sampling,
@@ -760,8 +741,6 @@ impl<'p> ErrorEstimator<'p> {
                 both_truncation: None,
                 slide_and_step: (f64::NAN, step),
                 estimate_harmonic,
-                first_truncation: first.truncation,
-                tail_asks_wider: first.tail_asks,
                 step_changes_regime: first.changes_regime,
                 contraction,
                 method,
@@ -819,8 +798,6 @@ impl<'p> ErrorEstimator<'p> {
             both_truncation: Some(both),
             slide_and_step: (slide, step),
             estimate_harmonic,
-            first_truncation: reported.truncation.clone(),
-            tail_asks_wider: reported.tail_asks,
             step_changes_regime: reported.changes_regime,
             contraction,
             method,
@@ -1221,8 +1198,6 @@ mod tests {
             both_truncation: None,
             slide_and_step: (f64::NAN, f64::NAN),
             estimate_harmonic: 3,
-            first_truncation: vec![t],
-            tail_asks_wider: false,
             step_changes_regime: false,
             contraction: 0.0,
             method: EstimateMethod::Step,
