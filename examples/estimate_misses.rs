@@ -24,81 +24,14 @@
 //! reference paths first). Findings: docs/accuracy.md, "The misses on the small blade pair".
 
 use fricbound::analysis::error_estimate::{ErrorEstimator, EstimateProblems};
-use fricbound::analysis::frf::{self, FrfPoint, FrfRun, Silent};
-use fricbound::contact::ContactState;
-use fricbound::hbm::system::HbmSystem;
+use fricbound::analysis::frf::{self, FrfPoint, Silent};
 use fricbound::model::Problem;
-use fricbound::scene;
-use fricbound::study::scaling::{self, ModelSize};
 
-fn problem(dir: &std::path::Path, overrides: &[String]) -> Problem {
-    let path = dir.join("blade-pair.toml");
-    scene::load_problem(&path, overrides)
-        .expect("scene is valid")
-        .1
-}
-
-/// The crossing of `freq_hz` by `run` nearest in amplitude to `near`: (amplitude, segment,
-/// nearest point), as in `tests/error_estimate_fe.rs`.
-fn amplitude_near(run: &FrfRun, freq_hz: f64, near: f64) -> Option<(f64, usize, usize)> {
-    run.crossings(freq_hz, 0)
-        .into_iter()
-        .min_by(|x, y| {
-            (x.amplitude - near)
-                .abs()
-                .total_cmp(&(y.amplitude - near).abs())
-        })
-        .map(|c| (c.amplitude, c.segment, c.nearest_point))
-}
-
-/// Per contact: state, T̂⁰, origin of a stuck state, smallest friction margin (as
-/// `examples/upper_branch_states.rs`).
-fn describe(system: &mut HbmSystem, problem: &Problem, x: &[f64]) -> String {
-    let mut line = String::new();
-    for c in 0..problem.contacts.len() {
-        let Ok(state) = system.contact_forces(c, x, false) else {
-            line.push_str(" | (march failed)");
-            continue;
-        };
-        let law = system.law(c);
-        let (t0, _n0) = system.last_constant_forces(c);
-        let aft = system.aft();
-        let keeps_ic = aft.initial_state_derivative(&law) != 0.0;
-        let nmax = aft.n.iter().fold(0.0_f64, |m, &x| m.max(x));
-        let margin = aft
-            .n
-            .iter()
-            .zip(&aft.t)
-            .filter(|(n, _)| **n > 0.0)
-            .map(|(n, t)| (law.mu * n - t.abs()) / (law.mu * nmax))
-            .fold(f64::INFINITY, f64::min);
-        let open = aft.n.iter().filter(|n| **n <= 0.0).count();
-        let origin = match state {
-            ContactState::Stuck if keeps_ic => "ic",
-            ContactState::Stuck => "hist",
-            _ => "-",
-        };
-        line.push_str(&format!(
-            " | {} T0 {t0:+.3e} {origin} margin {margin:.2e} open {open}",
-            state.label()
-        ));
-    }
-    line
-}
+mod common;
+use common::{amplitude_near, describe, SmallBladePair};
 
 fn main() {
-    let dir = tempfile::tempdir().expect("temporary directory");
-    let size = ModelSize {
-        contact_pairs: Some(2),
-        ..ModelSize::uniform(false, 1)
-    };
-    scaling::full_problem(size, 1, dir.path()).expect("mesh");
-    let mesh = dir.path().join("blade-pair-2d-r1-p2.msh");
-    let text = format!(
-        "{}\n[reduction]\nmodes = 8\nmodal_damping = 0.002\n",
-        scaling::blade_pair_scene(&mesh, false, 1)
-    );
-    std::fs::write(dir.path().join("blade-pair.toml"), text).expect("scene file");
+    let scene = SmallBladePair::new();
     let with = |extra: &[String]| -> Vec<String> {
         [
             "analysis.freq_start_hz=928".to_string(),
@@ -115,10 +48,10 @@ fn main() {
             format!("accuracy.estimate={estimate}"),
         ])
     };
-    let reference_problem = problem(dir.path(), &at(11, false));
+    let reference_problem = scene.problem(&at(11, false));
     let reference_set = reference_problem.unknown_harmonics();
     let reference = frf::solve(&reference_problem, &mut Silent).expect("reference solves");
-    let check = frf::solve(&problem(dir.path(), &at(9, false)), &mut Silent).expect("H = 9");
+    let check = frf::solve(&scene.problem(&at(9, false)), &mut Silent).expect("H = 9");
     let converged: Vec<f64> = reference
         .points
         .iter()
@@ -130,7 +63,7 @@ fn main() {
         .collect();
     let mut ref_solver = frf::PointSolver::new(&reference_problem).expect("point solver");
     for h in [1_usize, 3] {
-        let problem = problem(dir.path(), &at(h, true));
+        let problem = scene.problem(&at(h, true));
         let set = problem.unknown_harmonics();
         let run = frf::solve(&problem, &mut Silent).expect("run solves");
         // Truth, estimate and miss flag of every point, as the test computes them.

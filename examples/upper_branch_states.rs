@@ -9,29 +9,21 @@
 //! march's initial condition T(0) = m μ N(0) (`ic`: it never slipped nor separated, so its T̂⁰
 //! depends on m and on N(0)) or forgot it (`hist`: it slipped in the transient or in the period),
 //! and its smallest friction margin over the closed samples, min (μN − |T|)/(μ max N) (0 where
-//! it slips).
+//! it slips), and its open samples (`common::describe`).
 //!
 //! Run: `cargo run --release --example upper_branch_states [H ...] [-- samples=S ...]`
 //! (default H = 5 7 9 11 at 128 samples, and 128, 512, 2048 samples at H = 7).
 
 use fricbound::analysis::frf::{self, FrfRun, Silent};
-use fricbound::contact::ContactState;
 use fricbound::hbm::system::HbmSystem;
-use fricbound::model::Problem;
-use fricbound::scene;
-use fricbound::study::scaling::{self, ModelSize};
+
+mod common;
+use common::{describe, SmallBladePair};
 
 /// Frequencies (Hz) at which the crossings of each path are compared.
 const PROBES: [f64; 9] = [
     924.3, 928.61, 929.5, 930.5, 931.5, 932.5, 933.2, 934.5, 935.5,
 ];
-
-fn problem(dir: &std::path::Path, overrides: &[String]) -> Problem {
-    let path = dir.join("blade-pair.toml");
-    scene::load_problem(&path, overrides)
-        .expect("scene is valid")
-        .1
-}
 
 /// Every crossing of `freq_hz` by the path of `run`: (interpolated amplitude, index of the path
 /// point nearest in frequency on that segment).
@@ -58,18 +50,7 @@ fn main() {
     if settings.is_empty() {
         settings = vec![(5, 128), (7, 128), (9, 128), (11, 128), (7, 512), (7, 2048)];
     }
-    let dir = tempfile::tempdir().expect("temporary directory");
-    let size = ModelSize {
-        contact_pairs: Some(2),
-        ..ModelSize::uniform(false, 1)
-    };
-    scaling::full_problem(size, 1, dir.path()).expect("mesh");
-    let mesh = dir.path().join("blade-pair-2d-r1-p2.msh");
-    let text = format!(
-        "{}\n[reduction]\nmodes = 8\nmodal_damping = 0.002\n",
-        scaling::blade_pair_scene(&mesh, false, 1)
-    );
-    std::fs::write(dir.path().join("blade-pair.toml"), text).expect("scene file");
+    let scene = SmallBladePair::new();
     let mut runs = Vec::new();
     for (h, samples) in settings {
         let overrides: Vec<String> = [
@@ -80,7 +61,7 @@ fn main() {
             "accuracy.estimate=false".to_string(),
         ]
         .to_vec();
-        let problem = problem(dir.path(), &overrides);
+        let problem = scene.problem(&overrides);
         let names: Vec<String> = problem.contacts.iter().map(|c| c.name.clone()).collect();
         let started = std::time::Instant::now();
         let run = frf::solve(&problem, &mut Silent).expect("run solves");
@@ -139,34 +120,4 @@ fn main() {
             }
         }
     }
-}
-
-/// Per contact: state, T̂⁰, origin of a stuck state, smallest friction margin.
-fn describe(system: &mut HbmSystem, problem: &Problem, x: &[f64]) -> String {
-    let mut line = String::new();
-    for c in 0..problem.contacts.len() {
-        let state = system.contact_forces(c, x, false).expect("contact forces");
-        let law = system.law(c);
-        let (t0, _n0) = system.last_constant_forces(c);
-        let aft = system.aft();
-        let keeps_ic = aft.initial_state_derivative(&law) != 0.0;
-        let nmax = aft.n.iter().fold(0.0_f64, |m, &x| m.max(x));
-        let margin = aft
-            .n
-            .iter()
-            .zip(&aft.t)
-            .filter(|(n, _)| **n > 0.0)
-            .map(|(n, t)| (law.mu * n - t.abs()) / (law.mu * nmax))
-            .fold(f64::INFINITY, f64::min);
-        let origin = match state {
-            ContactState::Stuck if keeps_ic => "ic",
-            ContactState::Stuck => "hist",
-            _ => "-",
-        };
-        line.push_str(&format!(
-            " | {} T0 {t0:+.4e} {origin} margin {margin:.2e}",
-            state.label()
-        ));
-    }
-    line
 }
