@@ -221,6 +221,43 @@ fn wrong_type() {
     assert_cli_rejects(&file.label(), &[], &["invalid type"]);
 }
 
+/// Two tangential stiffnesses where the law takes one (an anisotropic kₜ along t₁, t₂): refused
+/// at parsing with the line, the field and why, in the file and through `--set`, on contacts
+/// and on patches.
+#[test]
+fn two_tangential_stiffnesses_are_refused() {
+    let text = paper_with("kt = 3.0e5", "kt = [3.0e5, 1.0e5]");
+    let line = 1 + text[..text.find("kt = [3.0e5").expect("edited")]
+        .matches('\n')
+        .count();
+    let at = format!("line {line}, column 6");
+    let file = SceneFile::new(&text);
+    let err = library_error(&file, &[]);
+    let why = "`kt` takes one number (N/m), got an array of 2";
+    assert_parse(
+        &err,
+        &file.label(),
+        &[&at, why, "isotropic", "| kt = [3.0e5, 1.0e5]"],
+    );
+    assert_cli_rejects(&file.label(), &[], &[&at, why]);
+
+    let file = SceneFile::new(&paper_wedge_scene());
+    let assignment = "contacts.1.kt=[3.0e5, 1.0e5]";
+    let err = library_error(&file, &[assignment]);
+    assert_override(&err, &file.label(), assignment, why);
+
+    let blade = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("meshes/blade-pair/blade-pair-3d-limits.toml")
+        .display()
+        .to_string();
+    let assignment = "contact_patches.0.kt=[2.0e7, 1.0e7, 5.0e6]";
+    assert_cli_rejects(
+        &blade,
+        &[assignment],
+        &[assignment, "`kt` takes one number (N/m), got an array of 3"],
+    );
+}
+
 #[test]
 fn missing_file() {
     let dir = tempfile::tempdir().expect("temporary folder");

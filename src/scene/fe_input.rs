@@ -134,7 +134,9 @@ pub struct ContactPatchSpec {
     /// Physical group of the body's contact face.
     pub body: String,
     /// Tangential contact stiffness of the whole patch (N/m), shared among the pairs in
-    /// proportion to their tributary areas.
+    /// proportion to their tributary areas; one number, isotropic in the tangent plane of a
+    /// `jenkins-2d` patch (an array is refused: `schema::one_tangential_stiffness`).
+    #[serde(deserialize_with = "crate::scene::schema::one_tangential_stiffness")]
     pub kt: f64,
     /// Normal contact stiffness of the whole patch (N/m), shared likewise.
     pub kn: f64,

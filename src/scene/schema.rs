@@ -14,6 +14,47 @@ use crate::scene::fe_input::{
 };
 use crate::scene::limits_schema::{LimitsSpec, SweepSpec};
 
+/// Reads a tangential stiffness kₜ (N/m): one number (integer or float). An array, such as
+/// `kt = [k1, k2]` for an anisotropic stiffness along t₁ and t₂, is refused with a message that
+/// says why: the `jenkins-2d` law is isotropic (kₜ is the same in every direction of the tangent
+/// plane). With kₜ₁ ≠ kₜ₂ the maximum-dissipation return onto the Coulomb circle is a
+/// closest-point projection in the compliance metric, not the radial return the march and its
+/// Jacobian implement (README, "2D tangential friction"). The parser adds the file, line and
+/// source line to the message.
+pub(crate) fn one_tangential_stiffness<'de, D>(deserializer: D) -> Result<f64, D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    struct OneStiffness;
+    impl<'de> serde::de::Visitor<'de> for OneStiffness {
+        type Value = f64;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("one number, the tangential stiffness kt in N/m")
+        }
+        fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<f64, E> {
+            Ok(v)
+        }
+        fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<f64, E> {
+            Ok(v as f64)
+        }
+        fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<f64, E> {
+            Ok(v as f64)
+        }
+        fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<f64, A::Error> {
+            let mut count = 0usize;
+            while seq.next_element::<serde::de::IgnoredAny>()?.is_some() {
+                count += 1;
+            }
+            Err(serde::de::Error::custom(format!(
+                "`kt` takes one number (N/m), got an array of {count}: the tangential stiffness \
+                 is isotropic, the same along every tangent direction (an anisotropic kt, one \
+                 per tangent direction, is not supported: README, \"2D tangential friction\")"
+            )))
+        }
+    }
+    deserializer.deserialize_any(OneStiffness)
+}
+
 /// Top-level scene.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -124,7 +165,9 @@ pub struct ContactSpec {
     /// Frame by vectors: normal direction, pointing from the damper into the body.
     #[serde(default)]
     pub normal: Option<Vec<f64>>,
-    /// Tangential stiffness (N/m).
+    /// Tangential stiffness (N/m): one number, the same in every tangential direction (a
+    /// `jenkins-2d` point is isotropic; `one_tangential_stiffness` refuses an array).
+    #[serde(deserialize_with = "one_tangential_stiffness")]
     pub kt: f64,
     /// Normal stiffness (N/m).
     pub kn: f64,
