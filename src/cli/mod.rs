@@ -356,9 +356,8 @@ impl FrfObserver for RunObserver<'_> {
         };
         let before = match &jump.fill_cut {
             Some(g) => format!(
-                "{before}\nthe branch past it, followed back down toward the fold, was ABANDONED \
-                 {}: it goes on above {:.4} Hz, not computed (possibly the resonance peak), and \
-                 the run will be reported incomplete",
+                "{before}\nthe branch past it (a fill or bridge) was left at its edge {}: it may \
+                 go on beyond {:.4} Hz, not followed (recorded as the jump's fill_cut)",
                 g.describe(),
                 g.freq_hz
             ),
