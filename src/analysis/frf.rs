@@ -78,10 +78,12 @@ pub struct Jump {
     /// How the branch before the jump ended: followed until it left the range, or given up
     /// inside it (where and why). [`BranchEnd::Bridge`] for a bridge branch.
     pub before: BranchEnd,
-    /// Where the branch after the jump, followed back down toward the fold (the fill), was
-    /// left while heading up again past a fold of its own, off every stretch followed before
-    /// (see [`fill_cut`]): that branch goes on above the point, not computed. None otherwise
-    /// (and for bridges).
+    /// Where the branch after the jump (the fill, followed back down toward the fold, or a
+    /// bridge, followed toward the edges of its stretch) was left at its edge after turning
+    /// back at a fold of its own, off every stretch followed before (see [`fill_cut`]): that
+    /// branch may go on beyond the point, not followed. Recorded only: it does not count in
+    /// [`Jump::abandons_branch`] nor the run's status (the branch followed on from the jump
+    /// target, which may pass it, is not compared). None otherwise.
     pub fill_cut: Option<GivenUp>,
 }
 
