@@ -7,6 +7,8 @@
 //! linear response with all contacts stuck (closed form, `analysis::linear`), whatever the
 //! frame angles, gap, harmonics or pre-load.
 
+mod support;
+
 use fricbound::analysis::frf::{self, FrfPoint, FrfRun, Silent};
 use fricbound::analysis::limits;
 use fricbound::analysis::linear::{self, LinearCase};
@@ -206,10 +208,77 @@ fn frictionless_contacts_give_the_normal_spring_linear_system() {
 
 /// 25 harmonics with 4096 samples per period: a big harmonic balance (6 DOFs × 51 blocks) must
 /// still follow the whole path.
+///
+/// The path reaches the end frequency, but it abandons a branch on the way: near 254.8 Hz,
+/// having turned back up at a fold onto a branch above those followed there, it wanders
+/// without getting higher and is given up, and the run jumps to the branch found past
+/// 255.05 Hz. Newton from the point given up, just above it (before the jump's frequency),
+/// converges to a solution that no branch of the run holds: that branch is missing there, so
+/// the run is incomplete and says so (it was reported complete before abandoned branches
+/// counted, when only uncovered frequencies did).
 #[test]
-fn many_harmonics_cover_the_range() {
+fn many_harmonics_reach_the_end_but_abandon_a_branch() {
     let p = problem(&["harmonics.max=25", "harmonics.samples=4096"]);
-    solve_complete(&p, "H = 25");
+    let label = "H = 25";
+    let run = frf::solve(&p, &mut Silent).unwrap_or_else(|e| panic!("{label}: {e}"));
+    check_points(&p, &run.points, label);
+    let reason = run.incomplete_reason().expect("an abandoned branch");
+    assert!(reason.contains("a branch was abandoned at"), "{reason}");
+    assert!(
+        run.jumps.iter().all(|j| j.uncovered_hz() == 0.0),
+        "{:?}",
+        run.jumps
+    );
+    let mut solver = frf::PointSolver::new(&p).expect("point solver");
+    for (jump, given_up) in run.abandoned() {
+        let last = &run.points[jump.first_point - 1];
+        let down = given_up
+            .fold_hz
+            .is_some_and(|fold| fold >= given_up.freq_hz);
+        let (f, q) = [5e-4, 2e-4]
+            .iter()
+            .find_map(|offset| {
+                let f = given_up.freq_hz * if down { 1.0 - offset } else { 1.0 + offset };
+                solver.solve(&last.coefficients, f).ok().map(|q| (f, q))
+            })
+            .unwrap_or_else(|| panic!("{label}: Newton past {given_up:?} does not converge"));
+        assert!(
+            f < jump.to_hz.max(jump.from_hz),
+            "{f} Hz is past the jump {jump:?}"
+        );
+        let a = q.amplitudes[0];
+        let crossings = run.crossings(f, 0);
+        assert!(
+            crossings.iter().all(|c| (c.amplitude - a).abs() > 1e-2 * a),
+            "{label}: Newton past the point given up at {} Hz gives {a} m at {f} Hz, on the \
+             run ({:?})",
+            given_up.freq_hz,
+            crossings.iter().map(|c| c.amplitude).collect::<Vec<_>>()
+        );
+    }
+
+    // The CLI on the same scene: exit 3, the status and the jump in solution.json say why,
+    // and the message at the jump says it on stderr.
+    let dir = tempfile::tempdir().unwrap();
+    let out = support::run_scene(
+        &support::scene("full-range.toml"),
+        dir.path(),
+        &["harmonics.max=25", "harmonics.samples=4096"],
+    );
+    let stderr = support::text(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(stderr.contains("ABANDONED"), "{stderr}");
+    let sol = support::json(&dir.path().join("solution.json"));
+    let status = sol["status"].as_str().unwrap_or_default();
+    assert_eq!(status, format!("incomplete: {reason}"));
+    let abandoned: Vec<&serde_json::Value> = sol["jumps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|j| j["abandoned"] == true)
+        .collect();
+    assert_eq!(abandoned.len(), run.abandoned().count(), "{}", sol["jumps"]);
+    assert_eq!(abandoned[0]["before"]["how"], "abandoned");
 }
 
 /// A small initial gap on both contacts (1 µm): the pre-load closes it, and contacts graze
@@ -325,7 +394,8 @@ fn limits_complete(path: &str, overrides: &[&str], label: &str) {
     let analysis = limits::analyse(&p, &settings, |_| {}).unwrap_or_else(|e| panic!("{e}"));
     assert!(
         analysis.is_complete(),
-        "{label}: not every curve is complete"
+        "{label}: not every curve is complete: {:?}",
+        analysis.unfinished()
     );
     for curve in analysis.limits.iter().chain(&analysis.intermediate) {
         let q = curve.case.apply(&p);

@@ -154,6 +154,17 @@ class FrfResult(ContinuationPath):
 
     - ``status``: ``complete`` or ``incomplete: <reason>`` (as ``solution.json``);
     - ``turning_points_hz``, ``leaps_hz``, ``jumps``, ``rejected_steps``, ``elapsed_s``;
+      each jump is a dict ``from_hz``, ``to_hz``, ``first_point``, ``kind``
+      (``past-fold``, ``past-dead-end``, ``bridge``), ``abandoned`` (True when the branch
+      before it was abandoned inside the range: the response beyond its last point is
+      missing and ``status`` is ``incomplete``), ``before`` (``left-range``, ``abandoned``,
+      ``retrace``, ``outside-range``, ``bridge``) and, for a branch given up, ``given_up_hz``,
+      ``given_up_amplitude`` (m), ``given_up_rising``, ``given_up_fold_hz`` and
+      ``given_up_cause`` (``dead-end`` or ``no-progress``; None otherwise), and
+      ``fill_cut_hz``, ``fill_cut_amplitude`` (m), ``fill_cut_fold_hz`` where the branch
+      after the jump (a fill or a bridge), followed toward the edge of its stretch, turned
+      back at a fold of its own and was left (None otherwise; recorded only: it does not set
+      ``abandoned`` nor the status);
     - ``csv``: the run's ``frf.csv`` exactly as the CLI writes it (:meth:`write_csv`).
     """
 

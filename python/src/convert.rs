@@ -269,6 +269,34 @@ pub fn frf_dict<'py>(
                 fricbound::analysis::frf::JumpKind::Bridge => "bridge",
             },
         )?;
+        // How the branch before ended (as `before.how` in solution.json), and where a branch
+        // given up was left: `abandoned` is true when the response beyond it is missing.
+        use fricbound::analysis::frf::BranchEnd;
+        jd.set_item("abandoned", j.abandons_branch())?;
+        let (how, given_up) = match &j.before {
+            BranchEnd::LeftRange => ("left-range", None),
+            BranchEnd::Abandoned(g) => ("abandoned", Some(g)),
+            BranchEnd::Retrace(g) => ("retrace", Some(g)),
+            BranchEnd::OutsideRange(g) => ("outside-range", Some(g)),
+            BranchEnd::Bridge => ("bridge", None),
+        };
+        jd.set_item("before", how)?;
+        jd.set_item("given_up_hz", given_up.map(|g| g.freq_hz))?;
+        jd.set_item("given_up_amplitude", given_up.map(|g| g.amplitude))?;
+        jd.set_item("given_up_rising", given_up.map(|g| g.amplitude_rising))?;
+        jd.set_item("given_up_fold_hz", given_up.and_then(|g| g.fold_hz))?;
+        jd.set_item(
+            "given_up_cause",
+            given_up.map(|g| match g.cause {
+                fricbound::analysis::frf::GiveUpCause::DeadEnd => "dead-end",
+                fricbound::analysis::frf::GiveUpCause::NoProgress => "no-progress",
+                fricbound::analysis::frf::GiveUpCause::FillEnd => "fill-end",
+            }),
+        )?;
+        let cut = j.fill_cut.as_ref();
+        jd.set_item("fill_cut_hz", cut.map(|g| g.freq_hz))?;
+        jd.set_item("fill_cut_amplitude", cut.map(|g| g.amplitude))?;
+        jd.set_item("fill_cut_fold_hz", cut.and_then(|g| g.fold_hz))?;
         jumps.append(jd)?;
     }
     d.set_item("jumps", jumps)?;

@@ -20,7 +20,7 @@ use crate::numerics::linalg::LinearSolveError;
 use crate::numerics::path::NoObserver;
 use crate::numerics::{
     Continuation, ContinuationError, ContinuationSettings, NewtonFailure, Observer,
-    ParametricResidual, PathEnd, PathPoint,
+    ParametricResidual, PathEnd, PathPoint, PathSummary,
 };
 
 /// One converged point of a nonlinear frequency response.
@@ -60,7 +60,10 @@ pub fn accuracy_of(points: &[FrfPoint]) -> Vec<(f64, &PointAccuracy)> {
 /// A jump of an FRF run from one branch to another: where the path turned back at a fold and
 /// did not come back, the run goes on on a branch found past the highest frequency reached, and
 /// solves further branches inside any stretch that neither branch reached.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+///
+/// Serialised (`solution.json`'s `jumps`) with its fields and `abandoned`
+/// ([`Jump::abandons_branch`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Jump {
     /// Highest frequency of the branch before the jump (Hz).
     pub from_hz: f64,
@@ -72,6 +75,147 @@ pub struct Jump {
     pub first_point: usize,
     /// Why the run changed branch.
     pub kind: JumpKind,
+    /// How the branch before the jump ended: followed until it left the range, or given up
+    /// inside it (where and why). [`BranchEnd::Bridge`] for a bridge branch.
+    pub before: BranchEnd,
+    /// Where the branch after the jump (the fill, followed back down toward the fold, or a
+    /// bridge, followed toward the edges of its stretch) was left at its edge after turning
+    /// back at a fold of its own, off every stretch followed before (see [`fill_cut`]): that
+    /// branch may go on beyond the point, not followed. Recorded only: it does not count in
+    /// [`Jump::abandons_branch`] nor the run's status (the branch followed on from the jump
+    /// target, which may pass it, is not compared). None otherwise.
+    pub fill_cut: Option<GivenUp>,
+}
+
+impl serde::Serialize for Jump {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut record = serializer.serialize_struct("Jump", 7)?;
+        record.serialize_field("from_hz", &self.from_hz)?;
+        record.serialize_field("to_hz", &self.to_hz)?;
+        record.serialize_field("first_point", &self.first_point)?;
+        record.serialize_field("kind", &self.kind)?;
+        record.serialize_field("abandoned", &self.abandons_branch())?;
+        record.serialize_field("before", &self.before)?;
+        record.serialize_field("fill_cut", &self.fill_cut)?;
+        record.end()
+    }
+}
+
+/// How the branch before a [`Jump`] ended (`before` in `solution.json`'s jumps, with `how`
+/// one of `left-range`, `abandoned`, `retrace`, `outside-range`, `bridge`).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[serde(rename_all = "kebab-case", tag = "how")]
+pub enum BranchEnd {
+    /// The branch was followed until it left the range below the start frequency
+    /// ([`PathEnd::LeftRangeBelow`]): nothing inside the range was given up on it.
+    LeftRange,
+    /// The path could not be followed on from its last point (a dead end or no progress), and
+    /// that point does not lie on a stretch already followed: the branch beyond it, possibly
+    /// with a resonance peak, was not computed. The run is incomplete.
+    Abandoned(GivenUp),
+    /// The path could not be followed on from its last point, but that point lies on a stretch
+    /// the run had already followed, within [`RETRACE_TOLERANCE`] at the same frequency: the
+    /// path was retracing itself, and nothing was abandoned.
+    Retrace(GivenUp),
+    /// The path could not be followed on from its last point, which lies below the start
+    /// frequency: the branch had run out of the range (as one that left it, but before the
+    /// continuation counted it as gone), so nothing inside the range was abandoned.
+    OutsideRange(GivenUp),
+    /// A bridge branch solved inside an uncovered stretch: the branch before it was not ended
+    /// by the path (see [`JumpKind::Bridge`]).
+    Bridge,
+}
+
+/// Where and why a branch was given up ([`BranchEnd::Abandoned`], [`BranchEnd::Retrace`]).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct GivenUp {
+    /// Frequency of the branch's last point (Hz).
+    pub freq_hz: f64,
+    /// First-harmonic amplitude of the first output there (m).
+    pub amplitude: f64,
+    /// Whether that amplitude was rising along the path into the last point (toward a
+    /// resonance peak the path did not reach).
+    pub amplitude_rising: bool,
+    /// The last fold the path had turned back at on that branch before the point (Hz); None
+    /// when it had not turned back on that branch.
+    pub fold_hz: Option<f64>,
+    /// Why the path could not be followed on.
+    pub cause: GiveUpCause,
+}
+
+/// Why a branch was given up ([`GivenUp`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GiveUpCause {
+    /// [`PathEnd::DeadEnd`]: the corrector failed at every step down to the minimum, and the
+    /// only way on found led back along the path already followed, or behind a fold.
+    DeadEnd,
+    /// [`PathEnd::NoProgress`]: the path wandered back and forth without reaching a higher
+    /// frequency for a fifth of the point budget.
+    NoProgress,
+    /// The fill of a branch past a jump, followed down toward the highest frequency of the
+    /// branch before, turned back up at a fold of its own and stopped on reaching that
+    /// frequency (its end): the branch it was on goes on above ([`Jump::fill_cut`]).
+    FillEnd,
+}
+
+impl GiveUpCause {
+    /// Plain words for a status line.
+    fn words(self) -> &'static str {
+        match self {
+            GiveUpCause::DeadEnd => {
+                "a dead end: the only way on found led back along the path already followed"
+            }
+            GiveUpCause::FillEnd => {
+                "the end of a fill or bridge: the branch, followed toward the edge of the \
+                 stretch it was solved for, turned back at a fold of its own and was followed \
+                 no further"
+            }
+            GiveUpCause::NoProgress => {
+                "no progress: the path wandered back and forth without reaching a higher \
+                 frequency"
+            }
+        }
+    }
+}
+
+/// Relative tolerance on every output's first-harmonic amplitude within which the last point
+/// of a branch given up counts as lying on a stretch already followed ([`BranchEnd::Retrace`]):
+/// another segment of the run's points crossing the same frequency, interpolated linearly,
+/// must match each amplitude to 1 % of it. The sampled contact law makes the solution curve a
+/// chain of pieces meeting at corners, and converged points of neighbouring pieces at one
+/// frequency differ by the sampling: on the paper's system at F0 = 1 N a branch given up at
+/// 151.8405 Hz (3.2333e-4 m) is passed there by the branch solved past it at 3.2285e-4 m
+/// (0.15 %), and Newton from the point given up, just above it, lands on that branch.
+pub const RETRACE_TOLERANCE: f64 = 1e-2;
+
+impl GivenUp {
+    /// "at 886.8455 Hz (first output's amplitude 1.770e-5 m, rising), below the fold at
+    /// 886.8500 Hz where the path had turned back down, by a dead end: …", for status lines
+    /// and messages.
+    pub fn describe(&self) -> String {
+        let trend = if self.amplitude_rising {
+            "rising"
+        } else {
+            "falling"
+        };
+        let side = match self.fold_hz {
+            Some(fold) if fold >= self.freq_hz => {
+                format!(", below the fold at {fold:.4} Hz where the path had turned back down")
+            }
+            Some(fold) => {
+                format!(", above the fold at {fold:.4} Hz where the path had turned back up")
+            }
+            None => String::new(),
+        };
+        format!(
+            "at {:.4} Hz (first output's amplitude {:.3e} m, {trend}){side}, by {}",
+            self.freq_hz,
+            self.amplitude,
+            self.cause.words()
+        )
+    }
 }
 
 /// Why an FRF run changed branch (see [`Jump`]).
@@ -91,6 +235,14 @@ pub enum JumpKind {
 }
 
 impl Jump {
+    /// Whether the branch before the jump was abandoned inside the range
+    /// ([`BranchEnd::Abandoned`]): the response beyond its last point is missing. A
+    /// [`Jump::fill_cut`] is recorded but does not count: at F0 = 5 N on the paper's system
+    /// Newton just past such a cut lands on the branch followed on from the jump target.
+    pub fn abandons_branch(&self) -> bool {
+        matches!(self.before, BranchEnd::Abandoned(_))
+    }
+
     /// Width of the stretch not computed on any branch (Hz); stretches narrower than 10⁻⁹ of
     /// the frequency (round-off of a branch followed onto an end frequency) count as none.
     pub fn uncovered_hz(&self) -> f64 {
@@ -190,9 +342,41 @@ impl FrfRun {
         self.incomplete_reason().is_none()
     }
 
+    /// The jumps whose branch before was abandoned inside the range ([`BranchEnd::Abandoned`]):
+    /// the response beyond each such point on its branch is missing.
+    pub fn abandoned(&self) -> impl Iterator<Item = (&Jump, &GivenUp)> {
+        self.jumps.iter().filter_map(|j| match &j.before {
+            BranchEnd::Abandoned(g) => Some((j, g)),
+            _ => None,
+        })
+    }
+
     /// Why the run did not cover the range (None when it did), for the run's status line
-    /// (`incomplete: <reason>`).
+    /// (`incomplete: <reason>`): the range not reached, the stretches no branch reached, and
+    /// every branch abandoned inside the range ([`BranchEnd::Abandoned`]), whose response
+    /// beyond the point given up (possibly a resonance peak) is missing even though the run
+    /// went on past it.
     pub fn incomplete_reason(&self) -> Option<String> {
+        let abandoned: Vec<String> = self
+            .abandoned()
+            .map(|(j, g)| {
+                format!(
+                    "a branch was abandoned {}; the response beyond that point on that branch \
+                     (possibly the resonance peak) was not computed (the run went on on a \
+                     branch found past {:.4} Hz)",
+                    g.describe(),
+                    j.from_hz
+                )
+            })
+            .collect();
+
+        let coverage = self.coverage_reason();
+        let reasons: Vec<String> = coverage.into_iter().chain(abandoned).collect();
+        (!reasons.is_empty()).then(|| reasons.join("; "))
+    }
+
+    /// Why the run did not reach every frequency of the range (None when it did).
+    fn coverage_reason(&self) -> Option<String> {
         let last = self.points.last().map_or(f64::NAN, |p| p.freq_hz);
         let highest = self
             .points
@@ -607,6 +791,8 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
     };
     let mut start_hz = settings.freq_start_hz;
     loop {
+        let segment_start = adapter.points.len();
+        let segment_fold: Option<f64>;
         let segment = ContinuationSettings {
             freq_start_hz: start_hz,
             max_points: settings.max_points.saturating_sub(adapter.points.len()),
@@ -623,6 +809,7 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
         }
         match outcome {
             Ok(summary) => {
+                segment_fold = summary.turning_points.last().copied();
                 run.turning_points.extend(summary.turning_points);
                 run.rejected_steps += summary.rejected_steps;
                 run.leaps.extend(summary.leaps);
@@ -681,6 +868,16 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
             (budget / 2).min(FILL_POINTS),
             &mut adapter.estimator,
         );
+        let cut = summary.as_ref().and_then(|summary| {
+            fill_cut(
+                &adapter.points,
+                &run.branch_starts(),
+                &fill,
+                true,
+                summary.end,
+                summary.turning_points.last().copied(),
+            )
+        });
         if let Some(summary) = &summary {
             run.turning_points.extend(&summary.turning_points);
             run.rejected_steps += summary.rejected_steps;
@@ -705,17 +902,43 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
                     .max_points
                     .saturating_sub(adapter.points.len() + fill.len())
                     / 2;
-                branching.bridge(&mut system, &top, &bottom, budget, &mut adapter.estimator)
+                branching.bridge(
+                    &mut system,
+                    &top,
+                    &bottom,
+                    budget,
+                    &mut adapter.estimator,
+                    (&adapter.points, &run.branch_starts()),
+                )
             }
             _ => Vec::new(),
         };
+        // How the branch before ended, now that the branches solved past it are known (a
+        // branch given up whose last point one of them passes through abandoned nothing).
+        let later: Vec<&[FrfPoint]> = bridges
+            .iter()
+            .map(|(b, _)| b.as_slice())
+            .chain([fill.as_slice()])
+            .collect();
+        let branch_end = branch_end(
+            &adapter.points,
+            &run.branch_starts(),
+            segment_start,
+            segment_fold,
+            run.end,
+            &later,
+            settings.freq_start_hz,
+        );
         let mut reached = highest;
         let mut kind = if run.end == PathEnd::DeadEnd {
             JumpKind::PastDeadEnd
         } else {
             JumpKind::PastFold
         };
-        for branch in bridges.into_iter().chain([fill]) {
+        let mut before = branch_end;
+        let cuts: Vec<Option<GivenUp>> = bridges.iter().map(|(_, c)| *c).chain([cut]).collect();
+        let branches = bridges.into_iter().map(|(b, _)| b).chain([fill]);
+        for (branch, cut) in branches.zip(cuts) {
             let lowest = branch
                 .iter()
                 .map(|p| p.freq_hz)
@@ -726,6 +949,8 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
                 to_hz: if lowest.is_finite() { lowest } else { freq_hz },
                 first_point: adapter.points.len(),
                 kind,
+                before,
+                fill_cut: cut,
             };
             adapter.observer.jump(&jump);
             run.jumps.push(jump);
@@ -741,6 +966,7 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
                 adapter.points.push(p);
             }
             kind = JumpKind::Bridge;
+            before = BranchEnd::Bridge;
         }
         start_hz = freq_hz;
         guess = x;
@@ -748,6 +974,179 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
     run.points = adapter.points;
     run.elapsed_s = started.elapsed().as_secs_f64();
     Ok(run)
+}
+
+/// How the branch of `points[segment_start..]` ended, for the jump past it: [`PathEnd`] `end`
+/// of its continuation (a turned-back end: left the range, dead end or no progress), and
+/// `fold_hz`, the last turning point of that continuation. A branch given up (dead end, no
+/// progress) is [`BranchEnd::OutsideRange`] when its last point lies below `freq_start_hz`,
+/// [`BranchEnd::Retrace`] when it lies on a stretch already followed
+/// or on one of the branches solved past it (`later`, each a path without jumps; see
+/// [`on_followed_stretch`]), else [`BranchEnd::Abandoned`].
+fn branch_end(
+    points: &[FrfPoint],
+    branch_starts: &[usize],
+    segment_start: usize,
+    fold_hz: Option<f64>,
+    end: PathEnd,
+    later: &[&[FrfPoint]],
+    freq_start_hz: f64,
+) -> BranchEnd {
+    let cause = match end {
+        PathEnd::DeadEnd => GiveUpCause::DeadEnd,
+        PathEnd::NoProgress => GiveUpCause::NoProgress,
+        _ => return BranchEnd::LeftRange,
+    };
+    let Some(last) = points.len().checked_sub(1) else {
+        return BranchEnd::LeftRange;
+    };
+    let amplitude = points[last].amplitudes.first().copied().unwrap_or(f64::NAN);
+    let amplitude_rising = last > segment_start
+        && points[last - 1]
+            .amplitudes
+            .first()
+            .is_some_and(|&a| amplitude > a);
+    let given_up = GivenUp {
+        freq_hz: points[last].freq_hz,
+        amplitude,
+        amplitude_rising,
+        fold_hz,
+        cause,
+    };
+    if given_up.freq_hz < freq_start_hz {
+        BranchEnd::OutsideRange(given_up)
+    } else if on_followed_stretch(points, branch_starts, last, later) {
+        BranchEnd::Retrace(given_up)
+    } else {
+        BranchEnd::Abandoned(given_up)
+    }
+}
+
+/// Whether point `last` of `points` (the last point of a branch given up) lies on a stretch of
+/// path followed elsewhere: some segment between consecutive points, within a branch (not
+/// across a jump at `branch_starts`) and before the last monotone stretch that leads into
+/// `last` (which crosses its frequency trivially), or within one of the paths `later`,
+/// brackets its frequency with every output's linearly interpolated amplitude within
+/// [`RETRACE_TOLERANCE`] of the point's.
+fn on_followed_stretch(
+    points: &[FrfPoint],
+    branch_starts: &[usize],
+    last: usize,
+    later: &[&[FrfPoint]],
+) -> bool {
+    // The monotone stretch into `last`: back while the frequency keeps moving the same way.
+    let mut stretch_start = last;
+    if last > 0 {
+        let direction = (points[last].freq_hz - points[last - 1].freq_hz).signum();
+        stretch_start = last - 1;
+        while stretch_start > 0
+            && !branch_starts.contains(&stretch_start)
+            && (points[stretch_start].freq_hz - points[stretch_start - 1].freq_hz).signum()
+                == direction
+        {
+            stretch_start -= 1;
+        }
+    }
+    // The run's points up to the start of that stretch, cut at the branch starts.
+    let mut cuts: Vec<usize> = branch_starts
+        .iter()
+        .copied()
+        .filter(|&b| b > 0 && b <= stretch_start)
+        .collect();
+    cuts.sort_unstable();
+    cuts.dedup();
+    let mut paths: Vec<&[FrfPoint]> = Vec::new();
+    let mut from = 0;
+    for cut in cuts {
+        paths.push(&points[from..cut]);
+        from = cut;
+    }
+    paths.push(&points[from..=stretch_start]);
+    paths.extend_from_slice(later);
+    passes_through(&paths, &points[last])
+}
+
+/// Whether some segment between consecutive points of one of `paths` brackets `target`'s
+/// frequency with every output's linearly interpolated amplitude within
+/// [`RETRACE_TOLERANCE`] of `target`'s.
+fn passes_through(paths: &[&[FrfPoint]], target: &FrfPoint) -> bool {
+    paths.iter().any(|path| {
+        path.windows(2).any(|w| {
+            let (p, q) = (&w[0], &w[1]);
+            if (p.freq_hz - target.freq_hz) * (q.freq_hz - target.freq_hz) > 0.0
+                || p.freq_hz == q.freq_hz
+            {
+                return false;
+            }
+            let t = (target.freq_hz - p.freq_hz) / (q.freq_hz - p.freq_hz);
+            target.amplitudes.iter().enumerate().all(|(o, &a)| {
+                let on_segment = p.amplitudes[o] + t * (q.amplitudes[o] - p.amplitudes[o]);
+                (on_segment - a).abs() <= RETRACE_TOLERANCE * a.abs()
+            })
+        })
+    })
+}
+
+/// Where the fill of a branch past a jump (`fill`, in path order from the jump target down
+/// toward the highest frequency of the branch before) was left on a branch that goes on:
+/// when its last step heads up (it turned back at a fold of its own, the last at `fold_hz`,
+/// and stopped on reaching its end frequency: `end`), the branch goes on above its last
+/// point, which no continuation follows. None when it ended heading down, or otherwise than at
+/// its end frequency, or when its last point lies on the run's `points`
+/// before the jump (within a branch at `branch_starts`, see [`passes_through`]).
+///
+/// A bridge branch is followed the same way from inside a stretch toward each of its edges
+/// (`travel_down` false for the way up: then a last step heading down is the cut).
+fn fill_cut(
+    points: &[FrfPoint],
+    branch_starts: &[usize],
+    fill: &[FrfPoint],
+    travel_down: bool,
+    end: PathEnd,
+    fold_hz: Option<f64>,
+) -> Option<GivenUp> {
+    let [.., before, last] = fill else {
+        return None;
+    };
+    let heading_up = last.freq_hz > before.freq_hz;
+    if last.freq_hz == before.freq_hz || heading_up != travel_down {
+        return None;
+    }
+    // Only a branch that reached its edge is judged: one given up on the way (a dead end, no
+    // progress) may be passed by the branch followed on from the jump target, which comes
+    // later and is not compared (at F0 = 1 N on the paper's system such a fill ends at
+    // 152.2176 Hz); not classified yet.
+    let cause = match end {
+        PathEnd::EndFrequency => GiveUpCause::FillEnd,
+        PathEnd::DeadEnd | PathEnd::NoProgress | PathEnd::LeftRangeBelow | PathEnd::MaxPoints => {
+            return None
+        }
+    };
+    let mut cuts: Vec<usize> = branch_starts
+        .iter()
+        .copied()
+        .filter(|&b| b > 0 && b < points.len())
+        .collect();
+    cuts.sort_unstable();
+    cuts.dedup();
+    let mut paths: Vec<&[FrfPoint]> = Vec::new();
+    let mut from = 0;
+    for cut in cuts {
+        paths.push(&points[from..cut]);
+        from = cut;
+    }
+    paths.push(&points[from..]);
+    if passes_through(&paths, last) {
+        return None;
+    }
+    let amplitude = last.amplitudes.first().copied().unwrap_or(f64::NAN);
+    Some(GivenUp {
+        freq_hz: last.freq_hz,
+        amplitude,
+        amplitude_rising: before.amplitudes.first().is_some_and(|&a| amplitude > a),
+        fold_hz,
+        cause,
+    })
 }
 
 /// Point budget of each direction of a bridge branch (see [`Branching::bridge`]).
@@ -785,7 +1184,7 @@ impl Branching<'_> {
         to_hz: f64,
         max_points: usize,
         estimator: &mut Option<ErrorEstimator<'e>>,
-    ) -> (Vec<FrfPoint>, Option<crate::numerics::PathSummary>) {
+    ) -> (Vec<FrfPoint>, Option<PathSummary>) {
         let settings = ContinuationSettings {
             freq_start_hz: from_hz,
             freq_end_hz: to_hz,
@@ -824,8 +1223,9 @@ impl Branching<'_> {
         above: &FrfPoint,
         budget: usize,
         estimator: &mut Option<ErrorEstimator<'e>>,
-    ) -> Vec<Vec<FrfPoint>> {
-        let mut branches: Vec<Vec<FrfPoint>> = Vec::new();
+        (followed, branch_starts): (&[FrfPoint], &[usize]),
+    ) -> Vec<(Vec<FrfPoint>, Option<GivenUp>)> {
+        let mut branches: Vec<(Vec<FrfPoint>, Option<GivenUp>)> = Vec::new();
         let mut gaps = vec![(below.clone(), above.clone())];
         let mut used = 0;
         let solver = Continuation::new(self.settings, self.x_scale.to_vec());
@@ -837,8 +1237,23 @@ impl Branching<'_> {
                 continue;
             };
             let per_side = BRIDGE_POINTS.min((budget - used) / 2);
-            let (mut down, _) = self.follow(system, &x, freq_hz, lo.freq_hz, per_side, estimator);
-            let (up, _) = self.follow(system, &x, freq_hz, hi.freq_hz, per_side, estimator);
+            let (mut down, down_end) =
+                self.follow(system, &x, freq_hz, lo.freq_hz, per_side, estimator);
+            let (up, up_end) = self.follow(system, &x, freq_hz, hi.freq_hz, per_side, estimator);
+            // Either way turned back at a fold of its own before its edge: cut there.
+            let cut_of = |side: &[FrfPoint], travel_down: bool, end: &Option<PathSummary>| {
+                end.as_ref().and_then(|summary| {
+                    fill_cut(
+                        followed,
+                        branch_starts,
+                        side,
+                        travel_down,
+                        summary.end,
+                        summary.turning_points.last().copied(),
+                    )
+                })
+            };
+            let cut = cut_of(&down, true, &down_end).or(cut_of(&up, false, &up_end));
             down.reverse();
             // Both directions start with the point at `freq_hz`: keep one.
             let branch: Vec<FrfPoint> = down.into_iter().chain(up.into_iter().skip(1)).collect();
@@ -854,6 +1269,8 @@ impl Branching<'_> {
                 to_hz: low.freq_hz,
                 first_point: 0,
                 kind: JumpKind::Bridge,
+                before: BranchEnd::Bridge,
+                fill_cut: None,
             };
             if gap_below.uncovered_hz() > 0.0 {
                 gaps.push((lo.clone(), low.clone()));
@@ -866,9 +1283,9 @@ impl Branching<'_> {
             if gap_above.uncovered_hz() > 0.0 {
                 gaps.push((high.clone(), hi.clone()));
             }
-            branches.push(branch);
+            branches.push((branch, cut));
         }
-        branches.sort_by(|a, b| a[0].freq_hz.total_cmp(&b[0].freq_hz));
+        branches.sort_by(|(a, _), (b, _)| a[0].freq_hz.total_cmp(&b[0].freq_hz));
         branches
     }
 }
@@ -1288,6 +1705,8 @@ mod tests {
             to_hz: 97.0,
             first_point: 11,
             kind: JumpKind::PastFold,
+            before: BranchEnd::LeftRange,
+            fill_cut: None,
         }]);
         reference.points = points;
         let point = FrfPoint {
@@ -1321,6 +1740,8 @@ mod tests {
             to_hz,
             first_point: 0,
             kind: JumpKind::PastFold,
+            before: BranchEnd::LeftRange,
+            fill_cut: None,
         };
         assert!(run_with_jumps(vec![jump(66.0, 66.0)]).is_complete());
         assert!(run_with_jumps(vec![jump(66.0, 66.0 + 1e-12)]).is_complete());
@@ -1328,5 +1749,257 @@ mod tests {
         assert!(!gap.is_complete());
         let reason = gap.incomplete_reason().unwrap();
         assert!(reason.contains("151.8400-152.1400 Hz"), "{reason}");
+    }
+
+    /// The synthetic path of a branch rising along A = 1 + 0.1 (f − 100) from 100 to 110 Hz
+    /// (one point per Hz), then turned back at the fold at 110 Hz onto `back`: (Hz, amplitude)
+    /// points followed down.
+    fn folded_path(back: &[(f64, f64)]) -> Vec<FrfPoint> {
+        (0..=10)
+            .map(|k| {
+                let f = 100.0 + k as f64;
+                line_point(f, 1.0 + 0.1 * (f - 100.0), 0.0)
+            })
+            .chain(back.iter().map(|&(f, a)| line_point(f, a, 0.0)))
+            .collect()
+    }
+
+    /// A branch given up by a dead end on the middle branch past a fold, its amplitude rising
+    /// away from the upper branch it turned back from, is abandoned: the jump records where
+    /// (last point, first output's amplitude, the fold) and why, and the run that went on to the
+    /// end frequency past it is incomplete, saying so; its JSON record says `abandoned`.
+    #[test]
+    fn a_branch_abandoned_past_a_fold_makes_the_run_incomplete() {
+        let points = folded_path(&[(109.5, 2.5), (109.0, 3.0)]);
+        let end = branch_end(&points, &[], 0, Some(110.0), PathEnd::DeadEnd, &[], 0.0);
+        let BranchEnd::Abandoned(given_up) = end else {
+            panic!("{end:?}");
+        };
+        assert_eq!(given_up.freq_hz, 109.0);
+        assert_eq!(given_up.amplitude, 3.0);
+        assert!(given_up.amplitude_rising);
+        assert_eq!(given_up.fold_hz, Some(110.0));
+        assert_eq!(given_up.cause, GiveUpCause::DeadEnd);
+        let mut run = run_with_jumps(vec![Jump {
+            from_hz: 110.0,
+            to_hz: 110.0,
+            first_point: points.len(),
+            kind: JumpKind::PastDeadEnd,
+            before: end,
+            fill_cut: None,
+        }]);
+        run.points = points;
+        assert!(!run.is_complete());
+        let reason = run.incomplete_reason().unwrap();
+        for words in [
+            "abandoned at 109.0000 Hz",
+            "amplitude 3.000e0 m, rising",
+            "below the fold at 110.0000 Hz",
+            "dead end",
+            "possibly the resonance peak",
+            "past 110.0000 Hz",
+        ] {
+            assert!(reason.contains(words), "{words:?} not in {reason}");
+        }
+        let json = serde_json::to_value(run.jumps[0]).unwrap();
+        assert_eq!(json["abandoned"], true);
+        assert_eq!(json["before"]["how"], "abandoned");
+        assert_eq!(json["before"]["freq_hz"], 109.0);
+        assert_eq!(json["before"]["cause"], "dead-end");
+        // An uncovered stretch is reported with it.
+        run.jumps[0].to_hz = 111.0;
+        let reason = run.incomplete_reason().unwrap();
+        assert!(reason.contains("110.0000-111.0000 Hz") && reason.contains("abandoned at"));
+    }
+
+    /// A branch given up where it was retracing the stretch already followed (the points
+    /// after the fold lie back on the rising branch, within 1 % of its amplitude) abandoned
+    /// nothing: the run stays complete. Just outside the tolerance it is abandoned.
+    #[test]
+    fn a_branch_given_up_on_a_stretch_already_followed_is_a_retrace() {
+        for cause in [PathEnd::DeadEnd, PathEnd::NoProgress] {
+            let on_line = |f: f64| 1.0 + 0.1 * (f - 100.0);
+            let points = folded_path(&[(109.5, on_line(109.5)), (108.5, on_line(108.5) * 1.009)]);
+            let end = branch_end(&points, &[], 0, Some(110.0), cause, &[], 0.0);
+            assert!(matches!(end, BranchEnd::Retrace(_)), "{end:?}");
+            let mut run = run_with_jumps(vec![Jump {
+                from_hz: 110.0,
+                to_hz: 110.0,
+                first_point: points.len(),
+                kind: JumpKind::PastFold,
+                before: end,
+                fill_cut: None,
+            }]);
+            run.points = points;
+            assert!(run.is_complete(), "{:?}", run.incomplete_reason());
+            assert!(!run.jumps[0].abandons_branch());
+
+            let off = folded_path(&[(109.5, on_line(109.5)), (108.5, on_line(108.5) * 1.011)]);
+            let end = branch_end(&off, &[], 0, Some(110.0), cause, &[], 0.0);
+            assert!(matches!(end, BranchEnd::Abandoned(_)), "{end:?}");
+        }
+    }
+
+    /// The stretch followed on another branch counts too, but not a segment across a jump; a
+    /// branch given up while still rising (no fold) is abandoned with no fold named, one that
+    /// left the range below the start abandoned nothing.
+    #[test]
+    fn retraces_are_sought_within_branches_and_a_left_range_abandons_nothing() {
+        // Branch 1: 100..110 Hz on the line; branch 2 (from index 11): 112 Hz down to
+        // 105 Hz on a line with amplitude 5, then up again to 106 Hz at the first line's
+        // amplitude: the segment across the jump (110 Hz, 2) to (112 Hz, 5) does not count.
+        let mut points = folded_path(&[]);
+        points.push(line_point(112.0, 5.0, 0.0));
+        points.push(line_point(105.0, 5.0, 0.0));
+        points.push(line_point(106.0, 1.6, 0.0));
+        let end = branch_end(
+            &points,
+            &[11],
+            11,
+            Some(105.0),
+            PathEnd::NoProgress,
+            &[],
+            0.0,
+        );
+        let BranchEnd::Retrace(g) = end else {
+            panic!("{end:?}")
+        };
+        assert_eq!(g.cause, GiveUpCause::NoProgress);
+        assert!(g.describe().contains("above the fold at 105.0000 Hz"));
+        // At 111 Hz only the segment across the jump, (110 Hz, 2) to (112 Hz, 5), passes
+        // through the point's amplitude 3.5: not a stretch followed.
+        points.pop();
+        points.push(line_point(111.0, 3.5, 0.0));
+        let end = branch_end(
+            &points,
+            &[11],
+            11,
+            Some(105.0),
+            PathEnd::NoProgress,
+            &[],
+            0.0,
+        );
+        assert!(matches!(end, BranchEnd::Abandoned(_)), "{end:?}");
+
+        let rising = folded_path(&[]);
+        let end = branch_end(&rising, &[], 0, None, PathEnd::DeadEnd, &[], 0.0);
+        let BranchEnd::Abandoned(g) = end else {
+            panic!("{end:?}")
+        };
+        assert_eq!((g.freq_hz, g.fold_hz), (110.0, None));
+        assert!(!g.describe().contains("fold"));
+        // A branch solved past it (here a fill from 109 to 111 Hz) passing through the point
+        // within the tolerance: the branch goes on there, nothing was abandoned.
+        let fill = [line_point(109.0, 1.9, 0.0), line_point(111.0, 2.1, 0.0)];
+        let end = branch_end(&rising, &[], 0, None, PathEnd::DeadEnd, &[&fill], 0.0);
+        assert!(matches!(end, BranchEnd::Retrace(_)), "{end:?}");
+        let fill = [line_point(109.0, 1.9, 0.0), line_point(111.0, 2.2, 0.0)];
+        let end = branch_end(&rising, &[], 0, None, PathEnd::DeadEnd, &[&fill], 0.0);
+        assert!(matches!(end, BranchEnd::Abandoned(_)), "{end:?}");
+        // Given up below the start frequency: outside the range, nothing in it abandoned.
+        let end = branch_end(&rising, &[], 0, None, PathEnd::DeadEnd, &[], 110.5);
+        assert!(matches!(end, BranchEnd::OutsideRange(_)), "{end:?}");
+        let mut run = run_with_jumps(vec![Jump {
+            from_hz: 110.0,
+            to_hz: 110.0,
+            first_point: rising.len(),
+            kind: JumpKind::PastDeadEnd,
+            before: end,
+            fill_cut: None,
+        }]);
+        run.points = rising.clone();
+        assert!(run.is_complete(), "{:?}", run.incomplete_reason());
+        assert_eq!(
+            branch_end(
+                &rising,
+                &[],
+                0,
+                Some(110.0),
+                PathEnd::LeftRangeBelow,
+                &[],
+                0.0
+            ),
+            BranchEnd::LeftRange
+        );
+    }
+
+    /// The fill of the branch past a jump, followed from 115 Hz down toward 110 Hz (the highest
+    /// frequency of the branch before, on A = 1 + 0.1 (f − 100)), turns back up at a fold of its
+    /// own at 109.5 Hz and stops on reaching 110 Hz at amplitude 3.5, off the branch before: cut
+    /// (recorded in the jump, not in the status). Heading down at its end, or ending on the
+    /// branch before, it is not.
+    #[test]
+    fn a_fill_that_turned_back_up_off_the_path_followed_is_cut() {
+        let points = folded_path(&[]);
+        let fill = [
+            line_point(115.0, 3.0, 0.0),
+            line_point(112.0, 3.3, 0.0),
+            line_point(109.5, 3.6, 0.0),
+            line_point(110.0, 3.5, 0.0),
+        ];
+        let cut = fill_cut(
+            &points,
+            &[],
+            &fill,
+            true,
+            PathEnd::EndFrequency,
+            Some(109.5),
+        )
+        .unwrap();
+        assert_eq!((cut.freq_hz, cut.amplitude), (110.0, 3.5));
+        assert!(!cut.amplitude_rising);
+        assert_eq!(cut.cause, GiveUpCause::FillEnd);
+        assert!(cut.describe().contains("above the fold at 109.5000 Hz"));
+        let mut run = run_with_jumps(vec![Jump {
+            from_hz: 110.0,
+            to_hz: 109.5,
+            first_point: points.len(),
+            kind: JumpKind::PastFold,
+            before: BranchEnd::LeftRange,
+            fill_cut: Some(cut),
+        }]);
+        run.points = points.clone();
+        // Recorded, not counted in the status (see `Jump::abandons_branch`).
+        assert!(run.is_complete(), "{:?}", run.incomplete_reason());
+        let json = serde_json::to_value(run.jumps[0]).unwrap();
+        assert_eq!(json["abandoned"], false);
+        assert_eq!(json["fill_cut"]["freq_hz"], 110.0);
+        assert_eq!(json["fill_cut"]["cause"], "fill-end");
+        // Heading down at its end: the fill reached the fold's frequency from above.
+        assert_eq!(
+            fill_cut(&points, &[], &fill[..3], true, PathEnd::EndFrequency, None),
+            None
+        );
+        // Back on the branch before (A = 2 at 110 Hz): nothing cut.
+        let mut onto = fill.clone();
+        onto[3] = line_point(110.0, 2.0, 0.0);
+        assert_eq!(
+            fill_cut(
+                &points,
+                &[],
+                &onto,
+                true,
+                PathEnd::EndFrequency,
+                Some(109.5)
+            ),
+            None
+        );
+        // A bridge's way up that turned back down at a fold of its own before its edge.
+        let up = [
+            line_point(104.0, 3.0, 0.0),
+            line_point(106.0, 3.2, 0.0),
+            line_point(105.5, 3.3, 0.0),
+        ];
+        let cut = fill_cut(&points, &[], &up, false, PathEnd::EndFrequency, Some(106.0));
+        assert!(cut.is_some_and(|g| g.freq_hz == 105.5 && g.amplitude_rising));
+        assert_eq!(
+            fill_cut(&points, &[], &up[..2], false, PathEnd::EndFrequency, None),
+            None
+        );
+        // Left the range or out of points: not a cut.
+        assert_eq!(
+            fill_cut(&points, &[], &fill, true, PathEnd::MaxPoints, Some(109.5)),
+            None
+        );
     }
 }

@@ -36,7 +36,7 @@ use std::path::{Path, PathBuf};
 use indicatif::{ProgressBar, ProgressStyle};
 use sha2::{Digest, Sha256};
 
-use crate::analysis::frf::{self, FrfError, FrfObserver, FrfPoint, Jump, JumpKind};
+use crate::analysis::frf::{self, BranchEnd, FrfError, FrfObserver, FrfPoint, Jump, JumpKind};
 use crate::analysis::limits::LimitSettings;
 use crate::analysis::linear::{self, LinearCase};
 use crate::analysis::peaks::{self, ExtremumKind};
@@ -335,6 +335,34 @@ impl FrfObserver for RunObserver<'_> {
         } else {
             String::new()
         };
+        let before = match &jump.before {
+            BranchEnd::Abandoned(g) => format!(
+                "\nthe branch before it was ABANDONED {}: the response beyond that point on \
+                 that branch (possibly the resonance peak) is missing, and the run will be \
+                 reported incomplete",
+                g.describe()
+            ),
+            BranchEnd::Retrace(g) => format!(
+                "\nthe branch before it was given up {}, on a stretch already followed (a \
+                 retrace): nothing is missing there",
+                g.describe()
+            ),
+            BranchEnd::OutsideRange(g) => format!(
+                "\nthe branch before it was given up {}, below the start frequency: nothing \
+                 inside the range is missing there",
+                g.describe()
+            ),
+            BranchEnd::LeftRange | BranchEnd::Bridge => String::new(),
+        };
+        let before = match &jump.fill_cut {
+            Some(g) => format!(
+                "{before}\nthe branch past it (a fill or bridge) was left at its edge {}: it may \
+                 go on beyond {:.4} Hz, not followed (recorded as the jump's fill_cut)",
+                g.describe(),
+                g.freq_hz
+            ),
+            None => before,
+        };
         let msg = match jump.kind {
             JumpKind::PastFold => format!(
                 "the path turned back at a fold below {:.4} Hz and did not return: it goes on \
@@ -351,7 +379,7 @@ impl FrfObserver for RunObserver<'_> {
                  previous branch reached {:.4} Hz){uncovered}",
                 jump.to_hz, jump.from_hz
             ),
-        };
+        } + &before;
         match &self.bar {
             Some(bar) if !bar.is_hidden() => bar.println(msg),
             _ => eprintln!("{msg}"),

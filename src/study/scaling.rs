@@ -296,7 +296,8 @@ pub struct SolveMeasure {
     pub points: usize,
     /// Newton iterations (FRF runs).
     pub iterations: usize,
-    /// Whether the FRF reached the end of its window within `max_points`.
+    /// Whether the FRF covered its window within `max_points` (`FrfRun::is_complete`: the end
+    /// reached, no stretch on no branch, no branch abandoned inside it).
     pub complete: bool,
     /// Wall time of the FRF (s; FRF runs).
     pub frf_s: f64,
@@ -489,7 +490,7 @@ pub fn measure_solve(
         let outcome = frf::solve(p, &mut Collect(&mut points));
         m.frf_s = started.elapsed().as_secs_f64();
         m.points = points.len();
-        m.complete = outcome.is_ok_and(|run| run.end == crate::numerics::PathEnd::EndFrequency);
+        m.complete = outcome.is_ok_and(|run| run.is_complete());
         m.iterations = points.iter().map(|q| q.newton_iterations).sum();
         m.per_point_ms = 1e3 * m.frf_s / m.points.max(1) as f64;
         m.frf_iteration_ms = 1e3 * m.frf_s / m.iterations.max(1) as f64;

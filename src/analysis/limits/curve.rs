@@ -15,7 +15,10 @@ pub enum CurveStatus {
     /// The path reached the end frequency.
     Complete,
     /// The path ended before the end frequency (point budget used up, left the range below the
-    /// start, no progress) with every step setting tried; `reason` says where and why.
+    /// start, no progress), or left a stretch of the range uncovered, or abandoned a branch
+    /// inside the range (the response beyond the point given up is missing, see
+    /// `frf::BranchEnd::Abandoned`), with every step setting tried; `reason` says where and
+    /// why.
     Incomplete {
         /// Why the range was not covered (see `FrfRun::incomplete_reason`).
         reason: String,

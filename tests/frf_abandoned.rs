@@ -1,0 +1,165 @@
+//! Branches the FRF's continuation gave up (a dead end or no progress) before jumping past the
+//! highest frequency reached: how each jump records the branch before it, checked against an
+//! independent fixed-frequency Newton solve from the point given up, and the run's status.
+//!
+//! - `tests/data/liftoff-fold.toml` (1 DOF with a one-sided contact): the path bounces between
+//!   two corners of the sampled law at 32.07 and 32.52 Hz and is given up at 32.52 Hz on the
+//!   stretch it had followed already: a retrace, the run stays complete.
+//! - The paper's system at F0 = 1 N (50-350 Hz): every branch given up is classified, and each
+//!   classification is checked by Newton at a frequency just past the point given up (in the
+//!   direction the path was going), seeded from that point.
+
+mod support;
+
+use std::path::Path;
+
+use fricbound::analysis::frf::{self, BranchEnd, FrfRun, GivenUp, PointSolver, Silent};
+use fricbound::model::Problem;
+use fricbound::scene::{self, paper_wedge_scene};
+
+use support::{json, run_scene, text};
+
+fn liftoff_fold() -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/liftoff-fold.toml")
+        .display()
+        .to_string()
+}
+
+fn paper(overrides: &[&str]) -> Problem {
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    scene::parse(paper_wedge_scene(), "paper", &overrides)
+        .and_then(|s| s.validate("paper"))
+        .unwrap_or_else(|e| panic!("{overrides:?}: {e}"))
+}
+
+/// The points given up of a run, with the index of each one's point in the run.
+fn given_up(run: &FrfRun) -> Vec<(BranchEnd, GivenUp, usize)> {
+    run.jumps
+        .iter()
+        .filter_map(|j| match j.before {
+            BranchEnd::Abandoned(g) | BranchEnd::Retrace(g) | BranchEnd::OutsideRange(g) => {
+                Some((j.before, g, j.first_point - 1))
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+/// Newton at fixed frequencies just past the point given up (0.05 %, 0.2 %, 1 % of its
+/// frequency, in the direction the path was going: down when it had turned back down at its
+/// fold), from that point's coefficients: the first converged amplitude of the first output
+/// and its frequency, and whether some branch of the run crosses that frequency within 1 % of
+/// that amplitude. None when Newton converges at none of them.
+fn newton_past(p: &Problem, run: &FrfRun, g: &GivenUp, index: usize) -> Option<(f64, f64, bool)> {
+    let down = g.fold_hz.is_some_and(|fold| fold >= g.freq_hz);
+    let mut solver = PointSolver::new(p).expect("point solver");
+    for offset in [5e-4, 2e-3, 1e-2] {
+        let f = g.freq_hz * if down { 1.0 - offset } else { 1.0 + offset };
+        if let Ok(q) = solver.solve(&run.points[index].coefficients, f) {
+            let a = q.amplitudes[0];
+            let on_run = run
+                .crossings(f, 0)
+                .iter()
+                .any(|c| (c.amplitude - a).abs() <= 1e-2 * a);
+            return Some((f, a, on_run));
+        }
+    }
+    None
+}
+
+/// The lift-off oscillator's path is given up at a dead end at 32.52 Hz, on the stretch
+/// between two corners that it had followed twice already: a retrace, so the run, which jumped
+/// past the fold at 51.46 Hz and reached 60 Hz, is complete, and the CLI says so (exit 0,
+/// `before.how` = `retrace`, `abandoned` false).
+#[test]
+fn a_dead_end_on_a_stretch_already_followed_abandons_nothing() {
+    let (_, p) = scene::load_problem(
+        Path::new(&liftoff_fold()),
+        &["analysis.stability=false".to_string()],
+    )
+    .unwrap();
+    let run = frf::solve(&p, &mut Silent).unwrap();
+    assert!(run.is_complete(), "{:?}", run.incomplete_reason());
+    let given = given_up(&run);
+    assert_eq!(given.len(), 1, "{:?}", run.jumps);
+    let (end, g, _) = given[0];
+    assert!(matches!(end, BranchEnd::Retrace(_)), "{end:?}");
+    assert!((g.freq_hz - 32.52).abs() < 0.01, "{g:?}");
+
+    let dir = tempfile::tempdir().unwrap();
+    let out = run_scene(&liftoff_fold(), dir.path(), &["analysis.stability=false"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let sol = json(&dir.path().join("solution.json"));
+    assert_eq!(sol["status"], "complete");
+    let jump = &sol["jumps"][0];
+    assert_eq!(jump["kind"], "past-dead-end");
+    assert_eq!(jump["abandoned"], false);
+    assert_eq!(jump["before"]["how"], "retrace");
+    assert!(
+        text(&out.stderr).contains("a retrace"),
+        "{}",
+        text(&out.stderr)
+    );
+}
+
+/// At F0 = 1 N every branch given up is classified, and the classification agrees with Newton
+/// from the point given up at a frequency just past it: a branch abandoned inside the range
+/// leads to a solution no branch of the run holds; a retrace to one the run holds. One given
+/// up below the start frequency (50 Hz) is outside the range. The CLI's exit code and
+/// `solution.json` say the same.
+#[test]
+fn branches_given_up_at_a_low_preload_are_classified_as_newton_finds_them() {
+    let p = paper(&["static_loads.0.value=-1"]);
+    let run = frf::solve(&p, &mut Silent).unwrap();
+    let given = given_up(&run);
+    assert!(!given.is_empty(), "{:?}", run.jumps);
+    for (end, g, index) in &given {
+        let newton = newton_past(&p, &run, g, *index);
+        eprintln!("{end:?}: Newton past it {newton:?}");
+        match end {
+            BranchEnd::OutsideRange(_) => assert!(g.freq_hz < 50.0),
+            BranchEnd::Abandoned(_) => {
+                let (f, a, on_run) = newton.expect("Newton converges past the point");
+                assert!(!on_run, "{a} m at {f} Hz lies on the run");
+            }
+            BranchEnd::Retrace(_) => {
+                if let Some((f, a, on_run)) = newton {
+                    assert!(on_run, "{a} m at {f} Hz is on no branch of the run");
+                }
+            }
+            _ => unreachable!(),
+        }
+    }
+    let abandoned = run.jumps.iter().filter(|j| j.abandons_branch()).count();
+    assert_eq!(run.is_complete(), abandoned == 0);
+
+    let dir = tempfile::tempdir().unwrap();
+    let scene_file = dir.path().join("paper.toml");
+    std::fs::write(&scene_file, paper_wedge_scene()).unwrap();
+    let out_dir = dir.path().join("out");
+    let out = run_scene(
+        scene_file.to_str().unwrap(),
+        &out_dir,
+        &["static_loads.0.value=-1"],
+    );
+    let sol = json(&out_dir.join("solution.json"));
+    let status = sol["status"].as_str().unwrap().to_string();
+    let flagged = sol["jumps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|j| j["abandoned"] == true)
+        .count();
+    assert_eq!(flagged, abandoned, "{}", sol["jumps"]);
+    if abandoned > 0 {
+        assert_eq!(out.status.code(), Some(3), "{}", text(&out.stderr));
+        assert!(
+            status.starts_with("incomplete: ") && status.contains("a branch was abandoned at"),
+            "{status}"
+        );
+        assert!(text(&out.stderr).contains("ABANDONED"));
+    } else {
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    }
+}
