@@ -2,7 +2,7 @@
 //! steps when it fails or stops early), its resonance peak, and how it ended
 //! ([`CurveStatus`]): a case that does not cover the range keeps the points it finished.
 
-use crate::analysis::frf::{self, FrfObserver, FrfPoint};
+use crate::analysis::frf::{self, FrfObserver, FrfPoint, Jump};
 use crate::model::Problem;
 
 use super::case::LimitCase;
@@ -65,6 +65,9 @@ pub struct CaseCurve {
     pub points: Vec<FrfPoint>,
     /// Turning-point frequencies of the path (Hz).
     pub turning_points: Vec<f64>,
+    /// Jumps of the path to other branches, with how the branch before each ended
+    /// ([`Jump`]; `first_point` indexes `points`).
+    pub jumps: Vec<Jump>,
     /// Resonance peak of the first output DOF in the peak window; `None` when no finished point
     /// lies in it.
     pub peak: Option<Peak>,
@@ -93,6 +96,7 @@ const STEP_RETRIES: [f64; 4] = [1.0, 0.5, 0.25, 2.0];
 struct Collect {
     points: Vec<FrfPoint>,
     turning_points: Vec<f64>,
+    jumps: Vec<Jump>,
 }
 
 impl FrfObserver for Collect {
@@ -102,12 +106,16 @@ impl FrfObserver for Collect {
     fn turning_point(&mut self, freq_hz: f64) {
         self.turning_points.push(freq_hz);
     }
+    fn jump(&mut self, jump: &Jump) {
+        self.jumps.push(*jump);
+    }
 }
 
 /// One attempt: its points, turning points and status (before the peak is sought).
 struct Attempt {
     points: Vec<FrfPoint>,
     turning_points: Vec<f64>,
+    jumps: Vec<Jump>,
     status: CurveStatus,
 }
 
@@ -148,10 +156,12 @@ pub fn attempt_case(problem: &Problem, case: &LimitCase, window: Option<(f64, f6
                 },
                 points: run.points,
                 turning_points: run.turning_points,
+                jumps: run.jumps,
             },
             Err(source) => Attempt {
                 points: collect.points,
                 turning_points: collect.turning_points,
+                jumps: collect.jumps,
                 status: CurveStatus::Failed {
                     error: LimitError::Curve {
                         case: case.name.clone(),
@@ -201,6 +211,7 @@ pub fn attempt_case(problem: &Problem, case: &LimitCase, window: Option<(f64, f6
         case: case.clone(),
         points: attempt.points,
         turning_points: attempt.turning_points,
+        jumps: attempt.jumps,
         peak,
         retries,
         status,
