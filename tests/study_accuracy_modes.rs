@@ -66,8 +66,7 @@ fn modes_rows_vary_the_interior_modes_and_their_error_falls() {
             let reason = r.status.strip_prefix("incomplete: ").unwrap_or(&r.status);
             // Coverage reasons come first in the status: none here, only abandoned branches.
             assert!(
-                reason.starts_with("a branch was abandoned at")
-                    && !reason.contains("no other branch of the run passes"),
+                reason.starts_with("a branch was abandoned at"),
                 "{label}: {}",
                 r.status
             );

@@ -163,8 +163,8 @@ class FrfResult(ContinuationPath):
       ``given_up_cause`` (``dead-end`` or ``no-progress``; None otherwise), and
       ``fill_cut_hz``, ``fill_cut_amplitude`` (m), ``fill_cut_fold_hz`` where the branch
       after the jump (a fill or a bridge), followed toward the edge of its stretch, turned
-      back at a fold of its own and was left (None otherwise; it does not set ``abandoned``,
-      but ``status`` is ``incomplete`` when no other stretch of the run passes that point);
+      back at a fold of its own and was left (None otherwise; recorded only: it does not set
+      ``abandoned`` nor the status);
     - ``csv``: the run's ``frf.csv`` exactly as the CLI writes it (:meth:`write_csv`).
     """
 

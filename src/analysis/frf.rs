@@ -81,16 +81,10 @@ pub struct Jump {
     /// Where the branch after the jump (the fill, followed back down toward the fold, or a
     /// bridge, followed toward the edges of its stretch) was left at its edge after turning
     /// back at a fold of its own, off every stretch followed before (see [`fill_cut`]): that
-    /// branch may go on beyond the point, not followed. It is judged on the finished run
-    /// ([`FrfRun::unfollowed_cuts`]): a cut that no other stretch of the run passes makes the
-    /// run incomplete (the branch followed on from the jump target, which comes later, often
-    /// passes it). It does not count in [`Jump::abandons_branch`]. None otherwise.
+    /// branch may go on beyond the point, not followed. Recorded only: it does not count in
+    /// [`Jump::abandons_branch`] nor the run's status (the branch followed on from the jump
+    /// target, which may pass it, is not compared). None otherwise.
     pub fill_cut: Option<GivenUp>,
-    /// Number of points of the branch solved past the jump (the fill or the bridge), reported
-    /// from `first_point` on; points after them (the run followed on from the jump target)
-    /// belong to the next stretch. Used to judge [`Jump::fill_cut`] against every stretch
-    /// but the cut branch itself ([`FrfRun::unfollowed_cuts`]); not serialised.
-    pub branch_points: usize,
 }
 
 impl serde::Serialize for Jump {
@@ -243,8 +237,8 @@ pub enum JumpKind {
 impl Jump {
     /// Whether the branch before the jump was abandoned inside the range
     /// ([`BranchEnd::Abandoned`]): the response beyond its last point is missing. A
-    /// [`Jump::fill_cut`] does not count here: it is judged on the whole run
-    /// ([`FrfRun::unfollowed_cuts`]), since the branch that passes it often comes later.
+    /// [`Jump::fill_cut`] is recorded but does not count: at F0 = 5 N on the paper's system
+    /// Newton just past such a cut lands on the branch followed on from the jump target.
     pub fn abandons_branch(&self) -> bool {
         matches!(self.before, BranchEnd::Abandoned(_))
     }
@@ -357,59 +351,11 @@ impl FrfRun {
         })
     }
 
-    /// The jumps whose fill or bridge branch was left at the edge of its stretch
-    /// ([`Jump::fill_cut`]) at a point that no other stretch of the finished run passes
-    /// through: the branch goes on beyond that point, and its response there is missing.
-    ///
-    /// A cut is judged only here, on the whole run, since the stretch that passes it is often
-    /// the one followed on from the jump target after the fill (at F0 = 5 N on the paper's
-    /// system, Newton just past the cut at 80.4161 Hz lands on that branch within 1 %). The cut
-    /// branch's own points ([`Jump::branch_points`] from [`Jump::first_point`]) do not count:
-    /// a fill that reversed onto itself at a corner (the 3D blade pair's at 886.8455 Hz, whose
-    /// two sides agree to 1.2·10⁻⁶) would otherwise pass its own cut. A cut point passed,
-    /// within [`RETRACE_TOLERANCE`] on every output's amplitude, by a segment of any other
-    /// stretch is followed; one not found among the run's points counts as not followed.
-    pub fn unfollowed_cuts(&self) -> impl Iterator<Item = (&Jump, &GivenUp)> {
-        self.jumps.iter().filter_map(|j| {
-            let cut = j.fill_cut.as_ref()?;
-            (!self.passes_cut(j, cut)).then_some((j, cut))
-        })
-    }
-
-    /// Whether a segment of the run, within a branch and outside the branch solved past `jump`
-    /// (whose point `cut` is), passes through the cut point ([`passes_through`]).
-    fn passes_cut(&self, jump: &Jump, cut: &GivenUp) -> bool {
-        let own = jump.first_point..(jump.first_point + jump.branch_points).min(self.points.len());
-        let Some(target) = self.points[own.clone()].iter().find(|p| {
-            p.freq_hz == cut.freq_hz && p.amplitudes.first().copied() == Some(cut.amplitude)
-        }) else {
-            return false;
-        };
-        let mut bounds: Vec<usize> = self
-            .branch_starts()
-            .into_iter()
-            .chain([own.start, own.end])
-            .filter(|&b| b > 0 && b < self.points.len())
-            .collect();
-        bounds.sort_unstable();
-        bounds.dedup();
-        let mut paths: Vec<&[FrfPoint]> = Vec::new();
-        let mut from = 0;
-        for end in bounds.into_iter().chain([self.points.len()]) {
-            if from != own.start {
-                paths.push(&self.points[from..end]);
-            }
-            from = end;
-        }
-        passes_through(&paths, target)
-    }
-
     /// Why the run did not cover the range (None when it did), for the run's status line
     /// (`incomplete: <reason>`): the range not reached, the stretches no branch reached, and
     /// every branch abandoned inside the range ([`BranchEnd::Abandoned`]), whose response
     /// beyond the point given up (possibly a resonance peak) is missing even though the run
-    /// went on past it, and every fill or bridge left at a point no other stretch of the run
-    /// passes ([`FrfRun::unfollowed_cuts`]).
+    /// went on past it.
     pub fn incomplete_reason(&self) -> Option<String> {
         let abandoned: Vec<String> = self
             .abandoned()
@@ -424,25 +370,8 @@ impl FrfRun {
             })
             .collect();
 
-        let cut: Vec<String> = self
-            .unfollowed_cuts()
-            .map(|(j, g)| {
-                format!(
-                    "a branch solved past the jump at {:.4} Hz was left {}, and no other \
-                     branch of the run passes that point; the response beyond it on that \
-                     branch (possibly the resonance peak) was not computed",
-                    j.from_hz,
-                    g.describe()
-                )
-            })
-            .collect();
-
         let coverage = self.coverage_reason();
-        let reasons: Vec<String> = coverage
-            .into_iter()
-            .chain(abandoned)
-            .chain(cut)
-            .collect();
+        let reasons: Vec<String> = coverage.into_iter().chain(abandoned).collect();
         (!reasons.is_empty()).then(|| reasons.join("; "))
     }
 
@@ -1022,7 +951,6 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
                 kind,
                 before,
                 fill_cut: cut,
-                branch_points: branch.len(),
             };
             adapter.observer.jump(&jump);
             run.jumps.push(jump);
@@ -1343,7 +1271,6 @@ impl Branching<'_> {
                 kind: JumpKind::Bridge,
                 before: BranchEnd::Bridge,
                 fill_cut: None,
-                branch_points: 0,
             };
             if gap_below.uncovered_hz() > 0.0 {
                 gaps.push((lo.clone(), low.clone()));
@@ -1780,7 +1707,6 @@ mod tests {
             kind: JumpKind::PastFold,
             before: BranchEnd::LeftRange,
             fill_cut: None,
-            branch_points: 0,
         }]);
         reference.points = points;
         let point = FrfPoint {
@@ -1816,7 +1742,6 @@ mod tests {
             kind: JumpKind::PastFold,
             before: BranchEnd::LeftRange,
             fill_cut: None,
-            branch_points: 0,
         };
         assert!(run_with_jumps(vec![jump(66.0, 66.0)]).is_complete());
         assert!(run_with_jumps(vec![jump(66.0, 66.0 + 1e-12)]).is_complete());
@@ -1862,7 +1787,6 @@ mod tests {
             kind: JumpKind::PastDeadEnd,
             before: end,
             fill_cut: None,
-            branch_points: 0,
         }]);
         run.points = points;
         assert!(!run.is_complete());
@@ -1905,7 +1829,6 @@ mod tests {
                 kind: JumpKind::PastFold,
                 before: end,
                 fill_cut: None,
-                branch_points: 0,
             }]);
             run.points = points;
             assert!(run.is_complete(), "{:?}", run.incomplete_reason());
@@ -1983,7 +1906,6 @@ mod tests {
             kind: JumpKind::PastDeadEnd,
             before: end,
             fill_cut: None,
-            branch_points: 0,
         }]);
         run.points = rising.clone();
         assert!(run.is_complete(), "{:?}", run.incomplete_reason());
@@ -2003,9 +1925,9 @@ mod tests {
 
     /// The fill of the branch past a jump, followed from 115 Hz down toward 110 Hz (the highest
     /// frequency of the branch before, on A = 1 + 0.1 (f − 100)), turns back up at a fold of its
-    /// own at 109.5 Hz and stops on reaching 110 Hz at amplitude 3.5, off the branch before: cut.
-    /// The run is incomplete until another stretch passes the cut (not the fill's own points).
-    /// Heading down at its end, or ending on the branch before, it is not cut.
+    /// own at 109.5 Hz and stops on reaching 110 Hz at amplitude 3.5, off the branch before: cut
+    /// (recorded in the jump, not in the status). Heading down at its end, or ending on the
+    /// branch before, it is not.
     #[test]
     fn a_fill_that_turned_back_up_off_the_path_followed_is_cut() {
         let points = folded_path(&[]);
@@ -2035,31 +1957,10 @@ mod tests {
             kind: JumpKind::PastFold,
             before: BranchEnd::LeftRange,
             fill_cut: Some(cut),
-            branch_points: 3,
         }]);
-        // The fill as the run reports it: from its cut up, without the jump target (solved
-        // again by the branch's own run).
-        let reported: Vec<FrfPoint> = fill[1..].iter().rev().cloned().collect();
-        run.points = points.iter().chain(&reported).cloned().collect();
-        // No other stretch passes the cut (the fill's own other side of its fold, 3.54 at
-        // 110 Hz, is its own and 1.1 % off anyway): the run is incomplete.
-        let reason = run.incomplete_reason().expect("a cut no stretch passes");
-        assert!(reason.contains("no other branch of the run passes"), "{reason}");
-        assert_eq!(run.unfollowed_cuts().count(), 1);
-        // The branch's own run, followed on from the jump target (115 Hz), passes the cut
-        // within 0.11 % (3.496 at 110 Hz): followed.
-        run.points.extend([
-            line_point(115.0, 3.0, 0.0),
-            line_point(110.3, 3.52, 0.0),
-            line_point(109.8, 3.48, 0.0),
-        ]);
+        run.points = points.clone();
+        // Recorded, not counted in the status (see `Jump::abandons_branch`).
         assert!(run.is_complete(), "{:?}", run.incomplete_reason());
-        // A fill that reversed onto itself: its own points passing the cut do not count.
-        let mut own = run.clone();
-        own.points.truncate(points.len() + 3);
-        own.points.extend([line_point(109.9, 3.51, 0.0), line_point(110.2, 3.49, 0.0)]);
-        own.jumps[0].branch_points = 5;
-        assert_eq!(own.unfollowed_cuts().count(), 1);
         let json = serde_json::to_value(run.jumps[0]).unwrap();
         assert_eq!(json["abandoned"], false);
         assert_eq!(json["fill_cut"]["freq_hz"], 110.0);
