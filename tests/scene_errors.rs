@@ -241,7 +241,7 @@ fn two_tangential_stiffnesses_are_refused() {
     );
     assert_cli_rejects(&file.label(), &[], &[&at, why]);
 
-    let file = SceneFile::new(&paper_wedge_scene());
+    let file = SceneFile::new(paper_wedge_scene());
     let assignment = "contacts.1.kt=[3.0e5, 1.0e5]";
     let err = library_error(&file, &[assignment]);
     assert_override(&err, &file.label(), assignment, why);
