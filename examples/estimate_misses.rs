@@ -28,7 +28,7 @@ use fricbound::analysis::frf::{self, FrfPoint, Silent};
 use fricbound::model::Problem;
 
 mod common;
-use common::{amplitude_near, describe, SmallBladePair};
+use common::{describe, SmallBladePair};
 
 fn main() {
     let scene = SmallBladePair::new();
@@ -56,9 +56,12 @@ fn main() {
         .points
         .iter()
         .map(|p| {
-            amplitude_near(&check, p.freq_hz, p.amplitudes[0]).map_or(f64::INFINITY, |(a, _, _)| {
-                (a - p.amplitudes[0]).abs() / p.amplitudes[0]
-            })
+            check
+                .crossing_nearest(p.freq_hz, 0, p.amplitudes[0])
+                .map(|c| c.amplitude)
+                .map_or(f64::INFINITY, |a| {
+                    (a - p.amplitudes[0]).abs() / p.amplitudes[0]
+                })
         })
         .collect();
     let mut ref_solver = frf::PointSolver::new(&reference_problem).expect("point solver");
@@ -77,11 +80,15 @@ fn main() {
                 acc.path_normal.as_ref().and_then(|normal| {
                     frf::amplitude_across_path(&reference, &reference_set, p, &set, normal, 0)
                         .and_then(|(a, f)| {
-                            amplitude_near(&reference, f, a).map(|(_, k, near)| (a, k, near))
+                            reference
+                                .crossing_nearest(f, 0, a)
+                                .map(|c| (a, c.segment, c.nearest_point))
                         })
                 })
             } else {
-                amplitude_near(&reference, p.freq_hz, p.amplitudes[0])
+                reference
+                    .crossing_nearest(p.freq_hz, 0, p.amplitudes[0])
+                    .map(|c| (c.amplitude, c.segment, c.nearest_point))
             };
             let Some((a, k, nearest)) = counterpart else {
                 rows.push(None);

@@ -14,23 +14,9 @@
 mod common;
 
 use fricbound::analysis::error_estimate::EstimateMethod;
-use fricbound::analysis::frf::{self, FrfRun, Silent};
+use fricbound::analysis::frf::{self, Silent};
 use fricbound::model::Problem;
 use fricbound::scene;
-
-/// The first output's amplitude on the branch of `run` at `freq_hz` nearest to `near` (every
-/// segment of a branch that brackets the frequency), with the segment's index and the index
-/// of its point nearer in frequency (the reference point the comparison is made with).
-fn amplitude_near(run: &FrfRun, freq_hz: f64, near: f64) -> Option<(f64, usize, usize)> {
-    run.crossings(freq_hz, 0)
-        .into_iter()
-        .min_by(|x, y| {
-            (x.amplitude - near)
-                .abs()
-                .total_cmp(&(y.amplitude - near).abs())
-        })
-        .map(|c| (c.amplitude, c.segment, c.nearest_point))
-}
 
 /// One compared point: its harmonic count, frequency (Hz), true error (against the
 /// reference), estimate, the highest harmonic the estimate extended to, the reference's
@@ -97,9 +83,12 @@ fn truncation_estimate_tracks_the_true_error_on_the_blade_pair() {
         .points
         .iter()
         .map(|p| {
-            amplitude_near(&check, p.freq_hz, p.amplitudes[0]).map_or(f64::INFINITY, |(a, _, _)| {
-                (a - p.amplitudes[0]).abs() / p.amplitudes[0]
-            })
+            check
+                .crossing_nearest(p.freq_hz, 0, p.amplitudes[0])
+                .map(|c| c.amplitude)
+                .map_or(f64::INFINITY, |a| {
+                    (a - p.amplitudes[0]).abs() / p.amplitudes[0]
+                })
         })
         .collect();
     for (p, c) in reference.points.iter().zip(&converged).step_by(5) {
@@ -133,11 +122,15 @@ fn truncation_estimate_tracks_the_true_error_on_the_blade_pair() {
                 acc.path_normal.as_ref().and_then(|normal| {
                     frf::amplitude_across_path(&reference, &reference_set, p, &set, normal, 0)
                         .and_then(|(a, f)| {
-                            amplitude_near(&reference, f, a).map(|(_, k, near)| (a, k, near))
+                            reference
+                                .crossing_nearest(f, 0, a)
+                                .map(|c| (a, c.segment, c.nearest_point))
                         })
                 })
             } else {
-                amplitude_near(&reference, p.freq_hz, p.amplitudes[0])
+                reference
+                    .crossing_nearest(p.freq_hz, 0, p.amplitudes[0])
+                    .map(|c| (c.amplitude, c.segment, c.nearest_point))
             };
             let Some((a, k, nearest)) = counterpart else {
                 continue;

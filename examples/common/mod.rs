@@ -6,13 +6,11 @@
 //! | item | what |
 //! |---|---|
 //! | [`SmallBladePair`], [`write_small_blade_pair`] | the generated 2D blade pair with 2 contact pairs per side, 8 interior modes (Craig-Bampton), written into a temporary folder; its problem with `--set`-style overrides |
-//! | [`amplitude_near`] | the crossing of a frequency by an FRF path nearest in amplitude to a value |
 //! | [`describe`] | per contact: state, T̂⁰, origin of a stuck state, smallest friction margin, open samples |
 //!
 //! Each example uses a part of it.
 #![allow(dead_code)]
 
-use fricbound::analysis::frf::FrfRun;
 use fricbound::contact::ContactState;
 use fricbound::hbm::system::HbmSystem;
 use fricbound::model::Problem;
@@ -64,20 +62,6 @@ pub fn write_small_blade_pair(dir: &std::path::Path) {
         scaling::blade_pair_scene(&mesh, false, 1)
     );
     std::fs::write(dir.join("blade-pair.toml"), text).expect("scene file");
-}
-
-/// The crossing of `freq_hz` by `run` nearest in amplitude to `near`: (first output's
-/// amplitude, segment, index of the path point nearer in frequency), as in
-/// `tests/error_estimate_fe.rs`.
-pub fn amplitude_near(run: &FrfRun, freq_hz: f64, near: f64) -> Option<(f64, usize, usize)> {
-    run.crossings(freq_hz, 0)
-        .into_iter()
-        .min_by(|x, y| {
-            (x.amplitude - near)
-                .abs()
-                .total_cmp(&(y.amplitude - near).abs())
-        })
-        .map(|c| (c.amplitude, c.segment, c.nearest_point))
 }
 
 /// Per contact of the point `x` (full coefficients of `system`'s problem): its state over the

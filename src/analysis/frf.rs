@@ -336,6 +336,18 @@ impl FrfRun {
         out
     }
 
+    /// The crossing of `freq_hz` (Hz) by the path ([`FrfRun::crossings`]) whose amplitude of
+    /// output `output` is nearest to `near` (m): where a folded path crosses a frequency more
+    /// than once, the one to compare a point of amplitude `near` with. None when the path does
+    /// not cross the frequency.
+    pub fn crossing_nearest(&self, freq_hz: f64, output: usize, near: f64) -> Option<PathCrossing> {
+        self.crossings(freq_hz, output).into_iter().min_by(|x, y| {
+            (x.amplitude - near)
+                .abs()
+                .total_cmp(&(y.amplitude - near).abs())
+        })
+    }
+
     /// Whether the run covers the range: the path reached the end frequency, and every
     /// stretch it jumped over at a fold was computed on some branch.
     pub fn is_complete(&self) -> bool {
