@@ -15,7 +15,7 @@ use fricbound::contact::ContactState;
 use fricbound::hbm::system::HbmSystem;
 use fricbound::model::Problem;
 use fricbound::scene;
-use fricbound::study::scaling::{self, ModelSize};
+use fricbound::study::scaling;
 
 /// The small generated blade pair (the generator's coarsest 2D mesh, 2 contact pairs per side,
 /// 8 interior Craig-Bampton modes, 0.2 % modal damping; resonance near 918-934 Hz), as the
@@ -49,18 +49,9 @@ impl Default for SmallBladePair {
 }
 
 /// Writes the small blade pair's mesh (`blade-pair-2d-r1-p2.msh`) and scene
-/// (`blade-pair.toml`) into `dir`.
+/// (`blade-pair.toml`: [`scaling::small_reduced_blade_pair_scene`]) into `dir`.
 pub fn write_small_blade_pair(dir: &std::path::Path) {
-    let size = ModelSize {
-        contact_pairs: Some(2),
-        ..ModelSize::uniform(false, 1)
-    };
-    scaling::full_problem(size, 1, dir).expect("mesh");
-    let mesh = dir.join("blade-pair-2d-r1-p2.msh");
-    let text = format!(
-        "{}\n[reduction]\nmodes = 8\nmodal_damping = 0.002\n",
-        scaling::blade_pair_scene(&mesh, false, 1)
-    );
+    let text = scaling::small_reduced_blade_pair_scene(dir).expect("mesh");
     std::fs::write(dir.join("blade-pair.toml"), text).expect("scene file");
 }
 

@@ -153,6 +153,25 @@ pub fn full_problem(
         .map_err(setup)
 }
 
+/// Scene text of the small reduced 2D blade pair that the FE accuracy tests and examples
+/// share: the generator's coarsest mesh with 2 contact pairs per side (its mesh written into
+/// `dir` as `blade-pair-2d-r1-p2.msh`), 8 interior Craig-Bampton modes and 0.2 % modal damping,
+/// H = 1; its resonance is near 918-934 Hz. Small enough for a test, yet with the folds and
+/// stick-slip transitions of an FE damper.
+pub fn small_reduced_blade_pair_scene(dir: &Path) -> Result<String, ScalingError> {
+    let size = ModelSize {
+        contact_pairs: Some(2),
+        ..ModelSize::uniform(false, 1)
+    };
+    // Writes the mesh `blade-pair-2d-r1-p2.msh` into the folder.
+    full_problem(size, 1, dir)?;
+    let mesh = dir.join("blade-pair-2d-r1-p2.msh");
+    Ok(format!(
+        "{}\n[reduction]\nmodes = 8\nmodal_damping = 0.002\n",
+        blade_pair_scene(&mesh, false, 1)
+    ))
+}
+
 /// Sizes, times and memory of one reduction.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct ReductionMeasure {

@@ -4,24 +4,13 @@ use fricbound::fe::blade_pair::{generate, BladePairParams};
 use fricbound::fe::msh_write::{write_msh, MshFormat};
 use fricbound::model::Problem;
 use fricbound::scene;
-use fricbound::study::scaling::{self, blade_pair_scene, ModelSize};
+use fricbound::study::scaling::{self, blade_pair_scene};
 use std::path::Path;
 
-/// Scene text of the reduced 2D blade pair: the generator's coarsest mesh with 2 contact
-/// pairs per side (written into `dir` as `blade-pair-2d-r1-p2.msh`), 8 interior Craig-Bampton
-/// modes and 0.2 % modal damping; its resonance is near 918-934 Hz.
+/// Scene text of the reduced 2D blade pair (mesh written into `dir`):
+/// [`scaling::small_reduced_blade_pair_scene`].
 pub fn reduced_blade_pair_2d(dir: &Path) -> String {
-    let size = ModelSize {
-        contact_pairs: Some(2),
-        ..ModelSize::uniform(false, 1)
-    };
-    // Writes the mesh `blade-pair-2d-r1-p2.msh` into the folder.
-    scaling::full_problem(size, 1, dir).unwrap();
-    let mesh = dir.join("blade-pair-2d-r1-p2.msh");
-    format!(
-        "{}\n[reduction]\nmodes = 8\nmodal_damping = 0.002\n",
-        blade_pair_scene(&mesh, false, 1)
-    )
+    scaling::small_reduced_blade_pair_scene(dir).expect("blade pair mesh")
 }
 
 /// The unreduced blade pair on the generator's coarsest mesh (2D, or 3D with `three_d`), 2
