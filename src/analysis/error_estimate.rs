@@ -71,7 +71,13 @@
 //! path's direction on a path point; before the sampling step reused the factors, it took a
 //! Jacobian and a factorisation of its own). The bordered factorisation adds one row and
 //! column (dense storage) or one solve for the border column (storages that eliminate the
-//! border by blocks).
+//! border by blocks). A point whose step leaves its linear range ([`LinearRange`]) adds a
+//! Newton solve of the extended system at its frequency: a Jacobian, a factorisation and the
+//! line search's residuals per iteration, up to three times the continuation's iteration
+//! limit where it does not converge. It starts from the stepped point where the step lowers
+//! the residual (the iterate Newton from the padded point reaches first), so it repeats no
+//! work of the step. On the larger blade pair these solves take most of the estimate's time
+//! (docs/accuracy.md, "What the estimate costs, and where the time goes").
 
 use crate::contact::harmonic::HarmonicSet;
 use crate::contact::point::ContactState;
