@@ -71,7 +71,13 @@
 //! path's direction on a path point; before the sampling step reused the factors, it took a
 //! Jacobian and a factorisation of its own). The bordered factorisation adds one row and
 //! column (dense storage) or one solve for the border column (storages that eliminate the
-//! border by blocks).
+//! border by blocks). A point whose step leaves its linear range ([`LinearRange`]) adds a
+//! Newton solve of the extended system at its frequency: a Jacobian, a factorisation and the
+//! line search's residuals per iteration, up to three times the continuation's iteration
+//! limit where it does not converge. It starts from the stepped point where the step lowers
+//! the residual (the iterate Newton from the padded point reaches first), so it repeats no
+//! work of the step. On the larger blade pair these solves take most of the estimate's time
+//! (docs/accuracy.md, "What the estimate costs, and where the time goes").
 
 use crate::contact::harmonic::HarmonicSet;
 use crate::contact::point::ContactState;
@@ -437,6 +443,8 @@ struct Wider {
     /// Across the path (per output) and that step's contraction, where the path's normal was
     /// given and the bordered matrix factorised.
     across: Option<(Vec<f64>, f64)>,
+    /// The fixed-frequency step (wider unknowns), for the start of a converged solve.
+    fixed_step: Vec<f64>,
 }
 
 /// Whether the one Newton step of the extended system stays in the range where its
@@ -715,15 +723,17 @@ impl<'p> ErrorEstimator<'p> {
         let top = extended_harmonic(self.h_max);
         let first = assess(&deltas);
         let step = path.map_or(f64::NAN, |p| p.step);
-        let Some(fixed) = fixed_deltas else {
+        let Some(fixed_steps) = fixed_deltas else {
             let mut truncation = first.truncation.clone();
             let mut estimate_harmonic = top;
             let mut contraction = first.contraction;
+            let mut reported_step = deltas[0][..dim].to_vec();
             if first.needs_wider {
                 if let Some(w) = self.wider_truncation(x, omega, None, &base) {
                     truncation = w.fixed;
                     contraction = w.fixed_contraction;
                     estimate_harmonic = wider_harmonic(self.h_max);
+                    reported_step = w.fixed_step;
                 }
             }
             let method = self.settle(
@@ -731,7 +741,7 @@ impl<'p> ErrorEstimator<'p> {
                 omega,
                 &base,
                 (&mut truncation, estimate_harmonic, contraction),
-                false,
+                (false, &reported_step),
             );
             return PointAccuracy {
                 truncation,
@@ -746,12 +756,13 @@ impl<'p> ErrorEstimator<'p> {
                 method,
             };
         };
-        let fixed = assess(&fixed);
+        let fixed = assess(&fixed_steps);
         let across = PathSwitch::across(slide, step);
         let reported = if across { &first } else { &fixed };
         let mut both = (fixed.truncation.clone(), first.truncation.clone());
         let mut contractions = (fixed.contraction, first.contraction);
         let mut estimate_harmonic = top;
+        let mut reported_step = fixed_steps[0][..dim].to_vec();
         if reported.needs_wider {
             let normal = path.map(|p| p.normal);
             if let Some(w) = self.wider_truncation(x, omega, normal, &base) {
@@ -759,10 +770,12 @@ impl<'p> ErrorEstimator<'p> {
                     both = (w.fixed, a);
                     contractions = (w.fixed_contraction, a_contraction);
                     estimate_harmonic = wider_harmonic(self.h_max);
+                    reported_step = w.fixed_step;
                 } else if !across {
                     both.0 = w.fixed;
                     contractions.0 = w.fixed_contraction;
                     estimate_harmonic = wider_harmonic(self.h_max);
+                    reported_step = w.fixed_step;
                 }
             }
         }
@@ -781,7 +794,7 @@ impl<'p> ErrorEstimator<'p> {
             omega,
             &base,
             (&mut truncation, estimate_harmonic, contraction),
-            across,
+            (across, &reported_step),
         );
         if !across && method == EstimateMethod::Solved {
             both.0 = truncation.clone();
@@ -814,11 +827,12 @@ impl<'p> ErrorEstimator<'p> {
         omega: f64,
         base: &[f64],
         (truncation, estimate_harmonic, contraction): (&mut Vec<f64>, usize, f64),
-        across: bool,
+        (across, step): (bool, &[f64]),
     ) -> EstimateMethod {
         if truncation.iter().any(|v| v.is_nan()) {
             return EstimateMethod::None;
         }
+        let wider = estimate_harmonic == wider_harmonic(self.h_max);
         // A contraction that is not a number (the residual after the step failed) counts as
         // beyond the linear range.
         if contraction <= LinearRange::MAX_CONTRACTION {
@@ -827,8 +841,7 @@ impl<'p> ErrorEstimator<'p> {
         if across {
             return EstimateMethod::Unsized;
         }
-        let wider = estimate_harmonic == wider_harmonic(self.h_max);
-        match self.converged_truncation(x, omega, wider, base) {
+        match self.converged_truncation(x, omega, wider, base, (step, contraction)) {
             Some(solved) => {
                 *truncation = solved;
                 EstimateMethod::Solved
@@ -893,12 +906,13 @@ impl<'p> ErrorEstimator<'p> {
                     let s = d_omega / z_omega;
                     let fixed: Vec<f64> = step.iter().zip(&z).map(|(a, b)| a - s * b).collect();
                     let across = change(wider, &step[..dim], d_omega);
-                    let fixed = change(wider, &fixed[..dim], fixed[dim]);
-                    if let (Some(f), Some(a)) = (fixed, across) {
+                    let fixed_change = change(wider, &fixed[..dim], fixed[dim]);
+                    if let (Some(f), Some(a)) = (fixed_change, across) {
                         return Some(Wider {
                             fixed: f.0,
                             fixed_contraction: f.1,
                             across: Some(a),
+                            fixed_step: fixed[..dim].to_vec(),
                         });
                     }
                 }
@@ -909,6 +923,7 @@ impl<'p> ErrorEstimator<'p> {
             fixed: f.0,
             fixed_contraction: f.1,
             across: None,
+            fixed_step: step.clone(),
         })
     }
 
@@ -917,12 +932,21 @@ impl<'p> ErrorEstimator<'p> {
     /// of each output's amplitude from `base`; None when Newton does not converge. What the
     /// one Newton step of [`Self::estimate`] approximates, for the points where that step
     /// leaves its linear range ([`LinearRange`]).
+    ///
+    /// `step` is that Newton step at the fixed frequency on the same set (its unknowns), and
+    /// `contraction` the residual after it relative to the residual before it. Where the step
+    /// lowers the residual (contraction below 1), Newton from the padded point would take it
+    /// in full as its first iteration (same Jacobian, full step accepted by the line search),
+    /// so the solve starts from the stepped point instead: the same iterates, one Jacobian and
+    /// factorisation fewer. Other starts that were measured change the solution some points
+    /// converge to (docs/accuracy.md, "What the estimate costs").
     fn converged_truncation(
         &mut self,
         x: &[f64],
         omega: f64,
         wider: bool,
         base: &[f64],
+        (step, contraction): (&[f64], f64),
     ) -> Option<Vec<f64>> {
         let n = self.problem.model.n_dofs();
         let refined = if wider {
@@ -933,8 +957,15 @@ impl<'p> ErrorEstimator<'p> {
         let xr = refined.padded(n, x);
         // The step tolerance is relative to the point's largest coefficient.
         let scale = xr.iter().fold(0.0_f64, |m, v| m.max(v.abs())).max(1e-300);
+        let start: Vec<f64> = if contraction < 1.0 && step.len() == xr.len() {
+            xr.iter().zip(step).map(|(a, d)| a - d).collect()
+        } else {
+            xr.clone()
+        };
         let newton = Continuation::new(self.problem.analysis.continuation, vec![scale; xr.len()]);
-        let solved = newton.solve_fixed(&mut refined.operator, &xr, omega).ok()?;
+        let solved = newton
+            .solve_fixed(&mut refined.operator, &start, omega)
+            .ok()?;
         let ext = refined.operator.unknowns().clone();
         let full = refined.operator.expand(&solved.x, omega).ok()?;
         full.iter()
