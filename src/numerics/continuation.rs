@@ -107,18 +107,23 @@ pub struct Continuation {
 }
 
 /// A pass over a narrow window around a spot where the path stalled: the response's arc-length
-/// scale (and that of the adaptive scale's climb) and the step bounds are those of a range
-/// [`NARROW_WINDOW_FRACTION`] of the path's own, so that the response weighs that much more
-/// against the frequency in the arc length.
+/// scale (and that of the adaptive scale's climb) and the step bounds are those of a range a
+/// fraction [`NARROW_WINDOW_FRACTIONS`] of the path's own, so that the response weighs that
+/// much more against the frequency in the arc length.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct NarrowPass {
-    /// Frequency of the last point before the stall (Hz).
+    /// Frequency of the last point before the stall this window starts from (Hz).
     from_hz: f64,
+    /// Frequency of the last point before the first stall of this pass (Hz): `from_hz` unless
+    /// the path stalled inside a narrower window first.
+    stalled_hz: f64,
     /// Half width of the window (Hz): the pass ends at the first point farther than this from
     /// `from_hz`, either way.
     half_width_hz: f64,
     /// Factor applied to the scales and steps (the window's width over the range).
     factor: f64,
+    /// Index of `factor` in [`NARROW_WINDOW_FRACTIONS`].
+    attempt: usize,
     /// The settings' steps before the pass: (initial, min, max).
     steps: (f64, f64, f64),
 }
@@ -183,9 +188,12 @@ const RETRACE_LOOKAHEADS: &[f64] = &[1.0, 0.25, 0.0625];
 /// from the corner (about 3°) lies on it: the corner point would resume the incoming branch
 /// backwards (see [`Continuation::runs_back_along`]).
 const RETRACE_FRACTION: f64 = 0.05;
-/// Width of the window of a narrow-window pass past a stall, as a fraction of the range (see
-/// [`Continuation::enter_narrow`]).
-const NARROW_WINDOW_FRACTION: f64 = 0.01;
+/// Widths of the window of a narrow-window pass past a stall, as fractions of the range, tried
+/// in turn, each from the last point reached, while the path stalls inside the window (see
+/// [`Continuation::enter_narrow`]). On the 3D blade pair's limit curves over 845-900 Hz a
+/// hundredth passed the stall of m = +1 at 852.78 Hz, and a thousandth or a tenth that of
+/// m = −1 at 852.74 Hz, where a hundredth stalled again (benches/README.md).
+const NARROW_WINDOW_FRACTIONS: &[f64] = &[0.01, 0.001, 0.1];
 /// Most narrow-window passes in one run.
 const MAX_NARROW_PASSES: usize = 8;
 /// Largest turn of the tangent in one step before the step is cut (unless it is a corner).
@@ -290,28 +298,32 @@ impl Continuation {
         *self.carried.borrow_mut() = None;
     }
 
-    /// Starts a narrow-window pass from the last point before a stall, at `from_hz`: the
-    /// scales, the climb and the step bounds become those of a range [`NARROW_WINDOW_FRACTION`]
-    /// of this one's (the scene's default steps are proportional to the range), until a point
-    /// lands farther than half that width from `from_hz` ([`Self::leave_narrow`]).
+    /// Starts a narrow-window pass from the last point before a stall, at `from_hz` (the
+    /// path having first stalled after `stalled_hz`): the scales, the climb and the step bounds
+    /// become those of a range the fraction `NARROW_WINDOW_FRACTIONS[attempt]` of this one's
+    /// (the scene's default steps are proportional to the range), until a point lands farther
+    /// than half that width from `from_hz` ([`Self::leave_narrow`]).
     ///
     /// Why: the response's arc-length scale is set from the range (a climb to the response
     /// costs a quarter of it), so over a wide range the response weighs little against the
-    /// frequency and the corrector's hyperplanes cross a contact transition almost at constant
-    /// frequency, where the sampled residual's pieces can make Newton cycle at every step; over
-    /// a narrow window they cross it along the response, and the same path passes.
-    fn enter_narrow(&mut self, from_hz: f64, tangent: &mut [f64]) {
+    /// frequency in the arc length. It is that scale which decides whether the corrector gets
+    /// across some contact transitions: over 845-900 Hz the 3D blade pair's m = +1 limit curve
+    /// stalls at 852.78 Hz with the range's scale, whether the steps are the range's or a
+    /// hundredth of them, and passes with a hundredth of the scale (benches/README.md).
+    fn enter_narrow(&mut self, from_hz: f64, stalled_hz: f64, attempt: usize, tangent: &mut [f64]) {
         let a = &mut self.settings;
         let range = (a.freq_end_hz - a.freq_start_hz).abs();
-        let factor = NARROW_WINDOW_FRACTION;
+        let factor = NARROW_WINDOW_FRACTIONS[attempt];
         let steps = (a.initial_step, a.min_step, a.max_step);
         a.initial_step *= factor;
         a.min_step *= factor;
         a.max_step *= factor;
         self.narrow = Some(NarrowPass {
             from_hz,
+            stalled_hz,
             half_width_hz: 0.5 * factor * range,
             factor,
+            attempt,
             steps,
         });
         self.rescale(factor, tangent);
@@ -319,7 +331,7 @@ impl Continuation {
 
     /// Ends the narrow-window pass under way, if any: the scales, climb and steps of the range
     /// again (a scale the adaptive scale grew during the pass keeps its growth). Returns the
-    /// pass's start frequency (Hz).
+    /// frequency of the last point before the pass's first stall (Hz).
     fn leave_narrow(&mut self, tangent: &mut [f64]) -> Option<f64> {
         let pass = self.narrow.take()?;
         (
@@ -328,7 +340,7 @@ impl Continuation {
             self.settings.max_step,
         ) = pass.steps;
         self.rescale(1.0 / pass.factor, tangent);
-        Some(pass.from_hz)
+        Some(pass.stalled_hz)
     }
 
     /// Whether a narrow-window pass is under way and `freq_hz` lies outside its window.
@@ -1277,9 +1289,19 @@ impl Continuation {
                                 summary.end = PathEnd::DeadEnd;
                                 return Ok(summary);
                             }
-                            if self.narrow.is_none() && narrow_passes < MAX_NARROW_PASSES {
-                                narrow_passes += 1;
-                                self.enter_narrow(from, &mut tangent);
+                            // The next window: the first for a new stall, the next width for
+                            // one inside a window.
+                            let next = match self.narrow {
+                                None => (narrow_passes < MAX_NARROW_PASSES).then_some(0),
+                                Some(pass) => Some(pass.attempt + 1)
+                                    .filter(|&k| k < NARROW_WINDOW_FRACTIONS.len()),
+                            };
+                            if let Some(attempt) = next {
+                                if attempt == 0 {
+                                    narrow_passes += 1;
+                                }
+                                let stalled = self.leave_narrow(&mut tangent).unwrap_or(from);
+                                self.enter_narrow(from, stalled, attempt, &mut tangent);
                                 a = self.settings;
                                 ds = a.initial_step.clamp(a.min_step, a.max_step);
                                 previous_quality = None;
@@ -1806,8 +1828,8 @@ mod tests {
         let mut t = vec![0.6, 0.0, 0.8];
         let raw = |c: &Continuation, t: &[f64]| (t[0] * c.x_scale[0], t[2]);
         let before = raw(&c, &t);
-        c.enter_narrow(12.0, &mut t);
-        let f = NARROW_WINDOW_FRACTION;
+        c.enter_narrow(12.0, 12.0, 0, &mut t);
+        let f = NARROW_WINDOW_FRACTIONS[0];
         assert_eq!(c.x_scale, vec![2.0 * f, 0.5 * f]);
         assert_eq!(c.adaptive.as_ref().unwrap().climb, 2.0 * f);
         assert_eq!(
