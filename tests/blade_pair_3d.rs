@@ -249,7 +249,7 @@ fn the_m_plus_1_limit_curve_passes_its_former_stall_at_852_78_hz() {
 /// every step down to the minimum across a contact transition there, with that range's
 /// arc-length scale, while a run over a narrow window around the spot crosses it
 /// (benches/README.md, "Limit analysis across the bending pair"). The continuation now takes
-/// the stall over a narrow window (the response's scale and the steps of a range a hundredth as
+/// the stall over a narrow window (the response's arc-length scale of a range a hundredth as
 /// wide) and goes on past it as one path: checked here on the first 60 points, which rise in
 /// frequency point after point through the pass and on above 853 Hz.
 #[test]

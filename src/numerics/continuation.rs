@@ -25,7 +25,7 @@
 //! back along the followed path was refused or below the highest frequency reached (the caller
 //! goes on past the highest frequency, as after a path that wandered without progress).
 //! Otherwise the path is taken on from its last point over a narrow window around the spot,
-//! with the scales and step bounds of a range that narrow, and past the window with the
+//! with the arc-length scales of a range that narrow, and past the window with the
 //! range's again ([`Continuation::run`]); a stall inside the window ends the run with
 //! [`ContinuationError::Stalled`]. The last point is solved at exactly the end frequency. A path runs down in
 //! frequency when the end frequency is below the start (e.g. to fill in, back toward a fold, a
@@ -107,9 +107,9 @@ pub struct Continuation {
 }
 
 /// A pass over a narrow window around a spot where the path stalled: the response's arc-length
-/// scale (and that of the adaptive scale's climb) and the step bounds are those of a range a
-/// fraction [`NARROW_WINDOW_FRACTIONS`] of the path's own, so that the response weighs that
-/// much more against the frequency in the arc length.
+/// scale (and that of the adaptive scale's climb) is that of a range a fraction
+/// [`NARROW_WINDOW_FRACTIONS`] of the path's own, so that the response weighs that much more
+/// against the frequency in the arc length; the step bounds stay the range's.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct NarrowPass {
     /// Frequency of the last point before the stall this window starts from (Hz).
@@ -120,12 +120,10 @@ struct NarrowPass {
     /// Half width of the window (Hz): the pass ends at the first point farther than this from
     /// `from_hz`, either way.
     half_width_hz: f64,
-    /// Factor applied to the scales and steps (the window's width over the range).
+    /// Factor applied to the scales (the window's width over the range).
     factor: f64,
     /// Index of `factor` in [`NARROW_WINDOW_FRACTIONS`].
     attempt: usize,
-    /// The settings' steps before the pass: (initial, min, max).
-    steps: (f64, f64, f64),
 }
 
 /// Groups of unknowns whose arc-length scale grows with the response along the path.
@@ -299,46 +297,36 @@ impl Continuation {
     }
 
     /// Starts a narrow-window pass from the last point before a stall, at `from_hz` (the
-    /// path having first stalled after `stalled_hz`): the scales, the climb and the step bounds
-    /// become those of a range the fraction `NARROW_WINDOW_FRACTIONS[attempt]` of this one's
-    /// (the scene's default steps are proportional to the range), until a point lands farther
-    /// than half that width from `from_hz` ([`Self::leave_narrow`]).
+    /// path having first stalled after `stalled_hz`): the scales and the climb become those of
+    /// a range the fraction `NARROW_WINDOW_FRACTIONS[attempt]` of this one's, until a point
+    /// lands farther than half that width from `from_hz` ([`Self::leave_narrow`]). The step
+    /// bounds stay the scene's (its `min_step` is where the path gives up).
     ///
     /// Why: the response's arc-length scale is set from the range (a climb to the response
     /// costs a quarter of it), so over a wide range the response weighs little against the
     /// frequency in the arc length. It is that scale which decides whether the corrector gets
     /// across some contact transitions: over 845-900 Hz the 3D blade pair's m = +1 limit curve
     /// stalls at 852.78 Hz with the range's scale, whether the steps are the range's or a
-    /// hundredth of them, and passes with a hundredth of the scale (benches/README.md).
+    /// hundredth of them, and passes with a hundredth of the scale, whether the steps are the
+    /// range's or a hundredth of them (benches/README.md).
     fn enter_narrow(&mut self, from_hz: f64, stalled_hz: f64, attempt: usize, tangent: &mut [f64]) {
-        let a = &mut self.settings;
-        let range = (a.freq_end_hz - a.freq_start_hz).abs();
+        let range = (self.settings.freq_end_hz - self.settings.freq_start_hz).abs();
         let factor = NARROW_WINDOW_FRACTIONS[attempt];
-        let steps = (a.initial_step, a.min_step, a.max_step);
-        a.initial_step *= factor;
-        a.min_step *= factor;
-        a.max_step *= factor;
         self.narrow = Some(NarrowPass {
             from_hz,
             stalled_hz,
             half_width_hz: 0.5 * factor * range,
             factor,
             attempt,
-            steps,
         });
         self.rescale(factor, tangent);
     }
 
-    /// Ends the narrow-window pass under way, if any: the scales, climb and steps of the range
-    /// again (a scale the adaptive scale grew during the pass keeps its growth). Returns the
+    /// Ends the narrow-window pass under way, if any: the scales and climb of the range again
+    /// (a scale the adaptive scale grew during the pass keeps its growth). Returns the
     /// frequency of the last point before the pass's first stall (Hz).
     fn leave_narrow(&mut self, tangent: &mut [f64]) -> Option<f64> {
         let pass = self.narrow.take()?;
-        (
-            self.settings.initial_step,
-            self.settings.min_step,
-            self.settings.max_step,
-        ) = pass.steps;
         self.rescale(1.0 / pass.factor, tangent);
         Some(pass.stalled_hz)
     }
@@ -1103,7 +1091,7 @@ impl Continuation {
         x_guess: &[f64],
         observer: &mut O,
     ) -> Result<PathSummary, ContinuationError> {
-        let mut a = self.settings;
+        let a = self.settings;
         let mut narrow_passes = 0usize;
         let omega_start = a.freq_start_hz * OMEGA_SCALE;
         let omega_end = a.freq_end_hz * OMEGA_SCALE;
@@ -1244,7 +1232,6 @@ impl Continuation {
                         if let Some(from_hz) = self.leave_narrow(&mut tangent) {
                             observer.narrow_pass(from_hz, freq_hz);
                         }
-                        a = self.settings;
                         ds = a.initial_step.clamp(a.min_step, a.max_step);
                     }
                 }
@@ -1302,7 +1289,6 @@ impl Continuation {
                                 }
                                 let stalled = self.leave_narrow(&mut tangent).unwrap_or(from);
                                 self.enter_narrow(from, stalled, attempt, &mut tangent);
-                                a = self.settings;
                                 ds = a.initial_step.clamp(a.min_step, a.max_step);
                                 previous_quality = None;
                                 continue;
@@ -1322,7 +1308,6 @@ impl Continuation {
                             if let Some(from_hz) = self.leave_narrow(&mut tangent) {
                                 observer.narrow_pass(from_hz, freq_hz);
                             }
-                            a = self.settings;
                         }
                         ds = a.initial_step.clamp(a.min_step, a.max_step);
                         continue;
@@ -1813,9 +1798,9 @@ mod tests {
         assert!((norm(&t) - 1.0).abs() < 1e-12);
     }
 
-    /// A narrow-window pass makes the scales, the adaptive climb and the step bounds those of a
-    /// range a hundredth as wide, keeps the tangent's direction, spans half that width on each
-    /// side of the stall, and its end restores the range's settings.
+    /// A narrow-window pass makes the scales and the adaptive climb those of a range a
+    /// hundredth as wide, keeps the tangent's direction and the step bounds, spans half that
+    /// width on each side of the stall, and its end restores the range's scales.
     #[test]
     fn a_narrow_pass_scales_the_arc_length_to_its_window_and_restores_it() {
         let mut c = Continuation::new(settings(10.0, 18.0), vec![2.0, 0.5]).with_adaptive_scale(
@@ -1832,18 +1817,7 @@ mod tests {
         let f = NARROW_WINDOW_FRACTIONS[0];
         assert_eq!(c.x_scale, vec![2.0 * f, 0.5 * f]);
         assert_eq!(c.adaptive.as_ref().unwrap().climb, 2.0 * f);
-        assert_eq!(
-            (
-                c.settings.initial_step,
-                c.settings.min_step,
-                c.settings.max_step
-            ),
-            (
-                range.initial_step * f,
-                range.min_step * f,
-                range.max_step * f
-            )
-        );
+        assert_eq!(c.settings, range);
         let inside = raw(&c, &t);
         assert!((before.0 / before.1 - inside.0 / inside.1).abs() < 1e-12);
         assert!((norm(&t) - 1.0).abs() < 1e-12);
