@@ -3,7 +3,8 @@
 //! carry the `jenkins-2d` law; fixed-frequency solves near the first bending pair, where
 //! contacts stick, slip and lift off, give the same solutions in the schur (`auto`) and dense
 //! formulations; `fricbound run` of a narrow window completes with its result files and
-//! VTU output; and the m = +1 limit curve crosses its former stall at 852.78 Hz.
+//! VTU output; and the m = +1 limit curve crosses its former stall at 852.78 Hz, on a narrow
+//! window and, over a wide one, by the continuation's narrow-window pass.
 
 mod support;
 
@@ -242,6 +243,59 @@ fn the_m_plus_1_limit_curve_passes_its_former_stall_at_852_78_hz() {
         reached > 852.78 && (reached - end).abs() < 1e-6,
         "{reached}"
     );
+}
+
+/// Over 852.7-900 Hz the m = +1 limit curve stalls at 852.7776 Hz: the corrector fails at
+/// every step down to the minimum across a contact transition there, with that range's
+/// arc-length scale, while a run over a narrow window around the spot crosses it
+/// (benches/README.md, "Limit analysis across the bending pair"). The continuation now takes
+/// the stall over a narrow window (the response's arc-length scale of a range a hundredth as
+/// wide) and goes on past it as one path: checked here on the first 60 points, which rise in
+/// frequency point after point through the pass and on above 853 Hz.
+#[test]
+fn the_m_plus_1_limit_curve_passes_its_stall_at_852_78_hz_over_a_narrow_window() {
+    use fricbound::analysis::frf::{self, FrfObserver};
+    use fricbound::analysis::limits::case::two_point_cases;
+    #[derive(Default)]
+    struct Passes(Vec<(f64, f64)>);
+    impl FrfObserver for Passes {
+        fn narrow_pass(&mut self, from_hz: f64, to_hz: f64) {
+            self.0.push((from_hz, to_hz));
+        }
+    }
+    let (start, end) = (852.7, 900.0);
+    let o = [
+        format!("analysis.freq_start_hz={start}"),
+        format!("analysis.freq_end_hz={end}"),
+        "analysis.max_points=60".to_string(),
+        "accuracy.estimate=false".to_string(),
+    ];
+    let problem = scene::load_problem(Path::new(LIMITS_SCENE), &o).unwrap().1;
+    let case = two_point_cases(&problem)
+        .into_iter()
+        .find(|c| c.name == "m+1")
+        .unwrap();
+    let mut passes = Passes::default();
+    let run = frf::solve(&case.apply(&problem), &mut passes).unwrap_or_else(|e| panic!("{e}"));
+    let freqs: Vec<f64> = run.points.iter().map(|p| p.freq_hz).collect();
+    println!(
+        "m = +1 over {start}-{end} Hz: {} points up to {:.4} Hz, narrow passes {:?}",
+        freqs.len(),
+        freqs.last().unwrap(),
+        passes.0
+    );
+    assert_eq!(passes.0.len(), 1, "{:?}", passes.0);
+    let (from, to) = passes.0[0];
+    assert!((from - 852.7776).abs() < 1e-3, "{from}");
+    // Half the window: a hundredth of the range over two.
+    assert!(to - from > 0.005 * (end - start), "{to}");
+    assert!(freqs.contains(&from) && freqs.contains(&to));
+    assert!(
+        freqs.windows(2).all(|w| w[1] > w[0]),
+        "not monotone: {freqs:?}"
+    );
+    assert!(run.jumps.is_empty() && *freqs.last().unwrap() > 853.0);
+    assert_eq!(freqs.len(), 60);
 }
 
 const LIMITS_SCENE: &str = "meshes/blade-pair/blade-pair-3d-limits.toml";

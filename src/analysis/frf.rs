@@ -265,6 +265,9 @@ pub trait FrfObserver {
     fn turning_point(&mut self, _freq_hz: f64) {}
     /// The path could not be followed from `from_hz` and was resumed at `to_hz` (Hz).
     fn leap(&mut self, _from_hz: f64, _to_hz: f64) {}
+    /// The path stalled after `from_hz` and was taken on over a narrow window around it up to
+    /// `to_hz` (Hz; see `Continuation::run`).
+    fn narrow_pass(&mut self, _from_hz: f64, _to_hz: f64) {}
     /// The path turned back at a fold and did not return; it goes on on another branch, whose
     /// points come next (see [`Jump`]).
     fn jump(&mut self, _jump: &Jump) {}
@@ -747,6 +750,9 @@ impl<O: FrfObserver> Observer<HbmOperator<'_>> for Adapter<'_, '_, O> {
     }
     fn leap(&mut self, from_hz: f64, to_hz: f64) {
         self.observer.leap(from_hz, to_hz);
+    }
+    fn narrow_pass(&mut self, from_hz: f64, to_hz: f64) {
+        self.observer.narrow_pass(from_hz, to_hz);
     }
 }
 

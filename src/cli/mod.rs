@@ -385,6 +385,19 @@ impl FrfObserver for RunObserver<'_> {
             _ => eprintln!("{msg}"),
         }
     }
+    fn narrow_pass(&mut self, from_hz: f64, to_hz: f64) {
+        self.writer.narrow_pass(from_hz, to_hz);
+        if !self.quiet {
+            let msg = format!(
+                "the path stalled past {from_hz:.4} Hz and was followed on over a narrow window \
+                 around it up to {to_hz:.4} Hz"
+            );
+            match &self.bar {
+                Some(bar) if !bar.is_hidden() => bar.println(msg),
+                _ => eprintln!("{msg}"),
+            }
+        }
+    }
     fn leap(&mut self, from_hz: f64, to_hz: f64) {
         self.writer.leap(from_hz, to_hz);
         if !self.quiet {

@@ -23,8 +23,11 @@
 //! path would then retrace (and loop: back along the followed path and on again through the
 //! same corners). When neither is found the run ends with [`PathEnd::DeadEnd`] where a way
 //! back along the followed path was refused or below the highest frequency reached (the caller
-//! goes on past the highest frequency, as after a path that wandered without progress), and
-//! with [`ContinuationError::Stalled`] otherwise. The last point is solved at exactly the end frequency. A path runs down in
+//! goes on past the highest frequency, as after a path that wandered without progress).
+//! Otherwise the path is taken on from its last point over a narrow window around the spot,
+//! with the arc-length scales of a range that narrow, and past the window with the
+//! range's again ([`Continuation::run`]); a stall inside the window ends the run with
+//! [`ContinuationError::Stalled`]. The last point is solved at exactly the end frequency. A path runs down in
 //! frequency when the end frequency is below the start (e.g. to fill in, back toward a fold, a
 //! branch found past it).
 //!
@@ -99,6 +102,28 @@ pub struct Continuation {
     adaptive: Option<AdaptiveScale>,
     /// Groups of unknowns whose norm (an output's amplitude) the step length watches.
     amplitudes: Vec<Vec<usize>>,
+    /// The narrow-window pass under way, if any (see [`Continuation::enter_narrow`]).
+    narrow: Option<NarrowPass>,
+}
+
+/// A pass over a narrow window around a spot where the path stalled: the response's arc-length
+/// scale (and that of the adaptive scale's climb) is that of a range a fraction
+/// [`NARROW_WINDOW_FRACTIONS`] of the path's own, so that the response weighs that much more
+/// against the frequency in the arc length; the step bounds stay the range's.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct NarrowPass {
+    /// Frequency of the last point before the stall this window starts from (Hz).
+    from_hz: f64,
+    /// Frequency of the last point before the first stall of this pass (Hz): `from_hz` unless
+    /// the path stalled inside a narrower window first.
+    stalled_hz: f64,
+    /// Half width of the window (Hz): the pass ends at the first point farther than this from
+    /// `from_hz`, either way.
+    half_width_hz: f64,
+    /// Factor applied to the scales (the window's width over the range).
+    factor: f64,
+    /// Index of `factor` in [`NARROW_WINDOW_FRACTIONS`].
+    attempt: usize,
 }
 
 /// Groups of unknowns whose arc-length scale grows with the response along the path.
@@ -161,6 +186,14 @@ const RETRACE_LOOKAHEADS: &[f64] = &[1.0, 0.25, 0.0625];
 /// from the corner (about 3°) lies on it: the corner point would resume the incoming branch
 /// backwards (see [`Continuation::runs_back_along`]).
 const RETRACE_FRACTION: f64 = 0.05;
+/// Widths of the window of a narrow-window pass past a stall, as fractions of the range, tried
+/// in turn, each from the last point reached, while the path stalls inside the window (see
+/// [`Continuation::enter_narrow`]). On the 3D blade pair's limit curves over 845-900 Hz a
+/// hundredth passed the stall of m = +1 at 852.78 Hz, and a thousandth or a tenth that of
+/// m = −1 at 852.74 Hz, where a hundredth stalled again (benches/README.md).
+const NARROW_WINDOW_FRACTIONS: &[f64] = &[0.01, 0.001, 0.1];
+/// Most narrow-window passes in one run.
+const MAX_NARROW_PASSES: usize = 8;
 /// Largest turn of the tangent in one step before the step is cut (unless it is a corner).
 const MAX_TURN_DEGREES: f64 = 45.0;
 /// Turn of the tangent per step the step length aims at: a step that turned the tangent by
@@ -178,6 +211,7 @@ impl Continuation {
             carried: std::cell::RefCell::new(None),
             adaptive: None,
             amplitudes: Vec::new(),
+            narrow: None,
         }
     }
 
@@ -244,6 +278,63 @@ impl Continuation {
         tangent.iter_mut().for_each(|v| *v /= length);
         *self.last_factor.borrow_mut() = None;
         *self.carried.borrow_mut() = None;
+    }
+
+    /// Multiplies the scale of every unknown (and the adaptive scale's climb) by `factor` and
+    /// carries the unit tangent over to the new scaled space as the same direction. Kept
+    /// factorisations are dropped: they were built in the old one.
+    fn rescale(&mut self, factor: f64, tangent: &mut [f64]) {
+        let n = self.x_scale.len();
+        self.x_scale.iter_mut().for_each(|s| *s *= factor);
+        if let Some(adaptive) = &mut self.adaptive {
+            adaptive.climb *= factor;
+        }
+        tangent[..n].iter_mut().for_each(|v| *v /= factor);
+        let length = norm(tangent);
+        tangent.iter_mut().for_each(|v| *v /= length);
+        *self.last_factor.borrow_mut() = None;
+        *self.carried.borrow_mut() = None;
+    }
+
+    /// Starts a narrow-window pass from the last point before a stall, at `from_hz` (the
+    /// path having first stalled after `stalled_hz`): the scales and the climb become those of
+    /// a range the fraction `NARROW_WINDOW_FRACTIONS[attempt]` of this one's, until a point
+    /// lands farther than half that width from `from_hz` ([`Self::leave_narrow`]). The step
+    /// bounds stay the scene's (its `min_step` is where the path gives up).
+    ///
+    /// Why: the response's arc-length scale is set from the range (a climb to the response
+    /// costs a quarter of it), so over a wide range the response weighs little against the
+    /// frequency in the arc length. It is that scale which decides whether the corrector gets
+    /// across some contact transitions: over 845-900 Hz the 3D blade pair's m = +1 limit curve
+    /// stalls at 852.78 Hz with the range's scale, whether the steps are the range's or a
+    /// hundredth of them, and passes with a hundredth of the scale, whether the steps are the
+    /// range's or a hundredth of them (benches/README.md).
+    fn enter_narrow(&mut self, from_hz: f64, stalled_hz: f64, attempt: usize, tangent: &mut [f64]) {
+        let range = (self.settings.freq_end_hz - self.settings.freq_start_hz).abs();
+        let factor = NARROW_WINDOW_FRACTIONS[attempt];
+        self.narrow = Some(NarrowPass {
+            from_hz,
+            stalled_hz,
+            half_width_hz: 0.5 * factor * range,
+            factor,
+            attempt,
+        });
+        self.rescale(factor, tangent);
+    }
+
+    /// Ends the narrow-window pass under way, if any: the scales and climb of the range again
+    /// (a scale the adaptive scale grew during the pass keeps its growth). Returns the
+    /// frequency of the last point before the pass's first stall (Hz).
+    fn leave_narrow(&mut self, tangent: &mut [f64]) -> Option<f64> {
+        let pass = self.narrow.take()?;
+        self.rescale(1.0 / pass.factor, tangent);
+        Some(pass.stalled_hz)
+    }
+
+    /// Whether a narrow-window pass is under way and `freq_hz` lies outside its window.
+    fn past_narrow_window(&self, freq_hz: f64) -> bool {
+        self.narrow
+            .is_some_and(|pass| (freq_hz - pass.from_hz).abs() > pass.half_width_hz)
     }
 
     /// The hyperplane normal to the path of the unit tangent `t` (scaled space), as a covector
@@ -973,13 +1064,35 @@ impl Continuation {
     }
 
     /// Follows the path from `x_guess` at the start frequency to the end frequency.
+    ///
+    /// Where the path stalls (see the module docs), it is taken on from the last point before
+    /// the stall over a narrow window around it ([`Self::enter_narrow`]) and, once a point lies
+    /// outside that window, on over the range with the range's scales and steps, as one path;
+    /// each such pass is reported to the observer ([`Observer::narrow_pass`]). A stall inside a
+    /// narrow window ends the run as a stall. The scales the run ends with ([`Self::x_scale`])
+    /// are the range's.
     pub fn run<S: ParametricResidual, O: Observer<S>>(
         &mut self,
         system: &mut S,
         x_guess: &[f64],
         observer: &mut O,
     ) -> Result<PathSummary, ContinuationError> {
+        let outcome = self.run_path(system, x_guess, observer);
+        let mut tangent = vec![0.0; self.x_scale.len() + 1];
+        tangent[self.x_scale.len()] = 1.0;
+        self.leave_narrow(&mut tangent);
+        outcome
+    }
+
+    /// [`Self::run`] itself.
+    fn run_path<S: ParametricResidual, O: Observer<S>>(
+        &mut self,
+        system: &mut S,
+        x_guess: &[f64],
+        observer: &mut O,
+    ) -> Result<PathSummary, ContinuationError> {
         let a = self.settings;
+        let mut narrow_passes = 0usize;
         let omega_start = a.freq_start_hz * OMEGA_SCALE;
         let omega_end = a.freq_end_hz * OMEGA_SCALE;
         let n = system.dim();
@@ -1114,6 +1227,13 @@ impl Continuation {
                     };
                     let factor = by_iterations.min(by_turn).min(by_amplitude).clamp(0.5, 2.0);
                     ds = (ds * factor).clamp(a.min_step, a.max_step);
+                    let freq_hz = summary.points.last().map_or(f64::NAN, |p| p.freq_hz());
+                    if self.past_narrow_window(freq_hz) {
+                        if let Some(from_hz) = self.leave_narrow(&mut tangent) {
+                            observer.narrow_pass(from_hz, freq_hz);
+                        }
+                        ds = a.initial_step.clamp(a.min_step, a.max_step);
+                    }
                 }
                 Err(reason) => {
                     let new_ds = ds * 0.5;
@@ -1156,6 +1276,23 @@ impl Continuation {
                                 summary.end = PathEnd::DeadEnd;
                                 return Ok(summary);
                             }
+                            // The next window: the first for a new stall, the next width for
+                            // one inside a window.
+                            let next = match self.narrow {
+                                None => (narrow_passes < MAX_NARROW_PASSES).then_some(0),
+                                Some(pass) => Some(pass.attempt + 1)
+                                    .filter(|&k| k < NARROW_WINDOW_FRACTIONS.len()),
+                            };
+                            if let Some(attempt) = next {
+                                if attempt == 0 {
+                                    narrow_passes += 1;
+                                }
+                                let stalled = self.leave_narrow(&mut tangent).unwrap_or(from);
+                                self.enter_narrow(from, stalled, attempt, &mut tangent);
+                                ds = a.initial_step.clamp(a.min_step, a.max_step);
+                                previous_quality = None;
+                                continue;
+                            }
                             return Err(ContinuationError::Stalled {
                                 freq_hz: from,
                                 step: ds,
@@ -1163,8 +1300,14 @@ impl Continuation {
                             });
                         };
                         previous_quality = None;
+                        let freq_hz = point.freq_hz();
                         if self.accept(system, observer, &mut summary, point, t_new, &mut tangent) {
                             return Ok(summary);
+                        }
+                        if self.past_narrow_window(freq_hz) {
+                            if let Some(from_hz) = self.leave_narrow(&mut tangent) {
+                                observer.narrow_pass(from_hz, freq_hz);
+                            }
                         }
                         ds = a.initial_step.clamp(a.min_step, a.max_step);
                         continue;
@@ -1653,5 +1796,43 @@ mod tests {
         let after = raw(&c, &t);
         assert!((before.0 / before.1 - after.0 / after.1).abs() < 1e-12);
         assert!((norm(&t) - 1.0).abs() < 1e-12);
+    }
+
+    /// A narrow-window pass makes the scales and the adaptive climb those of a range a
+    /// hundredth as wide, keeps the tangent's direction and the step bounds, spans half that
+    /// width on each side of the stall, and its end restores the range's scales.
+    #[test]
+    fn a_narrow_pass_scales_the_arc_length_to_its_window_and_restores_it() {
+        let mut c = Continuation::new(settings(10.0, 18.0), vec![2.0, 0.5]).with_adaptive_scale(
+            AdaptiveScale {
+                group_of: vec![0, 1],
+                climb: 2.0,
+            },
+        );
+        let range = c.settings;
+        let mut t = vec![0.6, 0.0, 0.8];
+        let raw = |c: &Continuation, t: &[f64]| (t[0] * c.x_scale[0], t[2]);
+        let before = raw(&c, &t);
+        c.enter_narrow(12.0, 12.0, 0, &mut t);
+        let f = NARROW_WINDOW_FRACTIONS[0];
+        assert_eq!(c.x_scale, vec![2.0 * f, 0.5 * f]);
+        assert_eq!(c.adaptive.as_ref().unwrap().climb, 2.0 * f);
+        assert_eq!(c.settings, range);
+        let inside = raw(&c, &t);
+        assert!((before.0 / before.1 - inside.0 / inside.1).abs() < 1e-12);
+        assert!((norm(&t) - 1.0).abs() < 1e-12);
+        // The window: 0.08 Hz wide (a hundredth of 8 Hz) around 12 Hz.
+        assert!(!c.past_narrow_window(12.039) && !c.past_narrow_window(11.961));
+        assert!(c.past_narrow_window(12.041) && c.past_narrow_window(11.959));
+        assert_eq!(c.leave_narrow(&mut t), Some(12.0));
+        assert_eq!(c.settings, range);
+        for (s, s0) in c.x_scale.iter().zip([2.0, 0.5]) {
+            assert!((s / s0 - 1.0).abs() < 1e-14, "{s}");
+        }
+        assert!((c.adaptive.as_ref().unwrap().climb / 2.0 - 1.0).abs() < 1e-14);
+        let after = raw(&c, &t);
+        assert!((before.0 / before.1 - after.0 / after.1).abs() < 1e-12);
+        assert!(!c.past_narrow_window(100.0));
+        assert_eq!(c.leave_narrow(&mut t), None);
     }
 }

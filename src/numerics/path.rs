@@ -121,6 +121,11 @@ pub trait Observer<S: ParametricResidual> {
     fn turning_point(&mut self, _freq_hz: f64) {}
     /// The path could not be followed from `from_hz` and was resumed at `to_hz` (Hz).
     fn leap(&mut self, _from_hz: f64, _to_hz: f64) {}
+    /// The path stalled after `from_hz` and was taken on over a narrow window around it (the
+    /// response weighing more in the arc length, steps as for that window) up to `to_hz`, the
+    /// first point outside the window, from which it goes on with the range's scales and
+    /// steps (Hz).
+    fn narrow_pass(&mut self, _from_hz: f64, _to_hz: f64) {}
 }
 
 /// An observer that does nothing.

@@ -282,6 +282,10 @@ struct SolutionFile<'a> {
     turning_points_hz: &'a [f64],
     step_cuts: &'a [StepCut],
     leaps_hz: &'a [(f64, f64)],
+    /// Stalls passed over a narrow window around them (last point before the stall, first
+    /// point outside the window), Hz; omitted when none.
+    #[serde(skip_serializing_if = "<[_]>::is_empty")]
+    narrow_passes_hz: &'a [(f64, f64)],
     /// Jumps to another branch past a fold (highest frequency before, lowest of the new
     /// branch, its first point's index).
     jumps: &'a [Jump],
@@ -384,6 +388,7 @@ pub struct FrfWriter {
     turning_points: Vec<f64>,
     step_cuts: Vec<StepCut>,
     leaps: Vec<(f64, f64)>,
+    narrow_passes: Vec<(f64, f64)>,
     jumps: Vec<Jump>,
     /// Refined extrema, set by [`Self::write_peaks`].
     peaks: Option<Vec<PeakRecord>>,
@@ -437,6 +442,7 @@ impl FrfWriter {
             turning_points: Vec::new(),
             step_cuts: Vec::new(),
             leaps: Vec::new(),
+            narrow_passes: Vec::new(),
             jumps: Vec::new(),
             peaks: None,
             started: Instant::now(),
@@ -487,6 +493,7 @@ impl FrfWriter {
             turning_points_hz: &self.turning_points,
             step_cuts: &self.step_cuts,
             leaps_hz: &self.leaps,
+            narrow_passes_hz: &self.narrow_passes,
             jumps: &self.jumps,
             coefficients_file: (!inline).then(|| CoefficientsFile {
                 file: "coefficients.bin",
@@ -628,6 +635,10 @@ impl FrfObserver for FrfWriter {
 
     fn leap(&mut self, from_hz: f64, to_hz: f64) {
         self.leaps.push((from_hz, to_hz));
+    }
+
+    fn narrow_pass(&mut self, from_hz: f64, to_hz: f64) {
+        self.narrow_passes.push((from_hz, to_hz));
     }
 
     fn jump(&mut self, jump: &Jump) {
