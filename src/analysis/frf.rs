@@ -96,7 +96,7 @@ pub struct Jump {
 
 /// The judgement of a cut ([`Jump::fill_cut`]): Newton at a fixed frequency just past the cut,
 /// in the direction the stretch was going at its last step, from the cut point's coefficients
-/// (at most [`CUT_CHECK_OFFSETS`]`.len()` solves, the first that converges is kept), and the
+/// (at most five solves, the first that converges is kept, see [`judge_cuts`]), and the
 /// nearest crossing of that frequency by the run's points within a branch, compared on the
 /// coefficients (`cut_check` in `solution.json`'s jumps).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -111,7 +111,7 @@ pub struct CutCheck {
     /// None without a landing or a crossing.
     pub distance: Option<f64>,
     /// Newton iterations of the converged solve (0 without one): with the solves that did
-    /// not converge (at most [`CUT_CHECK_OFFSETS`]`.len()` in all), the judgement's cost.
+    /// not converge (at most five in all, see [`judge_cuts`]), the judgement's cost.
     pub newton_iterations: usize,
     /// What the judgement says.
     pub verdict: CutVerdict,
@@ -1307,8 +1307,13 @@ fn fill_cut(
 
 /// Offsets past a cut at which [`judge_cuts`] tries Newton, in units of the cut's last
 /// frequency step (clamped to [10⁻⁷, 5·10⁻⁴] of the cut's frequency), in the order tried: the
-/// first that converges is the landing.
+/// first that converges is the landing. Then [`CUT_CHECK_FALLBACKS`].
 pub const CUT_CHECK_OFFSETS: &[f64] = &[1.0, 0.25, 0.0625];
+/// Offsets past a cut, relative to its frequency, tried when none of [`CUT_CHECK_OFFSETS`]
+/// converges: at a dead end Newton at a fixed frequency can fail close past the point (at
+/// F0 = 1 N on the paper's system a bridge given up at 152.2176 Hz: no convergence from 10⁻⁷
+/// to 5·10⁻⁴ past it, a landing on the run at 10⁻³).
+pub const CUT_CHECK_FALLBACKS: &[f64] = &[1e-4, 1e-3];
 
 /// Judges the cut of every jump of `run` ([`Jump::fill_cut`]) now that every branch of the run
 /// is known, sets its [`Jump::cut_check`] and tells `observer` ([`FrfObserver::cut_judged`]).
@@ -1316,7 +1321,8 @@ pub const CUT_CHECK_OFFSETS: &[f64] = &[1.0, 0.25, 0.0625];
 /// Newton at a fixed frequency just past the cut, in the direction its stretch was going at
 /// its last step (away from the point before it on the branch; by its fold when the branch
 /// holds the cut point alone), from the cut point's coefficients, at the offsets
-/// [`CUT_CHECK_OFFSETS`] until one converges: at most three fixed-frequency solves per cut.
+/// [`CUT_CHECK_OFFSETS`] then [`CUT_CHECK_FALLBACKS`] until one converges: at most five
+/// fixed-frequency solves per cut, one where Newton converges just past it.
 /// The landing is compared, over all its Fourier coefficients, with every crossing of its
 /// frequency by the run's points (linear along a segment within a branch, not across a jump):
 /// within [`RETRACE_TOLERANCE`] of the nearest it is covered, else the branch goes on beyond the
@@ -1399,8 +1405,12 @@ fn judge_cut(
     let guess = system.restrict(&points[i].coefficients);
     let mut freq_hz = f;
     let mut landing = None;
-    for offset in CUT_CHECK_OFFSETS {
-        freq_hz = f + direction * offset * step;
+    let offsets = CUT_CHECK_OFFSETS
+        .iter()
+        .map(|m| m * step)
+        .chain(CUT_CHECK_FALLBACKS.iter().map(|r| r * f));
+    for offset in offsets {
+        freq_hz = f + direction * offset;
         let Ok(p) = newton.solve_fixed(system, &guess, 2.0 * PI * freq_hz) else {
             continue;
         };
