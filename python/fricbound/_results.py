@@ -168,7 +168,8 @@ class FrfResult(ContinuationPath):
       (``covered``, ``abandoned`` or ``unjudged``; the last two make ``status``
       ``incomplete``), ``cut_check_hz``, ``cut_check_amplitude`` (m, where Newton landed) and
       ``cut_check_distance`` (relative distance of the landing's coefficients from the
-      nearest stretch of the run);
+      nearest stretch of the run) and ``cut_check_own_side`` (True when that stretch is the
+      cut branch's own side of its fold, which next to the fold lies within the tolerance);
     - ``csv``: the run's ``frf.csv`` exactly as the CLI writes it (:meth:`write_csv`).
     """
 

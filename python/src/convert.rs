@@ -309,6 +309,7 @@ pub fn frf_dict<'py>(
         jd.set_item("cut_check_hz", check.map(|c| c.freq_hz))?;
         jd.set_item("cut_check_amplitude", check.and_then(|c| c.amplitude))?;
         jd.set_item("cut_check_distance", check.and_then(|c| c.distance))?;
+        jd.set_item("cut_check_own_side", check.map(|c| c.own_side))?;
         jumps.append(jd)?;
     }
     d.set_item("jumps", jumps)?;
