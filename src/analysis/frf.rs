@@ -1058,6 +1058,9 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
             .iter()
             .min_by(|a, b| a.freq_hz.total_cmp(&b.freq_hz))
             .cloned();
+        // The fill as followed, from the jump target: a branch given up at the point where
+        // the fill ends (its end frequency) lies on the fill's segment into the jump target.
+        let followed_fill = fill.clone();
         fill.reverse();
         fill.pop();
         let bridges = match (top, bottom) {
@@ -1082,7 +1085,7 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
         let later: Vec<&[FrfPoint]> = bridges
             .iter()
             .map(|(b, _)| b.as_slice())
-            .chain([fill.as_slice()])
+            .chain([followed_fill.as_slice()])
             .collect();
         let branch_end = branch_end(
             &adapter.points,
