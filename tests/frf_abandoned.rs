@@ -14,7 +14,7 @@ mod support;
 
 use std::path::Path;
 
-use fricbound::analysis::frf::{self, BranchEnd, FrfRun, GivenUp, PointSolver, Silent};
+use fricbound::analysis::frf::{self, BranchEnd, CutVerdict, FrfRun, GivenUp, PointSolver, Silent};
 use fricbound::model::Problem;
 use fricbound::scene::{self, paper_wedge_scene};
 
@@ -211,4 +211,91 @@ fn the_cli_says_which_branch_a_run_abandoned() {
         .collect();
     assert_eq!(flagged.len(), run.abandoned().count(), "{}", sol["jumps"]);
     assert_eq!(flagged[0]["before"]["how"], "abandoned");
+}
+
+/// The cuts of the fills and bridges (`fill_cut`: a branch solved past a jump and left off
+/// every stretch followed before) are judged once the run is over (`cut_check`), and each
+/// judgement agrees with an independent check: Newton by `PointSolver` at the judgement's
+/// frequency from the cut point's coefficients lands where the judgement says, and a landing
+/// judged covered has some crossing of the run within 1 % of its first output's amplitude,
+/// one judged abandoned none within 1 % on every output at once. At F0 = 5 N the cut at
+/// 80.4161 Hz lands on the branch followed on from the jump target: the run stays complete;
+/// the run's status counts exactly the cuts judged not covered.
+#[test]
+fn cuts_of_fills_and_bridges_are_judged_by_newton_past_them() {
+    let mut judged_at_5n = Vec::new();
+    for f0 in [1.0, 5.0] {
+        let p = paper(&[&format!("static_loads.0.value={}", -f0)]);
+        let run = frf::solve(&p, &mut Silent).unwrap();
+        let mut solver = PointSolver::new(&p).expect("point solver");
+        let starts = run.branch_starts();
+        for (k, jump) in run.jumps.iter().enumerate() {
+            let Some(cut) = jump.fill_cut else {
+                assert!(jump.cut_check.is_none(), "{jump:?}");
+                continue;
+            };
+            let check = jump.cut_check.expect("every cut is judged");
+            eprintln!("F0 = {f0} N: cut {cut:?}\n  judged {check:?}");
+            let end = starts.get(k + 1).copied().unwrap_or(run.points.len());
+            let point = run.points[jump.first_point..end]
+                .iter()
+                .find(|q| q.freq_hz == cut.freq_hz && q.amplitudes[0] == cut.amplitude)
+                .expect("the cut point is on its branch");
+            // Just past the cut: within 10⁻³ of its frequency.
+            assert!(
+                (check.freq_hz - cut.freq_hz).abs() <= 1e-3 * cut.freq_hz * (1.0 + 1e-12)
+                    && check.freq_hz != cut.freq_hz,
+                "{check:?}"
+            );
+            match (
+                check.verdict,
+                solver.solve(&point.coefficients, check.freq_hz),
+            ) {
+                (CutVerdict::Unjudged, landing) => assert!(landing.is_err(), "{landing:?}"),
+                (verdict, Ok(q)) => {
+                    let a = q.amplitudes[0];
+                    let judged = check.amplitude.expect("a landing");
+                    assert!((a - judged).abs() <= 1e-6 * judged, "{a} vs {judged}");
+                    let crossings = run.crossings(check.freq_hz, 0);
+                    let near_first = crossings
+                        .iter()
+                        .any(|c| (c.amplitude - a).abs() <= 1e-2 * a);
+                    let near_all = crossings.iter().any(|c| {
+                        (0..q.amplitudes.len()).all(|o| {
+                            let s = &run.points[c.segment..=c.segment + 1];
+                            let t = (check.freq_hz - s[0].freq_hz) / (s[1].freq_hz - s[0].freq_hz);
+                            let on =
+                                s[0].amplitudes[o] + t * (s[1].amplitudes[o] - s[0].amplitudes[o]);
+                            (on - q.amplitudes[o]).abs() <= 1e-2 * q.amplitudes[o]
+                        })
+                    });
+                    match verdict {
+                        CutVerdict::Covered => assert!(near_first, "{crossings:?}"),
+                        _ => assert!(!near_all, "{crossings:?}"),
+                    }
+                }
+                (verdict, Err(e)) => panic!("{verdict:?} but Newton fails: {e}"),
+            }
+            if f0 == 5.0 {
+                judged_at_5n.push((cut, check));
+            }
+        }
+        let uncovered = run
+            .jumps
+            .iter()
+            .filter(|j| j.cut_uncovered().is_some())
+            .count();
+        let abandoned = run.abandoned().count();
+        assert_eq!(run.is_complete(), uncovered + abandoned == 0);
+        if f0 == 5.0 {
+            assert!(run.is_complete(), "{:?}", run.incomplete_reason());
+        }
+    }
+    assert!(
+        judged_at_5n
+            .iter()
+            .any(|(cut, check)| (cut.freq_hz - 80.4161).abs() < 1e-3
+                && check.verdict == CutVerdict::Covered),
+        "{judged_at_5n:?}"
+    );
 }

@@ -162,9 +162,14 @@ class FrfResult(ContinuationPath):
       ``given_up_amplitude`` (m), ``given_up_rising``, ``given_up_fold_hz`` and
       ``given_up_cause`` (``dead-end`` or ``no-progress``; None otherwise), and
       ``fill_cut_hz``, ``fill_cut_amplitude`` (m), ``fill_cut_fold_hz`` where the branch
-      after the jump (a fill or a bridge), followed toward the edge of its stretch, turned
-      back at a fold of its own and was left (None otherwise; recorded only: it does not set
-      ``abandoned`` nor the status);
+      after the jump (a fill or a bridge) was left off every stretch followed before (at the
+      edge of its stretch after a fold of its own, or given up before it; None otherwise),
+      and its judgement by Newton just past it once the run is over: ``cut_verdict``
+      (``covered``, ``abandoned`` or ``unjudged``; the last two make ``status``
+      ``incomplete``), ``cut_check_hz``, ``cut_check_amplitude`` (m, where Newton landed) and
+      ``cut_check_distance`` (relative distance of the landing's coefficients from the
+      nearest stretch of the run) and ``cut_check_own_side`` (True when that stretch is the
+      cut branch's own side of its fold, which next to the fold lies within the tolerance);
     - ``csv``: the run's ``frf.csv`` exactly as the CLI writes it (:meth:`write_csv`).
     """
 

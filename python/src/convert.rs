@@ -297,6 +297,19 @@ pub fn frf_dict<'py>(
         jd.set_item("fill_cut_hz", cut.map(|g| g.freq_hz))?;
         jd.set_item("fill_cut_amplitude", cut.map(|g| g.amplitude))?;
         jd.set_item("fill_cut_fold_hz", cut.and_then(|g| g.fold_hz))?;
+        let check = j.cut_check.as_ref();
+        jd.set_item(
+            "cut_verdict",
+            check.map(|c| match c.verdict {
+                fricbound::analysis::frf::CutVerdict::Covered => "covered",
+                fricbound::analysis::frf::CutVerdict::Abandoned => "abandoned",
+                fricbound::analysis::frf::CutVerdict::Unjudged => "unjudged",
+            }),
+        )?;
+        jd.set_item("cut_check_hz", check.map(|c| c.freq_hz))?;
+        jd.set_item("cut_check_amplitude", check.and_then(|c| c.amplitude))?;
+        jd.set_item("cut_check_distance", check.and_then(|c| c.distance))?;
+        jd.set_item("cut_check_own_side", check.map(|c| c.own_side))?;
         jumps.append(jd)?;
     }
     d.set_item("jumps", jumps)?;

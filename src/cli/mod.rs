@@ -36,7 +36,7 @@ use std::path::{Path, PathBuf};
 use indicatif::{ProgressBar, ProgressStyle};
 use sha2::{Digest, Sha256};
 
-use crate::analysis::frf::{self, BranchEnd, FrfError, FrfObserver, FrfPoint, Jump, JumpKind};
+use crate::analysis::frf::{self, FrfError, FrfObserver, FrfPoint, Jump, JumpKind};
 use crate::analysis::limits::LimitSettings;
 use crate::analysis::linear::{self, LinearCase};
 use crate::analysis::peaks::{self, ExtremumKind};
@@ -335,29 +335,19 @@ impl FrfObserver for RunObserver<'_> {
         } else {
             String::new()
         };
-        let before = match &jump.before {
-            BranchEnd::Abandoned(g) => format!(
-                "\nthe branch before it was ABANDONED {}: the response beyond that point on \
-                 that branch (possibly the resonance peak) is missing, and the run will be \
-                 reported incomplete",
-                g.describe()
+        let before = match (jump.before.words(), jump.abandons_branch()) {
+            (Some(words), true) => format!(
+                "\nABANDONED: the branch before it was {words}, and the run will be reported \
+                 incomplete"
             ),
-            BranchEnd::Retrace(g) => format!(
-                "\nthe branch before it was given up {}, on a stretch already followed (a \
-                 retrace): nothing is missing there",
-                g.describe()
-            ),
-            BranchEnd::OutsideRange(g) => format!(
-                "\nthe branch before it was given up {}, below the start frequency: nothing \
-                 inside the range is missing there",
-                g.describe()
-            ),
-            BranchEnd::LeftRange | BranchEnd::Bridge => String::new(),
+            (Some(words), false) => format!("\nthe branch before it was {words}"),
+            (None, _) => String::new(),
         };
         let before = match &jump.fill_cut {
             Some(g) => format!(
-                "{before}\nthe branch past it (a fill or bridge) was left at its edge {}: it may \
-                 go on beyond {:.4} Hz, not followed (recorded as the jump's fill_cut)",
+                "{before}\nthe branch past it (a fill or bridge) was left {}: it may go on \
+                 beyond {:.4} Hz, not followed (the jump's fill_cut; judged by Newton past it \
+                 once the run is over)",
                 g.describe(),
                 g.freq_hz
             ),
@@ -396,6 +386,33 @@ impl FrfObserver for RunObserver<'_> {
                 Some(bar) if !bar.is_hidden() => bar.println(msg),
                 _ => eprintln!("{msg}"),
             }
+        }
+    }
+    fn cut_judged(&mut self, index: usize, jump: &Jump) {
+        self.writer.cut_judged(index, jump);
+        // Always said, as the jump was.
+        let (Some(g), Some(check)) = (&jump.fill_cut, &jump.cut_check) else {
+            return;
+        };
+        let msg = format!(
+            "{}the cut at {:.4} Hz of the branch past the jump at {:.4} Hz: {}{}",
+            if check.uncovered() {
+                "NOT COVERED: "
+            } else {
+                ""
+            },
+            g.freq_hz,
+            jump.from_hz,
+            check.describe(),
+            if check.uncovered() {
+                "; the run will be reported incomplete"
+            } else {
+                ""
+            }
+        );
+        match &self.bar {
+            Some(bar) if !bar.is_hidden() => bar.println(msg),
+            _ => eprintln!("{msg}"),
         }
     }
     fn leap(&mut self, from_hz: f64, to_hz: f64) {

@@ -644,6 +644,12 @@ impl FrfObserver for FrfWriter {
     fn jump(&mut self, jump: &Jump) {
         self.jumps.push(*jump);
     }
+
+    fn cut_judged(&mut self, index: usize, jump: &Jump) {
+        if let Some(j) = self.jumps.get_mut(index) {
+            *j = *jump;
+        }
+    }
 }
 
 #[cfg(test)]
