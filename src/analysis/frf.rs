@@ -485,10 +485,18 @@ impl FrfRun {
         })
     }
 
-    /// Whether the run covers the range: the path reached the end frequency, and every
-    /// stretch it jumped over at a fold was computed on some branch.
+    /// Whether the run is complete: it covers the range ([`Self::covers_range`]), no branch
+    /// was abandoned inside it and no cut of a fill or bridge is judged uncovered
+    /// ([`Self::incomplete_reason`]).
     pub fn is_complete(&self) -> bool {
         self.incomplete_reason().is_none()
+    }
+
+    /// Whether the run covers the range, abandoned branches and cuts aside: the path reached
+    /// the end frequency, and every stretch it jumped over at a fold was computed on some
+    /// branch.
+    pub fn covers_range(&self) -> bool {
+        self.coverage_reason().is_none()
     }
 
     /// The jumps whose branch before was abandoned inside the range ([`BranchEnd::Abandoned`]):
