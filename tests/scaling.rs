@@ -103,8 +103,10 @@ fn measured_frf_reaches_the_window_end() {
     // The path reaches the window's end with every stretch on a branch. Whether it also keeps
     // every branch (`complete`) is not asserted here: on this scene it depends on round-off.
     // The reduced matrices differ by about 1e-11 relative from run to run when other threads
-    // allocate at the same time (faer's SIMD kernels sum in an order that depends on the
-    // alignment of their operands), and the path near the folds at 908-914 Hz then differs
+    // run at the same time (the reduction's kernels are sequential and its random start is
+    // seeded; the order of floating-point sums in SIMD kernels that depends on the alignment
+    // of their operands is the likely cause, not pinned down), and the path near the folds at
+    // 908-914 Hz then differs
     // (984 to 1 158 points); in 10 of 110 runs of this test binary (and 2 of 18 solves on
     // concurrent threads) it gives a branch up at 913.55 Hz with the amplitude falling and the
     // run is `incomplete`, as it should say then.
