@@ -212,19 +212,9 @@ fn the_3d_frf_crosses_the_transition_at_886_685_hz_without_turning_back() {
 /// frequency on a narrow window and ends `complete`.
 #[test]
 fn the_m_plus_1_limit_curve_passes_its_former_stall_at_852_78_hz() {
-    use fricbound::analysis::limits::case::two_point_cases;
     use fricbound::analysis::limits::curve::attempt_case;
     let (start, end) = (LIMIT_WINDOW_HZ[0], LIMIT_WINDOW_HZ[1]);
-    let o = [
-        format!("analysis.freq_start_hz={start}"),
-        format!("analysis.freq_end_hz={end}"),
-        "accuracy.estimate=false".to_string(),
-    ];
-    let problem = scene::load_problem(Path::new(LIMITS_SCENE), &o).unwrap().1;
-    let case = two_point_cases(&problem)
-        .into_iter()
-        .find(|c| c.name == "m+1")
-        .unwrap();
+    let (problem, case) = m_plus_1_case(start, end, &[]);
     let curve = attempt_case(&problem, &case, None);
     let reached = curve
         .points
@@ -255,7 +245,6 @@ fn the_m_plus_1_limit_curve_passes_its_former_stall_at_852_78_hz() {
 #[test]
 fn the_m_plus_1_limit_curve_passes_its_stall_at_852_78_hz_over_a_narrow_window() {
     use fricbound::analysis::frf::{self, FrfObserver};
-    use fricbound::analysis::limits::case::two_point_cases;
     #[derive(Default)]
     struct Passes(Vec<(f64, f64)>);
     impl FrfObserver for Passes {
@@ -264,17 +253,7 @@ fn the_m_plus_1_limit_curve_passes_its_stall_at_852_78_hz_over_a_narrow_window()
         }
     }
     let (start, end) = (852.7, 900.0);
-    let o = [
-        format!("analysis.freq_start_hz={start}"),
-        format!("analysis.freq_end_hz={end}"),
-        "analysis.max_points=60".to_string(),
-        "accuracy.estimate=false".to_string(),
-    ];
-    let problem = scene::load_problem(Path::new(LIMITS_SCENE), &o).unwrap().1;
-    let case = two_point_cases(&problem)
-        .into_iter()
-        .find(|c| c.name == "m+1")
-        .unwrap();
+    let (problem, case) = m_plus_1_case(start, end, &["analysis.max_points=60"]);
     let mut passes = Passes::default();
     let run = frf::solve(&case.apply(&problem), &mut passes).unwrap_or_else(|e| panic!("{e}"));
     let freqs: Vec<f64> = run.points.iter().map(|p| p.freq_hz).collect();
@@ -299,6 +278,27 @@ fn the_m_plus_1_limit_curve_passes_its_stall_at_852_78_hz_over_a_narrow_window()
 }
 
 const LIMITS_SCENE: &str = "meshes/blade-pair/blade-pair-3d-limits.toml";
+
+/// The limit scene over `start`-`end` Hz (the estimate off, `extra` overrides added) and its
+/// limit case m = +1 (both patches stuck at T = +μN at the start of the march).
+fn m_plus_1_case(
+    start: f64,
+    end: f64,
+    extra: &[&str],
+) -> (Problem, fricbound::analysis::limits::case::LimitCase) {
+    let mut o = vec![
+        format!("analysis.freq_start_hz={start}"),
+        format!("analysis.freq_end_hz={end}"),
+        "accuracy.estimate=false".to_string(),
+    ];
+    o.extend(extra.iter().map(|s| s.to_string()));
+    let problem = scene::load_problem(Path::new(LIMITS_SCENE), &o).unwrap().1;
+    let case = fricbound::analysis::limits::case::two_point_cases(&problem)
+        .into_iter()
+        .find(|c| c.name == "m+1")
+        .unwrap();
+    (problem, case)
+}
 
 /// A window across the former stall of the m = +1 limit curve (Hz).
 const LIMIT_WINDOW_HZ: [f64; 2] = [852.5, 853.2];
