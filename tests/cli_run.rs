@@ -112,8 +112,8 @@ fn run_writes_all_results() {
     let (header, peaks) = csv(&out.join("peaks.csv"));
     assert_eq!(
         header,
-        "dof,kind,freq_hz,amplitude,refined,path_index,path_freq_hz,path_amplitude,\
-         left_state,right_state"
+        "dof,kind,freq_hz,amplitude,refined,at_branch_end,path_index,path_freq_hz,\
+         path_amplitude,left_state,right_state"
     );
     assert!(
         peaks.iter().any(|r| r[1] == "resonance"),
@@ -251,7 +251,8 @@ fn check_two_dof_peaks(
     let (header, rows) = csv(&out.join("peaks.csv"));
     assert_eq!(
         header,
-        "dof,kind,freq_hz,amplitude,refined,path_index,path_freq_hz,path_amplitude,ground_state"
+        "dof,kind,freq_hz,amplitude,refined,at_branch_end,path_index,path_freq_hz,\
+         path_amplitude,ground_state"
     );
     let kinds: Vec<(&str, &str)> = rows
         .iter()
@@ -268,9 +269,10 @@ fn check_two_dof_peaks(
             if r[0] == "x1" { 0 } else { 1 },
             if r[1] == "resonance" { 1.0 } else { -1.0 },
         );
-        let (freq, amp, path_freq, path_amp) = (num(2), num(3), num(6), num(7));
+        let (freq, amp, path_freq, path_amp) = (num(2), num(3), num(7), num(8));
         assert_eq!(r[4], "true", "refined: {r:?}");
-        let i: usize = r[5].parse().unwrap();
+        assert_eq!(r[5], "false", "at_branch_end: {r:?}");
+        let i: usize = r[6].parse().unwrap();
         let row_freq = |k: usize| -> f64 { frf[k][0].parse().unwrap() };
         assert_eq!(
             row_freq(i),
@@ -288,8 +290,9 @@ fn check_two_dof_peaks(
         assert_eq!(j["dof"], r[0].as_str());
         assert_eq!(j["kind"], r[1].as_str());
         assert_eq!(j["refined"], true);
+        assert_eq!(j["at_branch_end"], false);
         assert_eq!(j["path_index"], i);
-        assert_eq!(j["states"], serde_json::json!([r[8]]));
+        assert_eq!(j["states"], serde_json::json!([r[9]]));
         for (key, v) in [
             ("freq_hz", freq),
             ("amplitude", amp),
@@ -342,11 +345,11 @@ fn frf_peaks_are_the_linear_frf_extrema() {
             ("x2", "resonance"),
         ],
     );
-    assert!(stuck_rows.iter().all(|r| r[8] == "stuck"), "{stuck_rows:?}");
+    assert!(stuck_rows.iter().all(|r| r[9] == "stuck"), "{stuck_rows:?}");
 
     // The free run stopped two points after x1's anti-resonance: incomplete (exit 3), and its
     // peaks.csv holds the extrema passed, with the values of the complete run (the same path).
-    let budget = rows[1][5].parse::<usize>().unwrap() + 2;
+    let budget = rows[1][6].parse::<usize>().unwrap() + 2;
     let part = dir.path().join("part");
     let max_points = format!("analysis.max_points={budget}");
     assert_eq!(run_two_dof(&part, &[&max_points]), Some(3));
@@ -357,7 +360,7 @@ fn frf_peaks_are_the_linear_frf_extrema() {
     // and anti-resonance, and x2's first resonance.
     let passed: Vec<Vec<String>> = rows
         .iter()
-        .filter(|r| r[5].parse::<usize>().unwrap() + 1 < budget)
+        .filter(|r| r[6].parse::<usize>().unwrap() + 1 < budget)
         .cloned()
         .collect();
     assert_eq!(passed.len(), 3, "{rows:?}");

@@ -26,6 +26,8 @@
 //! - [`peaks::path_extrema`]: the same for resonances and anti-resonances (local minima) of
 //!   every output of an FRF run, with the path points they were refined from
 //!   ([`peaks::PathExtremum`]); a failed refinement reports the path point, never an error.
+//!   Resonances that stand out only toward a break between branches are added, marked
+//!   `at_branch_end` ([`peaks::branch_end_peak_indices`]).
 //! - [`modes::natural_modes`], [`modes::damped_modes`]: natural frequencies and shapes of the
 //!   linear structure with contacts open or stuck (dense or Lanczos with a Sturm check), damped
 //!   eigenvalues and modal damping ratios.

@@ -123,6 +123,131 @@ pub fn peak_indices(points: &[FrfPoint], output: usize) -> Vec<usize> {
     extremum_indices(points, output, ExtremumKind::Resonance)
 }
 
+/// How far a point stands out on one side along a branch: the walk from it toward one end of
+/// the branch, up to the first higher point or the end.
+struct Side {
+    /// Lowest amplitude met before a higher point (or the end): the base of the prominence.
+    low: f64,
+    /// Index of that lowest point (the point itself when the side is empty).
+    low_at: usize,
+    /// Whether the walk reached the end of the branch without meeting a higher point.
+    reached_end: bool,
+}
+
+/// The walk from `i` over `range` (indices into `amp`, in walking order).
+fn side(amp: &[f64], i: usize, range: impl Iterator<Item = usize>) -> Side {
+    let mut s = Side {
+        low: amp[i],
+        low_at: i,
+        reached_end: true,
+    };
+    for j in range {
+        if amp[j] > amp[i] {
+            s.reached_end = false;
+            break;
+        }
+        if amp[j] < s.low {
+            s.low = amp[j];
+            s.low_at = j;
+        }
+    }
+    s
+}
+
+/// The branches of a path of `n` points: the index ranges between `branch_starts` (indices of
+/// points not continuous with the point before; others than 1..n are ignored), in path order.
+fn branches(n: usize, branch_starts: &[usize]) -> Vec<std::ops::Range<usize>> {
+    let mut cuts: Vec<usize> = branch_starts
+        .iter()
+        .copied()
+        .filter(|&i| i > 0 && i < n)
+        .collect();
+    cuts.push(0);
+    cuts.push(n);
+    cuts.sort_unstable();
+    cuts.dedup();
+    cuts.windows(2).map(|w| w[0]..w[1]).collect()
+}
+
+/// Indices (into the whole path, in path order) of the resonances of output `output` that
+/// stand out only toward a branch end: points of a branch of `points` (between
+/// `branch_starts`, see [`path_extrema`]) that are not resonances by [`extremum_indices`]
+/// because on one side (or both) the branch ends at a break between branches before any
+/// higher point, so the response may rise beyond the break, unfollowed. Such a point counts
+/// when
+/// - it is a local maximum of its branch, its first or last point included (higher than its
+///   neighbour before, at least its neighbour after; an end has one neighbour);
+/// - it is neither the first nor the last point of the whole path (those are the ends of the
+///   frequency range, where the run stops on purpose);
+/// - it stands out by [`MIN_PROMINENCE`] of its amplitude on its sides that meet a higher
+///   point or the path's own ends (the usual prominence, one side only), or, when both sides
+///   run into breaks, on its deeper side;
+/// - within its reach (the frequencies of its branch from it to the bases of its prominence,
+///   or to the break on a side that runs into one, mirrored about its own frequency), every
+///   point of the other branches lies below it by at least [`MIN_PROMINENCE`] of its
+///   amplitude, so it is not the junction with another branch that carries the response on
+///   (a branch resumed at a dead end starts at the point where the one before stopped).
+pub fn branch_end_peak_indices(
+    points: &[FrfPoint],
+    output: usize,
+    branch_starts: &[usize],
+) -> Vec<usize> {
+    let amp: Vec<f64> = points.iter().map(|p| p.amplitudes[output]).collect();
+    let freq: Vec<f64> = points.iter().map(|p| p.freq_hz).collect();
+    let n = amp.len();
+    let mut found = Vec::new();
+    for range in branches(n, branch_starts) {
+        let (start, end) = (range.start, range.end);
+        let branch = &points[range.clone()];
+        let a = &amp[range.clone()];
+        let m = a.len();
+        if m < 2 {
+            continue;
+        }
+        let usual = extremum_indices(branch, output, ExtremumKind::Resonance);
+        for i in 0..m {
+            let global = start + i;
+            if usual.contains(&i) || global == 0 || global + 1 == n {
+                continue;
+            }
+            let local_max = (i == 0 || a[i] > a[i - 1]) && (i + 1 == m || a[i] >= a[i + 1]);
+            if !local_max {
+                continue;
+            }
+            let left = side(a, i, (0..i).rev());
+            let right = side(a, i, i + 1..m);
+            // A side is open when it runs into a break between branches without a higher
+            // point (the path's own first and last points close it).
+            let left_open = left.reached_end && start > 0;
+            let right_open = right.reached_end && end < n;
+            if !left_open && !right_open {
+                continue;
+            }
+            let base = match (left_open, right_open) {
+                (true, true) => left.low.min(right.low),
+                (true, false) => right.low,
+                _ => left.low,
+            };
+            let margin = MIN_PROMINENCE * a[i].abs();
+            if a[i] - base < margin {
+                continue;
+            }
+            let from = if left_open { 0 } else { left.low_at };
+            let to = if right_open { m - 1 } else { right.low_at };
+            let reach = (from..=to)
+                .map(|j| (freq[start + j] - freq[global]).abs())
+                .fold(0.0, f64::max);
+            let overtaken = (0..n)
+                .filter(|j| !range.contains(j))
+                .any(|j| (freq[j] - freq[global]).abs() <= reach && amp[j] > a[i] - margin);
+            if !overtaken {
+                found.push(global);
+            }
+        }
+    }
+    found
+}
+
 /// Refines the local maximum of output `output` at `points[index]` (an interior point) along
 /// the path between its neighbours: [`refine_extremum_at`] for [`ExtremumKind::Resonance`].
 pub fn refine_at(
@@ -246,13 +371,21 @@ pub struct PathExtremum {
     pub path_freq_hz: f64,
     /// First-harmonic amplitude of the output at that path point (m).
     pub path_amplitude: f64,
+    /// Whether this is a resonance at a branch end ([`branch_end_peak_indices`]): the highest
+    /// response of its branch toward a break between branches, where the path was not
+    /// followed on. The response may rise beyond it; when the point is its branch's first or
+    /// last point it cannot be bracketed and `peak` is the path point, `refined = false`.
+    pub at_branch_end: bool,
 }
 
 /// Every resonance and anti-resonance of every output along a solved path ([`extremum_indices`]),
 /// refined ([`refine_extremum_at`]): ordered by output (in `problem.outputs` order), then along
 /// the path. `branch_starts` are the indices of points where the path is not continuous with
 /// the point before (a branch reached by a jump over a fold; empty for one branch): extrema are
-/// searched and refined within each branch only, never across such a break. This never fails:
+/// searched and refined within each branch only, never across such a break. A resonance that
+/// stands out only toward a break ([`branch_end_peak_indices`]) is added, marked
+/// `at_branch_end`: refined when it lies inside its branch, the path point (`refined = false`)
+/// when it is the branch's first or last point. This never fails:
 /// when no point solver can be built for the problem, or a refinement fails, the path point is
 /// reported with `refined = false`.
 pub fn path_extrema(
@@ -261,19 +394,11 @@ pub fn path_extrema(
     branch_starts: &[usize],
 ) -> Vec<PathExtremum> {
     let mut solver = PointSolver::new(problem).ok();
-    let mut cuts: Vec<usize> = branch_starts
-        .iter()
-        .copied()
-        .filter(|&i| i > 0 && i < points.len())
-        .collect();
-    cuts.push(0);
-    cuts.push(points.len());
-    cuts.sort_unstable();
-    cuts.dedup();
+    let spans = branches(points.len(), branch_starts);
     let mut found = Vec::new();
     for output in 0..problem.outputs.len() {
-        for span in cuts.windows(2) {
-            let (start, branch) = (span[0], &points[span[0]..span[1]]);
+        for span in &spans {
+            let (start, branch) = (span.start, &points[span.clone()]);
             let mut at: Vec<(usize, ExtremumKind)> =
                 [ExtremumKind::Resonance, ExtremumKind::AntiResonance]
                     .into_iter()
@@ -296,10 +421,39 @@ pub fn path_extrema(
                     path_index: start + i,
                     path_freq_hz: branch[i].freq_hz,
                     path_amplitude: branch[i].amplitudes[output],
+                    at_branch_end: false,
                 });
             }
         }
     }
+    // The resonances at branch ends, refined after all the others (so those are solved exactly
+    // as without them): an interior point between its neighbours, an end point not at all.
+    for output in 0..problem.outputs.len() {
+        for index in branch_end_peak_indices(points, output, branch_starts) {
+            let Some(span) = spans.iter().find(|s| s.contains(&index)) else {
+                continue;
+            };
+            let (branch, i) = (&points[span.clone()], index - span.start);
+            let interior = i > 0 && i + 1 < branch.len();
+            let peak = match solver.as_mut() {
+                Some(solver) if interior => {
+                    refine_extremum_at(solver, branch, output, i, ExtremumKind::Resonance)
+                }
+                _ => Peak::from_point(&branch[i], output, false),
+            };
+            found.push(PathExtremum {
+                output,
+                kind: ExtremumKind::Resonance,
+                peak,
+                path_index: index,
+                path_freq_hz: branch[i].freq_hz,
+                path_amplitude: branch[i].amplitudes[output],
+                at_branch_end: true,
+            });
+        }
+    }
+    // By output, then along the path (a stable sort: the order above within each).
+    found.sort_by_key(|e| (e.output, e.path_index));
     found
 }
 
@@ -460,6 +614,116 @@ mod tests {
             .collect();
         assert_eq!(split.len() + 1, whole.len(), "{split:?}");
         assert_eq!(split.iter().collect::<Vec<_>>(), expected);
+    }
+
+    fn path(points: &[(f64, f64)]) -> Vec<FrfPoint> {
+        points.iter().map(|&(f, a)| point(f, a)).collect()
+    }
+
+    /// A branch that rises up to a break (a dead end) has its last point reported; the branch
+    /// after the break, which starts lower and has its own resonance, adds nothing: its first
+    /// point stands out toward the break but the first branch is higher within its reach.
+    #[test]
+    fn a_branch_rising_to_its_end_has_a_peak_there() {
+        let points = path(&[
+            (0.0, 1.0),
+            (1.0, 1.5),
+            (2.0, 2.0),
+            (3.0, 2.5),
+            (3.5, 1.0),
+            (4.0, 0.8),
+            (5.0, 0.9),
+            (6.0, 0.7),
+        ]);
+        assert_eq!(branch_end_peak_indices(&points, 0, &[4]), vec![3]);
+        // The usual resonance of the second branch is not one at a branch end.
+        assert_eq!(
+            extremum_indices(&points[4..], 0, ExtremumKind::Resonance),
+            vec![2]
+        );
+        // One branch: the rise ends inside the path, at a valley, and nothing is added.
+        assert!(branch_end_peak_indices(&points, 0, &[]).is_empty());
+    }
+
+    /// The layout of the 3D blade pair's bridge: a branch whose highest point is its second,
+    /// its first only 3·10⁻⁴ lower (less than the prominence), is reported at that second
+    /// point; the same points as one branch, or with the rise at the path's own last point,
+    /// are not.
+    #[test]
+    fn a_maximum_next_to_a_branch_start_is_reported() {
+        let mut points = path(&[
+            (0.0, 1.0),
+            (1.0, 2.0),
+            (2.0, 2.5),
+            (3.0, 2.0),
+            (4.0, 1.0),
+            (5.0, 2.999),
+            (4.9, 3.0),
+            (6.0, 2.0),
+            (7.0, 1.5),
+            (8.0, 1.0),
+        ]);
+        assert_eq!(branch_end_peak_indices(&points, 0, &[5]), vec![6]);
+        assert!(extremum_indices(&points[5..], 0, ExtremumKind::Resonance).is_empty());
+        assert!(branch_end_peak_indices(&points, 0, &[]).is_empty());
+        // A higher point of the first branch within its reach takes it over.
+        points[2].amplitudes[0] = 3.0;
+        assert!(branch_end_peak_indices(&points, 0, &[5]).is_empty());
+        // The run's own last point is an end of the range, not of a branch.
+        let rising = path(&[(0.0, 1.0), (1.0, 0.5), (2.0, 1.0), (3.0, 2.0)]);
+        assert!(branch_end_peak_indices(&rising, 0, &[]).is_empty());
+        assert!(branch_end_peak_indices(&rising, 0, &[2]).is_empty());
+    }
+
+    /// A branch resumed where the one before stopped (a dead end: its first point is that
+    /// point again) and rising on is no peak, nor is the point where the first stopped.
+    #[test]
+    fn a_branch_resumed_at_a_dead_end_adds_no_peak() {
+        let points = path(&[
+            (0.0, 1.0),
+            (1.0, 1.5),
+            (2.0, 2.0),
+            (2.0, 2.0),
+            (1.9, 1.9),
+            (3.0, 2.5),
+            (4.0, 3.0),
+            (5.0, 1.0),
+        ]);
+        assert!(branch_end_peak_indices(&points, 0, &[3]).is_empty());
+    }
+
+    /// The linear two-DOF path cut at x1's first resonance (the peak point starts the second
+    /// branch) reports that point as a resonance at a branch end, unrefined, with the path
+    /// point's values; every other extremum is the one of the whole path, and without the cut
+    /// no extremum is at a branch end.
+    #[test]
+    fn a_resonance_cut_at_its_peak_is_reported_at_the_branch_end() {
+        let p = problem();
+        let points = coarse_path(&p);
+        let whole = path_extrema(&p, &points, &[]);
+        assert!(whole.iter().all(|e| !e.at_branch_end));
+        let r = whole
+            .iter()
+            .find(|e| e.output == 0 && e.kind == ExtremumKind::Resonance)
+            .expect("x1's first resonance")
+            .path_index;
+        let split = path_extrema(&p, &points, &[r]);
+        let ends: Vec<&PathExtremum> = split.iter().filter(|e| e.at_branch_end).collect();
+        assert!(ends.iter().any(|e| e.output == 0), "{split:?}");
+        for e in &ends {
+            assert_eq!(e.path_index, r, "{e:?}");
+            assert_eq!(e.kind, ExtremumKind::Resonance);
+            assert!(!e.peak.refined);
+            assert_eq!(e.peak.freq_hz, points[r].freq_hz);
+            assert_eq!(e.peak.amplitude, points[r].amplitudes[e.output]);
+        }
+        let kept: Vec<&PathExtremum> = split.iter().filter(|e| !e.at_branch_end).collect();
+        let expected: Vec<&PathExtremum> = whole.iter().filter(|e| e.path_index != r).collect();
+        assert_eq!(kept, expected);
+        // Ordered by output, then along the path.
+        assert!(split
+            .windows(2)
+            .all(|w| (w[0].output, w[0].path_index) <= (w[1].output, w[1].path_index)));
     }
 
     /// When the refining solves fail (no Newton iteration allowed), the path points are

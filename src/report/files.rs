@@ -215,13 +215,17 @@ pub fn linear_csv(problem: &Problem, curve: &LinearCurve) -> String {
 
 /// Header of an FRF run's `peaks.csv`: `dof`, `kind` (`resonance` or `anti-resonance`),
 /// `freq_hz` and `amplitude` (the refined extremum: Hz, first-harmonic amplitude in m),
-/// `refined` (`true`, or `false` when the refinement failed and the values are the path
-/// point's), `path_index`, `path_freq_hz` and `path_amplitude` (the point of the solved path
+/// `refined` (`true`, or `false` when the refinement failed or the extremum is the first or
+/// last point of a branch, and the values are the path point's), `at_branch_end` (`true` for a
+/// resonance that stands out only toward a break between branches, where the path was not
+/// followed on, so the response may rise beyond it: [`crate::analysis::peaks::branch_end_peak_indices`]),
+/// `path_index`, `path_freq_hz` and `path_amplitude` (the point of the solved path
 /// the extremum was refined from: its index in path order, Hz, m), then `<contact>_state` at
 /// the refined extremum per contact of `contacts`.
 pub fn peaks_header(contacts: &[String]) -> String {
-    let mut h =
-        String::from("dof,kind,freq_hz,amplitude,refined,path_index,path_freq_hz,path_amplitude");
+    let mut h = String::from(
+        "dof,kind,freq_hz,amplitude,refined,at_branch_end,path_index,path_freq_hz,path_amplitude",
+    );
     for c in contacts {
         let _ = write!(h, ",{c}_state");
     }
@@ -237,11 +241,12 @@ pub fn peaks_csv(outputs: &[String], contacts: &[String], extrema: &[PathExtremu
         let dof = outputs.get(e.output).map_or("?", String::as_str);
         let _ = write!(
             s,
-            "{dof},{},{:.10e},{:.10e},{},{},{:.10e},{:.10e}",
+            "{dof},{},{:.10e},{:.10e},{},{},{},{:.10e},{:.10e}",
             e.kind.label(),
             e.peak.freq_hz,
             e.peak.amplitude,
             e.peak.refined,
+            e.at_branch_end,
             e.path_index,
             e.path_freq_hz,
             e.path_amplitude
@@ -312,8 +317,12 @@ struct PeakRecord {
     freq_hz: f64,
     /// Refined first-harmonic amplitude (m).
     amplitude: f64,
-    /// False when the refinement failed (the values are then the path point's).
+    /// False when the refinement failed or the extremum is a branch's first or last point
+    /// (the values are then the path point's).
     refined: bool,
+    /// A resonance standing out only toward a break between branches: the response may rise
+    /// beyond it, where the path was not followed on.
+    at_branch_end: bool,
     /// Contact states at the refined extremum.
     states: Vec<ContactState>,
     /// The path point it was refined from: index, frequency (Hz), amplitude (m).
@@ -542,6 +551,7 @@ impl FrfWriter {
                     freq_hz: e.peak.freq_hz,
                     amplitude: e.peak.amplitude,
                     refined: e.peak.refined,
+                    at_branch_end: e.at_branch_end,
                     states: e.peak.states.clone(),
                     path_index: e.path_index,
                     path_freq_hz: e.path_freq_hz,
