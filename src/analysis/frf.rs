@@ -2221,19 +2221,23 @@ mod tests {
         // Branch 1: 100..110 Hz on the line; branch 2 (from index 11): 112 Hz down to
         // 105 Hz on a line with amplitude 5, then up again to 106 Hz at the first line's
         // amplitude: the segment across the jump (110 Hz, 2) to (112 Hz, 5) does not count.
+        // How branch 2, given up at its last point after the fold at 105 Hz, ended.
+        let end_of_branch_2 = |points: &[FrfPoint]| {
+            branch_end(
+                points,
+                &[11],
+                11,
+                Some(105.0),
+                PathEnd::NoProgress,
+                &[],
+                0.0,
+            )
+        };
         let mut points = folded_path(&[]);
         points.push(line_point(112.0, 5.0, 0.0));
         points.push(line_point(105.0, 5.0, 0.0));
         points.push(line_point(106.0, 1.6, 0.0));
-        let end = branch_end(
-            &points,
-            &[11],
-            11,
-            Some(105.0),
-            PathEnd::NoProgress,
-            &[],
-            0.0,
-        );
+        let end = end_of_branch_2(&points);
         let BranchEnd::Retrace(g) = end else {
             panic!("{end:?}")
         };
@@ -2243,15 +2247,7 @@ mod tests {
         // through the point's amplitude 3.5: not a stretch followed.
         points.pop();
         points.push(line_point(111.0, 3.5, 0.0));
-        let end = branch_end(
-            &points,
-            &[11],
-            11,
-            Some(105.0),
-            PathEnd::NoProgress,
-            &[],
-            0.0,
-        );
+        let end = end_of_branch_2(&points);
         assert!(matches!(end, BranchEnd::Abandoned(_)), "{end:?}");
 
         let rising = folded_path(&[]);

@@ -295,6 +295,16 @@ struct RunObserver<'a> {
     quiet: bool,
 }
 
+impl RunObserver<'_> {
+    /// Prints a message above the progress bar, or on stderr when there is none.
+    fn say(&self, msg: String) {
+        match &self.bar {
+            Some(bar) if !bar.is_hidden() => bar.println(msg),
+            _ => eprintln!("{msg}"),
+        }
+    }
+}
+
 impl FrfObserver for RunObserver<'_> {
     fn point(&mut self, point: &FrfPoint) {
         self.writer.point(point);
@@ -315,10 +325,7 @@ impl FrfObserver for RunObserver<'_> {
         if !self.quiet {
             let msg =
                 format!("step cut after {freq_hz:.4} Hz ({step:.3e} -> {new_step:.3e}): {reason}");
-            match &self.bar {
-                Some(bar) if !bar.is_hidden() => bar.println(msg),
-                _ => eprintln!("{msg}"),
-            }
+            self.say(msg);
         }
     }
     fn turning_point(&mut self, freq_hz: f64) {
@@ -370,10 +377,7 @@ impl FrfObserver for RunObserver<'_> {
                 jump.to_hz, jump.from_hz
             ),
         } + &before;
-        match &self.bar {
-            Some(bar) if !bar.is_hidden() => bar.println(msg),
-            _ => eprintln!("{msg}"),
-        }
+        self.say(msg);
     }
     fn narrow_pass(&mut self, from_hz: f64, to_hz: f64) {
         self.writer.narrow_pass(from_hz, to_hz);
@@ -382,10 +386,7 @@ impl FrfObserver for RunObserver<'_> {
                 "the path stalled past {from_hz:.4} Hz and was followed on over a narrow window \
                  around it up to {to_hz:.4} Hz"
             );
-            match &self.bar {
-                Some(bar) if !bar.is_hidden() => bar.println(msg),
-                _ => eprintln!("{msg}"),
-            }
+            self.say(msg);
         }
     }
     fn cut_judged(&mut self, index: usize, jump: &Jump) {
@@ -410,10 +411,7 @@ impl FrfObserver for RunObserver<'_> {
                 ""
             }
         );
-        match &self.bar {
-            Some(bar) if !bar.is_hidden() => bar.println(msg),
-            _ => eprintln!("{msg}"),
-        }
+        self.say(msg);
     }
     fn leap(&mut self, from_hz: f64, to_hz: f64) {
         self.writer.leap(from_hz, to_hz);
@@ -422,10 +420,7 @@ impl FrfObserver for RunObserver<'_> {
                 "the path could not be followed past {from_hz:.4} Hz and resumed at \
                  {to_hz:.4} Hz (no points in between)"
             );
-            match &self.bar {
-                Some(bar) if !bar.is_hidden() => bar.println(msg),
-                _ => eprintln!("{msg}"),
-            }
+            self.say(msg);
         }
     }
 }
