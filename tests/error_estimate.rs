@@ -13,7 +13,9 @@
 //! `PathSwitch::SLIDE_STEPS`); the across-path estimate is compared too, against the
 //! reference where it crosses the hyperplane normal to the path, and printed.
 
-use fricbound::analysis::error_estimate::{run_warnings, PathSwitch};
+use fricbound::analysis::error_estimate::{
+    run_warnings, ErrorEstimator, EstimateProblems, PathSwitch,
+};
 use fricbound::analysis::frf::{self, Silent};
 use fricbound::model::Problem;
 use fricbound::scene;
@@ -51,12 +53,22 @@ fn truncation_estimate_tracks_the_true_error_on_the_paper_case() {
     let mut failures = Vec::new();
     // Points where the estimate exceeds 3× the true error (conservative side).
     let mut over: Vec<(usize, f64)> = Vec::new();
+    // The extended system solved to convergence across the path at every point (what a point
+    // next to a fold reports where its across-path step leaves its linear range; no point of
+    // this path reports it, so it is formed here for each): (H, true error across the path,
+    // solved estimate) where the true error > 1e-3, and the points below 1e-4 that would warn.
+    let mut solved_across: Vec<(usize, f64, f64)> = Vec::new();
+    let mut solved_across_small = 0;
+    let mut solved_across_warns = Vec::new();
+    let mut solved_across_failed = 0;
     println!("H  freq_hz   true_err   trunc_est  ratio   sampling_est");
     for h in [1, 3, 5, 7] {
         let problem = zoom_2nd(&[format!("harmonics.max={h}")]);
         let run = frf::solve(&problem, &mut Silent).expect("run solves");
         assert!(run.is_complete());
         let set = problem.unknown_harmonics();
+        let refined = EstimateProblems::new(&problem).expect("the estimate is on");
+        let mut estimator = ErrorEstimator::new(&problem, &refined).expect("estimator builds");
         for p in &run.points {
             let acc = p
                 .accuracy
@@ -80,6 +92,23 @@ fn truncation_estimate_tracks_the_true_error_on_the_paper_case() {
                         across.push((h, truth, across_est[0]));
                     } else if truth < 1e-4 && across_est[0] > 0.01 {
                         across_small_warns += 1;
+                    }
+                    let omega = 2.0 * std::f64::consts::PI * p.freq_hz;
+                    match estimator.solved_across(
+                        &p.coefficients,
+                        omega,
+                        normal,
+                        acc.estimate_harmonic,
+                    ) {
+                        Some(solved) if truth > 1e-3 => solved_across.push((h, truth, solved[0])),
+                        Some(solved) if truth < 1e-4 => {
+                            solved_across_small += 1;
+                            if solved[0] > problem.analysis.error_estimate.warn_threshold {
+                                solved_across_warns.push((h, p.freq_hz, truth, solved[0]));
+                            }
+                        }
+                        Some(_) => {}
+                        None => solved_across_failed += 1,
                     }
                 }
             }
@@ -153,10 +182,39 @@ fn truncation_estimate_tracks_the_true_error_on_the_paper_case() {
             ratios.iter().copied().fold(0.0, f64::max)
         );
     }
+    let solved_misses: Vec<&(usize, f64, f64)> = solved_across
+        .iter()
+        .filter(|a| !(1.0 / 3.0..=3.0).contains(&(a.2 / a.1)))
+        .collect();
+    for h in [1, 3, 5, 7] {
+        let ratios: Vec<f64> = solved_across
+            .iter()
+            .filter(|a| a.0 == h)
+            .map(|a| a.2 / a.1)
+            .collect();
+        println!(
+            "solved across the path, H = {h}: {} points with true error > 1e-3, ratio \
+             {:.3}-{:.3}",
+            ratios.len(),
+            ratios.iter().copied().fold(f64::INFINITY, f64::min),
+            ratios.iter().copied().fold(0.0, f64::max)
+        );
+    }
+    println!(
+        "solved across the path: {solved_across_small} points below 1e-4, of which warn \
+         {solved_across_warns:?}; {solved_across_failed} solves did not converge; outside a \
+         factor 3: {solved_misses:?}"
+    );
     println!(
         "across the path: {across_small_warns} points with true error < 1e-4 would warn; \
          largest slide {largest_slide:.1} steps, {switched} points report the across-path step"
     );
+    // The converged across-path solve meets the criteria against the true error across the
+    // path (measured: H = 1 0.91-1.01 at 105 points, H = 3 0.99-1.05 at 103, every solve
+    // converges, none of the 1036 points below 1e-4 warns).
+    assert!(solved_misses.is_empty(), "{solved_misses:?}");
+    assert!(solved_across_warns.is_empty(), "{solved_across_warns:?}");
+    assert!(solved_across.len() > 100 && solved_across_small > 100);
     // No point of this path is next to a fold: the fixed-frequency step is reported
     // everywhere (the largest slide measured: 21 steps, on the H = 1 flank).
     assert_eq!(switched, 0);
