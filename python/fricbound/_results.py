@@ -172,7 +172,12 @@ class FrfResult(ContinuationPath):
       stretch is the cut branch's own side of its fold, which next to the fold lies within
       the tolerance) and ``cut_check_resolved_distance`` (relative distance between the
       landing and Newton's solution at its frequency from that stretch: at most 1e-6, the
-      same solution); a bridge cut at both of its sides has the same keys for its way up's
+      same solution), and, when the landing is that own side (the stretch came back along
+      it), the judgement past that fold: ``cut_check_beyond_fold_hz`` (the fold),
+      ``cut_check_beyond_fold_amplitude`` (m, where Newton landed past it; None when it
+      converged nowhere) and ``cut_check_beyond_fold_run_amplitude`` (m, the run's largest
+      amplitude there; a landing above it on no stretch makes the cut ``abandoned``); a
+      bridge cut at both of its sides has the same keys for its way up's
       cut prefixed ``second_`` (``second_fill_cut_hz``, ``second_cut_verdict``, …; None
       otherwise);
     - ``csv``: the run's ``frf.csv`` exactly as the CLI writes it (:meth:`write_csv`).
