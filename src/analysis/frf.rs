@@ -81,14 +81,16 @@ pub struct Jump {
     /// Where the branch after the jump (the fill, followed back down toward the fold, or a
     /// bridge, followed toward the edges of its stretch) was left off every stretch followed
     /// before (see [`fill_cut`]): at its edge after turning back at a fold of its own, or
-    /// given up before its edge (a dead end, no progress). That branch may go on beyond the
+    /// given up before its edge (a dead end, no progress, its point budget used up); for a
+    /// bridge cut both ways, its way down's ([`Jump::second_cut`]). That branch may go on beyond the
     /// point, not followed. It does not count in [`Jump::abandons_branch`] (which is about the
     /// branch before the jump); whether it counts in the run's status is decided by
     /// [`Jump::cut_check`], once the branches solved after it are known. None otherwise.
     pub fill_cut: Option<GivenUp>,
     /// How [`Jump::fill_cut`] was judged once the run was over ([`CutCheck`]): by a Newton
     /// solve just past it, whose landing either lies on a stretch of the run (the cut is
-    /// covered) or not (the branch given up there goes on, unfollowed: the run is incomplete).
+    /// covered; past the cut stretch's fold when the landing is its own other side) or not
+    /// (the branch given up there goes on, unfollowed: the run is incomplete).
     /// None without a cut, and for jumps reported before the judgement (see
     /// [`FrfObserver::cut_judged`]).
     pub cut_check: Option<CutCheck>,
