@@ -218,9 +218,11 @@ fn the_cli_says_which_branch_a_run_abandoned() {
 /// judgement agrees with an independent check: Newton by `PointSolver` at the judgement's
 /// frequency from the cut point's coefficients lands where the judgement says, and a landing
 /// judged covered has some crossing of the run within 1 % of its first output's amplitude,
-/// one judged abandoned none within 1 % on every output at once. At F0 = 5 N the cut at
-/// 80.4161 Hz lands on the branch followed on from the jump target: the run stays complete;
-/// the run's status counts exactly the cuts judged not covered.
+/// one judged abandoned none within 1 % on every output at once; a landing on the cut's own
+/// side is judged past its fold, where Newton lands where the judgement says, above every
+/// crossing of the run when not covered. At F0 = 5 N the cut at 80.4161 Hz lands on the fill's
+/// own side, and past its fold below the run: the run stays complete; the run's status counts
+/// exactly the cuts judged not covered.
 #[test]
 fn cuts_of_fills_and_bridges_are_judged_by_newton_past_them() {
     let mut judged_at_5n = Vec::new();
@@ -269,9 +271,33 @@ fn cuts_of_fills_and_bridges_are_judged_by_newton_past_them() {
                             (on - q.amplitudes[o]).abs() <= 1e-2 * q.amplitudes[o]
                         })
                     });
-                    match verdict {
-                        CutVerdict::Covered => assert!(near_first, "{crossings:?}"),
-                        _ => assert!(!near_all, "{crossings:?}"),
+                    match (verdict, check.beyond_fold) {
+                        (_, None) if verdict == CutVerdict::Covered => {
+                            assert!(near_first, "{crossings:?}")
+                        }
+                        (_, None) => assert!(!near_all, "{crossings:?}"),
+                        // The landing is the cut's own side: judged past its fold.
+                        (_, Some(fold)) => {
+                            assert!(near_first, "{crossings:?}");
+                            let judged = fold.amplitude.expect("a landing past the fold");
+                            let at_fold = run.points[jump.first_point..end]
+                                .iter()
+                                .find(|q| q.freq_hz == fold.fold_hz)
+                                .expect("the fold is on the cut's branch");
+                            let q = solver
+                                .solve(&at_fold.coefficients, fold.freq_hz)
+                                .expect("Newton past the fold");
+                            let b = q.amplitudes[0];
+                            assert!((b - judged).abs() <= 1e-6 * judged, "{b} vs {judged}");
+                            let largest = run
+                                .crossings(fold.freq_hz, 0)
+                                .iter()
+                                .map(|c| c.amplitude)
+                                .fold(f64::NEG_INFINITY, f64::max);
+                            if verdict != CutVerdict::Covered {
+                                assert!(b > largest, "{b} under the run's {largest}");
+                            }
+                        }
                     }
                 }
                 (verdict, Err(e)) => panic!("{verdict:?} but Newton fails: {e}"),
@@ -291,11 +317,22 @@ fn cuts_of_fills_and_bridges_are_judged_by_newton_past_them() {
             assert!(run.is_complete(), "{:?}", run.incomplete_reason());
         }
     }
+    // The fill at 80.4161 Hz came back along its own side (Newton from it finds the landing)
+    // from its fold at 80.4043 Hz; past that fold Newton lands on the lower branch, below the
+    // resonance branch the run followed there: covered.
     assert!(
-        judged_at_5n
-            .iter()
-            .any(|(cut, check)| (cut.freq_hz - 80.4161).abs() < 1e-3
-                && check.verdict == CutVerdict::Covered),
+        judged_at_5n.iter().any(|(cut, check)| {
+            (cut.freq_hz - 80.4161).abs() < 1e-3
+                && check.verdict == CutVerdict::Covered
+                && check.own_side
+                && check.beyond_fold.is_some_and(|fold| {
+                    fold.verdict == CutVerdict::Covered
+                        && fold
+                            .amplitude
+                            .zip(fold.run_amplitude)
+                            .is_some_and(|(a, r)| a < r)
+                })
+        }),
         "{judged_at_5n:?}"
     );
 }

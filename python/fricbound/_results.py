@@ -163,13 +163,23 @@ class FrfResult(ContinuationPath):
       ``given_up_cause`` (``dead-end`` or ``no-progress``; None otherwise), and
       ``fill_cut_hz``, ``fill_cut_amplitude`` (m), ``fill_cut_fold_hz`` where the branch
       after the jump (a fill or a bridge) was left off every stretch followed before (at the
-      edge of its stretch after a fold of its own, or given up before it; None otherwise),
-      and its judgement by Newton just past it once the run is over: ``cut_verdict``
-      (``covered``, ``abandoned`` or ``unjudged``; the last two make ``status``
-      ``incomplete``), ``cut_check_hz``, ``cut_check_amplitude`` (m, where Newton landed) and
-      ``cut_check_distance`` (relative distance of the landing's coefficients from the
-      nearest stretch of the run) and ``cut_check_own_side`` (True when that stretch is the
-      cut branch's own side of its fold, which next to the fold lies within the tolerance);
+      edge of its stretch after a fold of its own, given up before it, or out of points;
+      None otherwise), and its judgement by Newton just past it once the run is over:
+      ``cut_verdict`` (``covered``, ``abandoned`` or ``unjudged``; the last two make
+      ``status`` ``incomplete``), ``cut_check_hz``, ``cut_check_amplitude`` (m, where Newton
+      landed), ``cut_check_distance`` (relative distance of the landing's coefficients from
+      the stretch of the run the verdict rests on), ``cut_check_own_side`` (True when that
+      stretch is the cut branch's own side of its fold, which next to the fold lies within
+      the tolerance) and ``cut_check_resolved_distance`` (relative distance between the
+      landing and Newton's solution at its frequency from that stretch: at most 1e-6, the
+      same solution), and, when the landing is that own side (the stretch came back along
+      it), the judgement past that fold: ``cut_check_beyond_fold_hz`` (the fold),
+      ``cut_check_beyond_fold_amplitude`` (m, where Newton landed past it; None when it
+      converged nowhere) and ``cut_check_beyond_fold_run_amplitude`` (m, the run's largest
+      amplitude there; a landing above it on no stretch makes the cut ``abandoned``); a
+      bridge cut at both of its sides has the same keys for its way up's
+      cut prefixed ``second_`` (``second_fill_cut_hz``, ``second_cut_verdict``, …; None
+      otherwise);
     - ``csv``: the run's ``frf.csv`` exactly as the CLI writes it (:meth:`write_csv`).
     """
 

@@ -291,25 +291,68 @@ pub fn frf_dict<'py>(
                 fricbound::analysis::frf::GiveUpCause::DeadEnd => "dead-end",
                 fricbound::analysis::frf::GiveUpCause::NoProgress => "no-progress",
                 fricbound::analysis::frf::GiveUpCause::FillEnd => "fill-end",
+                fricbound::analysis::frf::GiveUpCause::PointBudget => "point-budget",
             }),
         )?;
-        let cut = j.fill_cut.as_ref();
-        jd.set_item("fill_cut_hz", cut.map(|g| g.freq_hz))?;
-        jd.set_item("fill_cut_amplitude", cut.map(|g| g.amplitude))?;
-        jd.set_item("fill_cut_fold_hz", cut.and_then(|g| g.fold_hz))?;
-        let check = j.cut_check.as_ref();
-        jd.set_item(
-            "cut_verdict",
-            check.map(|c| match c.verdict {
-                fricbound::analysis::frf::CutVerdict::Covered => "covered",
-                fricbound::analysis::frf::CutVerdict::Abandoned => "abandoned",
-                fricbound::analysis::frf::CutVerdict::Unjudged => "unjudged",
-            }),
-        )?;
-        jd.set_item("cut_check_hz", check.map(|c| c.freq_hz))?;
-        jd.set_item("cut_check_amplitude", check.and_then(|c| c.amplitude))?;
-        jd.set_item("cut_check_distance", check.and_then(|c| c.distance))?;
-        jd.set_item("cut_check_own_side", check.map(|c| c.own_side))?;
+        // The first cut under its own keys, the second (a bridge cut on both sides) under
+        // the same keys prefixed `second_`.
+        let cuts = [
+            ("", j.fill_cut.as_ref(), j.cut_check.as_ref()),
+            (
+                "second_",
+                j.second_cut.as_ref(),
+                j.second_cut_check.as_ref(),
+            ),
+        ];
+        for (prefix, cut, check) in cuts {
+            jd.set_item(format!("{prefix}fill_cut_hz"), cut.map(|g| g.freq_hz))?;
+            jd.set_item(
+                format!("{prefix}fill_cut_amplitude"),
+                cut.map(|g| g.amplitude),
+            )?;
+            jd.set_item(
+                format!("{prefix}fill_cut_fold_hz"),
+                cut.and_then(|g| g.fold_hz),
+            )?;
+            jd.set_item(
+                format!("{prefix}cut_verdict"),
+                check.map(|c| match c.verdict {
+                    fricbound::analysis::frf::CutVerdict::Covered => "covered",
+                    fricbound::analysis::frf::CutVerdict::Abandoned => "abandoned",
+                    fricbound::analysis::frf::CutVerdict::Unjudged => "unjudged",
+                }),
+            )?;
+            jd.set_item(format!("{prefix}cut_check_hz"), check.map(|c| c.freq_hz))?;
+            jd.set_item(
+                format!("{prefix}cut_check_amplitude"),
+                check.and_then(|c| c.amplitude),
+            )?;
+            jd.set_item(
+                format!("{prefix}cut_check_distance"),
+                check.and_then(|c| c.distance),
+            )?;
+            jd.set_item(
+                format!("{prefix}cut_check_own_side"),
+                check.map(|c| c.own_side),
+            )?;
+            jd.set_item(
+                format!("{prefix}cut_check_resolved_distance"),
+                check.and_then(|c| c.resolved_distance),
+            )?;
+            let fold = check.and_then(|c| c.beyond_fold.as_ref());
+            jd.set_item(
+                format!("{prefix}cut_check_beyond_fold_hz"),
+                fold.map(|f| f.fold_hz),
+            )?;
+            jd.set_item(
+                format!("{prefix}cut_check_beyond_fold_amplitude"),
+                fold.and_then(|f| f.amplitude),
+            )?;
+            jd.set_item(
+                format!("{prefix}cut_check_beyond_fold_run_amplitude"),
+                fold.and_then(|f| f.run_amplitude),
+            )?;
+        }
         jumps.append(jd)?;
     }
     d.set_item("jumps", jumps)?;

@@ -81,24 +81,33 @@ pub struct Jump {
     /// Where the branch after the jump (the fill, followed back down toward the fold, or a
     /// bridge, followed toward the edges of its stretch) was left off every stretch followed
     /// before (see [`fill_cut`]): at its edge after turning back at a fold of its own, or
-    /// given up before its edge (a dead end, no progress). That branch may go on beyond the
+    /// given up before its edge (a dead end, no progress, its point budget used up); for a
+    /// bridge cut both ways, its way down's ([`Jump::second_cut`]). That branch may go on beyond the
     /// point, not followed. It does not count in [`Jump::abandons_branch`] (which is about the
     /// branch before the jump); whether it counts in the run's status is decided by
     /// [`Jump::cut_check`], once the branches solved after it are known. None otherwise.
     pub fill_cut: Option<GivenUp>,
     /// How [`Jump::fill_cut`] was judged once the run was over ([`CutCheck`]): by a Newton
     /// solve just past it, whose landing either lies on a stretch of the run (the cut is
-    /// covered) or not (the branch given up there goes on, unfollowed: the run is incomplete).
+    /// covered; past the cut stretch's fold when the landing is its own other side) or not
+    /// (the branch given up there goes on, unfollowed: the run is incomplete).
     /// None without a cut, and for jumps reported before the judgement (see
     /// [`FrfObserver::cut_judged`]).
     pub cut_check: Option<CutCheck>,
+    /// The cut of a bridge's way up when its way down was cut too (then [`Jump::fill_cut`] is
+    /// the way down's): a bridge, followed toward both edges of its stretch, can be left off
+    /// the run at both, and each may leave its branch unfollowed beyond. None otherwise.
+    pub second_cut: Option<GivenUp>,
+    /// How [`Jump::second_cut`] was judged, as [`Jump::cut_check`] for [`Jump::fill_cut`].
+    pub second_cut_check: Option<CutCheck>,
 }
 
 /// The judgement of a cut ([`Jump::fill_cut`]): Newton at a fixed frequency just past the cut,
 /// in the direction the stretch was going at its last step, from the cut point's coefficients
-/// (at most five solves, the first that converges is kept, see [`judge_cuts`]), and the
-/// nearest crossing of that frequency by the run's points within a branch, compared on the
-/// coefficients (`cut_check` in `solution.json`'s jumps).
+/// (at most five solves, the first that converges is kept, see [`judge_cuts`]), the crossings
+/// of that frequency by the run's points within a branch, compared on the coefficients, and
+/// Newton at that frequency from each crossing within [`RETRACE_TOLERANCE`], which tells
+/// whether the landing is that crossing's solution (`cut_check` in `solution.json`'s jumps).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct CutCheck {
     /// Frequency of the last solve tried, the converged one if any (Hz).
@@ -106,19 +115,61 @@ pub struct CutCheck {
     /// First output's first-harmonic amplitude where Newton landed (m); None when no solve
     /// converged.
     pub amplitude: Option<f64>,
-    /// ‖c − c_run‖ / ‖c‖ over all Fourier coefficients between the landing c and the nearest
-    /// crossing c_run of its frequency by the run (linear along a segment within a branch);
+    /// ‖c − c_run‖ / ‖c‖ over all Fourier coefficients between the landing c and the crossing
+    /// c_run of its frequency by the run (linear along a segment within a branch) that the
+    /// verdict rests on: the one Newton found the landing on when covered, else the nearest;
     /// None without a landing or a crossing.
     pub distance: Option<f64>,
-    /// Whether that nearest crossing lies on the cut's own branch, on the stretch into the cut
-    /// or the other side of the fold before it: then the landing is covered only as far as
-    /// the tolerance tells two sides of a fold apart (next to a fold it does not; see
+    /// Whether that crossing lies on the cut's own branch, on the stretch into the cut or the
+    /// other side of the fold before it: next to a fold the two sides lie within
+    /// [`RETRACE_TOLERANCE`] of each other, and only Newton from that side
+    /// ([`CutCheck::resolved_distance`]) tells whether the landing is on it (see
     /// [`judge_cuts`]).
     pub own_side: bool,
     /// Newton iterations of the converged solve (0 without one): with the solves that did
     /// not converge (at most five in all, see [`judge_cuts`]), the judgement's cost.
     pub newton_iterations: usize,
+    /// ‖c − c_N‖ / ‖c‖ between the landing c and Newton's solution c_N at the landing's
+    /// frequency started from the crossing of [`CutCheck::distance`] (see [`judge_cuts`]): at
+    /// most [`SAME_SOLUTION_TOLERANCE`], the landing is that stretch's solution (covered);
+    /// above, it is another solution. None when no crossing lies within
+    /// [`RETRACE_TOLERANCE`] of the landing, or Newton from it converged nowhere.
+    pub resolved_distance: Option<f64>,
+    /// When the landing is the cut's own other side ([`CutCheck::own_side`], the same
+    /// solution: the stretch came back along the side it had followed into its fold, so the
+    /// path reversed there on one solution curve), the same judgement past that fold, the way
+    /// that side was heading: the branch goes on there. The cut's verdict is then its verdict.
+    /// None otherwise.
+    pub beyond_fold: Option<FoldCheck>,
     /// What the judgement says.
+    pub verdict: CutVerdict,
+}
+
+/// The judgement past the fold of a cut stretch that came back along its own other side
+/// ([`CutCheck::beyond_fold`]): Newton past the fold, from the fold point's coefficients, at
+/// the offsets of [`judge_cuts`], compared with the run as the landing past the cut is.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct FoldCheck {
+    /// Frequency of the fold: the turning point of the cut's stretch (Hz).
+    pub fold_hz: f64,
+    /// Frequency of the last solve tried past it, the converged one if any (Hz).
+    pub freq_hz: f64,
+    /// First output's first-harmonic amplitude where Newton landed (m); None when no solve
+    /// converged.
+    pub amplitude: Option<f64>,
+    /// As [`CutCheck::distance`], for this landing.
+    pub distance: Option<f64>,
+    /// As [`CutCheck::resolved_distance`], for this landing.
+    pub resolved_distance: Option<f64>,
+    /// The largest first-output amplitude of the run where it crosses `freq_hz` (m); None when
+    /// it does not.
+    pub run_amplitude: Option<f64>,
+    /// `covered` when Newton from a stretch of the run finds the landing, or when the landing
+    /// lies below the run's largest amplitude there (a lower branch beside the response the
+    /// run has, which the run does not follow anywhere, as below the end of a fill);
+    /// `abandoned` when it lies on no stretch and above everything the run has there: the
+    /// branch beyond the fold, not followed, carries a larger response (possibly the resonance
+    /// peak); `unjudged` when no solve converged.
     pub verdict: CutVerdict,
 }
 
@@ -127,11 +178,16 @@ pub struct CutCheck {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum CutVerdict {
-    /// Newton past the cut landed on a stretch of the run, within [`RETRACE_TOLERANCE`] on the
-    /// coefficients: the branch beyond the cut is the one the run has there.
+    /// Newton past the cut landed on a stretch of the run: within [`RETRACE_TOLERANCE`] of it
+    /// on the coefficients, and Newton from that stretch at the landing's frequency converges
+    /// to the landing (within [`SAME_SOLUTION_TOLERANCE`]): the branch beyond the cut is the
+    /// one the run has there.
     Covered,
-    /// Newton past the cut landed on no stretch of the run: the branch given up at the cut
-    /// goes on beyond it, not followed (possibly to a resonance peak). The run is incomplete.
+    /// Newton past the cut landed on no stretch of the run: none crosses its frequency within
+    /// [`RETRACE_TOLERANCE`], or Newton from each that does converges to another solution (a
+    /// landing beyond a fold of the cut's own stretch, next to its other side) or nowhere.
+    /// The branch given up at the cut goes on beyond it, not followed (possibly to a resonance
+    /// peak). The run is incomplete.
     Abandoned,
     /// Newton past the cut converged at none of the offsets tried: whether the branch goes on
     /// there is not known. Counted as not covered (the run is incomplete and says why), since
@@ -146,39 +202,101 @@ impl CutCheck {
         !matches!(self.verdict, CutVerdict::Covered)
     }
 
-    /// "Newton at 886.8485 Hz from the cut lands at 1.772e-5 m, 0.03 % from the run (covered)",
-    /// for status lines and messages.
+    /// "Newton just past the cut, at 886.8496 Hz, lands at 1.772e-5 m (first output), 0.02 %
+    /// (on the coefficients) from the nearest stretch of the run (the cut branch's own side of
+    /// its fold), but Newton from that stretch at the same frequency converges to another
+    /// solution …: the landing lies on a branch beyond the fold …, not followed", for status
+    /// lines and messages.
     pub fn describe(&self) -> String {
-        let distance = self.distance.map_or(
-            "no stretch of the run crosses that frequency".to_string(),
-            |d| {
-                format!(
-                    "{:.2} % (on the coefficients) from the nearest stretch of the run{}",
-                    100.0 * d,
-                    if self.own_side {
-                        " (the cut branch's own side of its fold)"
-                    } else {
-                        ""
-                    }
-                )
-            },
-        );
-        match (self.verdict, self.amplitude) {
-            (CutVerdict::Unjudged, _) | (_, None) => format!(
+        let Some(a) = self
+            .amplitude
+            .filter(|_| self.verdict != CutVerdict::Unjudged || self.beyond_fold.is_some())
+        else {
+            return format!(
                 "Newton just past the cut converged at none of the frequencies tried (the last \
                  {:.4} Hz): whether the branch goes on there is not known",
                 self.freq_hz
-            ),
-            (verdict, Some(a)) => format!(
-                "Newton just past the cut, at {:.4} Hz, lands at {a:.3e} m (first output), \
-                 {distance}: {}",
-                self.freq_hz,
-                if verdict == CutVerdict::Covered {
-                    "covered"
-                } else {
-                    "on no branch of the run"
+            );
+        };
+        let landing = format!(
+            "Newton just past the cut, at {:.4} Hz, lands at {a:.3e} m (first output)",
+            self.freq_hz
+        );
+        let Some(d) = self.distance else {
+            return format!(
+                "{landing}; no stretch of the run crosses that frequency: on no branch of the run"
+            );
+        };
+        let stretch = if self.own_side {
+            "the cut branch's own side of its fold"
+        } else {
+            "another stretch of the run"
+        };
+        let place = format!(
+            "{landing}, {:.2} % (on the coefficients) from the nearest stretch of the run \
+             checked, {stretch}",
+            100.0 * d
+        );
+        if let (Some(fold), Some(r)) = (&self.beyond_fold, self.resolved_distance) {
+            let back = format!(
+                "{place}, and Newton from that side at the same frequency converges to the \
+                 landing ({r:.1e} apart): the stretch came back along the side it had followed \
+                 into its fold at {:.4} Hz, so the branch goes on beyond that fold",
+                fold.fold_hz
+            );
+            let Some(b) = fold.amplitude else {
+                return format!(
+                    "{back}; Newton past the fold converged at none of the frequencies tried \
+                     (the last {:.4} Hz): whether the response there is on the run is not known",
+                    fold.freq_hz
+                );
+            };
+            let past = format!(
+                "{back}; Newton past the fold, at {:.4} Hz, lands at {b:.3e} m",
+                fold.freq_hz
+            );
+            let run = fold.run_amplitude.map_or(
+                "no stretch of the run crosses that frequency".to_string(),
+                |m| format!("the run's largest amplitude there is {m:.3e} m"),
+            );
+            let on_run = fold
+                .resolved_distance
+                .is_some_and(|d| d <= SAME_SOLUTION_TOLERANCE);
+            return match fold.verdict {
+                CutVerdict::Covered if on_run => {
+                    format!("{past}, on a stretch of the run: covered")
                 }
+                CutVerdict::Covered => format!(
+                    "{past}, on no stretch of the run but below it ({run}): a lower branch \
+                     beside the response the run has, covered"
+                ),
+                _ => format!(
+                    "{past}, on no stretch of the run and above it ({run}): a branch beyond the \
+                     fold of the fill or bridge, not followed"
+                ),
+            };
+        }
+        match (self.verdict, self.resolved_distance) {
+            (CutVerdict::Covered, Some(r)) => format!(
+                "{place}, and Newton from that stretch at the same frequency converges to the \
+                 landing ({r:.1e} apart): covered"
             ),
+            (CutVerdict::Covered, None) => format!("{place}: covered"),
+            (_, Some(r)) if self.own_side => format!(
+                "{place}, but Newton from that side at the same frequency converges to another \
+                 solution ({r:.1e} apart): the landing lies on a branch beyond the fold of the \
+                 fill or bridge, not followed"
+            ),
+            (_, Some(r)) => format!(
+                "{place}, but Newton from that stretch at the same frequency converges to \
+                 another solution ({r:.1e} apart): the landing lies on a branch the run does \
+                 not have"
+            ),
+            (_, None) if d <= RETRACE_TOLERANCE => format!(
+                "{place}, but Newton from that stretch at the same frequency does not converge: \
+                 whether the landing lies on it is not known"
+            ),
+            (_, None) => format!("{place}: on no branch of the run"),
         }
     }
 }
@@ -186,7 +304,7 @@ impl CutCheck {
 impl serde::Serialize for Jump {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         use serde::ser::SerializeStruct;
-        let mut record = serializer.serialize_struct("Jump", 8)?;
+        let mut record = serializer.serialize_struct("Jump", 10)?;
         record.serialize_field("from_hz", &self.from_hz)?;
         record.serialize_field("to_hz", &self.to_hz)?;
         record.serialize_field("first_point", &self.first_point)?;
@@ -195,6 +313,8 @@ impl serde::Serialize for Jump {
         record.serialize_field("before", &self.before)?;
         record.serialize_field("fill_cut", &self.fill_cut)?;
         record.serialize_field("cut_check", &self.cut_check)?;
+        record.serialize_field("second_cut", &self.second_cut)?;
+        record.serialize_field("second_cut_check", &self.second_cut_check)?;
         record.end()
     }
 }
@@ -280,6 +400,10 @@ pub enum GiveUpCause {
     /// branch before, turned back up at a fold of its own and stopped on reaching that
     /// frequency (its end): the branch it was on goes on above ([`Jump::fill_cut`]).
     FillEnd,
+    /// A fill or bridge branch used up the points allowed for it ([`PathEnd::MaxPoints`])
+    /// before reaching the edge of its stretch: the branch goes on beyond its last point,
+    /// not followed ([`Jump::fill_cut`]).
+    PointBudget,
 }
 
 impl GiveUpCause {
@@ -298,6 +422,10 @@ impl GiveUpCause {
                 "no progress: the path wandered back and forth without reaching a higher \
                  frequency"
             }
+            GiveUpCause::PointBudget => {
+                "its point budget: the fill or bridge used up the points allowed for it before \
+                 reaching the edge of the stretch it was solved for"
+            }
         }
     }
 }
@@ -311,6 +439,14 @@ impl GiveUpCause {
 /// 151.8405 Hz (3.2333e-4 m) is passed there by the branch solved past it at 3.2285e-4 m
 /// (0.15 %), and Newton from the point given up, just above it, lands on that branch.
 pub const RETRACE_TOLERANCE: f64 = 1e-2;
+
+/// Relative distance ‖c − c'‖ / ‖c‖ over all Fourier coefficients within which two solutions
+/// converged by Newton at one frequency are the same solution ([`CutCheck::resolved_distance`]).
+/// Measured: the same solution reached from two starts differs by 3·10⁻¹⁶ to 5·10⁻¹⁴ on the
+/// paper's system at F0 = 1 and 5 N, and by 5·10⁻¹¹ to 4.5·10⁻¹⁰ on the 3D blade pair (schur);
+/// the two sides of a fold of the paper's system at F0 = 1 N one step out of it differ by
+/// 5.1·10⁻⁷ (19.7275 Hz) to 10⁻² (the unit tests of this module).
+pub const SAME_SOLUTION_TOLERANCE: f64 = 1e-8;
 
 impl GivenUp {
     /// "at 886.8455 Hz (first output's amplitude 1.770e-5 m, rising), below the fold at
@@ -364,14 +500,29 @@ impl Jump {
         matches!(self.before, BranchEnd::Abandoned(_))
     }
 
-    /// The cut of the branch after the jump and its judgement, when that judgement leaves the
-    /// response beyond the cut missing or unknown ([`CutCheck::uncovered`]). A cut not judged
-    /// (no [`Jump::cut_check`]: a jump reported during the run) does not count.
+    /// The cuts of the branch after the jump ([`Jump::fill_cut`], then [`Jump::second_cut`]),
+    /// each with its judgement once there is one.
+    pub fn cuts(&self) -> impl Iterator<Item = (&GivenUp, Option<&CutCheck>)> {
+        [
+            (&self.fill_cut, &self.cut_check),
+            (&self.second_cut, &self.second_cut_check),
+        ]
+        .into_iter()
+        .filter_map(|(g, c)| g.as_ref().map(|g| (g, c.as_ref())))
+    }
+
+    /// The cuts of the branch after the jump whose judgement leaves the response beyond them
+    /// missing or unknown ([`CutCheck::uncovered`]), each with that judgement. A cut not
+    /// judged (a jump reported during the run) does not count.
+    pub fn cuts_uncovered(&self) -> impl Iterator<Item = (&GivenUp, &CutCheck)> {
+        self.cuts()
+            .filter_map(|(g, c)| c.filter(|c| c.uncovered()).map(|c| (g, c)))
+    }
+
+    /// The first of [`Jump::cuts_uncovered`]: a cut of the branch after the jump and its
+    /// judgement, when that judgement leaves the response beyond the cut missing or unknown.
     pub fn cut_uncovered(&self) -> Option<(&GivenUp, &CutCheck)> {
-        match (&self.fill_cut, &self.cut_check) {
-            (Some(g), Some(c)) if c.uncovered() => Some((g, c)),
-            _ => None,
-        }
+        self.cuts_uncovered().next()
     }
 
     /// Width of the stretch not computed on any branch (Hz); stretches narrower than 10⁻⁹ of
@@ -529,8 +680,8 @@ impl FrfRun {
             })
             .collect();
 
-        let cuts = self.jumps.iter().filter_map(|j| {
-            j.cut_uncovered().map(|(g, c)| {
+        let cuts = self.jumps.iter().flat_map(|j| {
+            j.cuts_uncovered().map(move |(g, c)| {
                 format!(
                     "a branch solved past the jump at {:.4} Hz was left {}; {}, so the response \
                      beyond that point on that branch (possibly the resonance peak) {}",
@@ -1117,9 +1268,15 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
             JumpKind::PastFold
         };
         let mut before = branch_end;
-        let cuts: Vec<Option<GivenUp>> = bridges.iter().map(|(_, c)| *c).chain([cut]).collect();
+        // A bridge's cuts: its way down's, then its way up's.
+        let cuts: Vec<[Option<GivenUp>; 2]> = bridges
+            .iter()
+            .map(|(_, c)| *c)
+            .chain([[cut, None]])
+            .collect();
         let branches = bridges.into_iter().map(|(b, _)| b).chain([fill]);
-        for (branch, cut) in branches.zip(cuts) {
+        for (branch, cuts) in branches.zip(cuts) {
+            let (cut, second_cut) = bridge_cuts(cuts);
             let lowest = branch
                 .iter()
                 .map(|p| p.freq_hz)
@@ -1133,6 +1290,8 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
                 before,
                 fill_cut: cut,
                 cut_check: None,
+                second_cut,
+                second_cut_check: None,
             };
             adapter.observer.jump(&jump);
             run.jumps.push(jump);
@@ -1159,6 +1318,16 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
     judge_cuts(&mut system, &newton, &mut run, adapter.observer);
     run.elapsed_s = started.elapsed().as_secs_f64();
     Ok(run)
+}
+
+/// The cuts of a bridge's way down and way up ([`fill_cut`]) as its jump's
+/// ([`Jump::fill_cut`], [`Jump::second_cut`]): the way down's first, and a single cut, either
+/// way's, as `fill_cut`.
+fn bridge_cuts([down, up]: [Option<GivenUp>; 2]) -> (Option<GivenUp>, Option<GivenUp>) {
+    match down {
+        Some(down) => (Some(down), up),
+        None => (up, None),
+    }
 }
 
 /// How the branch of `points[segment_start..]` ended, for the jump past it: [`PathEnd`] `end`
@@ -1277,9 +1446,10 @@ fn passes_through(paths: &[&[FrfPoint]], target: &FrfPoint) -> bool {
 /// when its last step heads up (it turned back at a fold of its own, the last at `fold_hz`,
 /// and stopped on reaching its end frequency: `end`), the branch goes on above its last
 /// point, which no continuation follows; when it was given up before its edge (`end` a dead
-/// end or no progress, heading either way), the branch goes on beyond its last point. None
-/// when it reached its end frequency heading down, or ended otherwise (out of points, out of
-/// its range), or when its last point lies on the run's `points` before the jump (within a
+/// end or no progress, heading either way) or stopped there for its point budget (`end`
+/// [`PathEnd::MaxPoints`]), the branch goes on beyond its last point. None when it reached
+/// its end frequency heading down, or left its range, or when its last point lies on the
+/// run's `points` before the jump (within a
 /// branch at `branch_starts`, see [`passes_through`]). Whether a cut leaves response missing
 /// is judged once the run is over ([`judge_cuts`]): the branch followed on from the jump
 /// target may pass it.
@@ -1303,7 +1473,8 @@ fn fill_cut(
         PathEnd::EndFrequency if turned_back => GiveUpCause::FillEnd,
         PathEnd::DeadEnd => GiveUpCause::DeadEnd,
         PathEnd::NoProgress => GiveUpCause::NoProgress,
-        PathEnd::EndFrequency | PathEnd::LeftRangeBelow | PathEnd::MaxPoints => return None,
+        PathEnd::MaxPoints => GiveUpCause::PointBudget,
+        PathEnd::EndFrequency | PathEnd::LeftRangeBelow => return None,
     };
     let mut cuts: Vec<usize> = branch_starts
         .iter()
@@ -1342,8 +1513,9 @@ pub const CUT_CHECK_OFFSETS: &[f64] = &[1.0, 0.25, 0.0625];
 /// to 5·10⁻⁴ past it, a landing on the run at 10⁻³).
 pub const CUT_CHECK_FALLBACKS: &[f64] = &[1e-4, 1e-3];
 
-/// Judges the cut of every jump of `run` ([`Jump::fill_cut`]) now that every branch of the run
-/// is known, sets its [`Jump::cut_check`] and tells `observer` ([`FrfObserver::cut_judged`]).
+/// Judges the cuts of every jump of `run` ([`Jump::fill_cut`], [`Jump::second_cut`]) now that
+/// every branch of the run is known, sets their [`Jump::cut_check`] and
+/// [`Jump::second_cut_check`] and tells `observer` ([`FrfObserver::cut_judged`]).
 ///
 /// Newton at a fixed frequency just past the cut, in the direction its stretch was going at
 /// its last step (away from the point before it on the branch; by its fold when the branch
@@ -1352,11 +1524,16 @@ pub const CUT_CHECK_FALLBACKS: &[f64] = &[1e-4, 1e-3];
 /// fixed-frequency solves per cut, one where Newton converges just past it.
 /// The landing is compared, over all its Fourier coefficients, with every crossing of its
 /// frequency by the run's points (linear along a segment within a branch, not across a jump),
-/// the cut's own branch included (the nearest crossing lying on the other side of the cut's
-/// fold is recorded as [`CutCheck::own_side`]):
-/// within [`RETRACE_TOLERANCE`] of the nearest it is covered, else the branch goes on beyond the
-/// cut unfollowed ([`CutVerdict::Abandoned`]); when no solve converges the cut is
-/// [`CutVerdict::Unjudged`], which the status counts as not covered.
+/// the cut's own branch included (a crossing on the other side of the cut's fold is recorded
+/// as [`CutCheck::own_side`]). Each crossing within [`RETRACE_TOLERANCE`], nearest first, is
+/// then solved again by Newton at the landing's frequency, from its interpolated coefficients
+/// (else from the segment's nearer point): the first whose solution is the landing (within
+/// [`SAME_SOLUTION_TOLERANCE`]) covers the cut. When none does the branch goes on beyond the
+/// cut unfollowed ([`CutVerdict::Abandoned`]): next to a fold of the cut's own stretch its two
+/// sides lie within the tolerance of each other, so a landing on the branch beyond the cut is
+/// that close to the side already followed, and only Newton from that side tells them apart.
+/// When no solve past the cut converges the cut is [`CutVerdict::Unjudged`]; the status
+/// counts both as not covered.
 fn judge_cuts<O: FrfObserver>(
     system: &mut HbmOperator<'_>,
     newton: &Continuation,
@@ -1365,17 +1542,24 @@ fn judge_cuts<O: FrfObserver>(
 ) {
     let starts = run.branch_starts();
     for k in 0..run.jumps.len() {
-        let Some(cut) = run.jumps[k].fill_cut else {
+        let jump = run.jumps[k];
+        if jump.fill_cut.is_none() && jump.second_cut.is_none() {
             continue;
-        };
-        let first = run.jumps[k].first_point;
+        }
+        let first = jump.first_point;
         let end = starts
             .get(k + 1)
             .copied()
             .unwrap_or(run.points.len())
             .max(first);
-        let check = judge_cut(system, newton, &run.points, &starts, first..end, &cut);
-        run.jumps[k].cut_check = Some(check);
+        let mut judge =
+            |cut: &GivenUp| judge_cut(system, newton, &run.points, &starts, first..end, cut);
+        let checks = (
+            jump.fill_cut.as_ref().map(&mut judge),
+            jump.second_cut.as_ref().map(&mut judge),
+        );
+        run.jumps[k].cut_check = checks.0;
+        run.jumps[k].second_cut_check = checks.1;
         observer.cut_judged(k, &run.jumps[k]);
     }
 }
@@ -1395,6 +1579,8 @@ fn judge_cut(
         distance: None,
         own_side: false,
         newton_iterations,
+        resolved_distance: None,
+        beyond_fold: None,
         verdict: CutVerdict::Unjudged,
     };
     let is_cut = |p: &FrfPoint| {
@@ -1432,9 +1618,103 @@ fn judge_cut(
             (if down { -1.0 } else { 1.0 }, 1e-4 * f)
         }
     };
-    let guess = system.restrict(&points[i].coefficients);
+    let (freq_hz, landing) = land_past(system, newton, &points[i].coefficients, f, direction, step);
+    let Some(landing) = landing else {
+        return unjudged(freq_hz, 0);
+    };
+    // The cut's own stretch and the one before it on its branch (the other side of the fold
+    // it turned back at): next to a fold its two sides lie within the tolerance of each
+    // other, so the comparison by interpolation does not tell the branch beyond the cut from
+    // the side already followed; nor can that side be left out (at F0 = 5 N on the paper's
+    // system the landings 10⁻⁷ to 2·10⁻³ past the cut at 80.4161 Hz follow that side within
+    // 0.002-0.18 %, as close as its linear interpolation over a 0.75 Hz segment allows, and
+    // no other stretch crosses there). Newton from the crossing tells them apart.
+    let away: Vec<usize> = if i == branch.start {
+        (i..branch.end).collect()
+    } else {
+        (branch.start..=i).rev().collect()
+    };
+    let mut turns = 0;
+    let mut heading = 0.0;
+    let mut reach = 0;
+    // The fold the cut's stretch turned back at: the point where the way back from the cut
+    // first turns.
+    let mut fold = None;
+    for w in 1..away.len() {
+        let d = (points[away[w]].freq_hz - points[away[w - 1]].freq_hz).signum();
+        if d != 0.0 && heading != 0.0 && d != heading {
+            turns += 1;
+            fold.get_or_insert(w - 1);
+            if turns == 2 {
+                break;
+            }
+        }
+        if d != 0.0 {
+            heading = d;
+        }
+        reach = w;
+    }
+    let own = away.get(reach).map_or(i..=i, |&j| i.min(j)..=i.max(j));
+    let compared = compare_with_run(system, newton, points, starts, &own, &landing);
+    // Landed on the cut's own other side, the same solution: the stretch came back along
+    // the side it had followed into its fold, so that fold is where the path reversed on one
+    // solution curve, and the branch goes on beyond it, the way that side was heading.
+    let beyond_fold = match (compared.covered, compared.own_side, fold) {
+        (true, true, Some(w)) => {
+            let j = away[w];
+            let fold_hz = points[j].freq_hz;
+            let into = away[w + 1..]
+                .iter()
+                .map(|&k| points[k].freq_hz)
+                .find(|&g| g != fold_hz);
+            into.map(|g| {
+                let step = (fold_hz - g).abs().clamp(1e-7 * fold_hz, 5e-4 * fold_hz);
+                let (freq_hz, landing) = land_past(
+                    system,
+                    newton,
+                    &points[j].coefficients,
+                    fold_hz,
+                    (fold_hz - g).signum(),
+                    step,
+                );
+                judge_beyond_fold(
+                    system, newton, points, starts, &own, fold_hz, freq_hz, landing,
+                )
+            })
+        }
+        _ => None,
+    };
+    let verdict = match (&beyond_fold, compared.covered) {
+        (Some(b), _) => b.verdict,
+        (None, true) => CutVerdict::Covered,
+        (None, false) => CutVerdict::Abandoned,
+    };
+    CutCheck {
+        freq_hz,
+        amplitude: Some(landing.amplitudes.first().copied().unwrap_or(f64::NAN)),
+        distance: compared.distance,
+        own_side: compared.own_side,
+        newton_iterations: landing.newton_iterations,
+        resolved_distance: compared.resolved_distance,
+        beyond_fold,
+        verdict,
+    }
+}
+
+/// Newton at fixed frequencies past `f` (Hz) in `direction` (±1) from the coefficients
+/// `start`, at the offsets [`CUT_CHECK_OFFSETS`] of `step` (Hz), then
+/// [`CUT_CHECK_FALLBACKS`]: the frequency of the last solve tried (Hz) and the first point
+/// that converged, if any.
+fn land_past(
+    system: &mut HbmOperator<'_>,
+    newton: &Continuation,
+    start: &[f64],
+    f: f64,
+    direction: f64,
+    step: f64,
+) -> (f64, Option<FrfPoint>) {
+    let guess = system.restrict(start);
     let mut freq_hz = f;
-    let mut landing = None;
     let offsets = CUT_CHECK_OFFSETS
         .iter()
         .map(|m| m * step)
@@ -1446,44 +1726,88 @@ fn judge_cut(
         };
         if let Ok(mut point) = full_point(system, &p) {
             point.freq_hz = freq_hz;
-            landing = Some(point);
-            break;
+            return (freq_hz, Some(point));
         }
     }
+    (freq_hz, None)
+}
+
+/// The judgement past the fold at `fold_hz` (Hz) of a cut stretch that came back along its
+/// own other side ([`CutCheck::beyond_fold`]): `landing`, solved at `freq_hz` (Hz) past the
+/// fold, compared with the run ([`compare_with_run`]).
+#[allow(clippy::too_many_arguments)]
+fn judge_beyond_fold(
+    system: &mut HbmOperator<'_>,
+    newton: &Continuation,
+    points: &[FrfPoint],
+    starts: &[usize],
+    own: &std::ops::RangeInclusive<usize>,
+    fold_hz: f64,
+    freq_hz: f64,
+    landing: Option<FrfPoint>,
+) -> FoldCheck {
     let Some(landing) = landing else {
-        return unjudged(freq_hz, 0);
+        return FoldCheck {
+            fold_hz,
+            freq_hz,
+            amplitude: None,
+            distance: None,
+            resolved_distance: None,
+            run_amplitude: None,
+            verdict: CutVerdict::Unjudged,
+        };
     };
-    // The cut's own stretch and the one before it on its branch (the other side of the fold
-    // it turned back at): next to a fold its two sides lie within the tolerance of each
-    // other, so a landing there does not tell the branch beyond the cut from the side already
-    // followed. They are compared all the same (at F0 = 5 N on the paper's system the landings
-    // 10⁻⁷ to 2·10⁻³ past the cut at 80.4161 Hz follow that side within 0.002-0.18 %, as close
-    // as its linear interpolation over a 0.75 Hz segment allows), and the judgement says
-    // whether the nearest crossing is there (`CutCheck::own_side`).
-    let away: Vec<usize> = if i == branch.start {
-        (i..branch.end).collect()
-    } else {
-        (branch.start..=i).rev().collect()
+    let compared = compare_with_run(system, newton, points, starts, own, &landing);
+    let amplitude = landing.amplitudes.first().copied().unwrap_or(f64::NAN);
+    let verdict = match compared.run_amplitude {
+        _ if compared.covered => CutVerdict::Covered,
+        Some(run) if amplitude <= run => CutVerdict::Covered,
+        _ => CutVerdict::Abandoned,
     };
-    let mut turns = 0;
-    let mut heading = 0.0;
-    let mut reach = 0;
-    for w in 1..away.len() {
-        let d = (points[away[w]].freq_hz - points[away[w - 1]].freq_hz).signum();
-        if d != 0.0 && heading != 0.0 && d != heading {
-            turns += 1;
-            if turns == 2 {
-                break;
-            }
-        }
-        if d != 0.0 {
-            heading = d;
-        }
-        reach = w;
+    FoldCheck {
+        fold_hz,
+        freq_hz,
+        amplitude: Some(amplitude),
+        distance: compared.distance,
+        resolved_distance: compared.resolved_distance,
+        run_amplitude: compared.run_amplitude,
+        verdict,
     }
-    let own = away.get(reach).map_or(i..=i, |&j| i.min(j)..=i.max(j));
+}
+
+/// How a landing compares with the run ([`compare_with_run`]).
+struct Comparison {
+    /// [`CutCheck::distance`].
+    distance: Option<f64>,
+    /// [`CutCheck::own_side`].
+    own_side: bool,
+    /// [`CutCheck::resolved_distance`].
+    resolved_distance: Option<f64>,
+    /// Whether Newton from a crossing within [`RETRACE_TOLERANCE`] found the landing.
+    covered: bool,
+    /// The largest first-output amplitude of the run's crossings of the landing's frequency
+    /// (m); None without a crossing.
+    run_amplitude: Option<f64>,
+}
+
+/// Compares `landing` with every crossing of its frequency by the run's `points` within a
+/// branch (not across a jump at `starts`), those inside `own` marked as the cut's own side:
+/// each crossing within [`RETRACE_TOLERANCE`] on the coefficients, nearest first, is solved
+/// again by Newton at the landing's frequency ([`resolve_crossing`]), and the first whose
+/// solution is the landing (within [`SAME_SOLUTION_TOLERANCE`]) covers it.
+fn compare_with_run(
+    system: &mut HbmOperator<'_>,
+    newton: &Continuation,
+    points: &[FrfPoint],
+    starts: &[usize],
+    own: &std::ops::RangeInclusive<usize>,
+    landing: &FrfPoint,
+) -> Comparison {
+    let freq_hz = landing.freq_hz;
     let norm = crate::numerics::linalg::norm(&landing.coefficients);
-    let nearest = (0..points.len().saturating_sub(1))
+    let mut run_amplitude: Option<f64> = None;
+    // Every crossing of the landing's frequency within a branch, nearest first.
+    let mut crossings: Vec<Crossing> = (0..points.len().saturating_sub(1))
         .filter(|&k| !starts.contains(&(k + 1)))
         .filter_map(|k| {
             let (p, q) = (&points[k], &points[k + 1]);
@@ -1491,30 +1815,100 @@ fn judge_cut(
                 return None;
             }
             let t = (freq_hz - p.freq_hz) / (q.freq_hz - p.freq_hz);
+            if let (Some(a), Some(b)) = (p.amplitudes.first(), q.amplitudes.first()) {
+                let on = a + t * (b - a);
+                run_amplitude = Some(run_amplitude.map_or(on, |r| r.max(on)));
+            }
             let squared: f64 = landing
                 .coefficients
                 .iter()
                 .zip(p.coefficients.iter().zip(&q.coefficients))
                 .map(|(c, (a, b))| (c - (a + t * (b - a))).powi(2))
                 .sum();
-            Some((
-                squared.sqrt() / norm,
-                own.contains(&k) && own.contains(&(k + 1)),
-            ))
+            Some(Crossing {
+                segment: k,
+                t,
+                distance: squared.sqrt() / norm,
+                own_side: own.contains(&k) && own.contains(&(k + 1)),
+            })
         })
-        .min_by(|a, b| a.0.total_cmp(&b.0));
-    let (distance, own_side) = (nearest.map(|n| n.0), nearest.is_some_and(|n| n.1));
-    CutCheck {
-        freq_hz,
-        amplitude: Some(landing.amplitudes.first().copied().unwrap_or(f64::NAN)),
-        distance,
-        own_side,
-        newton_iterations: landing.newton_iterations,
-        verdict: match distance {
-            Some(d) if d <= RETRACE_TOLERANCE => CutVerdict::Covered,
-            _ => CutVerdict::Abandoned,
-        },
+        .collect();
+    crossings.sort_by(|a, b| a.distance.total_cmp(&b.distance));
+    let omega = 2.0 * PI * freq_hz;
+    let mut covered = false;
+    let mut resolved: Option<(&Crossing, Option<f64>)> = None;
+    for crossing in crossings
+        .iter()
+        .take_while(|c| c.distance <= RETRACE_TOLERANCE)
+    {
+        let apart = resolve_crossing(system, newton, points, crossing, omega, landing);
+        let covers = apart.is_some_and(|d| d <= SAME_SOLUTION_TOLERANCE);
+        if resolved.is_none() || covers {
+            resolved = Some((crossing, apart));
+        }
+        if covers {
+            covered = true;
+            break;
+        }
     }
+    let shown = resolved.map(|(c, _)| c).or(crossings.first());
+    Comparison {
+        distance: shown.map(|c| c.distance),
+        own_side: shown.is_some_and(|c| c.own_side),
+        resolved_distance: resolved.and_then(|(_, d)| d),
+        covered,
+        run_amplitude,
+    }
+}
+
+/// A crossing of a frequency by a segment of the run's points (see [`judge_cut`]).
+struct Crossing {
+    /// Index of the segment's first point.
+    segment: usize,
+    /// Where along the segment, from its first point (0) to its second (1).
+    t: f64,
+    /// ‖c − c_run‖ / ‖c‖ between the landing and the linear interpolation along the segment.
+    distance: f64,
+    /// Whether the segment lies on the cut's own side of its fold ([`CutCheck::own_side`]).
+    own_side: bool,
+}
+
+/// ‖c − c_N‖ / ‖c‖ between `landing` (converged at ω = `omega`, rad/s) and Newton's solution
+/// c_N at the same ω from `crossing` (its coefficients interpolated along the segment, else
+/// those of the segment's nearer point when Newton does not converge from them): the same
+/// solution to solver precision when at most [`SAME_SOLUTION_TOLERANCE`]. None when Newton
+/// converges from neither.
+fn resolve_crossing(
+    system: &mut HbmOperator<'_>,
+    newton: &Continuation,
+    points: &[FrfPoint],
+    crossing: &Crossing,
+    omega: f64,
+    landing: &FrfPoint,
+) -> Option<f64> {
+    let (p, q) = (&points[crossing.segment], &points[crossing.segment + 1]);
+    let t = crossing.t;
+    let interpolated: Vec<f64> = p
+        .coefficients
+        .iter()
+        .zip(&q.coefficients)
+        .map(|(a, b)| a + t * (b - a))
+        .collect();
+    let nearer = if t < 0.5 { p } else { q };
+    let norm = crate::numerics::linalg::norm(&landing.coefficients);
+    let starts = [interpolated.as_slice(), nearer.coefficients.as_slice()];
+    let apart = starts.into_iter().find_map(|start| {
+        let guess = system.restrict(start);
+        let solved = newton.solve_fixed(system, &guess, omega).ok()?;
+        let c = system.expand(&solved.x, omega).ok()?;
+        let squared: f64 = c
+            .iter()
+            .zip(&landing.coefficients)
+            .map(|(a, b)| (a - b).powi(2))
+            .sum();
+        Some(squared.sqrt() / norm)
+    });
+    apart
 }
 
 /// Point budget of each direction of a bridge branch (see [`Branching::bridge`]).
@@ -1583,7 +1977,7 @@ impl Branching<'_> {
     /// down toward `below` and up toward `above`, and what is still uncovered on either side
     /// is bridged in turn, up to [`MAX_BRIDGES`] branches and `budget` points. Returns the
     /// branches found, each in path order from its lowest point up, sorted by their lowest
-    /// frequency.
+    /// frequency, with the cuts of its way down and of its way up (see [`fill_cut`]).
     fn bridge<'e>(
         &self,
         system: &mut HbmOperator<'_>,
@@ -1592,8 +1986,8 @@ impl Branching<'_> {
         budget: usize,
         estimator: &mut Option<ErrorEstimator<'e>>,
         (followed, branch_starts): (&[FrfPoint], &[usize]),
-    ) -> Vec<(Vec<FrfPoint>, Option<GivenUp>)> {
-        let mut branches: Vec<(Vec<FrfPoint>, Option<GivenUp>)> = Vec::new();
+    ) -> Vec<(Vec<FrfPoint>, [Option<GivenUp>; 2])> {
+        let mut branches: Vec<(Vec<FrfPoint>, [Option<GivenUp>; 2])> = Vec::new();
         let mut gaps = vec![(below.clone(), above.clone())];
         let mut used = 0;
         let solver = Continuation::new(self.settings, self.x_scale.to_vec());
@@ -1608,7 +2002,8 @@ impl Branching<'_> {
             let (mut down, down_end) =
                 self.follow(system, &x, freq_hz, lo.freq_hz, per_side, estimator);
             let (up, up_end) = self.follow(system, &x, freq_hz, hi.freq_hz, per_side, estimator);
-            // Either way turned back at a fold of its own before its edge: cut there.
+            // Either way turned back at a fold of its own before its edge, or was given up or
+            // ran out of points before it: cut there (both ways may be).
             let cut_of = |side: &[FrfPoint], travel_down: bool, end: &Option<PathSummary>| {
                 end.as_ref().and_then(|summary| {
                     fill_cut(
@@ -1621,7 +2016,7 @@ impl Branching<'_> {
                     )
                 })
             };
-            let cut = cut_of(&down, true, &down_end).or(cut_of(&up, false, &up_end));
+            let cuts = [cut_of(&down, true, &down_end), cut_of(&up, false, &up_end)];
             down.reverse();
             // Both directions start with the point at `freq_hz`: keep one.
             let branch: Vec<FrfPoint> = down.into_iter().chain(up.into_iter().skip(1)).collect();
@@ -1640,6 +2035,8 @@ impl Branching<'_> {
                 before: BranchEnd::Bridge,
                 fill_cut: None,
                 cut_check: None,
+                second_cut: None,
+                second_cut_check: None,
             };
             if gap_below.uncovered_hz() > 0.0 {
                 gaps.push((lo.clone(), low.clone()));
@@ -1652,7 +2049,7 @@ impl Branching<'_> {
             if gap_above.uncovered_hz() > 0.0 {
                 gaps.push((high.clone(), hi.clone()));
             }
-            branches.push((branch, cut));
+            branches.push((branch, cuts));
         }
         branches.sort_by(|(a, _), (b, _)| a[0].freq_hz.total_cmp(&b[0].freq_hz));
         branches
@@ -2077,6 +2474,8 @@ mod tests {
             before: BranchEnd::LeftRange,
             fill_cut: None,
             cut_check: None,
+            second_cut: None,
+            second_cut_check: None,
         }]);
         reference.points = points;
         let point = FrfPoint {
@@ -2113,6 +2512,8 @@ mod tests {
             before: BranchEnd::LeftRange,
             fill_cut: None,
             cut_check: None,
+            second_cut: None,
+            second_cut_check: None,
         };
         assert!(run_with_jumps(vec![jump(66.0, 66.0)]).is_complete());
         assert!(run_with_jumps(vec![jump(66.0, 66.0 + 1e-12)]).is_complete());
@@ -2159,6 +2560,8 @@ mod tests {
             before: end,
             fill_cut: None,
             cut_check: None,
+            second_cut: None,
+            second_cut_check: None,
         }]);
         run.points = points;
         assert!(!run.is_complete());
@@ -2202,6 +2605,8 @@ mod tests {
                 before: end,
                 fill_cut: None,
                 cut_check: None,
+                second_cut: None,
+                second_cut_check: None,
             }]);
             run.points = points;
             assert!(run.is_complete(), "{:?}", run.incomplete_reason());
@@ -2276,6 +2681,8 @@ mod tests {
             before: end,
             fill_cut: None,
             cut_check: None,
+            second_cut: None,
+            second_cut_check: None,
         }]);
         run.points = rising.clone();
         assert!(run.is_complete(), "{:?}", run.incomplete_reason());
@@ -2328,6 +2735,8 @@ mod tests {
             before: BranchEnd::LeftRange,
             fill_cut: Some(cut),
             cut_check: None,
+            second_cut: None,
+            second_cut_check: None,
         }]);
         run.points = points.clone();
         // Not judged yet (a jump as reported during the run): not counted in the status.
@@ -2345,6 +2754,8 @@ mod tests {
             distance: Some(2e-3),
             own_side: false,
             newton_iterations: 3,
+            resolved_distance: Some(1e-9),
+            beyond_fold: None,
             verdict: CutVerdict::Covered,
         };
         run.jumps[0].cut_check = Some(check);
@@ -2352,6 +2763,7 @@ mod tests {
         assert!(!run.jumps[0].abandons_branch());
         run.jumps[0].cut_check = Some(CutCheck {
             distance: Some(0.4),
+            resolved_distance: None,
             verdict: CutVerdict::Abandoned,
             ..check
         });
@@ -2410,9 +2822,16 @@ mod tests {
             fill_cut(&points, &[], &up[..2], false, PathEnd::EndFrequency, None),
             None
         );
-        // Left the range or out of points: not a cut.
+        // Left the range: not a cut.
         assert_eq!(
-            fill_cut(&points, &[], &fill, true, PathEnd::MaxPoints, Some(109.5)),
+            fill_cut(
+                &points,
+                &[],
+                &fill,
+                true,
+                PathEnd::LeftRangeBelow,
+                Some(109.5)
+            ),
             None
         );
         // Given up before its edge (a dead end, no progress), heading either way and off the
@@ -2428,5 +2847,300 @@ mod tests {
             }
             assert_eq!(fill_cut(&points, &[], &onto, true, end, None), None);
         }
+    }
+
+    /// A fill or bridge that used up its point budget before the edge of its stretch, heading
+    /// either way and off the path followed, leaves its branch unfollowed beyond its last
+    /// point: a cut (`point-budget`), judged like the others; the status names the cause. On
+    /// the path followed, nothing is cut.
+    #[test]
+    fn a_fill_or_bridge_out_of_points_is_cut() {
+        let points = folded_path(&[]);
+        // A fill from 115 Hz heading down toward 110 Hz, stopped at 112 Hz; a bridge's way up
+        // stopped at 106 Hz.
+        let down = [line_point(115.0, 3.0, 0.0), line_point(112.0, 3.3, 0.0)];
+        let up = [line_point(104.0, 3.0, 0.0), line_point(106.0, 3.2, 0.0)];
+        for (side, travel_down) in [(&down[..], true), (&up[..], false)] {
+            let cut = fill_cut(&points, &[], side, travel_down, PathEnd::MaxPoints, None)
+                .expect("a stretch out of points off the path is cut");
+            assert_eq!(cut.cause, GiveUpCause::PointBudget);
+            assert_eq!(cut.freq_hz, side[1].freq_hz);
+            assert!(
+                cut.describe().contains("point budget"),
+                "{}",
+                cut.describe()
+            );
+            let json = serde_json::to_value(cut).unwrap();
+            assert_eq!(json["cause"], "point-budget");
+        }
+        // Stopped on the branch before (A = 1.6 at 106 Hz): nothing left unfollowed.
+        let on = [line_point(104.0, 3.0, 0.0), line_point(106.0, 1.6, 0.0)];
+        assert_eq!(
+            fill_cut(&points, &[], &on, false, PathEnd::MaxPoints, None),
+            None
+        );
+    }
+
+    /// A bridge followed toward both edges of its stretch and left at both (its way down
+    /// turned back up at a fold of its own, its way up was given up by a dead end) keeps both
+    /// cuts: `fill_cut` the way down's, `second_cut` the way up's; both are judged, and the
+    /// second alone not covered makes the run incomplete, naming it. Its JSON record has both.
+    #[test]
+    fn a_bridge_cut_on_both_sides_keeps_and_counts_both_cuts() {
+        let points = folded_path(&[]);
+        let way_down = [
+            line_point(107.0, 3.0, 0.0),
+            line_point(104.5, 3.3, 0.0),
+            line_point(104.8, 3.4, 0.0),
+        ];
+        let way_up = [line_point(107.0, 3.0, 0.0), line_point(108.5, 3.1, 0.0)];
+        let cuts = [
+            fill_cut(
+                &points,
+                &[],
+                &way_down,
+                true,
+                PathEnd::EndFrequency,
+                Some(104.5),
+            ),
+            fill_cut(&points, &[], &way_up, false, PathEnd::DeadEnd, None),
+        ];
+        let (cut, second_cut) = bridge_cuts(cuts);
+        let (cut, second_cut) = (cut.unwrap(), second_cut.unwrap());
+        assert_eq!((cut.freq_hz, cut.cause), (104.8, GiveUpCause::FillEnd));
+        assert_eq!(
+            (second_cut.freq_hz, second_cut.cause),
+            (108.5, GiveUpCause::DeadEnd)
+        );
+        // One way cut: it is the jump's `fill_cut`, whichever way.
+        assert_eq!(bridge_cuts([None, cuts[1]]), (cuts[1], None));
+        assert_eq!(bridge_cuts([cuts[0], None]), (cuts[0], None));
+        let covered = CutCheck {
+            freq_hz: 104.9,
+            amplitude: Some(3.41),
+            distance: Some(1e-4),
+            own_side: false,
+            newton_iterations: 2,
+            resolved_distance: Some(1e-12),
+            beyond_fold: None,
+            verdict: CutVerdict::Covered,
+        };
+        let abandoned = CutCheck {
+            freq_hz: 108.6,
+            amplitude: Some(3.11),
+            distance: None,
+            resolved_distance: None,
+            verdict: CutVerdict::Abandoned,
+            ..covered
+        };
+        let mut run = run_with_jumps(vec![Jump {
+            from_hz: 104.0,
+            to_hz: 104.0,
+            first_point: points.len(),
+            kind: JumpKind::Bridge,
+            before: BranchEnd::Bridge,
+            fill_cut: Some(cut),
+            cut_check: Some(covered),
+            second_cut: Some(second_cut),
+            second_cut_check: Some(covered),
+        }]);
+        run.points = points;
+        assert!(run.is_complete(), "{:?}", run.incomplete_reason());
+        assert_eq!(run.jumps[0].cuts().count(), 2);
+        run.jumps[0].second_cut_check = Some(abandoned);
+        let reason = run
+            .incomplete_reason()
+            .expect("the way up's cut is not covered");
+        assert!(
+            reason.contains("was left at 108.5000 Hz") && !reason.contains("left at 104.8000"),
+            "{reason}"
+        );
+        assert_eq!(
+            run.jumps[0].cut_uncovered().map(|(g, _)| g.freq_hz),
+            Some(108.5)
+        );
+        let json = serde_json::to_value(run.jumps[0]).unwrap();
+        assert_eq!(json["fill_cut"]["freq_hz"], 104.8);
+        assert_eq!(json["cut_check"]["verdict"], "covered");
+        assert_eq!(json["cut_check"]["resolved_distance"], 1e-12);
+        assert_eq!(json["second_cut"]["freq_hz"], 108.5);
+        assert_eq!(json["second_cut_check"]["verdict"], "abandoned");
+    }
+
+    /// The paper's system at F0 = 1 N, for [`judge_cut`] at its real folds.
+    fn paper_at_1n() -> Problem {
+        crate::scene::parse(
+            crate::scene::PAPER_DEFAULT_SCENE,
+            "paper",
+            &["static_loads.0.value=-1".to_string()],
+        )
+        .and_then(|s| s.validate("paper"))
+        .expect("the built-in scene is valid")
+    }
+
+    /// At the real folds of the paper's system at F0 = 1 N: a stretch followed into a fold
+    /// and one point back out of it, cut there (as a fill or bridge stopping at its edge).
+    /// Newton one step past the cut lands on the branch beyond it. Where the other side of the
+    /// fold (the cut stretch's own side) crosses that frequency within 1 % of the landing,
+    /// linear interpolation cannot tell them apart, but Newton at that frequency from the
+    /// other side converges to another solution: the cut is not covered. With the branch
+    /// beyond the cut in the run (the points the FRF followed there, as another branch), the
+    /// same landing is covered, Newton from that branch converging to it.
+    #[test]
+    fn a_landing_beyond_a_fold_of_its_own_stretch_is_told_from_the_other_side_by_newton() {
+        let problem = paper_at_1n();
+        let run = solve(&problem, &mut Silent).unwrap();
+        let starts = run.branch_starts();
+        let mut system = HbmOperator::new(&problem).unwrap();
+        let set = system.unknowns().clone();
+        let x_scale = arc_length_x_scale(&problem, &set, &system).unwrap();
+        let newton = Continuation::new(problem.analysis.continuation, x_scale);
+        let p = &run.points;
+        let direction = |k: usize| (p[k + 1].freq_hz - p[k].freq_hz).signum();
+        let same_branch = |a: usize, b: usize| !starts.iter().any(|&s| s > a && s <= b);
+        let mut told = 0;
+        for k in 1..p.len().saturating_sub(2) {
+            // A fold at point k: the stretch into it and the one out of it in one branch.
+            if !same_branch(k - 1, k + 2) || direction(k - 1) * direction(k) >= 0.0 {
+                continue;
+            }
+            let mut a = k - 1;
+            while a > 0 && same_branch(a - 1, k) && direction(a - 1) == direction(k - 1) {
+                a -= 1;
+            }
+            let mut b = k + 1;
+            while b + 1 < p.len()
+                && same_branch(k, b + 1)
+                && direction(b) == direction(k)
+                && b < k + 20
+            {
+                b += 1;
+            }
+            // The stretch into the fold and one point out: cut at point k + 1.
+            let stretch: Vec<FrfPoint> = p[a..=k + 1].to_vec();
+            let cut = GivenUp {
+                freq_hz: p[k + 1].freq_hz,
+                amplitude: p[k + 1].amplitudes[0],
+                amplitude_rising: p[k + 1].amplitudes[0] > p[k].amplitudes[0],
+                fold_hz: Some(p[k].freq_hz),
+                cause: GiveUpCause::FillEnd,
+            };
+            let alone = judge_cut(&mut system, &newton, &stretch, &[], 0..stretch.len(), &cut);
+            let (Some(d), true) = (alone.distance, alone.own_side) else {
+                continue;
+            };
+            if d > RETRACE_TOLERANCE || alone.verdict == CutVerdict::Unjudged {
+                continue;
+            }
+            // The branch beyond the cut, as the run followed it, as another branch.
+            let mut with_beyond = stretch.clone();
+            with_beyond.extend_from_slice(&p[k + 1..=b]);
+            let beyond = judge_cut(
+                &mut system,
+                &newton,
+                &with_beyond,
+                &[stretch.len()],
+                0..stretch.len(),
+                &cut,
+            );
+            eprintln!(
+                "fold at {:.4} Hz, cut at {:.4} Hz: alone {alone:?}; with the branch beyond \
+                 {beyond:?}",
+                p[k].freq_hz, cut.freq_hz
+            );
+            assert_eq!(beyond.freq_hz, alone.freq_hz);
+            if beyond.verdict != CutVerdict::Covered || beyond.own_side {
+                // The run's branch beyond the cut does not cross the landing's frequency.
+                continue;
+            }
+            assert!(beyond.resolved_distance.unwrap() <= SAME_SOLUTION_TOLERANCE);
+            // Where Newton from the other side finds the landing itself, the stretch came
+            // back along that side (a reversal on one solution curve, a corner of the sampled
+            // law): judged beyond the fold instead. Elsewhere the two sides are two solutions.
+            if alone.beyond_fold.is_some() {
+                assert!(alone.resolved_distance.unwrap() <= SAME_SOLUTION_TOLERANCE);
+                continue;
+            }
+            assert_eq!(alone.verdict, CutVerdict::Abandoned, "{alone:?}");
+            let apart = alone.resolved_distance.expect("Newton from the other side");
+            assert!(apart > SAME_SOLUTION_TOLERANCE, "{alone:?}");
+            let words = alone.describe();
+            assert!(words.contains("beyond the fold"), "{words}");
+            told += 1;
+        }
+        assert!(told > 0, "no fold within 1 % told apart by Newton");
+    }
+
+    /// A stretch that came back along the side it had followed into its fold (the paper's
+    /// system at F0 = 1 N: a monotone stretch of the run above 100 Hz, then its last points
+    /// again in reverse, as a fill or bridge reversing on one solution curve), cut there. Newton
+    /// past the cut lands on that side, the same solution (covered by interpolation before
+    /// Newton was asked); the branch goes on beyond the fold, where the run, without the
+    /// points it followed there, has nothing: not covered, the status naming a branch beyond
+    /// the fold not followed. With those points in the run (as another branch) it is covered.
+    #[test]
+    fn a_stretch_back_along_its_own_side_is_judged_beyond_its_fold() {
+        let problem = paper_at_1n();
+        let run = solve(&problem, &mut Silent).unwrap();
+        let starts = run.branch_starts();
+        let mut system = HbmOperator::new(&problem).unwrap();
+        let set = system.unknowns().clone();
+        let x_scale = arc_length_x_scale(&problem, &set, &system).unwrap();
+        let newton = Continuation::new(problem.analysis.continuation, x_scale);
+        let p = &run.points;
+        let direction = |k: usize| (p[k + 1].freq_hz - p[k].freq_hz).signum();
+        // Ten points of one branch above 100 Hz, the frequency moving one way throughout.
+        let a = (0..p.len().saturating_sub(10))
+            .find(|&a| {
+                p[a].freq_hz > 100.0
+                    && !starts.iter().any(|&s| s > a && s <= a + 9)
+                    && (a..a + 9).all(|k| direction(k) == direction(a) && direction(k) != 0.0)
+            })
+            .expect("a monotone stretch");
+        let mut back: Vec<FrfPoint> = p[a..=a + 5].to_vec();
+        back.push(p[a + 4].clone());
+        back.push(p[a + 3].clone());
+        let last = &p[a + 3];
+        let cut = GivenUp {
+            freq_hz: last.freq_hz,
+            amplitude: last.amplitudes[0],
+            amplitude_rising: last.amplitudes[0] > p[a + 4].amplitudes[0],
+            fold_hz: Some(p[a + 5].freq_hz),
+            cause: GiveUpCause::FillEnd,
+        };
+        let alone = judge_cut(&mut system, &newton, &back, &[], 0..back.len(), &cut);
+        eprintln!("stretch from {:.4} Hz: {alone:?}", p[a].freq_hz);
+        assert!(alone.own_side, "{alone:?}");
+        assert!(alone.distance.unwrap() <= RETRACE_TOLERANCE, "{alone:?}");
+        assert!(
+            alone.resolved_distance.unwrap() <= SAME_SOLUTION_TOLERANCE,
+            "{alone:?}"
+        );
+        let fold = alone.beyond_fold.expect("judged beyond the fold");
+        assert_eq!(fold.fold_hz, p[a + 5].freq_hz);
+        assert_eq!(fold.run_amplitude, None, "{fold:?}");
+        assert_eq!(alone.verdict, CutVerdict::Abandoned, "{alone:?}");
+        let words = alone.describe();
+        assert!(
+            words.contains("came back along the side") && words.contains("not followed"),
+            "{words}"
+        );
+        let mut with_beyond = back.clone();
+        with_beyond.extend_from_slice(&p[a + 5..=a + 9]);
+        let beyond = judge_cut(
+            &mut system,
+            &newton,
+            &with_beyond,
+            &[back.len()],
+            0..back.len(),
+            &cut,
+        );
+        eprintln!("with the points beyond: {beyond:?}");
+        let fold = beyond.beyond_fold.expect("judged beyond the fold");
+        assert!(
+            fold.resolved_distance.unwrap() <= SAME_SOLUTION_TOLERANCE,
+            "{fold:?}"
+        );
+        assert_eq!(beyond.verdict, CutVerdict::Covered, "{beyond:?}");
     }
 }

@@ -36,7 +36,9 @@ use std::path::{Path, PathBuf};
 use indicatif::{ProgressBar, ProgressStyle};
 use sha2::{Digest, Sha256};
 
-use crate::analysis::frf::{self, FrfError, FrfObserver, FrfPoint, Jump, JumpKind};
+use crate::analysis::frf::{
+    self, CutCheck, FrfError, FrfObserver, FrfPoint, GivenUp, Jump, JumpKind,
+};
 use crate::analysis::limits::LimitSettings;
 use crate::analysis::linear::{self, LinearCase};
 use crate::analysis::peaks::{self, ExtremumKind};
@@ -350,16 +352,15 @@ impl FrfObserver for RunObserver<'_> {
             (Some(words), false) => format!("\nthe branch before it was {words}"),
             (None, _) => String::new(),
         };
-        let before = match &jump.fill_cut {
-            Some(g) => format!(
+        let before = jump.cuts().fold(before, |before, (g, _)| {
+            format!(
                 "{before}\nthe branch past it (a fill or bridge) was left {}: it may go on \
                  beyond {:.4} Hz, not followed (the jump's fill_cut; judged by Newton past it \
                  once the run is over)",
                 g.describe(),
                 g.freq_hz
-            ),
-            None => before,
-        };
+            )
+        });
         let msg = match jump.kind {
             JumpKind::PastFold => format!(
                 "the path turned back at a fold below {:.4} Hz and did not return: it goes on \
@@ -392,26 +393,29 @@ impl FrfObserver for RunObserver<'_> {
     fn cut_judged(&mut self, index: usize, jump: &Jump) {
         self.writer.cut_judged(index, jump);
         // Always said, as the jump was.
-        let (Some(g), Some(check)) = (&jump.fill_cut, &jump.cut_check) else {
-            return;
-        };
-        let msg = format!(
-            "{}the cut at {:.4} Hz of the branch past the jump at {:.4} Hz: {}{}",
-            if check.uncovered() {
-                "NOT COVERED: "
-            } else {
-                ""
-            },
-            g.freq_hz,
-            jump.from_hz,
-            check.describe(),
-            if check.uncovered() {
-                "; the run will be reported incomplete"
-            } else {
-                ""
-            }
-        );
-        self.say(msg);
+        let judged: Vec<(GivenUp, CutCheck)> = jump
+            .cuts()
+            .filter_map(|(g, check)| check.map(|c| (*g, *c)))
+            .collect();
+        for (g, check) in judged {
+            let msg = format!(
+                "{}the cut at {:.4} Hz of the branch past the jump at {:.4} Hz: {}{}",
+                if check.uncovered() {
+                    "NOT COVERED: "
+                } else {
+                    ""
+                },
+                g.freq_hz,
+                jump.from_hz,
+                check.describe(),
+                if check.uncovered() {
+                    "; the run will be reported incomplete"
+                } else {
+                    ""
+                }
+            );
+            self.say(msg);
+        }
     }
     fn leap(&mut self, from_hz: f64, to_hz: f64) {
         self.writer.leap(from_hz, to_hz);
