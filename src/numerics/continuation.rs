@@ -28,7 +28,7 @@
 //! the spot lies below the highest frequency reached (the caller goes on past the highest
 //! frequency, as after a path that wandered without progress), and with
 //! [`ContinuationError::Stalled`] otherwise. A window taken at such a dead end ends the path
-//! there too when its first points land back on the path already followed. The last point is solved at exactly the end frequency. A path runs down in
+//! there too when one of its points lands back on the path already followed. The last point is solved at exactly the end frequency. A path runs down in
 //! frequency when the end frequency is below the start (e.g. to fill in, back toward a fold, a
 //! branch found past it).
 //!
