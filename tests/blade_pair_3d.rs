@@ -212,8 +212,8 @@ fn the_3d_frf_crosses_the_transition_at_886_685_hz_without_turning_back() {
 /// middle branch of the bending pair's resonance was never followed from the fold at
 /// 886.85 Hz (benches/README.md, "FRF across the bending pair"). A narrow window is now tried
 /// there first: the path passes the transition, folds at 886.847 Hz and runs down the middle
-/// branch, the amplitude rising, out of the window below 886.39 Hz. The point budget ends the
-/// run (exit code 3).
+/// branch, the amplitude rising, out of the window below 886.39 Hz and on below 880 Hz. The
+/// point budget ends the run (exit code 3).
 #[test]
 fn the_3d_frf_passes_the_dead_end_at_886_685_hz_onto_the_middle_branch() {
     let out =
@@ -278,10 +278,10 @@ fn the_3d_frf_passes_the_dead_end_at_886_685_hz_onto_the_middle_branch() {
         points[fold].1
     );
     // Past the fold the path runs down in frequency on the middle branch, whose amplitude rises
-    // above any of the lower branch's.
-    assert!(last_hz < 886.39, "{last_hz}");
+    // far above any of the lower branch's (measured: 874.80 Hz, 5.08e-5 m, against 6.53e-6 m).
+    assert!(last_hz < 880.0, "{last_hz}");
     assert!(
-        last_amplitude > 1.4 * below_fold,
+        last_amplitude > 4.0 * below_fold,
         "{last_amplitude} vs {below_fold}"
     );
     let _ = std::fs::remove_dir_all(&out);
