@@ -23,12 +23,13 @@
 //! path would then retrace (and loop: back along the followed path and on again through the
 //! same corners). When neither is found the path is taken on from its last point over a
 //! narrow window around the spot, with the arc-length scales of a range that narrow, and past
-//! the window with the range's again ([`Continuation::run`]). Where no window is left to try,
-//! the run ends with [`PathEnd::DeadEnd`] if a way back along the followed path was refused or
-//! the spot lies below the highest frequency reached (the caller goes on past the highest
-//! frequency, as after a path that wandered without progress), and with
-//! [`ContinuationError::Stalled`] otherwise. A window taken at such a dead end ends the path
-//! there too when one of its points lands back on the path already followed. The last point is solved at exactly the end frequency. A path runs down in
+//! the window with the range's again ([`Continuation::run`]), unless the spot lies below the
+//! highest frequency reached (behind a fold): the run then ends with [`PathEnd::DeadEnd`] (the
+//! caller goes on past the highest frequency, as after a path that wandered without progress).
+//! Where no window is left to try, the run ends with [`PathEnd::DeadEnd`] if a way back along
+//! the followed path was refused, and with [`ContinuationError::Stalled`] otherwise. A window
+//! taken where such a way back was refused ends the path as a dead end when one of its points
+//! lands back on the path already followed. The last point is solved at exactly the end frequency. A path runs down in
 //! frequency when the end frequency is below the start (e.g. to fill in, back toward a fold, a
 //! branch found past it).
 //!
@@ -1307,14 +1308,16 @@ impl Continuation {
                             // followed (refused: the path would retrace itself and loop through
                             // the same corners until `stagnation_points` ended it), or behind
                             // the highest frequency reached (the path turned back at a fold),
-                            // the spot is a dead end: the narrow windows are tried first (on
-                            // the 3D blade pair's middle branch they pass such spots), and a
-                            // point of theirs that lands back on the path already followed
-                            // ends the path there as well. With no window left, the path
-                            // ends for the caller to go on past the highest frequency
-                            // reached, as it would after that loop. Otherwise it is a stall.
-                            let dead_end = refused_retrace || dir * from < furthest.0 - a.min_step;
-                            if next.is_none() && dead_end {
+                            // the spot is a dead end: the path ends for the caller to go on
+                            // past the highest frequency reached, as it would after that loop.
+                            // At the highest frequency reached, the narrow windows are tried
+                            // first (on the 3D blade pair they pass such a spot at 886.685 Hz
+                            // onto the middle branch), and a point of theirs that lands back
+                            // on the path already followed ends the path there as well.
+                            // Otherwise it is a stall.
+                            let behind = dir * from < furthest.0 - a.min_step;
+                            let dead_end = refused_retrace || behind;
+                            if dead_end && (behind || next.is_none()) {
                                 summary.end = PathEnd::DeadEnd;
                                 return Ok(summary);
                             }
