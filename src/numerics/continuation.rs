@@ -21,15 +21,13 @@
 //! is kept only when a look-ahead step from it leaves that path (a sharp fold), since at a
 //! contact transition such a point can lead straight back onto the incoming branch, which the
 //! path would then retrace (and loop: back along the followed path and on again through the
-//! same corners). When neither is found the path is taken on from its last point over a
-//! narrow window around the spot, with the arc-length scales of a range that narrow, and past
-//! the window with the range's again ([`Continuation::run`]), unless the spot lies below the
-//! highest frequency reached (behind a fold): the run then ends with [`PathEnd::DeadEnd`] (the
-//! caller goes on past the highest frequency, as after a path that wandered without progress).
-//! Where no window is left to try, the run ends with [`PathEnd::DeadEnd`] if a way back along
-//! the followed path was refused, and with [`ContinuationError::Stalled`] otherwise. A window
-//! taken where such a way back was refused ends the path as a dead end when one of its points
-//! lands back on the path already followed. The last point is solved at exactly the end frequency. A path runs down in
+//! same corners). When neither is found the run ends with [`PathEnd::DeadEnd`] where a way
+//! back along the followed path was refused or below the highest frequency reached (the caller
+//! goes on past the highest frequency, as after a path that wandered without progress).
+//! Otherwise the path is taken on from its last point over a narrow window around the spot,
+//! with the arc-length scales of a range that narrow, and past the window with the
+//! range's again ([`Continuation::run`]); a stall inside the window ends the run with
+//! [`ContinuationError::Stalled`]. The last point is solved at exactly the end frequency. A path runs down in
 //! frequency when the end frequency is below the start (e.g. to fill in, back toward a fold, a
 //! branch found past it).
 //!
@@ -965,24 +963,6 @@ impl Continuation {
         false
     }
 
-    /// Whether `point` lies back on the path already followed (`points`, the last
-    /// [`RETRACE_HISTORY`] of them looked at): closer to the polyline through them than
-    /// [`RETRACE_FRACTION`] of its distance from the last one, as in
-    /// [`Continuation::runs_back_along`]. A step that goes on from the last point has its
-    /// distance from the polyline equal to its distance from that point.
-    fn retraces(&self, point: &PathPoint, points: &[PathPoint]) -> bool {
-        let recent = &points[points.len().saturating_sub(RETRACE_HISTORY)..];
-        let path = self.scaled_points(recent);
-        let (Some(last), Some(q)) = (
-            path.last(),
-            self.scaled_points(std::slice::from_ref(point)).pop(),
-        ) else {
-            return false;
-        };
-        let reach = norm(&q.iter().zip(last).map(|(a, b)| a - b).collect::<Vec<_>>());
-        distance_to_polyline(&q, &path) <= RETRACE_FRACTION * reach
-    }
-
     /// The path point of a corrected y, its tangent, the distance of the correction relative
     /// to the step, and the angle (degrees) the tangent turned by over the step.
     #[allow(clippy::too_many_arguments)]
@@ -1113,9 +1093,6 @@ impl Continuation {
     ) -> Result<PathSummary, ContinuationError> {
         let a = self.settings;
         let mut narrow_passes = 0usize;
-        // Whether the narrow-window pass under way started where the path had met a dead end
-        // (see below): its points must then leave the path already followed.
-        let mut narrow_from_dead_end = false;
         let omega_start = a.freq_start_hz * OMEGA_SCALE;
         let omega_end = a.freq_end_hz * OMEGA_SCALE;
         let n = system.dim();
@@ -1232,13 +1209,6 @@ impl Continuation {
             match outcome {
                 Ok((point, t_new, degrees)) => {
                     previous_quality = None;
-                    if narrow_from_dead_end
-                        && self.narrow.is_some()
-                        && self.retraces(&point, &summary.points)
-                    {
-                        summary.end = PathEnd::DeadEnd;
-                        return Ok(summary);
-                    }
                     let iterations = point.iterations;
                     if self.accept(system, observer, &mut summary, point, t_new, &mut tangent) {
                         return Ok(summary);
@@ -1262,7 +1232,6 @@ impl Continuation {
                         if let Some(from_hz) = self.leave_narrow(&mut tangent) {
                             observer.narrow_pass(from_hz, freq_hz);
                         }
-                        narrow_from_dead_end = false;
                         ds = a.initial_step.clamp(a.min_step, a.max_step);
                     }
                 }
@@ -1297,6 +1266,16 @@ impl Continuation {
                             }
                         };
                         let Some((point, t_new)) = resumed else {
+                            // Where the only way on found was back along the path already
+                            // followed (refused: the path would retrace itself and loop through
+                            // the same corners until `stagnation_points` ended it), or behind
+                            // the highest frequency reached (the path turned back at a fold),
+                            // the path ends for the caller to go on past the highest frequency
+                            // reached, as it would after that loop. Otherwise it is a stall.
+                            if refused_retrace || dir * from < furthest.0 - a.min_step {
+                                summary.end = PathEnd::DeadEnd;
+                                return Ok(summary);
+                            }
                             // The next window: the first for a new stall, the next width for
                             // one inside a window.
                             let next = match self.narrow {
@@ -1304,29 +1283,9 @@ impl Continuation {
                                 Some(pass) => Some(pass.attempt + 1)
                                     .filter(|&k| k < NARROW_WINDOW_FRACTIONS.len()),
                             };
-                            // Where the only way on found was back along the path already
-                            // followed (refused: the path would retrace itself and loop through
-                            // the same corners until `stagnation_points` ended it), or behind
-                            // the highest frequency reached (the path turned back at a fold),
-                            // the spot is a dead end: the path ends for the caller to go on
-                            // past the highest frequency reached, as it would after that loop.
-                            // At the highest frequency reached, the narrow windows are tried
-                            // first (on the 3D blade pair they pass such a spot at 886.685 Hz
-                            // onto the middle branch), and a point of theirs that lands back
-                            // on the path already followed ends the path there as well.
-                            // Otherwise it is a stall.
-                            let behind = dir * from < furthest.0 - a.min_step;
-                            let dead_end = refused_retrace || behind;
-                            if dead_end && (behind || next.is_none()) {
-                                summary.end = PathEnd::DeadEnd;
-                                return Ok(summary);
-                            }
                             if let Some(attempt) = next {
                                 if attempt == 0 {
                                     narrow_passes += 1;
-                                    narrow_from_dead_end = dead_end;
-                                } else {
-                                    narrow_from_dead_end |= dead_end;
                                 }
                                 let stalled = self.leave_narrow(&mut tangent).unwrap_or(from);
                                 self.enter_narrow(from, stalled, attempt, &mut tangent);
@@ -1349,7 +1308,6 @@ impl Continuation {
                             if let Some(from_hz) = self.leave_narrow(&mut tangent) {
                                 observer.narrow_pass(from_hz, freq_hz);
                             }
-                            narrow_from_dead_end = false;
                         }
                         ds = a.initial_step.clamp(a.min_step, a.max_step);
                         continue;
