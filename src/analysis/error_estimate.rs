@@ -617,12 +617,8 @@ impl<'p> ErrorEstimator<'p> {
     /// unknowns, then ω), and the same normal on the full coefficients; None when it does not
     /// fit or is not finite.
     fn border(&self, normal: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
-        let (on_x, on_omega) = normal.split_last().map(|(w, x)| (x, *w))?;
-        if on_x.len() != self.full_index.len() || normal.iter().any(|v| !v.is_finite()) {
-            return None;
-        }
-        let mut row = self.truncation.on_kept_blocks(on_x, self.set.n_blocks())?;
-        row.push(on_omega);
+        let row = self.row_on(&self.truncation, normal)?;
+        let (&on_omega, on_x) = normal.split_last()?;
         let mut full = vec![0.0; self.problem.model.n_dofs() * self.set.n_blocks() + 1];
         for (&i, &w) in self.full_index.iter().zip(on_x) {
             full[i] = w;
@@ -1053,6 +1049,7 @@ impl<'p> ErrorEstimator<'p> {
         base: &[f64],
     ) -> Option<Wider> {
         let n = self.problem.model.n_dofs();
+        let row = normal.and_then(|normal| self.row_on(&self.wider, normal));
         let wider = &mut self.wider;
         let xr = wider.padded(n, x);
         let dim = xr.len();
@@ -1063,15 +1060,6 @@ impl<'p> ErrorEstimator<'p> {
             .residual_and_jacobian(&xr, omega, &mut r, &mut wider.jacobian, &mut dr)
             .ok()?;
         let ext = wider.operator.unknowns().clone();
-        let row = normal.and_then(|normal| {
-            let (on_omega, on_x) = normal.split_last()?;
-            if on_x.len() != self.full_index.len() || normal.iter().any(|v| !v.is_finite()) {
-                return None;
-            }
-            let mut row = wider.on_kept_blocks(on_x, self.set.n_blocks())?;
-            row.push(*on_omega);
-            Some(row)
-        });
         let problem = self.problem;
         let r_norm = crate::numerics::linalg::norm(&r);
         // The change of each output and the step's contraction ([`LinearRange`]).

@@ -1612,7 +1612,7 @@ fn judge_cut(
             .map(|p| p.freq_hz)
     };
     let (direction, step) = match before {
-        Some(b) => ((f - b).signum(), (f - b).abs().clamp(1e-7 * f, 5e-4 * f)),
+        Some(b) => ((f - b).signum(), (f - b).abs()),
         None => {
             let down = cut.fold_hz.is_some_and(|fold| fold >= f);
             (if down { -1.0 } else { 1.0 }, 1e-4 * f)
@@ -1668,14 +1668,13 @@ fn judge_cut(
                 .map(|&k| points[k].freq_hz)
                 .find(|&g| g != fold_hz);
             into.map(|g| {
-                let step = (fold_hz - g).abs().clamp(1e-7 * fold_hz, 5e-4 * fold_hz);
                 let (freq_hz, landing) = land_past(
                     system,
                     newton,
                     &points[j].coefficients,
                     fold_hz,
                     (fold_hz - g).signum(),
-                    step,
+                    (fold_hz - g).abs(),
                 );
                 judge_beyond_fold(
                     system, newton, points, starts, &own, fold_hz, freq_hz, landing,
@@ -1702,9 +1701,9 @@ fn judge_cut(
 }
 
 /// Newton at fixed frequencies past `f` (Hz) in `direction` (±1) from the coefficients
-/// `start`, at the offsets [`CUT_CHECK_OFFSETS`] of `step` (Hz), then
-/// [`CUT_CHECK_FALLBACKS`]: the frequency of the last solve tried (Hz) and the first point
-/// that converged, if any.
+/// `start`, at the offsets [`CUT_CHECK_OFFSETS`] of `step` (Hz, the last frequency step into
+/// `f`, clamped to [10⁻⁷, 5·10⁻⁴] of `f`), then [`CUT_CHECK_FALLBACKS`]: the frequency of the
+/// last solve tried (Hz) and the first point that converged, if any.
 fn land_past(
     system: &mut HbmOperator<'_>,
     newton: &Continuation,
@@ -1714,6 +1713,7 @@ fn land_past(
     step: f64,
 ) -> (f64, Option<FrfPoint>) {
     let guess = system.restrict(start);
+    let step = step.clamp(1e-7 * f, 5e-4 * f);
     let mut freq_hz = f;
     let offsets = CUT_CHECK_OFFSETS
         .iter()
