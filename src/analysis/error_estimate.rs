@@ -88,12 +88,18 @@
 //! residual (the iterate Newton from the padded point reaches first), so it repeats no work of
 //! the step. A point sent to the wider set but kept on 2H + 1 by [`WidenGate`] saves the
 //! wider set's residual, Jacobian and factorisation. On the larger blade pair at H = 1
-//! (855-895 Hz, 1076 points) these solves take most of the estimate's time: 28 s of user CPU
-//! with the estimate against 2.8 s without (about 10×; 15 s, about 5×, before the solve across
-//! the path, which sizes 285 of its 607 points next to the small folds); the gate keeps none
-//! of its points on 2H + 1, since 417 of its 450 widened points have 2H + 1 estimates above
-//! the 1 % threshold itself (docs/accuracy.md, "What the estimate costs, and where the time
-//! goes").
+//! (855-895 Hz, 1076 points) these solves take most of the estimate's time (the failing ones
+//! 46 %, the converging ones 40 %, the steps 14 %): 23-26 s of user CPU with the estimate
+//! against 3.2-3.4 s without (6.8-8.2×; 15 s, about 5×, before the solve across the path,
+//! which sizes 285 of its 607 points next to the small folds); the gate keeps none of its
+//! points on 2H + 1, since 417 of its 450 widened points have 2H + 1 estimates above the 1 %
+//! threshold itself (docs/accuracy.md, "What the estimate costs, and where the time goes").
+//!
+//! Every estimate runs on a pool of one thread of the estimator's own
+//! (`ErrorEstimator::on_one_thread`): faer then factorises the extended systems (2-5× the
+//! run's) on that one thread instead of splitting each factorisation over rayon's threads,
+//! which on a loaded machine mostly wait for each other (on the blade pair above 28-43 s of
+//! user and 2-18 s of system CPU before, with the same results).
 
 use crate::contact::harmonic::HarmonicSet;
 use crate::contact::point::ContactState;
