@@ -88,12 +88,18 @@
 //! residual (the iterate Newton from the padded point reaches first), so it repeats no work of
 //! the step. A point sent to the wider set but kept on 2H + 1 by [`WidenGate`] saves the
 //! wider set's residual, Jacobian and factorisation. On the larger blade pair at H = 1
-//! (855-895 Hz, 1076 points) these solves take most of the estimate's time: 28 s of user CPU
-//! with the estimate against 2.8 s without (about 10×; 15 s, about 5×, before the solve across
-//! the path, which sizes 285 of its 607 points next to the small folds); the gate keeps none
-//! of its points on 2H + 1, since 417 of its 450 widened points have 2H + 1 estimates above
-//! the 1 % threshold itself (docs/accuracy.md, "What the estimate costs, and where the time
-//! goes").
+//! (855-895 Hz, 1076 points) these solves take most of the estimate's time (the failing ones
+//! 46 %, the converging ones 40 %, the steps 14 %): 23-26 s of user CPU with the estimate
+//! against 3.2-3.4 s without (6.8-8.2×; 15 s, about 5×, before the solve across the path,
+//! which sizes 285 of its 607 points next to the small folds); the gate keeps none of its
+//! points on 2H + 1, since 417 of its 450 widened points have 2H + 1 estimates above the 1 %
+//! threshold itself (docs/accuracy.md, "What the estimate costs, and where the time goes").
+//!
+//! Every estimate runs on a pool of one thread of the estimator's own
+//! (`ErrorEstimator::on_one_thread`): faer then factorises the extended systems (2-5× the
+//! run's) on that one thread instead of splitting each factorisation over rayon's threads,
+//! which on a loaded machine mostly wait for each other (on the blade pair above 28-43 s of
+//! user and 2-18 s of system CPU before, with the same results).
 
 use crate::contact::harmonic::HarmonicSet;
 use crate::contact::point::ContactState;
@@ -586,6 +592,9 @@ pub struct ErrorEstimator<'p> {
     /// For each of the run's unknowns, its index among the full coefficients (the run's
     /// operator restricts by selection).
     full_index: Vec<usize>,
+    /// A pool of one thread that every estimate runs on ([`Self::on_one_thread`]); None where
+    /// the thread could not be started (the estimate then runs on the caller's thread).
+    one_thread: Option<rayon::ThreadPool>,
 }
 
 impl<'p> ErrorEstimator<'p> {
@@ -610,7 +619,31 @@ impl<'p> ErrorEstimator<'p> {
             sampling,
             set,
             full_index,
+            one_thread: rayon::ThreadPoolBuilder::new()
+                .num_threads(1)
+                .thread_name(|_| "error-estimate".to_string())
+                .build()
+                .ok(),
         })
+    }
+
+    /// Runs `work` on the estimator's pool of one thread, so that the dense factorisations of
+    /// the extended systems (faer, whose default parallelism spreads a factorisation over
+    /// rayon's threads, the pool's own there) run sequentially. The extended systems are 2-5×
+    /// the run's, large enough for faer to split their factorisations; on the larger blade pair
+    /// at H = 1 the split factorisations cost 30 s of user and 9 s of system CPU against 24 s
+    /// and 0.1 s on one thread, with the same wall time and identical results, on the 2-core
+    /// machine shared with other jobs (docs/accuracy.md, "What the estimate costs, and where
+    /// the time goes"). Where the pool could not be started, `work` runs on the caller's thread.
+    fn on_one_thread<R: Send>(&mut self, work: impl FnOnce(&mut Self) -> R + Send) -> R {
+        match self.one_thread.take() {
+            Some(pool) => {
+                let out = pool.install(|| work(self));
+                self.one_thread = Some(pool);
+                out
+            }
+            None => work(self),
+        }
     }
 
     /// The border row on the extended unknowns for the path normal `normal` (the run's
@@ -637,7 +670,20 @@ impl<'p> ErrorEstimator<'p> {
     ///
     /// `states` are the point's contact states: a contact stuck all period sends the point on
     /// to the wider set when its estimate is not negligible ([`TailTest`]).
+    ///
+    /// Runs on the estimator's own thread ([`Self::on_one_thread`]).
     pub fn estimate(
+        &mut self,
+        x: &[f64],
+        omega: f64,
+        path: Option<PathPlace>,
+        states: &[ContactState],
+    ) -> PointAccuracy {
+        self.on_one_thread(|e| e.estimate_here(x, omega, path, states))
+    }
+
+    /// [`Self::estimate`] on the calling thread.
+    fn estimate_here(
         &mut self,
         x: &[f64],
         omega: f64,
@@ -940,7 +986,9 @@ impl<'p> ErrorEstimator<'p> {
         normal.push(*on_omega);
         let base = amplitudes(self.problem, &self.set, x);
         let wider = harmonic == wider_harmonic(self.h_max);
-        self.converged_across(x, omega, wider, &base, &normal, (&[], f64::INFINITY))
+        self.on_one_thread(|e| {
+            e.converged_across(x, omega, wider, &base, &normal, (&[], f64::INFINITY))
+        })
     }
 
     /// Whether a point that [`TailTest`] sends to the wider set is widened ([`WidenGate`]).
