@@ -220,7 +220,7 @@ fn curve_pareto_figure(
             "incomplete runs (peak error on the curve as followed)",
             &partial_x,
             &partial_y,
-            RGBColor(230, 160, 40),
+            RGBColor(175, 165, 215),
             false,
         ));
     }
