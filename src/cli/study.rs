@@ -169,14 +169,20 @@ fn pareto_stem(curve: &StudyCurve, several: bool) -> String {
 
 /// Lone points (NaN between them breaks the line) of `pairs` not in `front`.
 fn lone_points(pairs: &[(f64, f64)], front: &[usize]) -> (Vec<f64>, Vec<f64>) {
+    lone_points_where(pairs, |i| !front.contains(&i))
+}
+
+/// Lone points (NaN between them breaks the line) of the `pairs` whose index passes `keep`.
+fn lone_points_where(pairs: &[(f64, f64)], keep: impl Fn(usize) -> bool) -> (Vec<f64>, Vec<f64>) {
     (0..pairs.len())
-        .filter(|i| !front.contains(i))
+        .filter(|&i| keep(i))
         .flat_map(|i| [pairs[i], (f64::NAN, f64::NAN)])
         .unzip()
 }
 
 /// One curve's figure: peak amplitude error against time, the Pareto front dashed and each of
-/// its settings labelled in the legend.
+/// its settings labelled in the legend; the settings whose run is not complete (never on the
+/// front, [`CurveStudy::pareto`]) as a series of their own.
 fn curve_pareto_figure(
     study: &CurveStudy,
     title: &str,
@@ -186,7 +192,9 @@ fn curve_pareto_figure(
     let (pairs, front) = study.pareto();
     let front_x: Vec<f64> = front.iter().map(|&i| pairs[i].0).collect();
     let front_y: Vec<f64> = front.iter().map(|&i| pairs[i].1).collect();
-    let (others_x, others_y) = lone_points(&pairs, &front);
+    let complete = |i: usize| study.results[i].is_complete();
+    let (others_x, others_y) = lone_points_where(&pairs, |i| complete(i) && !front.contains(&i));
+    let (partial_x, partial_y) = lone_points_where(&pairs, |i| !complete(i));
     let fronts: Vec<([f64; 1], [f64; 1])> = front
         .iter()
         .map(|&i| ([pairs[i].0], [pairs[i].1]))
@@ -207,6 +215,15 @@ fn curve_pareto_figure(
             false,
         ),
     ];
+    if !partial_x.is_empty() {
+        series.push(marked(
+            "incomplete runs (peak error on the curve as followed)",
+            &partial_x,
+            &partial_y,
+            RGBColor(175, 165, 215),
+            false,
+        ));
+    }
     for (k, (&i, (x, y))) in front.iter().zip(&fronts).enumerate() {
         let label = study.results[i].setting.label.as_str();
         series.push(marked(label, x, y, plot::palette(k + 1), false));
@@ -325,8 +342,10 @@ fn curve_section(
     let (_, front) = study.pareto();
     let mut md = format!(
         "## Curve `{}`\n\n{} Reference: {} ({} points, {:.2} s). Reference converged to: curve \
-         L2 {:.2e}, peak amplitude {:.2e}, peak frequency {:.2e} (against {}). Errors are \
-         relative to this curve's reference, for the first output ({output}).\n\n\
+         L2 {:.2e}, peak amplitude {:.2e}, peak frequency {:.2e} (against {}, {}). Errors are \
+         relative to this curve's reference, for the first output ({output}). A setting whose \
+         run is not `complete` has its peak errors measured on the curve as followed and is \
+         never on the Pareto front.\n\n\
          | group | setting | status | unknowns | points | Newton its | time (s) | curve L2 err | \
          peak amp err | peak freq err | Pareto |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
         study.curve.name,
@@ -338,6 +357,7 @@ fn curve_section(
         study.check_errors.max_peak_amplitude(),
         study.check_errors.max_peak_frequency(),
         check.label,
+        study.check.status,
     );
     for (i, (r, e)) in study.results.iter().zip(&study.errors).enumerate() {
         let _ = writeln!(
