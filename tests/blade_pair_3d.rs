@@ -210,8 +210,10 @@ fn the_3d_frf_crosses_the_transition_at_886_685_hz_without_turning_back() {
 /// every step and the only way on the corner search finds leads back onto the incoming branch:
 /// the branch used to be given up there as a dead end, the run jumping past it, so that the
 /// middle branch of the bending pair's resonance was never followed from the fold at
-/// 886.85 Hz (benches/README.md, "FRF across the bending pair"). A narrow window is now tried
-/// there first: the path passes the transition, folds at 886.847 Hz and runs down the middle
+/// 886.85 Hz (benches/README.md, "FRF across the bending pair"). The path comes to it rising
+/// monotonically from 884 Hz (no reversal of the frequency among its last 64 points), so a
+/// narrow window is now tried there first (benches/README.md, "Which dead ends get the narrow
+/// windows"): the path passes the transition, folds at 886.847 Hz and runs down the middle
 /// branch, the amplitude rising, out of the window below 886.39 Hz and on below 880 Hz. The
 /// point budget ends the run (exit code 3).
 #[test]

@@ -24,9 +24,12 @@
 //! same corners). When neither is found the path is taken on from its last point over a
 //! narrow window around the spot, with the arc-length scales of a range that narrow, and past
 //! the window with the range's again ([`Continuation::run`]), unless the spot lies below the
-//! highest frequency reached (behind a fold): the run then ends with [`PathEnd::DeadEnd`] (the
-//! caller goes on past the highest frequency, as after a path that wandered without progress).
-//! Where no window is left to try, the run ends with [`PathEnd::DeadEnd`] if a way back along
+//! highest frequency reached (behind a fold), or a way back along the followed path was
+//! refused after a stretch on which the frequency turned back and forth (the path bouncing
+//! between corners of the sampled law, see `frequency_reversals`): the run then ends with
+//! [`PathEnd::DeadEnd`] (the caller goes on past the highest frequency, as after a path that
+//! wandered without progress). The points of a window taken where a way back was refused are
+//! held back from the observer until the path leaves the window. Where no window is left to try, the run ends with [`PathEnd::DeadEnd`] if a way back along
 //! the followed path was refused, and with [`ContinuationError::Stalled`] otherwise. A window
 //! taken where such a way back was refused ends the path as a dead end when one of its points
 //! lands back on the path already followed. The last point is solved at exactly the end frequency. A path runs down in
@@ -1482,16 +1485,22 @@ impl Continuation {
                             // the highest frequency reached (the path turned back at a fold),
                             // the spot is a dead end: the path ends for the caller to go on
                             // past the highest frequency reached, as it would after that loop.
-                            // At the highest frequency reached, the narrow windows are tried
+                            // At the highest frequency reached, where the path came to the
+                            // spot monotone in frequency over its last RETRACE_HISTORY points
+                            // (a single transition met head-on), the narrow windows are tried
                             // first (on the 3D blade pair they pass such a spot at 886.685 Hz
                             // onto the middle branch), their points held back until the path
                             // leaves the window; a point of theirs that lands back on the path
                             // already followed, or a window that fails, drops them and ends
-                            // the path at the dead end, as without the windows.
-                            // Otherwise it is a stall.
+                            // the path at the dead end, as without the windows. Where the
+                            // frequency turned back and forth among those points, the path is
+                            // bouncing between corners of the sampled law (the loop the dead
+                            // end is there to end) and ends there without windows (see
+                            // `frequency_reversals`). Otherwise it is a stall.
                             let behind = dir * from < furthest.0 - a.min_step;
                             let dead_end = refused_retrace || behind;
-                            if dead_end && (behind || next.is_none()) {
+                            let bouncing = held.is_none() && frequency_reversals(recent) > 0;
+                            if dead_end && (behind || next.is_none() || bouncing) {
                                 match held.take() {
                                     Some(h) => self.drop_held(h, &mut summary),
                                     None => summary.end = PathEnd::DeadEnd,
@@ -1570,6 +1579,38 @@ impl Continuation {
         }
         Ok(summary)
     }
+}
+
+/// How many times the frequency of consecutive `points` changes direction (steps that leave
+/// the frequency unchanged are skipped): 0 on a stretch monotone in frequency.
+///
+/// Decides whether a dead end at the highest frequency reached gets the narrow windows (see
+/// [`Continuation::run`]): only with no reversal among the last [`RETRACE_HISTORY`] points.
+/// Why, measured (benches/README.md, "Narrow windows at dead ends"): the 3D blade pair's dead
+/// end at 886.6853 Hz (840-900 Hz and 884-944 Hz) is met on a stretch rising monotonically from
+/// 884 Hz (0 reversals), and a window passes it onto the middle branch of the bending pair's
+/// resonance. The paper's system at F0 = 1 N meets its dead end at 151.8405 Hz after bouncing
+/// between corners of the sampled law (6 reversals in the last 64 points, turning points every
+/// 0.03-0.1 Hz over 147.7-151.8 Hz); a window there stepped over the turning points the run
+/// finds at 152.1-153.1 Hz (151.84 → 152.42 → 153.88 Hz in two points), and the path beyond was
+/// not the one the run follows with the jump past the dead end (it ended at a dead end at
+/// 241.65 Hz that Newton cannot go past). The stall signature does not tell the two apart:
+/// at both the corrector's residual after 12 iterations falls in proportion to the step over the
+/// halvings (a kink), and the corner search ends on a point leading back onto the path.
+fn frequency_reversals(points: &[PathPoint]) -> usize {
+    let mut last_sign = 0.0;
+    let mut count = 0;
+    for pair in points.windows(2) {
+        let sign = (pair[1].omega - pair[0].omega).signum();
+        if pair[1].omega == pair[0].omega {
+            continue;
+        }
+        if last_sign != 0.0 && sign != last_sign {
+            count += 1;
+        }
+        last_sign = sign;
+    }
+    count
 }
 
 /// Euclidean distance from `q` to the polyline through `points` (to the point itself when
@@ -1883,6 +1924,28 @@ mod tests {
     /// followed lies ends the path as [`PathEnd::DeadEnd`] (for the FRF to go on past the
     /// fold), not as a stall: the path rises to the fold, turns once and runs down to the dead
     /// end at 10 Hz, never back up along itself, every point on the path.
+    /// The reversals that keep the narrow windows from a dead end: none on a monotone stretch
+    /// (steps at an unchanged frequency, e.g. a creep toward a kink, skipped), one per change
+    /// of direction on a stretch bouncing between corners.
+    #[test]
+    fn frequency_reversals_count_the_changes_of_direction() {
+        let at = |hz: &[f64]| -> Vec<PathPoint> {
+            hz.iter()
+                .map(|&f| PathPoint {
+                    omega: f * OMEGA_SCALE,
+                    x: vec![0.0],
+                    iterations: 1,
+                    residual: 0.0,
+                    step: 0.0,
+                })
+                .collect()
+        };
+        assert_eq!(frequency_reversals(&at(&[])), 0);
+        assert_eq!(frequency_reversals(&at(&[1.0, 2.0, 2.0, 2.0, 3.0])), 0);
+        assert_eq!(frequency_reversals(&at(&[3.0, 2.0, 1.0])), 0);
+        assert_eq!(frequency_reversals(&at(&[1.0, 2.0, 2.0, 1.5, 1.7, 1.6])), 3);
+    }
+
     #[test]
     fn a_dead_end_behind_a_fold_ends_the_path_for_the_caller_to_jump() {
         let mut points = Vec::new();
