@@ -205,6 +205,90 @@ fn the_3d_frf_crosses_the_transition_at_886_685_hz_without_turning_back() {
     assert!(frf.solution.contains("\"status\": \"complete\""), "status");
 }
 
+/// Over a window as wide as 840-900 Hz (so with that range's arc-length scales and steps), the
+/// path from 884 Hz meets `left-25`'s transition at 886.685 Hz where the corrector fails at
+/// every step and the only way on the corner search finds leads back onto the incoming branch:
+/// the branch used to be given up there as a dead end, the run jumping past it, so that the
+/// middle branch of the bending pair's resonance was never followed from the fold at
+/// 886.85 Hz (benches/README.md, "FRF across the bending pair"). The path comes to it rising
+/// monotonically from 884 Hz (no reversal of the frequency among its last 64 points), so a
+/// narrow window is now tried there first (benches/README.md, "Which dead ends get the narrow
+/// windows"): the path passes the transition, folds at 886.847 Hz and runs down the middle
+/// branch, the amplitude rising, out of the window below 886.39 Hz and on below 880 Hz. The
+/// point budget ends the run (exit code 3).
+#[test]
+fn the_3d_frf_passes_the_dead_end_at_886_685_hz_onto_the_middle_branch() {
+    let out =
+        std::env::temp_dir().join(format!("fricbound-blade-3d-middle-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let run = support::run_scene(
+        SCENE,
+        &out,
+        &[
+            "analysis.freq_start_hz=884",
+            "analysis.freq_end_hz=944",
+            "analysis.max_points=260",
+            "analysis.linear_points=3",
+            "accuracy.estimate=false",
+        ],
+    );
+    assert_eq!(run.status.code(), Some(3), "{}", support::text(&run.stderr));
+    let solution = support::json(&out.join("solution.json"));
+    let status = solution["status"].as_str().unwrap();
+    assert!(status.contains("max_points"), "{status}");
+    assert_eq!(solution["jumps"].as_array().unwrap().len(), 0, "jumps");
+    let passes: Vec<(f64, f64)> = solution["narrow_passes_hz"]
+        .as_array()
+        .unwrap_or_else(|| panic!("no narrow pass: {status}"))
+        .iter()
+        .map(|p| (p[0].as_f64().unwrap(), p[1].as_f64().unwrap()))
+        .collect();
+    println!(
+        "narrow passes {passes:?}, turning points {}",
+        solution["turning_points_hz"]
+    );
+    assert!(
+        passes
+            .iter()
+            .any(|&(from, to)| (from - 886.6853).abs() < 1e-3 && to < 886.39),
+        "{passes:?}"
+    );
+    let folds: Vec<f64> = solution["turning_points_hz"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert!(
+        folds.iter().any(|&f| (886.84..886.85).contains(&f)),
+        "{folds:?}"
+    );
+    let (_, rows) = support::csv(&out.join("frf.csv"));
+    let points: Vec<(f64, f64)> = rows
+        .iter()
+        .map(|r| (r[0].parse().unwrap(), r[1].parse().unwrap()))
+        .collect();
+    let fold = (0..points.len())
+        .max_by(|&i, &j| points[i].0.total_cmp(&points[j].0))
+        .unwrap();
+    let below_fold = points[..fold].iter().map(|p| p.1).fold(0.0, f64::max);
+    let (last_hz, last_amplitude) = *points.last().unwrap();
+    println!(
+        "{} points, fold at {:.4} Hz ({:.4e} m), last {last_hz:.4} Hz ({last_amplitude:.4e} m)",
+        points.len(),
+        points[fold].0,
+        points[fold].1
+    );
+    // Past the fold the path runs down in frequency on the middle branch, whose amplitude rises
+    // far above any of the lower branch's (measured: 874.80 Hz, 5.08e-5 m, against 6.53e-6 m).
+    assert!(last_hz < 880.0, "{last_hz}");
+    assert!(
+        last_amplitude > 4.0 * below_fold,
+        "{last_amplitude} vs {below_fold}"
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}
+
 /// The m = +1 limit curve of `blade-pair-3d-limits.toml` used to stall at 852.78 Hz: point
 /// `left-17` slips essentially along one direction there, and its 2D march crept towards a
 /// degenerate fixed point without settling in 2000 periods (benches/README.md, "3D blade pair

@@ -21,13 +21,18 @@
 //! is kept only when a look-ahead step from it leaves that path (a sharp fold), since at a
 //! contact transition such a point can lead straight back onto the incoming branch, which the
 //! path would then retrace (and loop: back along the followed path and on again through the
-//! same corners). When neither is found the run ends with [`PathEnd::DeadEnd`] where a way
-//! back along the followed path was refused or below the highest frequency reached (the caller
-//! goes on past the highest frequency, as after a path that wandered without progress).
-//! Otherwise the path is taken on from its last point over a narrow window around the spot,
-//! with the arc-length scales of a range that narrow, and past the window with the
-//! range's again ([`Continuation::run`]); a stall inside the window ends the run with
-//! [`ContinuationError::Stalled`]. The last point is solved at exactly the end frequency. A path runs down in
+//! same corners). When neither is found the path is taken on from its last point over a
+//! narrow window around the spot, with the arc-length scales of a range that narrow, and past
+//! the window with the range's again ([`Continuation::run`]), unless the spot lies below the
+//! highest frequency reached (behind a fold), or a way back along the followed path was
+//! refused after a stretch on which the frequency turned back and forth (the path bouncing
+//! between corners of the sampled law, see `frequency_reversals`): the run then ends with
+//! [`PathEnd::DeadEnd`] (the caller goes on past the highest frequency, as after a path that
+//! wandered without progress). The points of a window taken where a way back was refused are
+//! held back from the observer until the path leaves the window. Where no window is left to try, the run ends with [`PathEnd::DeadEnd`] if a way back along
+//! the followed path was refused, and with [`ContinuationError::Stalled`] otherwise. A window
+//! taken where such a way back was refused ends the path as a dead end when one of its points
+//! lands back on the path already followed. The last point is solved at exactly the end frequency. A path runs down in
 //! frequency when the end frequency is below the start (e.g. to fill in, back toward a fold, a
 //! branch found past it).
 //!
@@ -124,6 +129,42 @@ struct NarrowPass {
     factor: f64,
     /// Index of `factor` in [`NARROW_WINDOW_FRACTIONS`].
     attempt: usize,
+}
+
+/// A narrow-window pass taken from a dead end, whose points are held back from the observer
+/// until the path leaves the window: the state of the path at the dead end (to end there, as
+/// if no window had been tried, when the window fails) and what the observer is owed.
+#[derive(Debug, Clone)]
+struct HeldBack {
+    /// Points of the path at the dead end.
+    points: usize,
+    /// Turning points of the path at the dead end.
+    turning_points: usize,
+    /// Leaps of the path at the dead end.
+    leaps: usize,
+    /// Rejected steps of the path at the dead end.
+    rejected_steps: usize,
+    /// Arc-length scales at the dead end (m).
+    x_scale: Vec<f64>,
+    /// Adaptive scale at the dead end.
+    adaptive: Option<AdaptiveScale>,
+    /// Narrow-window pass under way at the dead end.
+    narrow: Option<NarrowPass>,
+    /// Observer calls owed since the dead end, in order.
+    events: Vec<HeldEvent>,
+}
+
+/// An observer call held back (see [`HeldBack`]).
+#[derive(Debug, Clone)]
+enum HeldEvent {
+    /// [`Observer::accepted`] for the path point of this index, with this normal.
+    Accepted(usize, Vec<f64>),
+    /// [`Observer::rejected`].
+    Rejected(f64, f64, f64, NewtonFailure),
+    /// [`Observer::turning_point`].
+    TurningPoint(f64),
+    /// [`Observer::leap`].
+    Leap(f64, f64),
 }
 
 /// Groups of unknowns whose arc-length scale grows with the response along the path.
@@ -963,6 +1004,24 @@ impl Continuation {
         false
     }
 
+    /// Whether `point` lies back on the path already followed (`points`, the last
+    /// [`RETRACE_HISTORY`] of them looked at): closer to the polyline through them than
+    /// [`RETRACE_FRACTION`] of its distance from the last one, as in
+    /// [`Continuation::runs_back_along`]. A step that goes on from the last point has its
+    /// distance from the polyline equal to its distance from that point.
+    fn retraces(&self, point: &PathPoint, points: &[PathPoint]) -> bool {
+        let recent = &points[points.len().saturating_sub(RETRACE_HISTORY)..];
+        let path = self.scaled_points(recent);
+        let (Some(last), Some(q)) = (
+            path.last(),
+            self.scaled_points(std::slice::from_ref(point)).pop(),
+        ) else {
+            return false;
+        };
+        let reach = norm(&q.iter().zip(last).map(|(a, b)| a - b).collect::<Vec<_>>());
+        distance_to_polyline(&q, &path) <= RETRACE_FRACTION * reach
+    }
+
     /// The path point of a corrected y, its tangent, the distance of the correction relative
     /// to the step, and the angle (degrees) the tangent turned by over the step.
     #[allow(clippy::too_many_arguments)]
@@ -1038,10 +1097,13 @@ impl Continuation {
     /// when dω/ds changed sign from `tangent`), makes its tangent the current one and lets the
     /// scale follow the response. Returns true when the point left the range for good (the
     /// summary's end is then set).
+    /// With a window's points held back (`held`), the observer calls are kept in it instead.
+    #[allow(clippy::too_many_arguments)]
     fn accept<S: ParametricResidual, O: Observer<S>>(
         &mut self,
         system: &mut S,
         observer: &mut O,
+        held: &mut Option<HeldBack>,
         summary: &mut PathSummary,
         point: PathPoint,
         t_new: Vec<f64>,
@@ -1050,9 +1112,18 @@ impl Continuation {
         let n = t_new.len() - 1;
         if t_new[n] * tangent[n] < 0.0 {
             summary.turning_points.push(point.freq_hz());
-            observer.turning_point(point.freq_hz());
+            match held {
+                Some(h) => h.events.push(HeldEvent::TurningPoint(point.freq_hz())),
+                None => observer.turning_point(point.freq_hz()),
+            }
         }
-        observer.accepted(system, &point, Some(&self.path_normal(&t_new)));
+        let normal = self.path_normal(&t_new);
+        match held {
+            Some(h) => h
+                .events
+                .push(HeldEvent::Accepted(summary.points.len(), normal)),
+            None => observer.accepted(system, &point, Some(&normal)),
+        }
         let left = self.left_range(&point);
         *tangent = t_new;
         self.adapt_scale(&point.x, tangent);
@@ -1061,6 +1132,77 @@ impl Continuation {
             summary.end = PathEnd::LeftRangeBelow;
         }
         left
+    }
+
+    /// Starts holding back the points of a narrow window taken from a dead end: the path's
+    /// state there.
+    fn hold_back(&self, summary: &PathSummary) -> HeldBack {
+        HeldBack {
+            points: summary.points.len(),
+            turning_points: summary.turning_points.len(),
+            leaps: summary.leaps.len(),
+            rejected_steps: summary.rejected_steps,
+            x_scale: self.x_scale.clone(),
+            adaptive: self.adaptive.clone(),
+            narrow: self.narrow,
+            events: Vec::new(),
+        }
+    }
+
+    /// Drops a held-back window: the path and the scales as they were at the dead end it was
+    /// taken from, and the path ends there ([`PathEnd::DeadEnd`]), as without the window.
+    fn drop_held(&mut self, held: HeldBack, summary: &mut PathSummary) {
+        summary.points.truncate(held.points);
+        summary.turning_points.truncate(held.turning_points);
+        summary.leaps.truncate(held.leaps);
+        summary.rejected_steps = held.rejected_steps;
+        self.x_scale = held.x_scale;
+        self.adaptive = held.adaptive;
+        self.narrow = held.narrow;
+        *self.last_factor.borrow_mut() = None;
+        *self.carried.borrow_mut() = None;
+        summary.end = PathEnd::DeadEnd;
+    }
+
+    /// Hands a held-back window's observer calls over, in order, the operator evaluated at
+    /// each point again before it is reported (as [`Observer::accepted`] expects). Returns
+    /// true when such an evaluation fails: the path then ends at the last point reported, as
+    /// at a dead end (the summary's end is set).
+    fn release_or_end<S: ParametricResidual, O: Observer<S>>(
+        &mut self,
+        system: &mut S,
+        observer: &mut O,
+        held: HeldBack,
+        summary: &mut PathSummary,
+    ) -> bool {
+        let n = system.dim();
+        let mut r = vec![0.0; n];
+        let mut dr = vec![0.0; n];
+        let mut jac = system.new_jacobian();
+        for event in held.events {
+            match event {
+                HeldEvent::Accepted(index, normal) => {
+                    let Some(point) = summary.points.get(index) else {
+                        continue;
+                    };
+                    if system
+                        .residual_and_jacobian(&point.x, point.omega, &mut r, &mut jac, &mut dr)
+                        .is_err()
+                    {
+                        summary.points.truncate(index);
+                        summary.end = PathEnd::DeadEnd;
+                        return true;
+                    }
+                    observer.accepted(system, point, Some(&normal));
+                }
+                HeldEvent::Rejected(freq_hz, step, new_step, reason) => {
+                    observer.rejected(freq_hz, step, new_step, &reason)
+                }
+                HeldEvent::TurningPoint(freq_hz) => observer.turning_point(freq_hz),
+                HeldEvent::Leap(from_hz, to_hz) => observer.leap(from_hz, to_hz),
+            }
+        }
+        false
     }
 
     /// Follows the path from `x_guess` at the start frequency to the end frequency.
@@ -1093,6 +1235,11 @@ impl Continuation {
     ) -> Result<PathSummary, ContinuationError> {
         let a = self.settings;
         let mut narrow_passes = 0usize;
+        // A narrow-window pass taken where the path had met a dead end (see below): its points
+        // are held back from the observer until the path leaves the window, and dropped, the
+        // path ending at that dead end, when one lands back on the path already followed or
+        // the window fails.
+        let mut held: Option<HeldBack> = None;
         let omega_start = a.freq_start_hz * OMEGA_SCALE;
         let omega_end = a.freq_end_hz * OMEGA_SCALE;
         let n = system.dim();
@@ -1131,7 +1278,10 @@ impl Continuation {
                 });
             }
             if summary.points.len() - furthest.1 > self.stagnation_points() {
-                summary.end = PathEnd::NoProgress;
+                match held.take() {
+                    Some(h) => self.drop_held(h, &mut summary),
+                    None => summary.end = PathEnd::NoProgress,
+                }
                 return Ok(summary);
             }
             let reached = summary
@@ -1159,6 +1309,11 @@ impl Continuation {
                     .collect();
                 match self.solve_fixed(system, &guess, omega_end) {
                     Ok(mut p) => {
+                        if let Some(h) = held.take() {
+                            if self.release_or_end(system, observer, h, &mut summary) {
+                                return Ok(summary);
+                            }
+                        }
                         p.step = ds * frac;
                         observer.accepted(system, &p, None);
                         summary.points.push(p);
@@ -1167,9 +1322,21 @@ impl Continuation {
                     }
                     Err(reason) => {
                         let new_ds = ds * 0.5;
-                        observer.rejected(last.freq_hz(), ds, new_ds, &reason);
+                        match &mut held {
+                            Some(h) => h.events.push(HeldEvent::Rejected(
+                                last.freq_hz(),
+                                ds,
+                                new_ds,
+                                reason.clone(),
+                            )),
+                            None => observer.rejected(last.freq_hz(), ds, new_ds, &reason),
+                        }
                         summary.rejected_steps += 1;
                         if new_ds < a.min_step {
+                            if let Some(h) = held.take() {
+                                self.drop_held(h, &mut summary);
+                                return Ok(summary);
+                            }
                             return Err(ContinuationError::Stalled {
                                 freq_hz: last.freq_hz(),
                                 step: ds,
@@ -1209,8 +1376,28 @@ impl Continuation {
             match outcome {
                 Ok((point, t_new, degrees)) => {
                     previous_quality = None;
+                    if held.is_some()
+                        && self.narrow.is_some()
+                        && self.retraces(&point, &summary.points)
+                    {
+                        if let Some(h) = held.take() {
+                            self.drop_held(h, &mut summary);
+                            return Ok(summary);
+                        }
+                    }
                     let iterations = point.iterations;
-                    if self.accept(system, observer, &mut summary, point, t_new, &mut tangent) {
+                    if self.accept(
+                        system,
+                        observer,
+                        &mut held,
+                        &mut summary,
+                        point,
+                        t_new,
+                        &mut tangent,
+                    ) {
+                        if let Some(h) = held.take() {
+                            self.release_or_end(system, observer, h, &mut summary);
+                        }
                         return Ok(summary);
                     }
                     // The next step: shorter where Newton needed many iterations, and where
@@ -1229,7 +1416,13 @@ impl Continuation {
                     ds = (ds * factor).clamp(a.min_step, a.max_step);
                     let freq_hz = summary.points.last().map_or(f64::NAN, |p| p.freq_hz());
                     if self.past_narrow_window(freq_hz) {
-                        if let Some(from_hz) = self.leave_narrow(&mut tangent) {
+                        let left = self.leave_narrow(&mut tangent);
+                        if let Some(h) = held.take() {
+                            if self.release_or_end(system, observer, h, &mut summary) {
+                                return Ok(summary);
+                            }
+                        }
+                        if let Some(from_hz) = left {
                             observer.narrow_pass(from_hz, freq_hz);
                         }
                         ds = a.initial_step.clamp(a.min_step, a.max_step);
@@ -1237,7 +1430,15 @@ impl Continuation {
                 }
                 Err(reason) => {
                     let new_ds = ds * 0.5;
-                    observer.rejected(last.freq_hz(), ds, new_ds, &reason);
+                    match &mut held {
+                        Some(h) => h.events.push(HeldEvent::Rejected(
+                            last.freq_hz(),
+                            ds,
+                            new_ds,
+                            reason.clone(),
+                        )),
+                        None => observer.rejected(last.freq_hz(), ds, new_ds, &reason),
+                    }
                     summary.rejected_steps += 1;
                     if new_ds < a.min_step {
                         // The path cannot be followed through this spot (Newton cycles between
@@ -1259,23 +1460,18 @@ impl Continuation {
                                 let leapt =
                                     self.leap(system, &y, &tangent, recent, &mut refused_retrace)?;
                                 if let Some((point, _)) = &leapt {
-                                    observer.leap(from, point.freq_hz());
+                                    match &mut held {
+                                        Some(h) => {
+                                            h.events.push(HeldEvent::Leap(from, point.freq_hz()))
+                                        }
+                                        None => observer.leap(from, point.freq_hz()),
+                                    }
                                     summary.leaps.push((from, point.freq_hz()));
                                 }
                                 leapt
                             }
                         };
                         let Some((point, t_new)) = resumed else {
-                            // Where the only way on found was back along the path already
-                            // followed (refused: the path would retrace itself and loop through
-                            // the same corners until `stagnation_points` ended it), or behind
-                            // the highest frequency reached (the path turned back at a fold),
-                            // the path ends for the caller to go on past the highest frequency
-                            // reached, as it would after that loop. Otherwise it is a stall.
-                            if refused_retrace || dir * from < furthest.0 - a.min_step {
-                                summary.end = PathEnd::DeadEnd;
-                                return Ok(summary);
-                            }
                             // The next window: the first for a new stall, the next width for
                             // one inside a window.
                             let next = match self.narrow {
@@ -1283,15 +1479,50 @@ impl Continuation {
                                 Some(pass) => Some(pass.attempt + 1)
                                     .filter(|&k| k < NARROW_WINDOW_FRACTIONS.len()),
                             };
+                            // Where the only way on found was back along the path already
+                            // followed (refused: the path would retrace itself and loop through
+                            // the same corners until `stagnation_points` ended it), or behind
+                            // the highest frequency reached (the path turned back at a fold),
+                            // the spot is a dead end: the path ends for the caller to go on
+                            // past the highest frequency reached, as it would after that loop.
+                            // At the highest frequency reached, where the path came to the
+                            // spot monotone in frequency over its last RETRACE_HISTORY points
+                            // (a single transition met head-on), the narrow windows are tried
+                            // first (on the 3D blade pair they pass such a spot at 886.685 Hz
+                            // onto the middle branch), their points held back until the path
+                            // leaves the window; a point of theirs that lands back on the path
+                            // already followed, or a window that fails, drops them and ends
+                            // the path at the dead end, as without the windows. Where the
+                            // frequency turned back and forth among those points, the path is
+                            // bouncing between corners of the sampled law (the loop the dead
+                            // end is there to end) and ends there without windows (see
+                            // `frequency_reversals`). Otherwise it is a stall.
+                            let behind = dir * from < furthest.0 - a.min_step;
+                            let dead_end = refused_retrace || behind;
+                            let bouncing = held.is_none() && frequency_reversals(recent) > 0;
+                            if dead_end && (behind || next.is_none() || bouncing) {
+                                match held.take() {
+                                    Some(h) => self.drop_held(h, &mut summary),
+                                    None => summary.end = PathEnd::DeadEnd,
+                                }
+                                return Ok(summary);
+                            }
                             if let Some(attempt) = next {
                                 if attempt == 0 {
                                     narrow_passes += 1;
+                                }
+                                if dead_end && held.is_none() {
+                                    held = Some(self.hold_back(&summary));
                                 }
                                 let stalled = self.leave_narrow(&mut tangent).unwrap_or(from);
                                 self.enter_narrow(from, stalled, attempt, &mut tangent);
                                 ds = a.initial_step.clamp(a.min_step, a.max_step);
                                 previous_quality = None;
                                 continue;
+                            }
+                            if let Some(h) = held.take() {
+                                self.drop_held(h, &mut summary);
+                                return Ok(summary);
                             }
                             return Err(ContinuationError::Stalled {
                                 freq_hz: from,
@@ -1300,12 +1531,38 @@ impl Continuation {
                             });
                         };
                         previous_quality = None;
+                        if held.is_some()
+                            && self.narrow.is_some()
+                            && self.retraces(&point, &summary.points)
+                        {
+                            if let Some(h) = held.take() {
+                                self.drop_held(h, &mut summary);
+                                return Ok(summary);
+                            }
+                        }
                         let freq_hz = point.freq_hz();
-                        if self.accept(system, observer, &mut summary, point, t_new, &mut tangent) {
+                        if self.accept(
+                            system,
+                            observer,
+                            &mut held,
+                            &mut summary,
+                            point,
+                            t_new,
+                            &mut tangent,
+                        ) {
+                            if let Some(h) = held.take() {
+                                self.release_or_end(system, observer, h, &mut summary);
+                            }
                             return Ok(summary);
                         }
                         if self.past_narrow_window(freq_hz) {
-                            if let Some(from_hz) = self.leave_narrow(&mut tangent) {
+                            let left = self.leave_narrow(&mut tangent);
+                            if let Some(h) = held.take() {
+                                if self.release_or_end(system, observer, h, &mut summary) {
+                                    return Ok(summary);
+                                }
+                            }
+                            if let Some(from_hz) = left {
                                 observer.narrow_pass(from_hz, freq_hz);
                             }
                         }
@@ -1316,9 +1573,44 @@ impl Continuation {
                 }
             }
         }
-        summary.end = PathEnd::MaxPoints;
+        match held.take() {
+            Some(h) => self.drop_held(h, &mut summary),
+            None => summary.end = PathEnd::MaxPoints,
+        }
         Ok(summary)
     }
+}
+
+/// How many times the frequency of consecutive `points` changes direction (steps that leave
+/// the frequency unchanged are skipped): 0 on a stretch monotone in frequency.
+///
+/// Decides whether a dead end at the highest frequency reached gets the narrow windows (see
+/// [`Continuation::run`]): only with no reversal among the last [`RETRACE_HISTORY`] points.
+/// Why, measured (benches/README.md, "Narrow windows at dead ends"): the 3D blade pair's dead
+/// end at 886.6853 Hz (840-900 Hz and 884-944 Hz) is met on a stretch rising monotonically from
+/// 884 Hz (0 reversals), and a window passes it onto the middle branch of the bending pair's
+/// resonance. The paper's system at F0 = 1 N meets its dead end at 151.8405 Hz after bouncing
+/// between corners of the sampled law (6 reversals in the last 64 points, turning points every
+/// 0.03-0.1 Hz over 147.7-151.8 Hz); a window there stepped over the turning points the run
+/// finds at 152.1-153.1 Hz (151.84 → 152.42 → 153.88 Hz in two points), and the path beyond was
+/// not the one the run follows with the jump past the dead end (it ended at a dead end at
+/// 241.65 Hz that Newton cannot go past). The stall signature does not tell the two apart:
+/// at both the corrector's residual after 12 iterations falls in proportion to the step over the
+/// halvings (a kink), and the corner search ends on a point leading back onto the path.
+fn frequency_reversals(points: &[PathPoint]) -> usize {
+    let mut last_sign = 0.0;
+    let mut count = 0;
+    for pair in points.windows(2) {
+        let sign = (pair[1].omega - pair[0].omega).signum();
+        if pair[1].omega == pair[0].omega {
+            continue;
+        }
+        if last_sign != 0.0 && sign != last_sign {
+            count += 1;
+        }
+        last_sign = sign;
+    }
+    count
 }
 
 /// Euclidean distance from `q` to the polyline through `points` (to the point itself when
@@ -1632,6 +1924,28 @@ mod tests {
     /// followed lies ends the path as [`PathEnd::DeadEnd`] (for the FRF to go on past the
     /// fold), not as a stall: the path rises to the fold, turns once and runs down to the dead
     /// end at 10 Hz, never back up along itself, every point on the path.
+    /// The reversals that keep the narrow windows from a dead end: none on a monotone stretch
+    /// (steps at an unchanged frequency, e.g. a creep toward a kink, skipped), one per change
+    /// of direction on a stretch bouncing between corners.
+    #[test]
+    fn frequency_reversals_count_the_changes_of_direction() {
+        let at = |hz: &[f64]| -> Vec<PathPoint> {
+            hz.iter()
+                .map(|&f| PathPoint {
+                    omega: f * OMEGA_SCALE,
+                    x: vec![0.0],
+                    iterations: 1,
+                    residual: 0.0,
+                    step: 0.0,
+                })
+                .collect()
+        };
+        assert_eq!(frequency_reversals(&at(&[])), 0);
+        assert_eq!(frequency_reversals(&at(&[1.0, 2.0, 2.0, 2.0, 3.0])), 0);
+        assert_eq!(frequency_reversals(&at(&[3.0, 2.0, 1.0])), 0);
+        assert_eq!(frequency_reversals(&at(&[1.0, 2.0, 2.0, 1.5, 1.7, 1.6])), 3);
+    }
+
     #[test]
     fn a_dead_end_behind_a_fold_ends_the_path_for_the_caller_to_jump() {
         let mut points = Vec::new();
