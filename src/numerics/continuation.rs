@@ -1149,6 +1149,37 @@ impl Continuation {
         }
     }
 
+    /// Takes a converged point onto the path. A point of a held-back window that lands back on
+    /// the path already followed drops the window ([`Self::drop_held`]: the path ends at the
+    /// dead end the window was taken from); any other point is accepted ([`Self::accept`]),
+    /// and when that ends the path a held-back window is released or dropped
+    /// ([`Self::release_or_end`]). True when the path ends here.
+    #[allow(clippy::too_many_arguments)]
+    fn take_point<S: ParametricResidual, O: Observer<S>>(
+        &mut self,
+        system: &mut S,
+        observer: &mut O,
+        held: &mut Option<HeldBack>,
+        summary: &mut PathSummary,
+        point: PathPoint,
+        t_new: Vec<f64>,
+        tangent: &mut Vec<f64>,
+    ) -> bool {
+        if held.is_some() && self.narrow.is_some() && self.retraces(&point, &summary.points) {
+            if let Some(h) = held.take() {
+                self.drop_held(h, summary);
+                return true;
+            }
+        }
+        if self.accept(system, observer, held, summary, point, t_new, tangent) {
+            if let Some(h) = held.take() {
+                self.release_or_end(system, observer, h, summary);
+            }
+            return true;
+        }
+        false
+    }
+
     /// Drops a held-back window: the path and the scales as they were at the dead end it was
     /// taken from, and the path ends there ([`PathEnd::DeadEnd`]), as without the window.
     fn drop_held(&mut self, held: HeldBack, summary: &mut PathSummary) {
@@ -1376,17 +1407,8 @@ impl Continuation {
             match outcome {
                 Ok((point, t_new, degrees)) => {
                     previous_quality = None;
-                    if held.is_some()
-                        && self.narrow.is_some()
-                        && self.retraces(&point, &summary.points)
-                    {
-                        if let Some(h) = held.take() {
-                            self.drop_held(h, &mut summary);
-                            return Ok(summary);
-                        }
-                    }
                     let iterations = point.iterations;
-                    if self.accept(
+                    if self.take_point(
                         system,
                         observer,
                         &mut held,
@@ -1395,9 +1417,6 @@ impl Continuation {
                         t_new,
                         &mut tangent,
                     ) {
-                        if let Some(h) = held.take() {
-                            self.release_or_end(system, observer, h, &mut summary);
-                        }
                         return Ok(summary);
                     }
                     // The next step: shorter where Newton needed many iterations, and where
@@ -1531,17 +1550,8 @@ impl Continuation {
                             });
                         };
                         previous_quality = None;
-                        if held.is_some()
-                            && self.narrow.is_some()
-                            && self.retraces(&point, &summary.points)
-                        {
-                            if let Some(h) = held.take() {
-                                self.drop_held(h, &mut summary);
-                                return Ok(summary);
-                            }
-                        }
                         let freq_hz = point.freq_hz();
-                        if self.accept(
+                        if self.take_point(
                             system,
                             observer,
                             &mut held,
@@ -1550,9 +1560,6 @@ impl Continuation {
                             t_new,
                             &mut tangent,
                         ) {
-                            if let Some(h) = held.take() {
-                                self.release_or_end(system, observer, h, &mut summary);
-                            }
                             return Ok(summary);
                         }
                         if self.past_narrow_window(freq_hz) {
