@@ -245,27 +245,28 @@ fn cuts_of_fills_and_bridges_are_judged_by_newton_past_them() {
                 .expect("the cut point is on its branch");
             // Just past the cut: within 10⁻³ of its frequency.
             assert!(
-                (check.freq_hz - cut.freq_hz).abs() <= 1e-3 * cut.freq_hz * (1.0 + 1e-12)
-                    && check.freq_hz != cut.freq_hz,
+                (check.landing.freq_hz - cut.freq_hz).abs() <= 1e-3 * cut.freq_hz * (1.0 + 1e-12)
+                    && check.landing.freq_hz != cut.freq_hz,
                 "{check:?}"
             );
             match (
                 check.verdict,
-                solver.solve(&point.coefficients, check.freq_hz),
+                solver.solve(&point.coefficients, check.landing.freq_hz),
             ) {
                 (CutVerdict::Unjudged, landing) => assert!(landing.is_err(), "{landing:?}"),
                 (verdict, Ok(q)) => {
                     let a = q.amplitudes[0];
-                    let judged = check.amplitude.expect("a landing");
+                    let judged = check.landing.amplitude.expect("a landing");
                     assert!((a - judged).abs() <= 1e-6 * judged, "{a} vs {judged}");
-                    let crossings = run.crossings(check.freq_hz, 0);
+                    let crossings = run.crossings(check.landing.freq_hz, 0);
                     let near_first = crossings
                         .iter()
                         .any(|c| (c.amplitude - a).abs() <= 1e-2 * a);
                     let near_all = crossings.iter().any(|c| {
                         (0..q.amplitudes.len()).all(|o| {
                             let s = &run.points[c.segment..=c.segment + 1];
-                            let t = (check.freq_hz - s[0].freq_hz) / (s[1].freq_hz - s[0].freq_hz);
+                            let t = (check.landing.freq_hz - s[0].freq_hz)
+                                / (s[1].freq_hz - s[0].freq_hz);
                             let on =
                                 s[0].amplitudes[o] + t * (s[1].amplitudes[o] - s[0].amplitudes[o]);
                             (on - q.amplitudes[o]).abs() <= 1e-2 * q.amplitudes[o]
@@ -279,18 +280,18 @@ fn cuts_of_fills_and_bridges_are_judged_by_newton_past_them() {
                         // The landing is the cut's own side: judged past its fold.
                         (_, Some(fold)) => {
                             assert!(near_first, "{crossings:?}");
-                            let judged = fold.amplitude.expect("a landing past the fold");
+                            let judged = fold.landing.amplitude.expect("a landing past the fold");
                             let at_fold = run.points[jump.first_point..end]
                                 .iter()
                                 .find(|q| q.freq_hz == fold.fold_hz)
                                 .expect("the fold is on the cut's branch");
                             let q = solver
-                                .solve(&at_fold.coefficients, fold.freq_hz)
+                                .solve(&at_fold.coefficients, fold.landing.freq_hz)
                                 .expect("Newton past the fold");
                             let b = q.amplitudes[0];
                             assert!((b - judged).abs() <= 1e-6 * judged, "{b} vs {judged}");
                             let largest = run
-                                .crossings(fold.freq_hz, 0)
+                                .crossings(fold.landing.freq_hz, 0)
                                 .iter()
                                 .map(|c| c.amplitude)
                                 .fold(f64::NEG_INFINITY, f64::max);
@@ -328,6 +329,7 @@ fn cuts_of_fills_and_bridges_are_judged_by_newton_past_them() {
                 && check.beyond_fold.is_some_and(|fold| {
                     fold.verdict == CutVerdict::Covered
                         && fold
+                            .landing
                             .amplitude
                             .zip(fold.run_amplitude)
                             .is_some_and(|(a, r)| a < r)

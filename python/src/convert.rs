@@ -322,14 +322,15 @@ pub fn frf_dict<'py>(
                     fricbound::analysis::frf::CutVerdict::Unjudged => "unjudged",
                 }),
             )?;
-            jd.set_item(format!("{prefix}cut_check_hz"), check.map(|c| c.freq_hz))?;
+            let landing = check.map(|c| &c.landing);
+            jd.set_item(format!("{prefix}cut_check_hz"), landing.map(|l| l.freq_hz))?;
             jd.set_item(
                 format!("{prefix}cut_check_amplitude"),
-                check.and_then(|c| c.amplitude),
+                landing.and_then(|l| l.amplitude),
             )?;
             jd.set_item(
                 format!("{prefix}cut_check_distance"),
-                check.and_then(|c| c.distance),
+                landing.and_then(|l| l.distance),
             )?;
             jd.set_item(
                 format!("{prefix}cut_check_own_side"),
@@ -337,7 +338,7 @@ pub fn frf_dict<'py>(
             )?;
             jd.set_item(
                 format!("{prefix}cut_check_resolved_distance"),
-                check.and_then(|c| c.resolved_distance),
+                landing.and_then(|l| l.resolved_distance),
             )?;
             let fold = check.and_then(|c| c.beyond_fold.as_ref());
             jd.set_item(
@@ -346,7 +347,7 @@ pub fn frf_dict<'py>(
             )?;
             jd.set_item(
                 format!("{prefix}cut_check_beyond_fold_amplitude"),
-                fold.and_then(|f| f.amplitude),
+                fold.and_then(|f| f.landing.amplitude),
             )?;
             jd.set_item(
                 format!("{prefix}cut_check_beyond_fold_run_amplitude"),

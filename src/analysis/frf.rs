@@ -110,31 +110,19 @@ pub struct Jump {
 /// whether the landing is that crossing's solution (`cut_check` in `solution.json`'s jumps).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct CutCheck {
-    /// Frequency of the last solve tried, the converged one if any (Hz).
-    pub freq_hz: f64,
-    /// First output's first-harmonic amplitude where Newton landed (m); None when no solve
-    /// converged.
-    pub amplitude: Option<f64>,
-    /// ‖c − c_run‖ / ‖c‖ over all Fourier coefficients between the landing c and the crossing
-    /// c_run of its frequency by the run (linear along a segment within a branch) that the
-    /// verdict rests on: the one Newton found the landing on when covered, else the nearest;
-    /// None without a landing or a crossing.
-    pub distance: Option<f64>,
-    /// Whether that crossing lies on the cut's own branch, on the stretch into the cut or the
-    /// other side of the fold before it: next to a fold the two sides lie within
-    /// [`RETRACE_TOLERANCE`] of each other, and only Newton from that side
-    /// ([`CutCheck::resolved_distance`]) tells whether the landing is on it (see
+    /// Where Newton landed just past the cut and how that landing compares with the run
+    /// (flattened into `cut_check` in `solution.json`).
+    #[serde(flatten)]
+    pub landing: Landing,
+    /// Whether the crossing of [`Landing::distance`] lies on the cut's own branch, on the
+    /// stretch into the cut or the other side of the fold before it: next to a fold the two
+    /// sides lie within [`RETRACE_TOLERANCE`] of each other, and only Newton from that side
+    /// ([`Landing::resolved_distance`]) tells whether the landing is on it (see
     /// [`judge_cuts`]).
     pub own_side: bool,
     /// Newton iterations of the converged solve (0 without one): with the solves that did
     /// not converge (at most five in all, see [`judge_cuts`]), the judgement's cost.
     pub newton_iterations: usize,
-    /// ‖c − c_N‖ / ‖c‖ between the landing c and Newton's solution c_N at the landing's
-    /// frequency started from the crossing of [`CutCheck::distance`] (see [`judge_cuts`]): at
-    /// most [`SAME_SOLUTION_TOLERANCE`], the landing is that stretch's solution (covered);
-    /// above, it is another solution. None when no crossing lies within
-    /// [`RETRACE_TOLERANCE`] of the landing, or Newton from it converged nowhere.
-    pub resolved_distance: Option<f64>,
     /// When the landing is the cut's own other side ([`CutCheck::own_side`], the same
     /// solution: the stretch came back along the side it had followed into its fold, so the
     /// path reversed there on one solution curve), the same judgement past that fold, the way
@@ -145,6 +133,41 @@ pub struct CutCheck {
     pub verdict: CutVerdict,
 }
 
+/// A Newton landing at a fixed frequency past a point of the run (a cut, or the fold of a cut
+/// stretch, see [`judge_cuts`]), compared with the run: the fields shared by [`CutCheck`] and
+/// [`FoldCheck`].
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Landing {
+    /// Frequency of the last solve tried, the converged one if any (Hz).
+    pub freq_hz: f64,
+    /// First output's first-harmonic amplitude where Newton landed (m); None when no solve
+    /// converged.
+    pub amplitude: Option<f64>,
+    /// ‖c − c_run‖ / ‖c‖ over all Fourier coefficients between the landing c and the crossing
+    /// c_run of its frequency by the run (linear along a segment within a branch) that the
+    /// verdict rests on: the one Newton found the landing on when covered, else the nearest;
+    /// None without a landing or a crossing.
+    pub distance: Option<f64>,
+    /// ‖c − c_N‖ / ‖c‖ between the landing c and Newton's solution c_N at the landing's
+    /// frequency started from the crossing of [`Landing::distance`] (see [`judge_cuts`]): at
+    /// most [`SAME_SOLUTION_TOLERANCE`], the landing is that stretch's solution (covered);
+    /// above, it is another solution. None when no crossing lies within
+    /// [`RETRACE_TOLERANCE`] of the landing, or Newton from it converged nowhere.
+    pub resolved_distance: Option<f64>,
+}
+
+impl Landing {
+    /// No solve converged; `freq_hz` (Hz) is the frequency of the last one tried.
+    fn nowhere(freq_hz: f64) -> Self {
+        Self {
+            freq_hz,
+            amplitude: None,
+            distance: None,
+            resolved_distance: None,
+        }
+    }
+}
+
 /// The judgement past the fold of a cut stretch that came back along its own other side
 /// ([`CutCheck::beyond_fold`]): Newton past the fold, from the fold point's coefficients, at
 /// the offsets of [`judge_cuts`], compared with the run as the landing past the cut is.
@@ -152,17 +175,12 @@ pub struct CutCheck {
 pub struct FoldCheck {
     /// Frequency of the fold: the turning point of the cut's stretch (Hz).
     pub fold_hz: f64,
-    /// Frequency of the last solve tried past it, the converged one if any (Hz).
-    pub freq_hz: f64,
-    /// First output's first-harmonic amplitude where Newton landed (m); None when no solve
-    /// converged.
-    pub amplitude: Option<f64>,
-    /// As [`CutCheck::distance`], for this landing.
-    pub distance: Option<f64>,
-    /// As [`CutCheck::resolved_distance`], for this landing.
-    pub resolved_distance: Option<f64>,
-    /// The largest first-output amplitude of the run where it crosses `freq_hz` (m); None when
-    /// it does not.
+    /// Where Newton landed past the fold and how that landing compares with the run
+    /// (flattened into `beyond_fold` in `solution.json`).
+    #[serde(flatten)]
+    pub landing: Landing,
+    /// The largest first-output amplitude of the run where it crosses the landing's
+    /// frequency [`Landing::freq_hz`] (m); None when it does not.
     pub run_amplitude: Option<f64>,
     /// `covered` when Newton from a stretch of the run finds the landing, or when the landing
     /// lies below the run's largest amplitude there (a lower branch beside the response the
@@ -209,20 +227,21 @@ impl CutCheck {
     /// lines and messages.
     pub fn describe(&self) -> String {
         let Some(a) = self
+            .landing
             .amplitude
             .filter(|_| self.verdict != CutVerdict::Unjudged || self.beyond_fold.is_some())
         else {
             return format!(
                 "Newton just past the cut converged at none of the frequencies tried (the last \
                  {:.4} Hz): whether the branch goes on there is not known",
-                self.freq_hz
+                self.landing.freq_hz
             );
         };
         let landing = format!(
             "Newton just past the cut, at {:.4} Hz, lands at {a:.3e} m (first output)",
-            self.freq_hz
+            self.landing.freq_hz
         );
-        let Some(d) = self.distance else {
+        let Some(d) = self.landing.distance else {
             return format!(
                 "{landing}; no stretch of the run crosses that frequency: on no branch of the run"
             );
@@ -237,29 +256,30 @@ impl CutCheck {
              checked, {stretch}",
             100.0 * d
         );
-        if let (Some(fold), Some(r)) = (&self.beyond_fold, self.resolved_distance) {
+        if let (Some(fold), Some(r)) = (&self.beyond_fold, self.landing.resolved_distance) {
             let back = format!(
                 "{place}, and Newton from that side at the same frequency converges to the \
                  landing ({r:.1e} apart): the stretch came back along the side it had followed \
                  into its fold at {:.4} Hz, so the branch goes on beyond that fold",
                 fold.fold_hz
             );
-            let Some(b) = fold.amplitude else {
+            let Some(b) = fold.landing.amplitude else {
                 return format!(
                     "{back}; Newton past the fold converged at none of the frequencies tried \
                      (the last {:.4} Hz): whether the response there is on the run is not known",
-                    fold.freq_hz
+                    fold.landing.freq_hz
                 );
             };
             let past = format!(
                 "{back}; Newton past the fold, at {:.4} Hz, lands at {b:.3e} m",
-                fold.freq_hz
+                fold.landing.freq_hz
             );
             let run = fold.run_amplitude.map_or(
                 "no stretch of the run crosses that frequency".to_string(),
                 |m| format!("the run's largest amplitude there is {m:.3e} m"),
             );
             let on_run = fold
+                .landing
                 .resolved_distance
                 .is_some_and(|d| d <= SAME_SOLUTION_TOLERANCE);
             return match fold.verdict {
@@ -276,7 +296,7 @@ impl CutCheck {
                 ),
             };
         }
-        match (self.verdict, self.resolved_distance) {
+        match (self.verdict, self.landing.resolved_distance) {
             (CutVerdict::Covered, Some(r)) => format!(
                 "{place}, and Newton from that stretch at the same frequency converges to the \
                  landing ({r:.1e} apart): covered"
@@ -441,7 +461,7 @@ impl GiveUpCause {
 pub const RETRACE_TOLERANCE: f64 = 1e-2;
 
 /// Relative distance ‖c − c'‖ / ‖c‖ over all Fourier coefficients within which two solutions
-/// converged by Newton at one frequency are the same solution ([`CutCheck::resolved_distance`]).
+/// converged by Newton at one frequency are the same solution ([`Landing::resolved_distance`]).
 /// Measured: the same solution reached from two starts differs by 3·10⁻¹⁶ to 5·10⁻¹⁴ on the
 /// paper's system at F0 = 1 and 5 N, and by 5·10⁻¹¹ to 4.5·10⁻¹⁰ on the 3D blade pair (schur);
 /// the two sides of a fold of the paper's system at F0 = 1 N one step out of it differ by
@@ -1574,12 +1594,9 @@ fn judge_cut(
     cut: &GivenUp,
 ) -> CutCheck {
     let unjudged = |freq_hz: f64, newton_iterations: usize| CutCheck {
-        freq_hz,
-        amplitude: None,
-        distance: None,
+        landing: Landing::nowhere(freq_hz),
         own_side: false,
         newton_iterations,
-        resolved_distance: None,
         beyond_fold: None,
         verdict: CutVerdict::Unjudged,
     };
@@ -1689,12 +1706,9 @@ fn judge_cut(
         (None, false) => CutVerdict::Abandoned,
     };
     CutCheck {
-        freq_hz,
-        amplitude: Some(landing.amplitudes.first().copied().unwrap_or(f64::NAN)),
-        distance: compared.distance,
+        landing: compared.landing,
         own_side: compared.own_side,
         newton_iterations: landing.newton_iterations,
-        resolved_distance: compared.resolved_distance,
         beyond_fold,
         verdict,
     }
@@ -1749,27 +1763,21 @@ fn judge_beyond_fold(
     let Some(landing) = landing else {
         return FoldCheck {
             fold_hz,
-            freq_hz,
-            amplitude: None,
-            distance: None,
-            resolved_distance: None,
+            landing: Landing::nowhere(freq_hz),
             run_amplitude: None,
             verdict: CutVerdict::Unjudged,
         };
     };
     let compared = compare_with_run(system, newton, points, starts, own, &landing);
-    let amplitude = landing.amplitudes.first().copied().unwrap_or(f64::NAN);
+    let below_run = |run: f64| compared.landing.amplitude.is_some_and(|a| a <= run);
     let verdict = match compared.run_amplitude {
         _ if compared.covered => CutVerdict::Covered,
-        Some(run) if amplitude <= run => CutVerdict::Covered,
+        Some(run) if below_run(run) => CutVerdict::Covered,
         _ => CutVerdict::Abandoned,
     };
     FoldCheck {
         fold_hz,
-        freq_hz,
-        amplitude: Some(amplitude),
-        distance: compared.distance,
-        resolved_distance: compared.resolved_distance,
+        landing: compared.landing,
         run_amplitude: compared.run_amplitude,
         verdict,
     }
@@ -1777,12 +1785,11 @@ fn judge_beyond_fold(
 
 /// How a landing compares with the run ([`compare_with_run`]).
 struct Comparison {
-    /// [`CutCheck::distance`].
-    distance: Option<f64>,
+    /// The landing, at its frequency, with [`Landing::distance`] and
+    /// [`Landing::resolved_distance`] from this comparison.
+    landing: Landing,
     /// [`CutCheck::own_side`].
     own_side: bool,
-    /// [`CutCheck::resolved_distance`].
-    resolved_distance: Option<f64>,
     /// Whether Newton from a crossing within [`RETRACE_TOLERANCE`] found the landing.
     covered: bool,
     /// The largest first-output amplitude of the run's crossings of the landing's frequency
@@ -1853,9 +1860,13 @@ fn compare_with_run(
     }
     let shown = resolved.map(|(c, _)| c).or(crossings.first());
     Comparison {
-        distance: shown.map(|c| c.distance),
+        landing: Landing {
+            freq_hz,
+            amplitude: Some(landing.amplitudes.first().copied().unwrap_or(f64::NAN)),
+            distance: shown.map(|c| c.distance),
+            resolved_distance: resolved.and_then(|(_, d)| d),
+        },
         own_side: shown.is_some_and(|c| c.own_side),
-        resolved_distance: resolved.and_then(|(_, d)| d),
         covered,
         run_amplitude,
     }
@@ -2749,12 +2760,14 @@ mod tests {
         // Judged covered: still complete; judged abandoned or unjudged: incomplete, and the
         // status says where and what Newton found.
         let check = CutCheck {
-            freq_hz: 110.01,
-            amplitude: Some(3.6),
-            distance: Some(2e-3),
+            landing: Landing {
+                freq_hz: 110.01,
+                amplitude: Some(3.6),
+                distance: Some(2e-3),
+                resolved_distance: Some(1e-9),
+            },
             own_side: false,
             newton_iterations: 3,
-            resolved_distance: Some(1e-9),
             beyond_fold: None,
             verdict: CutVerdict::Covered,
         };
@@ -2762,8 +2775,11 @@ mod tests {
         assert!(run.is_complete(), "{:?}", run.incomplete_reason());
         assert!(!run.jumps[0].abandons_branch());
         run.jumps[0].cut_check = Some(CutCheck {
-            distance: Some(0.4),
-            resolved_distance: None,
+            landing: Landing {
+                distance: Some(0.4),
+                resolved_distance: None,
+                ..check.landing
+            },
             verdict: CutVerdict::Abandoned,
             ..check
         });
@@ -2780,8 +2796,11 @@ mod tests {
         assert_eq!(json["cut_check"]["verdict"], "abandoned");
         assert_eq!(json["cut_check"]["freq_hz"], 110.01);
         run.jumps[0].cut_check = Some(CutCheck {
-            amplitude: None,
-            distance: None,
+            landing: Landing {
+                amplitude: None,
+                distance: None,
+                ..check.landing
+            },
             newton_iterations: 0,
             verdict: CutVerdict::Unjudged,
             ..check
@@ -2916,20 +2935,22 @@ mod tests {
         assert_eq!(bridge_cuts([None, cuts[1]]), (cuts[1], None));
         assert_eq!(bridge_cuts([cuts[0], None]), (cuts[0], None));
         let covered = CutCheck {
-            freq_hz: 104.9,
-            amplitude: Some(3.41),
-            distance: Some(1e-4),
+            landing: Landing {
+                freq_hz: 104.9,
+                amplitude: Some(3.41),
+                distance: Some(1e-4),
+                resolved_distance: Some(1e-12),
+            },
             own_side: false,
             newton_iterations: 2,
-            resolved_distance: Some(1e-12),
             beyond_fold: None,
             verdict: CutVerdict::Covered,
         };
         let abandoned = CutCheck {
-            freq_hz: 108.6,
-            amplitude: Some(3.11),
-            distance: None,
-            resolved_distance: None,
+            landing: Landing {
+                amplitude: Some(3.11),
+                ..Landing::nowhere(108.6)
+            },
             verdict: CutVerdict::Abandoned,
             ..covered
         };
@@ -3026,7 +3047,7 @@ mod tests {
                 cause: GiveUpCause::FillEnd,
             };
             let alone = judge_cut(&mut system, &newton, &stretch, &[], 0..stretch.len(), &cut);
-            let (Some(d), true) = (alone.distance, alone.own_side) else {
+            let (Some(d), true) = (alone.landing.distance, alone.own_side) else {
                 continue;
             };
             if d > RETRACE_TOLERANCE || alone.verdict == CutVerdict::Unjudged {
@@ -3048,21 +3069,24 @@ mod tests {
                  {beyond:?}",
                 p[k].freq_hz, cut.freq_hz
             );
-            assert_eq!(beyond.freq_hz, alone.freq_hz);
+            assert_eq!(beyond.landing.freq_hz, alone.landing.freq_hz);
             if beyond.verdict != CutVerdict::Covered || beyond.own_side {
                 // The run's branch beyond the cut does not cross the landing's frequency.
                 continue;
             }
-            assert!(beyond.resolved_distance.unwrap() <= SAME_SOLUTION_TOLERANCE);
+            assert!(beyond.landing.resolved_distance.unwrap() <= SAME_SOLUTION_TOLERANCE);
             // Where Newton from the other side finds the landing itself, the stretch came
             // back along that side (a reversal on one solution curve, a corner of the sampled
             // law): judged beyond the fold instead. Elsewhere the two sides are two solutions.
             if alone.beyond_fold.is_some() {
-                assert!(alone.resolved_distance.unwrap() <= SAME_SOLUTION_TOLERANCE);
+                assert!(alone.landing.resolved_distance.unwrap() <= SAME_SOLUTION_TOLERANCE);
                 continue;
             }
             assert_eq!(alone.verdict, CutVerdict::Abandoned, "{alone:?}");
-            let apart = alone.resolved_distance.expect("Newton from the other side");
+            let apart = alone
+                .landing
+                .resolved_distance
+                .expect("Newton from the other side");
             assert!(apart > SAME_SOLUTION_TOLERANCE, "{alone:?}");
             let words = alone.describe();
             assert!(words.contains("beyond the fold"), "{words}");
@@ -3111,9 +3135,12 @@ mod tests {
         let alone = judge_cut(&mut system, &newton, &back, &[], 0..back.len(), &cut);
         eprintln!("stretch from {:.4} Hz: {alone:?}", p[a].freq_hz);
         assert!(alone.own_side, "{alone:?}");
-        assert!(alone.distance.unwrap() <= RETRACE_TOLERANCE, "{alone:?}");
         assert!(
-            alone.resolved_distance.unwrap() <= SAME_SOLUTION_TOLERANCE,
+            alone.landing.distance.unwrap() <= RETRACE_TOLERANCE,
+            "{alone:?}"
+        );
+        assert!(
+            alone.landing.resolved_distance.unwrap() <= SAME_SOLUTION_TOLERANCE,
             "{alone:?}"
         );
         let fold = alone.beyond_fold.expect("judged beyond the fold");
@@ -3138,7 +3165,7 @@ mod tests {
         eprintln!("with the points beyond: {beyond:?}");
         let fold = beyond.beyond_fold.expect("judged beyond the fold");
         assert!(
-            fold.resolved_distance.unwrap() <= SAME_SOLUTION_TOLERANCE,
+            fold.landing.resolved_distance.unwrap() <= SAME_SOLUTION_TOLERANCE,
             "{fold:?}"
         );
         assert_eq!(beyond.verdict, CutVerdict::Covered, "{beyond:?}");
