@@ -21,18 +21,19 @@
 //! is kept only when a look-ahead step from it leaves that path (a sharp fold), since at a
 //! contact transition such a point can lead straight back onto the incoming branch, which the
 //! path would then retrace (and loop: back along the followed path and on again through the
-//! same corners). When neither is found the path is taken on from its last point over a
+//! same corners). When neither is found, the path is taken on from its last point over a
 //! narrow window around the spot, with the arc-length scales of a range that narrow, and past
-//! the window with the range's again ([`Continuation::run`]), unless the spot lies below the
-//! highest frequency reached (behind a fold), or a way back along the followed path was
-//! refused after a stretch on which the frequency turned back and forth (the path bouncing
-//! between corners of the sampled law, see `frequency_reversals`): the run then ends with
-//! [`PathEnd::DeadEnd`] (the caller goes on past the highest frequency, as after a path that
-//! wandered without progress). The points of a window taken where a way back was refused are
-//! held back from the observer until the path leaves the window. Where no window is left to try, the run ends with [`PathEnd::DeadEnd`] if a way back along
-//! the followed path was refused, and with [`ContinuationError::Stalled`] otherwise. A window
-//! taken where such a way back was refused ends the path as a dead end when one of its points
-//! lands back on the path already followed. The last point is solved at exactly the end frequency. A path runs down in
+//! the window with the range's again ([`Continuation::run`]). The spot is instead a *dead
+//! end*, where the run ends with [`PathEnd::DeadEnd`] for the caller to go on past the highest
+//! frequency reached (as after a path that wandered without progress), when it lies below that
+//! frequency (behind a fold), or when a way back along the followed path was refused and either
+//! no window is left to try or the frequency turned back and forth over the last points (the
+//! path bouncing between corners of the sampled law, see `frequency_reversals`). A window
+//! taken where a way back was refused holds its points back from the observer until the path
+//! leaves it; a point of it that lands back on the path already followed, or the window
+//! failing, drops them and ends the path at that dead end. A stall with no window left ends
+//! the run with [`ContinuationError::Stalled`]. The last point is solved at exactly the end
+//! frequency. A path runs down in
 //! frequency when the end frequency is below the start (e.g. to fill in, back toward a fold, a
 //! branch found past it).
 //!
@@ -157,14 +158,48 @@ struct HeldBack {
 /// An observer call held back (see [`HeldBack`]).
 #[derive(Debug, Clone)]
 enum HeldEvent {
-    /// [`Observer::accepted`] for the path point of this index, with this normal.
+    /// [`Observer::accepted`] for the path point of this index, with this normal (the operator
+    /// is evaluated at the point again before the call).
     Accepted(usize, Vec<f64>),
-    /// [`Observer::rejected`].
+    /// Any other call.
+    Call(ObserverCall),
+}
+
+/// An observer call that needs nothing but its arguments, reported at once or held back with
+/// a window's points ([`report`]).
+#[derive(Debug, Clone)]
+enum ObserverCall {
+    /// [`Observer::rejected`]: frequency (Hz), step, new step, reason.
     Rejected(f64, f64, f64, NewtonFailure),
-    /// [`Observer::turning_point`].
+    /// [`Observer::turning_point`] (Hz).
     TurningPoint(f64),
-    /// [`Observer::leap`].
+    /// [`Observer::leap`] from, to (Hz).
     Leap(f64, f64),
+}
+
+impl ObserverCall {
+    /// Makes the call.
+    fn send<S: ParametricResidual, O: Observer<S>>(self, observer: &mut O) {
+        match self {
+            Self::Rejected(freq_hz, step, new_step, reason) => {
+                observer.rejected(freq_hz, step, new_step, &reason)
+            }
+            Self::TurningPoint(freq_hz) => observer.turning_point(freq_hz),
+            Self::Leap(from_hz, to_hz) => observer.leap(from_hz, to_hz),
+        }
+    }
+}
+
+/// Makes `call` on `observer`, or keeps it with the calls of the window held back (`held`).
+fn report<S: ParametricResidual, O: Observer<S>>(
+    held: &mut Option<HeldBack>,
+    observer: &mut O,
+    call: ObserverCall,
+) {
+    match held {
+        Some(h) => h.events.push(HeldEvent::Call(call)),
+        None => call.send(observer),
+    }
 }
 
 /// Groups of unknowns whose arc-length scale grows with the response along the path.
@@ -1112,10 +1147,7 @@ impl Continuation {
         let n = t_new.len() - 1;
         if t_new[n] * tangent[n] < 0.0 {
             summary.turning_points.push(point.freq_hz());
-            match held {
-                Some(h) => h.events.push(HeldEvent::TurningPoint(point.freq_hz())),
-                None => observer.turning_point(point.freq_hz()),
-            }
+            report(held, observer, ObserverCall::TurningPoint(point.freq_hz()));
         }
         let normal = self.path_normal(&t_new);
         match held {
@@ -1195,6 +1227,40 @@ impl Continuation {
         summary.end = PathEnd::DeadEnd;
     }
 
+    /// Ends the path with `end`, or, with a window held back (`held`), drops the window and
+    /// ends it at the dead end the window was taken from ([`Self::drop_held`]).
+    fn end_path(&mut self, held: &mut Option<HeldBack>, summary: &mut PathSummary, end: PathEnd) {
+        match held.take() {
+            Some(h) => self.drop_held(h, summary),
+            None => summary.end = end,
+        }
+    }
+
+    /// Leaves the narrow window the path has passed at `freq_hz` (Hz): the range's scales
+    /// again ([`Self::leave_narrow`]), a held-back window's calls handed over
+    /// ([`Self::release_or_end`]) and the pass reported. True when handing them over ended the
+    /// path.
+    fn leave_window<S: ParametricResidual, O: Observer<S>>(
+        &mut self,
+        system: &mut S,
+        observer: &mut O,
+        held: &mut Option<HeldBack>,
+        summary: &mut PathSummary,
+        tangent: &mut [f64],
+        freq_hz: f64,
+    ) -> bool {
+        let left = self.leave_narrow(tangent);
+        if let Some(h) = held.take() {
+            if self.release_or_end(system, observer, h, summary) {
+                return true;
+            }
+        }
+        if let Some(from_hz) = left {
+            observer.narrow_pass(from_hz, freq_hz);
+        }
+        false
+    }
+
     /// Hands a held-back window's observer calls over, in order, the operator evaluated at
     /// each point again before it is reported (as [`Observer::accepted`] expects). Returns
     /// true when such an evaluation fails: the path then ends at the last point reported, as
@@ -1226,11 +1292,7 @@ impl Continuation {
                     }
                     observer.accepted(system, point, Some(&normal));
                 }
-                HeldEvent::Rejected(freq_hz, step, new_step, reason) => {
-                    observer.rejected(freq_hz, step, new_step, &reason)
-                }
-                HeldEvent::TurningPoint(freq_hz) => observer.turning_point(freq_hz),
-                HeldEvent::Leap(from_hz, to_hz) => observer.leap(from_hz, to_hz),
+                HeldEvent::Call(call) => call.send(observer),
             }
         }
         false
@@ -1309,10 +1371,7 @@ impl Continuation {
                 });
             }
             if summary.points.len() - furthest.1 > self.stagnation_points() {
-                match held.take() {
-                    Some(h) => self.drop_held(h, &mut summary),
-                    None => summary.end = PathEnd::NoProgress,
-                }
+                self.end_path(&mut held, &mut summary, PathEnd::NoProgress);
                 return Ok(summary);
             }
             let reached = summary
@@ -1353,15 +1412,9 @@ impl Continuation {
                     }
                     Err(reason) => {
                         let new_ds = ds * 0.5;
-                        match &mut held {
-                            Some(h) => h.events.push(HeldEvent::Rejected(
-                                last.freq_hz(),
-                                ds,
-                                new_ds,
-                                reason.clone(),
-                            )),
-                            None => observer.rejected(last.freq_hz(), ds, new_ds, &reason),
-                        }
+                        let call =
+                            ObserverCall::Rejected(last.freq_hz(), ds, new_ds, reason.clone());
+                        report(&mut held, observer, call);
                         summary.rejected_steps += 1;
                         if new_ds < a.min_step {
                             if let Some(h) = held.take() {
@@ -1435,29 +1488,23 @@ impl Continuation {
                     ds = (ds * factor).clamp(a.min_step, a.max_step);
                     let freq_hz = summary.points.last().map_or(f64::NAN, |p| p.freq_hz());
                     if self.past_narrow_window(freq_hz) {
-                        let left = self.leave_narrow(&mut tangent);
-                        if let Some(h) = held.take() {
-                            if self.release_or_end(system, observer, h, &mut summary) {
-                                return Ok(summary);
-                            }
-                        }
-                        if let Some(from_hz) = left {
-                            observer.narrow_pass(from_hz, freq_hz);
+                        if self.leave_window(
+                            system,
+                            observer,
+                            &mut held,
+                            &mut summary,
+                            &mut tangent,
+                            freq_hz,
+                        ) {
+                            return Ok(summary);
                         }
                         ds = a.initial_step.clamp(a.min_step, a.max_step);
                     }
                 }
                 Err(reason) => {
                     let new_ds = ds * 0.5;
-                    match &mut held {
-                        Some(h) => h.events.push(HeldEvent::Rejected(
-                            last.freq_hz(),
-                            ds,
-                            new_ds,
-                            reason.clone(),
-                        )),
-                        None => observer.rejected(last.freq_hz(), ds, new_ds, &reason),
-                    }
+                    let call = ObserverCall::Rejected(last.freq_hz(), ds, new_ds, reason.clone());
+                    report(&mut held, observer, call);
                     summary.rejected_steps += 1;
                     if new_ds < a.min_step {
                         // The path cannot be followed through this spot (Newton cycles between
@@ -1479,12 +1526,8 @@ impl Continuation {
                                 let leapt =
                                     self.leap(system, &y, &tangent, recent, &mut refused_retrace)?;
                                 if let Some((point, _)) = &leapt {
-                                    match &mut held {
-                                        Some(h) => {
-                                            h.events.push(HeldEvent::Leap(from, point.freq_hz()))
-                                        }
-                                        None => observer.leap(from, point.freq_hz()),
-                                    }
+                                    let call = ObserverCall::Leap(from, point.freq_hz());
+                                    report(&mut held, observer, call);
                                     summary.leaps.push((from, point.freq_hz()));
                                 }
                                 leapt
@@ -1520,10 +1563,7 @@ impl Continuation {
                             let dead_end = refused_retrace || behind;
                             let bouncing = held.is_none() && frequency_reversals(recent) > 0;
                             if dead_end && (behind || next.is_none() || bouncing) {
-                                match held.take() {
-                                    Some(h) => self.drop_held(h, &mut summary),
-                                    None => summary.end = PathEnd::DeadEnd,
-                                }
+                                self.end_path(&mut held, &mut summary, PathEnd::DeadEnd);
                                 return Ok(summary);
                             }
                             if let Some(attempt) = next {
@@ -1562,16 +1602,17 @@ impl Continuation {
                         ) {
                             return Ok(summary);
                         }
-                        if self.past_narrow_window(freq_hz) {
-                            let left = self.leave_narrow(&mut tangent);
-                            if let Some(h) = held.take() {
-                                if self.release_or_end(system, observer, h, &mut summary) {
-                                    return Ok(summary);
-                                }
-                            }
-                            if let Some(from_hz) = left {
-                                observer.narrow_pass(from_hz, freq_hz);
-                            }
+                        if self.past_narrow_window(freq_hz)
+                            && self.leave_window(
+                                system,
+                                observer,
+                                &mut held,
+                                &mut summary,
+                                &mut tangent,
+                                freq_hz,
+                            )
+                        {
+                            return Ok(summary);
                         }
                         ds = a.initial_step.clamp(a.min_step, a.max_step);
                         continue;
@@ -1580,10 +1621,7 @@ impl Continuation {
                 }
             }
         }
-        match held.take() {
-            Some(h) => self.drop_held(h, &mut summary),
-            None => summary.end = PathEnd::MaxPoints,
-        }
+        self.end_path(&mut held, &mut summary, PathEnd::MaxPoints);
         Ok(summary)
     }
 }
@@ -1608,10 +1646,10 @@ fn frequency_reversals(points: &[PathPoint]) -> usize {
     let mut last_sign = 0.0;
     let mut count = 0;
     for pair in points.windows(2) {
-        let sign = (pair[1].omega - pair[0].omega).signum();
         if pair[1].omega == pair[0].omega {
             continue;
         }
+        let sign = (pair[1].omega - pair[0].omega).signum();
         if last_sign != 0.0 && sign != last_sign {
             count += 1;
         }
@@ -1927,10 +1965,6 @@ mod tests {
         }
     }
 
-    /// Behind the highest frequency reached, a dead end past which only the path already
-    /// followed lies ends the path as [`PathEnd::DeadEnd`] (for the FRF to go on past the
-    /// fold), not as a stall: the path rises to the fold, turns once and runs down to the dead
-    /// end at 10 Hz, never back up along itself, every point on the path.
     /// The reversals that keep the narrow windows from a dead end: none on a monotone stretch
     /// (steps at an unchanged frequency, e.g. a creep toward a kink, skipped), one per change
     /// of direction on a stretch bouncing between corners.
@@ -1953,6 +1987,10 @@ mod tests {
         assert_eq!(frequency_reversals(&at(&[1.0, 2.0, 2.0, 1.5, 1.7, 1.6])), 3);
     }
 
+    /// Behind the highest frequency reached, a dead end past which only the path already
+    /// followed lies ends the path as [`PathEnd::DeadEnd`] (for the FRF to go on past the
+    /// fold), not as a stall: the path rises to the fold, turns once and runs down to the dead
+    /// end at 10 Hz, never back up along itself, every point on the path.
     #[test]
     fn a_dead_end_behind_a_fold_ends_the_path_for_the_caller_to_jump() {
         let mut points = Vec::new();
