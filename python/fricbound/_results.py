@@ -160,7 +160,8 @@ class FrfResult(ContinuationPath):
       missing and ``status`` is ``incomplete``), ``before`` (``left-range``, ``abandoned``,
       ``retrace``, ``outside-range``, ``bridge``) and, for a branch given up, ``given_up_hz``,
       ``given_up_amplitude`` (m), ``given_up_rising``, ``given_up_fold_hz`` and
-      ``given_up_cause`` (``dead-end`` or ``no-progress``; None otherwise), and
+      ``given_up_cause`` (``dead-end`` or ``no-progress``, as ``cause`` in ``solution.json``;
+      None otherwise), and
       ``fill_cut_hz``, ``fill_cut_amplitude`` (m), ``fill_cut_fold_hz`` where the branch
       after the jump (a fill or a bridge) was left off every stretch followed before (at the
       edge of its stretch after a fold of its own, given up before it, or out of points;

@@ -17,6 +17,18 @@ use fricbound::scene::SweepSpec;
 use fricbound::study::accuracy::{CurveStudy, SettingErrors, SettingResult, StudyPlan};
 use fricbound::study::sweep::SweepPoint;
 
+/// The name `solution.json` gives a unit enum variant (serde's kebab-case rename), so the dicts
+/// carry the same strings as the files without a second table of names to keep in step.
+fn json_name<T: serde::Serialize>(value: &T) -> PyResult<String> {
+    match serde_json::to_value(value) {
+        Ok(serde_json::Value::String(name)) => Ok(name),
+        Ok(other) => Err(PyRuntimeError::new_err(format!(
+            "expected a unit variant's name, serialised as {other}"
+        ))),
+        Err(e) => Err(PyRuntimeError::new_err(e.to_string())),
+    }
+}
+
 /// The response envelope (`[limits] envelope`): per grid frequency and output DOF the smallest
 /// and largest amplitude over the initial states (m; NaN where no state was solved), the m of
 /// each group attaining them, and the check of the two limit curves against it.
@@ -287,12 +299,7 @@ pub fn frf_dict<'py>(
         jd.set_item("given_up_fold_hz", given_up.and_then(|g| g.fold_hz))?;
         jd.set_item(
             "given_up_cause",
-            given_up.map(|g| match g.cause {
-                fricbound::analysis::frf::GiveUpCause::DeadEnd => "dead-end",
-                fricbound::analysis::frf::GiveUpCause::NoProgress => "no-progress",
-                fricbound::analysis::frf::GiveUpCause::FillEnd => "fill-end",
-                fricbound::analysis::frf::GiveUpCause::PointBudget => "point-budget",
-            }),
+            given_up.map(|g| json_name(&g.cause)).transpose()?,
         )?;
         // The first cut under its own keys, the second (a bridge cut on both sides) under
         // the same keys prefixed `second_`.
@@ -316,11 +323,7 @@ pub fn frf_dict<'py>(
             )?;
             jd.set_item(
                 format!("{prefix}cut_verdict"),
-                check.map(|c| match c.verdict {
-                    fricbound::analysis::frf::CutVerdict::Covered => "covered",
-                    fricbound::analysis::frf::CutVerdict::Abandoned => "abandoned",
-                    fricbound::analysis::frf::CutVerdict::Unjudged => "unjudged",
-                }),
+                check.map(|c| json_name(&c.verdict)).transpose()?,
             )?;
             let landing = check.map(|c| &c.landing);
             jd.set_item(format!("{prefix}cut_check_hz"), landing.map(|l| l.freq_hz))?;

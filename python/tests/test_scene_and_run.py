@@ -2,6 +2,7 @@
 
 import csv
 import io
+import json
 import math
 import os
 import pickle
@@ -255,6 +256,32 @@ def test_linear_references_equal_the_cli_files(cli_binary, tmp_path):
         np.testing.assert_allclose(lin.freq_hz, rows["freq_hz"], rtol=1e-9)
         np.testing.assert_allclose(lin.amplitude("y2"), rows["y2_amp"], rtol=1e-9)
     assert len(fricbound.linear(scene, "stuck", points=11).freq_hz) == 11
+
+
+def test_jumps_name_causes_and_verdicts_as_solution_json(cli_binary, tmp_path):
+    """At a pre-load of 5 N the path jumps past a dead end and the fill after it is cut and
+    judged: each jump's kind, how the branch before it ended, why it was given up and the
+    cut's verdict carry the same names in Python as in the CLI's solution.json."""
+    overrides = {"static_loads.0.value": -5.0, "accuracy.estimate": False}
+    scene = Scene.paper()
+    for field, value in overrides.items():
+        scene.set(field, value)
+    out = tmp_path / "cli"
+    cli = [str(cli_binary), "run", "--quiet", "--out", str(out)]
+    for field, value in overrides.items():
+        cli += ["--set", f"{field}={str(value).lower()}"]
+    subprocess.run(cli, check=True)
+    with open(out / "solution.json") as f:
+        expected = json.load(f)["jumps"]
+    jumps = fricbound.run(scene).jumps
+    assert len(jumps) == len(expected) > 0
+    for got, want in zip(jumps, expected):
+        assert got["kind"] == want["kind"]
+        assert got["before"] == want["before"]["how"]
+        assert got["given_up_cause"] == want["before"].get("cause")
+        assert got["cut_verdict"] == (want["cut_check"] or {}).get("verdict")
+    assert any(j["given_up_cause"] == "dead-end" for j in jumps)
+    assert any(j["cut_verdict"] == "covered" for j in jumps)
 
 
 def test_incomplete_and_too_large_runs_say_so():
