@@ -461,12 +461,10 @@ impl GiveUpCause {
 pub const RETRACE_TOLERANCE: f64 = 1e-2;
 
 /// Relative distance ‖c − c'‖ / ‖c‖ over all Fourier coefficients within which two solutions
-/// converged by Newton at one frequency are the same solution ([`Landing::resolved_distance`]).
-/// Measured: the same solution reached from two starts differs by 3·10⁻¹⁶ to 5·10⁻¹⁴ on the
-/// paper's system at F0 = 1 and 5 N, and by 5·10⁻¹¹ to 4.5·10⁻¹⁰ on the 3D blade pair (schur);
-/// the two sides of a fold of the paper's system at F0 = 1 N one step out of it differ by
-/// 5.1·10⁻⁷ (19.7275 Hz) to 10⁻² (the unit tests of this module).
-pub const SAME_SOLUTION_TOLERANCE: f64 = 1e-8;
+/// converged by Newton at one frequency are the same solution ([`Landing::resolved_distance`]):
+/// the continuation's own, which tells a sharp fold's other side from the path already
+/// followed with it (measurements there).
+pub use crate::numerics::continuation::SAME_SOLUTION_TOLERANCE;
 
 impl GivenUp {
     /// "at 886.8455 Hz (first output's amplitude 1.770e-5 m, rising), below the fold at

@@ -21,7 +21,10 @@
 //! is kept only when a look-ahead step from it leaves that path (a sharp fold), since at a
 //! contact transition such a point can lead straight back onto the incoming branch, which the
 //! path would then retrace (and loop: back along the followed path and on again through the
-//! same corners). When neither is found, the path is taken on from its last point over a
+//! same corners). "On the path" means near the polyline through all the points followed so far
+//! and the same solution as the path's own at that frequency, by Newton: the other side of a
+//! sharp fold may run within a fraction of a per cent of the side followed, and a branch may
+//! come back onto a stretch followed long before. When neither is found, the path is taken on from its last point over a
 //! narrow window around the spot, with the arc-length scales of a range that narrow, and past
 //! the window with the range's again ([`Continuation::run`]). The spot is instead a *dead
 //! end*, where the run ends with [`PathEnd::DeadEnd`] for the caller to go on past the highest
@@ -262,6 +265,12 @@ const RETRACE_LOOKAHEADS: &[f64] = &[1.0, 0.25, 0.0625];
 /// from the corner (about 3°) lies on it: the corner point would resume the incoming branch
 /// backwards (see [`Continuation::runs_back_along`]).
 const RETRACE_FRACTION: f64 = 0.05;
+/// Relative distance ‖x − x'‖ / ‖x‖ on the unknowns within which two solutions converged by
+/// Newton at one frequency are the same solution. Measured: the same solution reached from two
+/// starts differs by 3·10⁻¹⁶ to 5·10⁻¹⁴ on the paper's system at F0 = 1 and 5 N, and by
+/// 5·10⁻¹¹ to 4.5·10⁻¹⁰ on the 3D blade pair (schur); the two sides of a fold of the paper's
+/// system at F0 = 1 N one step out of it differ by 5.1·10⁻⁷ (19.7275 Hz) to 10⁻².
+pub const SAME_SOLUTION_TOLERANCE: f64 = 1e-8;
 /// Widths of the window of a narrow-window pass past a stall, as fractions of the range, tried
 /// in turn, each from the last point reached, while the path stalls inside the window (see
 /// [`Continuation::enter_narrow`]). On the 3D blade pair's limit curves over 845-900 Hz a
@@ -846,15 +855,15 @@ impl Continuation {
     /// Tries to continue past a spot where the corrector fails at every step down to the
     /// minimum: predictions [`LEAPS`] of the largest step ahead along the tangent, each
     /// corrected to full tolerance; the first whose correction stays within the leap, whose
-    /// tangent keeps the direction of travel and which lies off the path already followed
-    /// (`recent`, as in [`Continuation::runs_back_along`]) is returned with its tangent. Steps
+    /// tangent keeps the direction of travel and which does not land on the path already
+    /// followed ([`Continuation::on_followed_path`]) is returned with its tangent. Steps
     /// that land beyond the end frequency are not tried (the end point is solved separately).
     fn leap<S: ParametricResidual>(
         &self,
         system: &mut S,
         y: &[f64],
         tangent: &[f64],
-        recent: &[PathPoint],
+        followed: &[PathPoint],
         refused_retrace: &mut bool,
     ) -> Result<Option<(PathPoint, Vec<f64>)>, ContinuationError> {
         let n = y.len() - 1;
@@ -879,11 +888,15 @@ impl Continuation {
                     .collect::<Vec<_>>(),
             );
             let reach = norm(&yc.iter().zip(y).map(|(a, b)| a - b).collect::<Vec<_>>());
-            let on_path =
-                distance_to_polyline(&yc, &self.scaled_points(recent)) <= RETRACE_FRACTION * reach;
             if distance <= ds && dot(&t_new, tangent) > 0.0 {
-                if !on_path {
-                    return Ok(Some((point, t_new)));
+                if !self.on_followed_path(system, &yc, reach, followed) {
+                    // The test evaluated the operator elsewhere: the observer expects it
+                    // evaluated at the point.
+                    let mut r = vec![0.0; n];
+                    if system.residual(&point.x, point.omega, &mut r).is_ok() {
+                        return Ok(Some((point, t_new)));
+                    }
+                    continue;
                 }
                 *refused_retrace = true;
             }
@@ -918,15 +931,15 @@ impl Continuation {
     /// incoming branch (its chord from `y` within [`CORNER_BACKWARD_COSINE`] of −t_in, with the
     /// incoming tangent) or further than the step from its prediction is rejected, and so is
     /// one behind the incoming direction (chord · t_in < 0) from which the path runs back onto
-    /// the `recent` points ([`Continuation::runs_back_along`]): only a sharp fold's outgoing
-    /// piece may leave a corner backwards. Returns the point and its tangent oriented along the
-    /// chord from `y`.
+    /// the path already followed (`followed`, [`Continuation::runs_back_along`]): only a sharp
+    /// fold's outgoing piece may leave a corner backwards. Returns the point and its tangent
+    /// oriented along the chord from `y`.
     fn corner<S: ParametricResidual>(
         &self,
         system: &mut S,
         y: &[f64],
         tangent: &[f64],
-        recent: &[PathPoint],
+        followed: &[PathPoint],
         refused_retrace: &mut bool,
     ) -> Result<Option<(PathPoint, Vec<f64>)>, ContinuationError> {
         let n = y.len() - 1;
@@ -980,11 +993,17 @@ impl Continuation {
                 // Behind the incoming direction: a sharp fold's outgoing piece, or a piece that
                 // leads back onto the incoming branch (its tangent there need not be the
                 // incoming one, which the test above relies on). Look ahead along it.
-                if dot(&chord, tangent) < 0.0
-                    && self.runs_back_along(system, (&yc, &t_new), y, recent)
-                {
-                    *refused_retrace = true;
-                    continue;
+                if dot(&chord, tangent) < 0.0 {
+                    if self.runs_back_along(system, (&yc, &t_new), y, followed) {
+                        *refused_retrace = true;
+                        continue;
+                    }
+                    // The look-ahead evaluated the operator elsewhere: the observer expects it
+                    // evaluated at the point.
+                    let mut r = vec![0.0; n];
+                    if system.residual(&point.x, point.omega, &mut r).is_err() {
+                        continue;
+                    }
                 }
                 return Ok(Some((point, t_new)));
             }
@@ -993,24 +1012,26 @@ impl Continuation {
     }
 
     /// Whether the path from a corner point `from` (scaled y) along its tangent `t` runs back
-    /// onto the path already followed (`recent`, the last accepted points, the corner `y`
-    /// last). One step is taken along `t` ([`RETRACE_LOOKAHEADS`] of the initial step, at most
-    /// half the extent of `recent` from `y`) and corrected; the point reached lies on the
-    /// followed path when its distance from the polyline through `recent` is below
-    /// [`RETRACE_FRACTION`] of its distance from `y`. At a contact transition of the sampled
-    /// contact law, a piece found behind the incoming direction can lead straight back onto the
-    /// incoming branch: the run would then retrace it downwards. A sharp fold's outgoing piece
-    /// leaves the followed path at an angle and is kept. When no look-ahead step converges
-    /// there is no evidence either way and the point is kept.
+    /// onto the path already followed (`followed`, the accepted points, the corner `y` last).
+    /// One step is taken along `t` ([`RETRACE_LOOKAHEADS`] of the initial step, at most half
+    /// the extent of the last [`RETRACE_HISTORY`] points from `y`) and corrected; the point
+    /// reached is tested by [`Continuation::on_followed_path`]. At a contact transition of the
+    /// sampled contact law, a piece found behind the incoming direction can lead straight back
+    /// onto the incoming branch (the run would then retrace it downwards), or onto an earlier
+    /// stretch of the path (the run would then go round the same loop again and again: the m =
+    /// −1 limit curve of the 3D blade pair, whose branch coming down from a fold at 868.68 Hz
+    /// met the branch that had risen to it at 854.62 Hz and turned up it again, seven times). A
+    /// sharp fold's outgoing piece leaves the followed path, however close to it, and is kept.
+    /// When no look-ahead step converges there is no evidence either way and the point is kept.
     fn runs_back_along<S: ParametricResidual>(
         &self,
         system: &mut S,
         (from, t): (&[f64], &[f64]),
         y: &[f64],
-        recent: &[PathPoint],
+        followed: &[PathPoint],
     ) -> bool {
         let n = y.len() - 1;
-        let path = self.scaled_points(recent);
+        let recent = &followed[followed.len().saturating_sub(RETRACE_HISTORY)..];
         let distance = |a: &[f64], b: &[f64]| {
             a.iter()
                 .zip(b)
@@ -1018,7 +1039,11 @@ impl Continuation {
                 .sum::<f64>()
                 .sqrt()
         };
-        let extent = path.iter().map(|p| distance(p, y)).fold(0.0, f64::max);
+        let extent = self
+            .scaled_points(recent)
+            .iter()
+            .map(|p| distance(p, y))
+            .fold(0.0, f64::max);
         let first = self.settings.initial_step.min(0.5 * extent);
         if first <= 0.0 {
             return false;
@@ -1032,11 +1057,68 @@ impl Continuation {
             if distance(&q, &predicted) > h {
                 continue;
             }
-            let reach = distance(&q, y);
-            let off_path = distance_to_polyline(&q, &path);
-            return off_path <= RETRACE_FRACTION * reach;
+            return self.on_followed_path(system, &q, distance(&q, y), followed);
         }
         false
+    }
+
+    /// Whether a converged point `q` (scaled y) at distance `reach` from where the path is
+    /// lies on the path already followed (`followed`, all its points): closer to the polyline
+    /// through them than [`RETRACE_FRACTION`] of `reach` (about 3°), and the same solution as
+    /// the path's own at q's frequency ([`Continuation::apart_from_path`] within
+    /// [`SAME_SOLUTION_TOLERANCE`], or not resolved by Newton). The polyline alone cannot tell
+    /// a retrace from the other side of a sharp fold that runs within a fraction of a per cent
+    /// of the side followed (the 3D blade pair's fold at 874.57 Hz: 4·10⁻² of the reach off the
+    /// polyline, 2.3·10⁻² apart by Newton; a retrace at 886.69 Hz: 7·10⁻⁴ off, 1.2·10⁻¹⁰ apart).
+    fn on_followed_path<S: ParametricResidual>(
+        &self,
+        system: &mut S,
+        q: &[f64],
+        reach: f64,
+        followed: &[PathPoint],
+    ) -> bool {
+        let path = self.scaled_points(followed);
+        if distance_to_polyline(q, &path) > RETRACE_FRACTION * reach {
+            return false;
+        }
+        !self
+            .apart_from_path(system, q, &path)
+            .is_some_and(|d| d > SAME_SOLUTION_TOLERANCE)
+    }
+
+    /// How far a converged point `q` (scaled y) near the polyline through `path` (scaled
+    /// points) lies from the solution the path itself has at q's frequency: Newton at that
+    /// frequency, started from the path's point there (interpolated along the polyline segment
+    /// nearest to q, or that segment's nearer end where it does not span the frequency), and
+    /// ‖x_N − x_q‖ / ‖x_q‖ on the unknowns. Near a sharp fold of the path the other side runs
+    /// within a fraction of a per cent of the side followed (measured on the 3D blade pair at
+    /// 873.56 Hz: 2·10⁻⁴ apart in amplitude 0.01 Hz from the fold), closer than the polyline
+    /// can resolve, but it is another solution: above [`SAME_SOLUTION_TOLERANCE`]. None when
+    /// Newton does not converge.
+    fn apart_from_path<S: ParametricResidual>(
+        &self,
+        system: &mut S,
+        q: &[f64],
+        path: &[Vec<f64>],
+    ) -> Option<f64> {
+        let n = q.len() - 1;
+        let segment = path
+            .windows(2)
+            .min_by(|a, b| distance_to_polyline(q, a).total_cmp(&distance_to_polyline(q, b)))?;
+        let (a, b) = (&segment[0], &segment[1]);
+        let guess_scaled: Vec<f64> = if (a[n] - q[n]) * (b[n] - q[n]) <= 0.0 && a[n] != b[n] {
+            let t = (q[n] - a[n]) / (b[n] - a[n]);
+            a.iter().zip(b).map(|(u, v)| u + t * (v - u)).collect()
+        } else if (a[n] - q[n]).abs() <= (b[n] - q[n]).abs() {
+            a.clone()
+        } else {
+            b.clone()
+        };
+        let guess: Vec<f64> = (0..n).map(|j| guess_scaled[j] * self.x_scale[j]).collect();
+        let solved = self.solve_fixed(system, &guess, q[n] * OMEGA_SCALE).ok()?;
+        let xq: Vec<f64> = (0..n).map(|j| q[j] * self.x_scale[j]).collect();
+        let apart: Vec<f64> = solved.x.iter().zip(&xq).map(|(u, v)| u - v).collect();
+        Some(norm(&apart) / norm(&xq))
     }
 
     /// Whether `point` lies back on the path already followed (`points`, the last
@@ -1511,20 +1593,25 @@ impl Continuation {
                         // the pieces of the sampled, piecewise-smooth contact law): try to land
                         // on it further on, with a fully converged point, before giving up.
                         let from = last.freq_hz();
-                        let recent =
-                            &summary.points[summary.points.len().saturating_sub(RETRACE_HISTORY)..];
+                        let followed = &summary.points;
+                        let recent = &followed[followed.len().saturating_sub(RETRACE_HISTORY)..];
                         let mut refused_retrace = false;
                         let resumed = match self.corner(
                             system,
                             &y,
                             &tangent,
-                            recent,
+                            followed,
                             &mut refused_retrace,
                         )? {
                             Some(found) => Some(found),
                             None => {
-                                let leapt =
-                                    self.leap(system, &y, &tangent, recent, &mut refused_retrace)?;
+                                let leapt = self.leap(
+                                    system,
+                                    &y,
+                                    &tangent,
+                                    followed,
+                                    &mut refused_retrace,
+                                )?;
                                 if let Some((point, _)) = &leapt {
                                     let call = ObserverCall::Leap(from, point.freq_hz());
                                     report(&mut held, observer, call);
@@ -2135,6 +2222,140 @@ mod tests {
         let last = points.last().unwrap();
         assert!((last.freq_hz() - 11.0).abs() < 1e-12);
         assert!((last.x[0] + 3.5).abs() < 1e-9 && (last.x[1] - 9.0).abs() < 1e-9);
+    }
+
+    /// A sharp fold at a corner whose outgoing side runs back within 1.6° of the incoming one
+    /// (as the 3D blade pair's fold at 874.57 Hz, whose sides lie 2.3 % apart 0.02 Hz from
+    /// it): y = (x₁, x₂, ω/2π) comes up along A, c + σ·a with a = (−1, −ε, −1) and σ ≥ 0, and
+    /// leaves along B, c + σ·b with b = (−1, ε, −1), c = (1, 0, 10.5), ε = 0.02. R = L±·(y − c)
+    /// is piecewise linear and continuous across the plane x₂ = 0 (L⁻ has null vector a, L⁺ =
+    /// L⁻ − 2·e₂·(0, 1, 0)ᵀ has b), so below 10.5 Hz both sides are solutions, 2εσ apart in x₂,
+    /// and above it none.
+    struct Hairpin;
+
+    impl Hairpin {
+        const CORNER: [f64; 3] = [1.0, 0.0, 10.5];
+        const EPS: f64 = 0.02;
+
+        fn operator(x: &[f64]) -> [[f64; 3]; 2] {
+            if x[1] <= 0.0 {
+                [[1.0, 0.0, -1.0], [0.0, 1.0, -Self::EPS]]
+            } else {
+                [[1.0, 0.0, -1.0], [0.0, -1.0, -Self::EPS]]
+            }
+        }
+    }
+
+    impl ParametricResidual for Hairpin {
+        type Error = Never;
+        fn dim(&self) -> usize {
+            2
+        }
+        fn residual_scale(&self) -> f64 {
+            1.0
+        }
+        fn residual(&mut self, x: &[f64], omega: f64, r: &mut [f64]) -> Result<(), Never> {
+            let y = [x[0], x[1], omega / OMEGA_SCALE];
+            for (ri, row) in r.iter_mut().zip(Self::operator(x)) {
+                *ri = (0..3).map(|j| row[j] * (y[j] - Self::CORNER[j])).sum();
+            }
+            Ok(())
+        }
+        fn new_jacobian(&mut self) -> AssembledJacobian {
+            AssembledJacobian::dense(2)
+        }
+        fn residual_and_jacobian(
+            &mut self,
+            x: &[f64],
+            omega: f64,
+            r: &mut [f64],
+            jac: &mut AssembledJacobian,
+            dr: &mut [f64],
+        ) -> Result<(), Never> {
+            self.residual(x, omega, r)?;
+            jac.clear();
+            for (i, row) in Self::operator(x).iter().enumerate() {
+                for (j, value) in row[..2].iter().enumerate() {
+                    let slot = jac.slot(i, j);
+                    jac.add_at(slot, *value);
+                }
+                dr[i] = row[2] / OMEGA_SCALE;
+            }
+            Ok(())
+        }
+    }
+
+    /// The outgoing side of a sharp fold that hugs the incoming side closer than the look-ahead's
+    /// polyline test resolves (1.4 % of its reach against [`RETRACE_FRACTION`]) is told from
+    /// the path already followed by Newton at the look-ahead's frequency, which lands on the
+    /// incoming side 2εσ away: the path turns the fold (one turning point, at 10.5 Hz) and
+    /// runs down along B until it leaves the range below the start, every point on A or B;
+    /// before, the corner was refused as a retrace and the path ended at a dead end there.
+    #[test]
+    fn a_sharp_fold_whose_sides_nearly_touch_is_turned() {
+        let mut points = Vec::new();
+        let mut c = Continuation::new(settings(10.0, 11.0), vec![1.0, 1.0]);
+        let summary = c
+            .run(&mut Hairpin, &[0.5, -0.01], &mut Collect(&mut points))
+            .expect("the fold is turned");
+        assert_eq!(summary.end, PathEnd::LeftRangeBelow, "{summary:?}");
+        assert_eq!(
+            summary.turning_points.len(),
+            1,
+            "{:?}",
+            summary.turning_points
+        );
+        assert!((summary.turning_points[0] - 10.5).abs() < 1e-3);
+        assert!(summary.leaps.is_empty(), "{:?}", summary.leaps);
+        let fold = points
+            .iter()
+            .position(|p| p.x[1] > 0.0)
+            .expect("a point on the outgoing side");
+        for (k, p) in points.iter().enumerate() {
+            let sigma = 10.5 - p.freq_hz();
+            let side = if k < fold { -1.0 } else { 1.0 };
+            assert!(
+                sigma >= -1e-9
+                    && (p.x[0] - 1.0 + sigma).abs() < 1e-9
+                    && (p.x[1] - side * Hairpin::EPS * sigma).abs() < 1e-9,
+                "point {k} off its side: {p:?}"
+            );
+        }
+        assert!(points.last().unwrap().freq_hz() < 9.5);
+    }
+
+    /// The path already followed is the whole path, not its last [`RETRACE_HISTORY`] points: a
+    /// point back on a stretch followed long before (side A, 150 points back) is on it, and a
+    /// point of the other side of the fold beyond the stretch of it followed, 2εσ from A, is
+    /// not, though the polyline through A passes within 4 % of its reach.
+    #[test]
+    fn the_followed_path_reaches_back_to_its_first_point() {
+        let c = Continuation::new(settings(10.0, 11.0), vec![1.0, 1.0]);
+        let on = |side: f64, f: f64| {
+            let sigma = 10.5 - f;
+            PathPoint {
+                omega: f * OMEGA_SCALE,
+                x: vec![1.0 - sigma, side * Hairpin::EPS * sigma],
+                iterations: 1,
+                residual: 0.0,
+                step: 0.0,
+            }
+        };
+        // Up side A from 10.0 to 10.5 Hz, then down side B to 10.35 Hz.
+        let mut followed: Vec<PathPoint> = (0..=150)
+            .map(|k| on(-1.0, 10.0 + k as f64 / 300.0))
+            .collect();
+        followed.extend((1..=50).map(|k| on(1.0, 10.5 - 0.003 * k as f64)));
+        let scaled = |p: &PathPoint| c.scaled_points(std::slice::from_ref(p)).pop().unwrap();
+        let last = scaled(followed.last().unwrap());
+        let reach = |q: &[f64]| norm(&q.iter().zip(&last).map(|(a, b)| a - b).collect::<Vec<_>>());
+        let back_on_a = scaled(&on(-1.0, 10.2));
+        assert!(c.on_followed_path(&mut Hairpin, &back_on_a, reach(&back_on_a), &followed));
+        let below_on_b = scaled(&on(1.0, 10.0));
+        assert!(!c.on_followed_path(&mut Hairpin, &below_on_b, reach(&below_on_b), &followed));
+        // Only the last RETRACE_HISTORY points, as before: A is out of sight there.
+        let recent = &followed[followed.len() - RETRACE_HISTORY..];
+        assert!(!c.on_followed_path(&mut Hairpin, &back_on_a, reach(&back_on_a), recent));
     }
 
     /// The scale of a group grows with its norm along the path and the tangent is carried over
