@@ -1,10 +1,13 @@
 //! Frequency-response runs: continuation of the harmonic balance over the scene's range, with
 //! per-point outputs (amplitudes, peaks, contact states) handed to an observer as they come.
 
+use std::collections::VecDeque;
 use std::f64::consts::PI;
+use std::thread::Scope;
 use std::time::Instant;
 
-use crate::analysis::error_estimate::{ErrorEstimator, EstimateProblems, PathPlace, PointAccuracy};
+use crate::analysis::error_estimate::{EstimateProblems, PathPlace, PointAccuracy};
+use crate::analysis::estimate_pool::{EstimatePool, EstimateTicket, Submitted};
 use crate::analysis::linear;
 use crate::analysis::monodromy::point_monodromy;
 use crate::analysis::stability::{PointStability, StabilityError};
@@ -43,6 +46,11 @@ pub struct FrfPoint {
     /// A-posteriori error estimate of the amplitudes (continuation points of a run whose
     /// scene asks for it; None for points solved on their own, such as refined peaks).
     pub accuracy: Option<PointAccuracy>,
+    /// The estimate a worker is still forming for this point, inside a run
+    /// ([`crate::analysis::estimate_pool`]); None on every point a run reports, whose
+    /// `accuracy` is filled by then.
+    #[serde(skip)]
+    pub pending_estimate: Option<EstimateTicket>,
     /// Hill stability of the point, when the scene asks for it (`analysis.stability`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stability: Option<PointStability>,
@@ -951,13 +959,108 @@ fn output_amplitude_groups(
         .collect()
 }
 
-struct Adapter<'o, 'e, O: FrfObserver> {
+struct Adapter<'o, 'p, 'e, O: FrfObserver> {
     observer: &'o mut O,
     points: Vec<FrfPoint>,
     /// A converged point whose full coefficients could not be recovered.
     failure: Option<HbmError>,
     /// The error estimate of every accepted point, when the scene asks for it.
-    estimator: Option<ErrorEstimator<'e>>,
+    estimates: Option<&'p EstimatePool<'e>>,
+    /// Whether the observer's events keep their order behind points whose estimates are still
+    /// being formed (the run's own observer); a branch followed silently passes them on at once,
+    /// its points keeping their pending estimates until the run reports them.
+    in_order: bool,
+    /// Events held back behind a point whose estimate has not come in yet, in order.
+    held: VecDeque<Held>,
+}
+
+/// An observer event of [`Adapter`], held back until the estimates of the points before it
+/// have come in.
+enum Held {
+    /// The point at this index of [`Adapter::points`].
+    Point(usize),
+    StepCut(f64, f64, f64, NewtonFailure),
+    TurningPoint(f64),
+    Leap(f64, f64),
+    NarrowPass(f64, f64),
+    /// Boxed: a jump is ten times the size of the other events.
+    Jump(Box<Jump>),
+}
+
+impl<O: FrfObserver> Adapter<'_, '_, '_, O> {
+    /// Gives `point` its error estimate at ω = `omega` (rad/s), at once or pending on a
+    /// worker, when the run estimates.
+    fn estimate(&self, point: &mut FrfPoint, omega: f64, place: Option<PathPlace>) {
+        let Some(pool) = self.estimates else { return };
+        match pool.submit(&point.coefficients, omega, place, &point.states) {
+            Submitted::Ready(accuracy) => point.accuracy = Some(accuracy),
+            Submitted::Pending(ticket) => point.pending_estimate = Some(ticket),
+        }
+    }
+
+    /// Appends `point` to the run's points and reports it (in order).
+    fn push_point(&mut self, point: FrfPoint) {
+        self.points.push(point);
+        self.report(Held::Point(self.points.len() - 1));
+    }
+
+    /// Reports `event` to the observer, after the events held back before it.
+    fn report(&mut self, event: Held) {
+        self.held.push_back(event);
+        self.flush(false);
+    }
+
+    /// Passes the held events on in order, each point with its estimate, up to the first point
+    /// whose estimate has not come in (or, with `wait`, waiting for every one).
+    fn flush(&mut self, wait: bool) {
+        while let Some(front) = self.held.front() {
+            if let (&Held::Point(i), true) = (front, self.in_order) {
+                if let (Some(ticket), Some(pool)) =
+                    (self.points[i].pending_estimate, self.estimates)
+                {
+                    let accuracy = if wait {
+                        pool.wait(ticket)
+                    } else {
+                        match pool.get(ticket) {
+                            Some(accuracy) => Some(accuracy),
+                            None => break,
+                        }
+                    };
+                    // None with `wait`: the workers stopped, the point goes without.
+                    self.points[i].accuracy = accuracy;
+                    self.points[i].pending_estimate = None;
+                }
+            }
+            let Some(event) = self.held.pop_front() else {
+                break;
+            };
+            match event {
+                Held::Point(i) => self.observer.point(&self.points[i]),
+                Held::StepCut(freq_hz, step, new_step, reason) => {
+                    self.observer.step_cut(freq_hz, step, new_step, &reason)
+                }
+                Held::TurningPoint(freq_hz) => self.observer.turning_point(freq_hz),
+                Held::Leap(from_hz, to_hz) => self.observer.leap(from_hz, to_hz),
+                Held::NarrowPass(from_hz, to_hz) => self.observer.narrow_pass(from_hz, to_hz),
+                Held::Jump(jump) => self.observer.jump(&jump),
+            }
+        }
+    }
+
+    /// The points, every estimate in (the events all passed on).
+    fn take_points(&mut self) -> Vec<FrfPoint> {
+        self.flush(true);
+        std::mem::take(&mut self.points)
+    }
+}
+
+impl<O: FrfObserver> Drop for Adapter<'_, '_, '_, O> {
+    /// A run that ends early (an error) still reports every point it accepted.
+    fn drop(&mut self) {
+        if self.in_order {
+            self.flush(true);
+        }
+    }
 }
 
 /// The outputs of a converged path point, on full coefficients.
@@ -987,6 +1090,7 @@ fn full_point(system: &mut HbmOperator<'_>, p: &PathPoint) -> Result<FrfPoint, H
         residual: p.residual,
         coefficients,
         accuracy: None,
+        pending_estimate: None,
         stability: None,
     })
 }
@@ -1050,7 +1154,7 @@ fn with_stability(
     Ok(point)
 }
 
-impl<O: FrfObserver> Observer<HbmOperator<'_>> for Adapter<'_, '_, O> {
+impl<O: FrfObserver> Observer<HbmOperator<'_>> for Adapter<'_, '_, '_, O> {
     fn accepted(&mut self, system: &mut HbmOperator<'_>, p: &PathPoint, normal: Option<&[f64]>) {
         let mut point =
             match full_point(system, p).and_then(|point| with_stability(system, point, p.omega)) {
@@ -1060,28 +1164,24 @@ impl<O: FrfObserver> Observer<HbmOperator<'_>> for Adapter<'_, '_, O> {
                     return;
                 }
             };
-        if let Some(estimator) = &mut self.estimator {
-            let place = normal.map(|normal| PathPlace {
-                normal,
-                step: p.step,
-            });
-            point.accuracy =
-                Some(estimator.estimate(&point.coefficients, p.omega, place, &point.states));
-        }
-        self.observer.point(&point);
-        self.points.push(point);
+        let place = normal.map(|normal| PathPlace {
+            normal,
+            step: p.step,
+        });
+        self.estimate(&mut point, p.omega, place);
+        self.push_point(point);
     }
     fn rejected(&mut self, freq_hz: f64, step: f64, new_step: f64, reason: &NewtonFailure) {
-        self.observer.step_cut(freq_hz, step, new_step, reason);
+        self.report(Held::StepCut(freq_hz, step, new_step, reason.clone()));
     }
     fn turning_point(&mut self, freq_hz: f64) {
-        self.observer.turning_point(freq_hz);
+        self.report(Held::TurningPoint(freq_hz));
     }
     fn leap(&mut self, from_hz: f64, to_hz: f64) {
-        self.observer.leap(from_hz, to_hz);
+        self.report(Held::Leap(from_hz, to_hz));
     }
     fn narrow_pass(&mut self, from_hz: f64, to_hz: f64) {
-        self.observer.narrow_pass(from_hz, to_hz);
+        self.report(Held::NarrowPass(from_hz, to_hz));
     }
 }
 
@@ -1105,8 +1205,24 @@ const JUMP_FRACTIONS: &[f64] = &[0.0005, 0.002, 0.005, 0.01, 0.02, 0.03, 0.05, 0
 /// in rising frequency). Each jump is reported ([`FrfRun::jumps`], [`FrfObserver::jump`]) with
 /// the frequencies its ends reached: the stretch between them was not computed on any branch
 /// (empty when the fill got back to the highest frequency).
+///
+/// The points' error estimates (when the scene asks for them) are formed on worker threads
+/// while the path goes on ([`crate::analysis::estimate_pool`]); the observer still receives
+/// every event in the order of the run, each point with its estimate.
 pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfRun, FrfError> {
     let started = Instant::now();
+    let refined = EstimateProblems::new(problem);
+    std::thread::scope(|scope| solve_in(scope, problem, refined.as_ref(), observer, started))
+}
+
+/// [`solve`], its estimates' workers (if any) scoped to `scope`.
+fn solve_in<'scope, 'p, O: FrfObserver>(
+    scope: &'scope Scope<'scope, 'p>,
+    problem: &'p Problem,
+    refined: Option<&'p EstimateProblems>,
+    observer: &mut O,
+    started: Instant,
+) -> Result<FrfRun, FrfError> {
     let mut system = HbmOperator::new(problem)?;
     let set = system.unknowns().clone();
     let settings = problem.analysis.continuation;
@@ -1116,16 +1232,16 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
     // How the scale grows and which amplitudes the steps follow: the same on every branch.
     let adaptive = adaptive_scale(problem, &set, &system);
     let amplitude_groups = output_amplitude_groups(problem, &set, &system);
-    let refined = EstimateProblems::new(problem);
-    let estimator = refined
-        .as_ref()
-        .map(|r| ErrorEstimator::new(problem, r))
+    let pool = refined
+        .map(|r| EstimatePool::start(scope, problem, r, EstimatePool::default_workers()))
         .transpose()?;
     let mut adapter = Adapter {
         observer,
         points: Vec::new(),
         failure: None,
-        estimator,
+        estimates: pool.as_ref(),
+        in_order: true,
+        held: VecDeque::new(),
     };
     let mut run = FrfRun {
         points: Vec::new(),
@@ -1213,7 +1329,7 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
             freq_hz,
             highest,
             (budget / 2).min(FILL_POINTS),
-            &mut adapter.estimator,
+            adapter.estimates,
         );
         let cut = summary.as_ref().and_then(|summary| {
             fill_cut(
@@ -1257,7 +1373,7 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
                     &top,
                     &bottom,
                     budget,
-                    &mut adapter.estimator,
+                    adapter.estimates,
                     (&adapter.points, &run.branch_starts()),
                 )
             }
@@ -1311,18 +1427,18 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
                 second_cut,
                 second_cut_check: None,
             };
-            adapter.observer.jump(&jump);
+            adapter.report(Held::Jump(Box::new(jump)));
             run.jumps.push(jump);
             for mut p in branch {
                 reached = reached.max(p.freq_hz);
-                // Points followed on a branch have their estimate (across the path) already;
-                // the others (solved at a fixed frequency) take it at their frequency.
-                if let (Some(estimator), None) = (&mut adapter.estimator, &p.accuracy) {
+                // Points followed on a branch have their estimate (across the path) already,
+                // or pending; the others (solved at a fixed frequency) take it at their
+                // frequency.
+                if p.accuracy.is_none() && p.pending_estimate.is_none() {
                     let omega = 2.0 * PI * p.freq_hz;
-                    p.accuracy = Some(estimator.estimate(&p.coefficients, omega, None, &p.states));
+                    adapter.estimate(&mut p, omega, None);
                 }
-                adapter.observer.point(&p);
-                adapter.points.push(p);
+                adapter.push_point(p);
             }
             kind = JumpKind::Bridge;
             before = BranchEnd::Bridge;
@@ -1330,10 +1446,10 @@ pub fn solve<O: FrfObserver>(problem: &Problem, observer: &mut O) -> Result<FrfR
         start_hz = freq_hz;
         guess = x;
     }
-    run.points = adapter.points;
+    run.points = adapter.take_points();
     // Every branch is known now: judge the cuts of the fills and bridges against all of them.
     let newton = Continuation::new(settings, x_scale);
-    judge_cuts(&mut system, &newton, &mut run, adapter.observer);
+    judge_cuts(&mut system, &newton, &mut run, &mut *adapter.observer);
     run.elapsed_s = started.elapsed().as_secs_f64();
     Ok(run)
 }
@@ -1944,17 +2060,17 @@ impl Branching<'_> {
     /// Follows the path silently from `x` (the operator's unknowns, converged at `from_hz`)
     /// toward `to_hz` (below or above) with at most `max_points` points. Returns the points in
     /// path order (the first is the start point) and the summary, None when the continuation
-    /// failed (its points up to the failure are kept). With an `estimator`, each point gets
-    /// its error estimate across the path as it is accepted (the estimator is lent to the
-    /// branch's observer and given back).
-    fn follow<'e>(
+    /// failed (its points up to the failure are kept). With `estimates`, each point gets
+    /// its error estimate across the path as it is accepted (or, formed on a worker, pending
+    /// until the run reports the point).
+    fn follow(
         &self,
         system: &mut HbmOperator<'_>,
         x: &[f64],
         from_hz: f64,
         to_hz: f64,
         max_points: usize,
-        estimator: &mut Option<ErrorEstimator<'e>>,
+        estimates: Option<&EstimatePool<'_>>,
     ) -> (Vec<FrfPoint>, Option<PathSummary>) {
         let settings = ContinuationSettings {
             freq_start_hz: from_hz,
@@ -1966,14 +2082,15 @@ impl Branching<'_> {
             observer: &mut Silent,
             points: Vec::new(),
             failure: None,
-            estimator: estimator.take(),
+            estimates,
+            in_order: false,
+            held: VecDeque::new(),
         };
         let mut continuation = Continuation::new(settings, self.x_scale.to_vec())
             .with_adaptive_scale(self.adaptive.clone())
             .with_amplitude_steps(self.amplitude_groups.to_vec());
         let summary = continuation.run(system, x, &mut collect).ok();
-        *estimator = collect.estimator.take();
-        (collect.points, summary)
+        (std::mem::take(&mut collect.points), summary)
     }
 
     /// Branches inside the stretch between `below` (the highest point of the branch before a
@@ -1987,13 +2104,13 @@ impl Branching<'_> {
     /// is bridged in turn, up to [`MAX_BRIDGES`] branches and `budget` points. Returns the
     /// branches found, each in path order from its lowest point up, sorted by their lowest
     /// frequency, with the cuts of its way down and of its way up (see [`fill_cut`]).
-    fn bridge<'e>(
+    fn bridge(
         &self,
         system: &mut HbmOperator<'_>,
         below: &FrfPoint,
         above: &FrfPoint,
         budget: usize,
-        estimator: &mut Option<ErrorEstimator<'e>>,
+        estimates: Option<&EstimatePool<'_>>,
         (followed, branch_starts): (&[FrfPoint], &[usize]),
     ) -> Vec<(Vec<FrfPoint>, [Option<GivenUp>; 2])> {
         let mut branches: Vec<(Vec<FrfPoint>, [Option<GivenUp>; 2])> = Vec::new();
@@ -2009,8 +2126,8 @@ impl Branching<'_> {
             };
             let per_side = BRIDGE_POINTS.min((budget - used) / 2);
             let (mut down, down_end) =
-                self.follow(system, &x, freq_hz, lo.freq_hz, per_side, estimator);
-            let (up, up_end) = self.follow(system, &x, freq_hz, hi.freq_hz, per_side, estimator);
+                self.follow(system, &x, freq_hz, lo.freq_hz, per_side, estimates);
+            let (up, up_end) = self.follow(system, &x, freq_hz, hi.freq_hz, per_side, estimates);
             // Either way turned back at a fold of its own before its edge, or was given up or
             // ran out of points before it: cut there (both ways may be).
             let cut_of = |side: &[FrfPoint], travel_down: bool, end: &Option<PathSummary>| {
@@ -2455,6 +2572,7 @@ mod tests {
             residual: 0.0,
             coefficients: vec![c1, 0.0, c3, 0.0],
             accuracy: None,
+            pending_estimate: None,
             stability: None,
         }
     }

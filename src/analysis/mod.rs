@@ -40,6 +40,8 @@
 //! - [`limits::LimitAnalysis::variability`]: the size of the variability between the limits.
 //! - [`error_estimate::ErrorEstimator`]: the a-posteriori truncation and sampling error
 //!   estimate of every converged continuation point ([`error_estimate::PointAccuracy`]).
+//! - [`estimate_pool::EstimatePool`]: those estimates on worker threads, so that an FRF run's
+//!   continuation goes on while its accepted points are estimated.
 //! - [`stability::point_stability`]: Hill stability of a converged point (Floquet exponents
 //!   from the quadratic Hill eigenvalue problem, [`stability::PointStability`]); computed on
 //!   every FRF point when the scene sets `analysis.stability`.
@@ -53,6 +55,7 @@
 //!   state), the independent check of Hill's verdict ([`monodromy::MonodromyStability`]).
 
 pub mod error_estimate;
+pub mod estimate_pool;
 pub mod frf;
 pub mod limits;
 pub mod linear;

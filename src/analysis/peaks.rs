@@ -529,6 +529,7 @@ mod tests {
             residual: 0.0,
             coefficients: Vec::new(),
             accuracy: None,
+            pending_estimate: None,
             stability: None,
         }
     }

@@ -696,6 +696,7 @@ mod tests {
             residual: 1e-12,
             coefficients: vec![k as f64; 18],
             accuracy: None,
+            pending_estimate: None,
             stability: None,
         }
     }

@@ -756,6 +756,7 @@ mod tests {
             coefficients: Vec::new(),
             accuracy: None,
             stability: None,
+            pending_estimate: None,
         };
         let r: Vec<FrfPoint> = (0..=10).map(|k| point(k as f64, 1.0 + k as f64)).collect();
         let a: Vec<FrfPoint> = (0..=10)

@@ -223,6 +223,7 @@ mod tests {
             residual: 1e-10,
             coefficients: Vec::new(),
             accuracy: None,
+            pending_estimate: None,
             stability: None,
         }
     }

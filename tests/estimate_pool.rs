@@ -1,0 +1,120 @@
+//! The error estimates formed on worker threads while the path goes on
+//! (`fricbound::analysis::estimate_pool`) against the same run estimating inline: the same
+//! points with the same estimates, bit for bit, and the observer's events in the same order,
+//! each point with its estimate when the observer receives it.
+//!
+//! A run inside a rayon job estimates inline (as the limit curves and the accuracy study do);
+//! the same run on a thread of its own uses one worker per thread of rayon's global pool. The
+//! paper's system at F0 = 1 N (50-350 Hz) jumps past two dead ends and bridges a stretch, so
+//! its points come from the run's path, from fills followed silently (their estimates pending
+//! until the run reports them) and from fixed-frequency solves.
+
+use fricbound::analysis::estimate_pool::EstimatePool;
+use fricbound::analysis::frf::{self, FrfObserver, FrfPoint, FrfRun, Jump, JumpKind};
+use fricbound::model::Problem;
+use fricbound::numerics::NewtonFailure;
+use fricbound::scene::{self, paper_wedge_scene};
+
+fn paper(overrides: &[&str]) -> Problem {
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    scene::parse(paper_wedge_scene(), "paper", &overrides)
+        .and_then(|s| s.validate("paper"))
+        .unwrap_or_else(|e| panic!("{overrides:?}: {e}"))
+}
+
+/// Every event an observer receives, in order, as text (`{:?}` of an f64 is its shortest
+/// round-trip form, so equal texts are equal bits, NaN included).
+#[derive(Default)]
+struct Recorder {
+    events: Vec<String>,
+    /// Points received without an estimate.
+    without_estimate: usize,
+}
+
+impl FrfObserver for Recorder {
+    fn point(&mut self, point: &FrfPoint) {
+        if point.accuracy.is_none() || point.pending_estimate.is_some() {
+            self.without_estimate += 1;
+        }
+        self.events.push(format!("point {point:?}"));
+    }
+    fn step_cut(&mut self, freq_hz: f64, step: f64, new_step: f64, reason: &NewtonFailure) {
+        self.events
+            .push(format!("cut {freq_hz:?} {step:?} {new_step:?} {reason:?}"));
+    }
+    fn turning_point(&mut self, freq_hz: f64) {
+        self.events.push(format!("turn {freq_hz:?}"));
+    }
+    fn leap(&mut self, from_hz: f64, to_hz: f64) {
+        self.events.push(format!("leap {from_hz:?} {to_hz:?}"));
+    }
+    fn narrow_pass(&mut self, from_hz: f64, to_hz: f64) {
+        self.events.push(format!("narrow {from_hz:?} {to_hz:?}"));
+    }
+    fn jump(&mut self, jump: &Jump) {
+        self.events.push(format!("jump {jump:?}"));
+    }
+    fn cut_judged(&mut self, index: usize, jump: &Jump) {
+        self.events.push(format!("judged {index} {jump:?}"));
+    }
+}
+
+fn run_recorded(p: &Problem) -> (FrfRun, Recorder) {
+    let mut recorder = Recorder::default();
+    let run = frf::solve(p, &mut recorder).unwrap();
+    (run, recorder)
+}
+
+/// The points of a run as text, without the timing.
+fn points_text(run: &FrfRun) -> String {
+    format!(
+        "{:?} {:?} {:?} {:?}",
+        run.points, run.jumps, run.turning_points, run.leaps
+    )
+}
+
+#[test]
+fn estimates_on_workers_equal_the_inline_ones_and_keep_the_events_in_order() {
+    let p = paper(&["static_loads.0.value=-1"]);
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let (inline, inline_events) = one.install(|| {
+        assert_eq!(
+            EstimatePool::default_workers(),
+            0,
+            "inline inside a rayon job"
+        );
+        run_recorded(&p)
+    });
+    let pooled_workers = std::thread::spawn(EstimatePool::default_workers)
+        .join()
+        .unwrap();
+    assert!(pooled_workers >= 1, "{pooled_workers}");
+    let (pooled, pooled_events) = std::thread::spawn(move || run_recorded(&p)).join().unwrap();
+
+    let kinds: Vec<JumpKind> = inline.jumps.iter().map(|j| j.kind).collect();
+    assert!(
+        kinds.contains(&JumpKind::Bridge) && kinds.contains(&JumpKind::PastDeadEnd),
+        "{kinds:?}"
+    );
+    assert!(inline.points.len() > 100, "{}", inline.points.len());
+    assert!(inline.points.iter().all(|q| q.accuracy.is_some()));
+    assert!(pooled
+        .points
+        .iter()
+        .all(|q| q.accuracy.is_some() && q.pending_estimate.is_none()));
+    assert_eq!(points_text(&inline), points_text(&pooled));
+    assert_eq!(inline_events.without_estimate, 0);
+    assert_eq!(pooled_events.without_estimate, 0);
+    assert_eq!(inline_events.events.len(), pooled_events.events.len());
+    for (k, (a, b)) in inline_events
+        .events
+        .iter()
+        .zip(&pooled_events.events)
+        .enumerate()
+    {
+        assert_eq!(a, b, "event {k}");
+    }
+}
