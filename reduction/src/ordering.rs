@@ -1,5 +1,16 @@
 //! Fill-reducing orderings: METIS nested dissection (through `metis-sys`,
 //! which vendors METIS 5 and builds it with the C compiler) or faer's AMD.
+//!
+//! METIS draws its random numbers from one Mersenne Twister whose state is a
+//! plain static of the process (GKlib's `random.c`), reseeded at the start of
+//! every `METIS_NodeND`. Two orderings computed at the same time on different
+//! threads (a limit analysis's curves, the settings of an accuracy study, tests
+//! run in parallel) would draw from that one state in an order set by the
+//! scheduler, and so get different orderings of the same graph from run to run,
+//! hence factorisations that differ by round-off (measured: reduced mass
+//! matrices of the 2D blade pair 10⁻¹¹ apart, enough to move a continuation
+//! path next to its folds). Every call therefore holds [`METIS_LOCK`]: the
+//! ordering of a graph is the same whatever runs beside it.
 
 use crate::csc::Csc;
 use crate::ReductionError;
@@ -23,6 +34,9 @@ impl std::fmt::Display for Ordering {
         }
     }
 }
+
+/// Held through every call into METIS (see the module docs).
+static METIS_LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 /// Nested-dissection ordering of the graph of the symmetric matrix whose lower
 /// triangle is `lower`. Returns `(fwd, inv)` with `fwd[new] = old` and
@@ -72,6 +86,11 @@ pub(crate) fn metis_nd(lower: &Csc) -> Result<(Vec<usize>, Vec<usize>), Reductio
     let mut options = [0i32; metis_sys::METIS_NOPTIONS as usize];
     let mut perm = vec![0i32; n];
     let mut iperm = vec![0i32; n];
+    // A poisoned lock only means another ordering panicked; METIS' state is
+    // reseeded by the next call, so the lock is taken all the same.
+    let _metis = METIS_LOCK
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     // SAFETY: arrays have the sizes METIS expects (xadj n+1, adjncy xadj[n],
     // options METIS_NOPTIONS, perm/iperm n); METIS does not keep pointers.
     let status = unsafe {
