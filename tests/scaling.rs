@@ -101,15 +101,13 @@ fn measured_frf_reaches_the_window_end() {
     // replaced).
     assert_eq!(m.formulation, "schur");
     // The path reaches the window's end with every stretch on a branch. Whether it also keeps
-    // every branch (`complete`) is not asserted here: on this scene it depends on round-off.
-    // The reduced matrices differ by about 1e-11 relative from run to run when other threads
-    // run at the same time (the reduction's kernels are sequential and its random start is
-    // seeded; the order of floating-point sums in SIMD kernels that depends on the alignment
-    // of their operands is the likely cause, not pinned down), and the path near the folds at
-    // 908-914 Hz then differs
-    // (984 to 1 158 points); in 10 of 110 runs of this test binary (and 2 of 18 solves on
-    // concurrent threads) it gives a branch up at 913.55 Hz with the amplitude falling and the
-    // run is `incomplete`, as it should say then.
+    // every branch (`complete`) is not asserted here: next to the folds at 908-914 Hz it
+    // depends on round-off, so on a processor whose kernels round differently the path may
+    // take other steps. Until METIS orderings were serialised (`fricbound_reduction::ordering`)
+    // the reduced matrices differed by about 1e-11 from run to run when other tests ran beside
+    // this one, and the path with them (984 to 1 158 points; in 10 of 110 runs a branch given
+    // up at 913.55 Hz, the run `incomplete`, as it should say then); since, 8 runs of this
+    // binary out of 8 gave the same 984 points, complete.
     assert!(m.frf && m.covered, "{m:?}");
     if !m.complete {
         eprintln!("this run abandoned a branch: {m:?}");
