@@ -10,7 +10,7 @@ mod support;
 
 use std::path::Path;
 
-use fricbound::analysis::frf::PointSolver;
+use fricbound::analysis::frf::{CutVerdict, PointSolver};
 use fricbound::analysis::linear::stuck_guess;
 use fricbound::contact::{ContactState, FrictionLaw};
 use fricbound::model::{Formulation, Problem};
@@ -294,6 +294,59 @@ fn the_3d_frf_over_the_bending_pair_is_one_complete_path_through_both_folds() {
     assert!(peak > points[bottom].1 && (874.5..876.0).contains(&peak_hz));
     assert!((points.last().unwrap().0 - 900.0).abs() < 1e-9);
     let _ = std::fs::remove_dir_all(&out);
+}
+
+/// Over 845-900 Hz (another window, so other arc-length scales than 840-900 Hz) the path
+/// comes up the lower branch to the spot at 886.85 Hz, next to the lower branch's fold, where
+/// the corrector fails at every step and no corner is found, and leaps from 886.8476 to
+/// 887.41 Hz: onto the upper branch's flank, past the fold, leaving out the middle and upper
+/// branches and the resonance peak. Followed back from the landing the path reaches 886.8476
+/// Hz on the flank, far from the point before the leap, so the leap is judged abandoned and
+/// the run incomplete (it used to say `complete`). Independently, Newton at 886.8476 Hz from
+/// the landing converges to a solution of about the amplitude the path back reached, far
+/// from the point before the leap: two solutions at that frequency, the leap went from one to
+/// the other.
+#[test]
+fn a_leap_past_the_lower_fold_is_judged_abandoned_and_the_run_incomplete() {
+    let problem = problem(&[
+        "analysis.freq_start_hz=845",
+        "analysis.freq_end_hz=900",
+        "accuracy.estimate=false",
+    ]);
+    let run =
+        fricbound::analysis::frf::solve(&problem, &mut fricbound::analysis::frf::Silent).unwrap();
+    println!("leaps {:?}, checks {:?}", run.leaps, run.leap_checks);
+    assert_eq!(run.leap_checks.len(), run.leaps.len());
+    let check = run
+        .leap_checks
+        .iter()
+        .find(|c| (886.8..886.9).contains(&c.from_hz))
+        .expect("a leap from the lower branch's fold region");
+    assert!(check.to_hz > 887.0, "{check:?}");
+    assert_eq!(check.verdict, CutVerdict::Abandoned, "{check:?}");
+    let (before, back) = (
+        check.before_amplitude.unwrap(),
+        check.back_amplitude.unwrap(),
+    );
+    assert!(back > 2.0 * before, "{check:?}");
+    assert!(check.distance.unwrap() > 0.1, "{check:?}");
+    let reason = run.incomplete_reason().expect("the run is incomplete");
+    assert!(reason.contains("leapt from 886.8"), "{reason}");
+    assert!(!run.is_complete());
+
+    let landing = run
+        .points
+        .iter()
+        .find(|p| p.freq_hz == check.to_hz)
+        .expect("the landing is a point of the run");
+    let mut solver = PointSolver::new(&problem).unwrap();
+    let there = solver.solve(&landing.coefficients, check.from_hz).unwrap();
+    println!(
+        "Newton at {:.4} Hz from the landing: {:.4e} m; the path back reached {back:.4e} m, \
+         the point before the leap is at {before:.4e} m",
+        check.from_hz, there.amplitudes[0]
+    );
+    assert!((there.amplitudes[0] - back).abs() < 1e-2 * back);
 }
 
 /// The m = −1 limit curve over 840-900 Hz comes up to a fold at 868.68 Hz, down a branch

@@ -146,6 +146,14 @@ fn branches_given_up_at_a_low_preload_are_classified_as_newton_finds_them() {
     );
     let sol = json(&out_dir.join("solution.json"));
     let status = sol["status"].as_str().unwrap().to_string();
+    // Each leap of the run is judged in solution.json as in the library.
+    let checks = sol["leap_checks"].as_array().unwrap();
+    assert_eq!(checks.len(), run.leap_checks.len());
+    assert_eq!(checks.len(), sol["leaps_hz"].as_array().unwrap().len());
+    for (c, l) in checks.iter().zip(&run.leap_checks) {
+        assert_eq!(c["verdict"], "covered");
+        assert_eq!(c["from_hz"].as_f64().unwrap(), l.from_hz);
+    }
     let flagged = sol["jumps"]
         .as_array()
         .unwrap()
@@ -337,4 +345,55 @@ fn cuts_of_fills_and_bridges_are_judged_by_newton_past_them() {
         }),
         "{judged_at_5n:?}"
     );
+}
+
+/// At F0 = 1 N the path leaps once, from 19.0467 to 19.2388 Hz, over a corner of the sampled
+/// contact law. Followed back from the landing, the path reaches 19.0467 Hz on the piece of
+/// the solution curve next to the one the leap left, within the run's 1 % of the point before
+/// the leap: the leap is covered. Independently, Newton at 19.0467 Hz from the landing
+/// converges to a solution within 1 % of that point too (on all Fourier coefficients).
+#[test]
+fn a_leap_over_a_corner_at_a_low_preload_is_covered_as_newton_finds() {
+    let p = paper(&["static_loads.0.value=-1"]);
+    let run = frf::solve(&p, &mut Silent).unwrap();
+    assert!(!run.leaps.is_empty(), "no leap at F0 = 1 N");
+    assert_eq!(run.leap_checks.len(), run.leaps.len());
+    let mut solver = PointSolver::new(&p).unwrap();
+    for check in &run.leap_checks {
+        eprintln!("{check:?}");
+        assert_eq!(check.verdict, CutVerdict::Covered, "{check:?}");
+        let d = check.distance.unwrap();
+        assert!(d <= frf::RETRACE_TOLERANCE, "{check:?}");
+        assert!(check.points >= 2);
+        let i = run
+            .points
+            .iter()
+            .position(|q| q.freq_hz == check.to_hz)
+            .expect("the landing is a point of the run");
+        let before = &run.points[i - 1];
+        assert_eq!(before.freq_hz, check.from_hz);
+        let there = solver
+            .solve(&run.points[i].coefficients, check.from_hz)
+            .unwrap();
+        let norm = before
+            .coefficients
+            .iter()
+            .map(|v| v * v)
+            .sum::<f64>()
+            .sqrt();
+        let apart = there
+            .coefficients
+            .iter()
+            .zip(&before.coefficients)
+            .map(|(a, b)| (a - b).powi(2))
+            .sum::<f64>()
+            .sqrt()
+            / norm;
+        eprintln!(
+            "Newton at {:.4} Hz from the landing: {apart:.3e} from the point before",
+            check.from_hz
+        );
+        assert!(apart <= frf::RETRACE_TOLERANCE, "{apart}");
+    }
+    assert!(run.is_complete(), "{:?}", run.incomplete_reason());
 }

@@ -253,7 +253,7 @@ pub fn points_dict<'py>(py: Python<'py>, points: &[FrfPoint]) -> PyResult<Bound<
 
 /// An FRF run: its points ([`points_dict`]), the names ([`problem_names`]), how it ended
 /// (`status`: `complete` or `incomplete: <reason>`, as in `solution.json`), turning points,
-/// leaps, jumps, cut steps, wall time, and `csv`: the run's `frf.csv` text as the CLI writes it.
+/// leaps and their judgement (`leap_checks`), jumps, cut steps, wall time, and `csv`: the run's `frf.csv` text as the CLI writes it.
 pub fn frf_dict<'py>(
     py: Python<'py>,
     problem: &Problem,
@@ -267,6 +267,20 @@ pub fn frf_dict<'py>(
     )?;
     d.set_item("turning_points_hz", run.turning_points.clone())?;
     d.set_item("leaps_hz", run.leaps.clone())?;
+    // The judgement of each leap, as `leap_checks` in solution.json.
+    let leap_checks = PyList::empty(py);
+    for c in &run.leap_checks {
+        let cd = PyDict::new(py);
+        cd.set_item("from_hz", c.from_hz)?;
+        cd.set_item("to_hz", c.to_hz)?;
+        cd.set_item("before_amplitude", c.before_amplitude)?;
+        cd.set_item("back_amplitude", c.back_amplitude)?;
+        cd.set_item("distance", c.distance)?;
+        cd.set_item("points", c.points)?;
+        cd.set_item("verdict", json_name(&c.verdict)?)?;
+        leap_checks.append(cd)?;
+    }
+    d.set_item("leap_checks", leap_checks)?;
     let jumps = PyList::empty(py);
     for j in &run.jumps {
         let jd = PyDict::new(py);

@@ -37,7 +37,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use sha2::{Digest, Sha256};
 
 use crate::analysis::frf::{
-    self, CutCheck, FrfError, FrfObserver, FrfPoint, GivenUp, Jump, JumpKind,
+    self, CutCheck, FrfError, FrfObserver, FrfPoint, GivenUp, Jump, JumpKind, LeapCheck,
 };
 use crate::analysis::limits::LimitSettings;
 use crate::analysis::linear::{self, LinearCase};
@@ -415,6 +415,18 @@ impl FrfObserver for RunObserver<'_> {
                 }
             );
             self.say(msg);
+        }
+    }
+    fn leap_judged(&mut self, check: &LeapCheck) {
+        self.writer.leap_judged(check);
+        // An uncovered leap is always said, as an uncovered cut is.
+        if check.uncovered() {
+            self.say(format!(
+                "NOT COVERED: {}; the run will be reported incomplete",
+                check.describe()
+            ));
+        } else if !self.quiet {
+            self.say(check.describe());
         }
     }
     fn leap(&mut self, from_hz: f64, to_hz: f64) {

@@ -15,7 +15,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::analysis::error_estimate::EstimateMethod;
-use crate::analysis::frf::{FrfObserver, FrfPoint, Jump};
+use crate::analysis::frf::{FrfObserver, FrfPoint, Jump, LeapCheck};
 use crate::analysis::linear::LinearCurve;
 use crate::analysis::peaks::{ExtremumKind, PathExtremum};
 use crate::contact::ContactState;
@@ -287,6 +287,9 @@ struct SolutionFile<'a> {
     turning_points_hz: &'a [f64],
     step_cuts: &'a [StepCut],
     leaps_hz: &'a [(f64, f64)],
+    /// The judgement of each leap, in the order of `leaps_hz`; omitted when none.
+    #[serde(skip_serializing_if = "<[_]>::is_empty")]
+    leap_checks: &'a [LeapCheck],
     /// Stalls passed over a narrow window around them (last point before the stall, first
     /// point outside the window), Hz; omitted when none.
     #[serde(skip_serializing_if = "<[_]>::is_empty")]
@@ -397,6 +400,7 @@ pub struct FrfWriter {
     turning_points: Vec<f64>,
     step_cuts: Vec<StepCut>,
     leaps: Vec<(f64, f64)>,
+    leap_checks: Vec<LeapCheck>,
     narrow_passes: Vec<(f64, f64)>,
     jumps: Vec<Jump>,
     /// Refined extrema, set by [`Self::write_peaks`].
@@ -451,6 +455,7 @@ impl FrfWriter {
             turning_points: Vec::new(),
             step_cuts: Vec::new(),
             leaps: Vec::new(),
+            leap_checks: Vec::new(),
             narrow_passes: Vec::new(),
             jumps: Vec::new(),
             peaks: None,
@@ -502,6 +507,7 @@ impl FrfWriter {
             turning_points_hz: &self.turning_points,
             step_cuts: &self.step_cuts,
             leaps_hz: &self.leaps,
+            leap_checks: &self.leap_checks,
             narrow_passes_hz: &self.narrow_passes,
             jumps: &self.jumps,
             coefficients_file: (!inline).then(|| CoefficientsFile {
@@ -659,6 +665,10 @@ impl FrfObserver for FrfWriter {
         if let Some(j) = self.jumps.get_mut(index) {
             *j = *jump;
         }
+    }
+
+    fn leap_judged(&mut self, check: &LeapCheck) {
+        self.leap_checks.push(*check);
     }
 }
 
