@@ -153,7 +153,14 @@ class FrfResult(ContinuationPath):
     :class:`ContinuationPath`, plus
 
     - ``status``: ``complete`` or ``incomplete: <reason>`` (as ``solution.json``);
-    - ``turning_points_hz``, ``leaps_hz``, ``jumps``, ``rejected_steps``, ``elapsed_s``;
+    - ``turning_points_hz``, ``leaps_hz``, ``leap_checks``, ``jumps``, ``rejected_steps``,
+      ``elapsed_s``; each leap check is a dict ``from_hz``, ``to_hz``, ``before_amplitude``
+      (m, the point before the leap), ``back_amplitude`` (m, where the path followed back from
+      the landing reached ``from_hz``; None when it did not), ``distance`` (relative, on all
+      Fourier coefficients, between the two), ``points`` (of the path back) and ``verdict``
+      (``covered`` within 1 %, ``abandoned`` beyond: the leap crossed onto another branch,
+      ``unjudged``: the path back did not reach ``from_hz``; the last two make ``status``
+      ``incomplete``);
       each jump is a dict ``from_hz``, ``to_hz``, ``first_point``, ``kind``
       (``past-fold``, ``past-dead-end``, ``bridge``), ``abandoned`` (True when the branch
       before it was abandoned inside the range: the response beyond its last point is

@@ -284,6 +284,30 @@ def test_jumps_name_causes_and_verdicts_as_solution_json(cli_binary, tmp_path):
     assert any(j["cut_verdict"] == "covered" for j in jumps)
 
 
+def test_leap_checks_as_solution_json(cli_binary, tmp_path):
+    """At a pre-load of 1 N the path leaps once over a corner of the sampled contact law; the
+    leap's judgement (the path followed back from the landing) is the same in Python as in the
+    CLI's solution.json, and covered."""
+    overrides = {"static_loads.0.value": -1.0, "accuracy.estimate": False}
+    scene = Scene.paper()
+    for field, value in overrides.items():
+        scene.set(field, value)
+    out = tmp_path / "cli"
+    cli = [str(cli_binary), "run", "--quiet", "--out", str(out)]
+    for field, value in overrides.items():
+        cli += ["--set", f"{field}={str(value).lower()}"]
+    subprocess.run(cli, check=True)
+    with open(out / "solution.json") as f:
+        expected = json.load(f)["leap_checks"]
+    got = fricbound.run(scene).leap_checks
+    assert len(got) == len(expected) > 0
+    for g, w in zip(got, expected):
+        assert g["verdict"] == w["verdict"] == "covered"
+        assert g["from_hz"] == w["from_hz"] and g["to_hz"] == w["to_hz"]
+        assert g["distance"] == pytest.approx(w["distance"], rel=1e-9)
+        assert g["points"] == w["points"]
+
+
 def test_incomplete_and_too_large_runs_say_so():
     """A run that uses up its point budget is returned as incomplete (the CLI's exit code 3);
     a scene estimated not to fit in memory is refused before anything is solved."""
