@@ -258,11 +258,10 @@ def test_linear_references_equal_the_cli_files(cli_binary, tmp_path):
     assert len(fricbound.linear(scene, "stuck", points=11).freq_hz) == 11
 
 
-def test_jumps_name_causes_and_verdicts_as_solution_json(cli_binary, tmp_path):
-    """At a pre-load of 5 N the path jumps past a dead end and the fill after it is cut and
-    judged: each jump's kind, how the branch before it ended, why it was given up and the
-    cut's verdict carry the same names in Python as in the CLI's solution.json."""
-    overrides = {"static_loads.0.value": -5.0, "accuracy.estimate": False}
+def _paper_and_cli_solution(cli_binary, tmp_path, static_load):
+    """The paper's scene at the static load `static_load` (N) without the error estimate, and
+    the CLI's solution.json of the same scene."""
+    overrides = {"static_loads.0.value": static_load, "accuracy.estimate": False}
     scene = Scene.paper()
     for field, value in overrides.items():
         scene.set(field, value)
@@ -272,7 +271,15 @@ def test_jumps_name_causes_and_verdicts_as_solution_json(cli_binary, tmp_path):
         cli += ["--set", f"{field}={str(value).lower()}"]
     subprocess.run(cli, check=True)
     with open(out / "solution.json") as f:
-        expected = json.load(f)["jumps"]
+        return scene, json.load(f)
+
+
+def test_jumps_name_causes_and_verdicts_as_solution_json(cli_binary, tmp_path):
+    """At a pre-load of 5 N the path jumps past a dead end and the fill after it is cut and
+    judged: each jump's kind, how the branch before it ended, why it was given up and the
+    cut's verdict carry the same names in Python as in the CLI's solution.json."""
+    scene, solution = _paper_and_cli_solution(cli_binary, tmp_path, -5.0)
+    expected = solution["jumps"]
     jumps = fricbound.run(scene).jumps
     assert len(jumps) == len(expected) > 0
     for got, want in zip(jumps, expected):
@@ -288,17 +295,8 @@ def test_leap_checks_as_solution_json(cli_binary, tmp_path):
     """At a pre-load of 1 N the path leaps once over a corner of the sampled contact law; the
     leap's judgement (the path followed back from the landing) is the same in Python as in the
     CLI's solution.json, and covered."""
-    overrides = {"static_loads.0.value": -1.0, "accuracy.estimate": False}
-    scene = Scene.paper()
-    for field, value in overrides.items():
-        scene.set(field, value)
-    out = tmp_path / "cli"
-    cli = [str(cli_binary), "run", "--quiet", "--out", str(out)]
-    for field, value in overrides.items():
-        cli += ["--set", f"{field}={str(value).lower()}"]
-    subprocess.run(cli, check=True)
-    with open(out / "solution.json") as f:
-        expected = json.load(f)["leap_checks"]
+    scene, solution = _paper_and_cli_solution(cli_binary, tmp_path, -1.0)
+    expected = solution["leap_checks"]
     got = fricbound.run(scene).leap_checks
     assert len(got) == len(expected) > 0
     for g, w in zip(got, expected):
