@@ -168,17 +168,18 @@ impl<'p> EstimatePool<'p> {
         Submitted::Pending(ticket)
     }
 
-    /// The estimate of `ticket` if it has come in, without waiting.
+    /// The estimate of `ticket` if it has come in, without waiting; handed over once (the
+    /// pool keeps no copy).
     pub fn get(&self, ticket: EstimateTicket) -> Option<PointAccuracy> {
         let mut done = self.done.borrow_mut();
         while let Ok((t, accuracy)) = self.results.try_recv() {
             done.insert(t, accuracy);
         }
-        done.get(&ticket).cloned()
+        done.remove(&ticket)
     }
 
     /// The estimate of `ticket`, waiting for it; None when it cannot come any more (every
-    /// worker has stopped).
+    /// worker has stopped). Handed over once, as by [`Self::get`].
     pub fn wait(&self, ticket: EstimateTicket) -> Option<PointAccuracy> {
         let mut done = self.done.borrow_mut();
         while !done.contains_key(&ticket) {
@@ -189,7 +190,7 @@ impl<'p> EstimatePool<'p> {
                 Err(_) => return None,
             }
         }
-        done.get(&ticket).cloned()
+        done.remove(&ticket)
     }
 }
 

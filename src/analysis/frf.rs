@@ -1833,9 +1833,9 @@ fn judge_leaps<O: FrfObserver>(
     run: &mut FrfRun,
     observer: &mut O,
 ) {
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1.0);
     for k in 0..run.leaps.len() {
         let (from_hz, to_hz) = run.leaps[k];
-        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1.0);
         let at = (1..run.points.len()).find(|&i| {
             close(run.points[i - 1].freq_hz, from_hz) && close(run.points[i].freq_hz, to_hz)
         });
@@ -1859,19 +1859,8 @@ fn judge_leaps<O: FrfObserver>(
             if let (true, Some(end)) = (reached, back.last()) {
                 check.back_amplitude = end.amplitudes.first().copied();
                 let omega = 2.0 * PI * end.freq_hz;
-                let guess = system.restrict(&before.coefficients);
-                let own = newton
-                    .solve_fixed(system, &guess, omega)
-                    .ok()
-                    .and_then(|p| system.expand(&p.x, omega).ok());
-                if let Some(own) = own {
-                    let norm = crate::numerics::linalg::norm(&own);
-                    let squared: f64 = own
-                        .iter()
-                        .zip(&end.coefficients)
-                        .map(|(a, b)| (a - b).powi(2))
-                        .sum();
-                    let d = squared.sqrt() / norm;
+                if let Some(own) = newton_at(system, newton, &before.coefficients, omega) {
+                    let d = relative_distance(&end.coefficients, &own);
                     check.distance = Some(d);
                     check.verdict = if d <= RETRACE_TOLERANCE {
                         CutVerdict::Covered
@@ -2208,20 +2197,31 @@ fn resolve_crossing(
         .map(|(a, b)| a + t * (b - a))
         .collect();
     let nearer = if t < 0.5 { p } else { q };
-    let norm = crate::numerics::linalg::norm(&landing.coefficients);
-    let starts = [interpolated.as_slice(), nearer.coefficients.as_slice()];
-    let apart = starts.into_iter().find_map(|start| {
-        let guess = system.restrict(start);
-        let solved = newton.solve_fixed(system, &guess, omega).ok()?;
-        let c = system.expand(&solved.x, omega).ok()?;
-        let squared: f64 = c
-            .iter()
-            .zip(&landing.coefficients)
-            .map(|(a, b)| (a - b).powi(2))
-            .sum();
-        Some(squared.sqrt() / norm)
-    });
-    apart
+    for start in [interpolated.as_slice(), nearer.coefficients.as_slice()] {
+        if let Some(c) = newton_at(system, newton, start, omega) {
+            return Some(relative_distance(&c, &landing.coefficients));
+        }
+    }
+    None
+}
+
+/// Newton's solution at ω = `omega` (rad/s) from the full coefficients `start`, on full
+/// coefficients; None when it does not converge.
+fn newton_at(
+    system: &mut HbmOperator<'_>,
+    newton: &Continuation,
+    start: &[f64],
+    omega: f64,
+) -> Option<Vec<f64>> {
+    let guess = system.restrict(start);
+    let solved = newton.solve_fixed(system, &guess, omega).ok()?;
+    system.expand(&solved.x, omega).ok()
+}
+
+/// ‖a − reference‖ / ‖reference‖ over all coefficients.
+fn relative_distance(a: &[f64], reference: &[f64]) -> f64 {
+    let squared: f64 = a.iter().zip(reference).map(|(u, v)| (u - v).powi(2)).sum();
+    squared.sqrt() / crate::numerics::linalg::norm(reference)
 }
 
 /// Point budget of each direction of a bridge branch (see [`Branching::bridge`]).
