@@ -9,8 +9,11 @@
 //! its points come from the run's path, from fills followed silently (their estimates pending
 //! until the run reports them) and from fixed-frequency solves.
 
-use fricbound::analysis::estimate_pool::EstimatePool;
-use fricbound::analysis::frf::{self, FrfObserver, FrfPoint, FrfRun, Jump, JumpKind};
+use std::f64::consts::PI;
+
+use fricbound::analysis::error_estimate::{EstimateMethod, EstimateProblems, PointAccuracy};
+use fricbound::analysis::estimate_pool::{EstimatePool, Submitted};
+use fricbound::analysis::frf::{self, FrfObserver, FrfPoint, FrfRun, Jump, JumpKind, Silent};
 use fricbound::model::Problem;
 use fricbound::numerics::NewtonFailure;
 use fricbound::scene::{self, paper_wedge_scene};
@@ -117,4 +120,49 @@ fn estimates_on_workers_equal_the_inline_ones_and_keep_the_events_in_order() {
     {
         assert_eq!(a, b, "event {k}");
     }
+}
+
+/// What the pool gives for a job whose estimator panics (a point of the wrong length: the
+/// estimator indexes past its end) followed by a good point, with `workers` workers: the
+/// panicking job's estimate and then the good one's (None where no worker is left).
+fn after_a_panic(workers: usize) -> (Option<PointAccuracy>, Option<PointAccuracy>) {
+    let p = paper(&["analysis.freq_start_hz=100", "analysis.freq_end_hz=101"]);
+    let refined = EstimateProblems::new(&p).expect("the estimate is on by default");
+    let run = frf::solve(&p, &mut Silent).expect("FRF over 100-101 Hz");
+    let point = &run.points[0];
+    let omega = 2.0 * PI * point.freq_hz;
+    std::thread::scope(|scope| {
+        let pool = EstimatePool::start(scope, &p, &refined, workers).expect("pool");
+        let wait = |x: &[f64]| match pool.submit(x, omega, None, &point.states) {
+            Submitted::Ready(_) => panic!("{workers} workers estimate inline"),
+            Submitted::Pending(ticket) => pool.wait(ticket),
+        };
+        (wait(&[]), wait(&point.coefficients))
+    })
+}
+
+/// A panic inside an estimate worker does not leave the run waiting for that point's
+/// estimate for ever: the point gets a NaN estimate (not formed), its worker stops, and the
+/// other workers estimate the points after it; with no worker left the next estimate is
+/// reported lost (None) instead of waited for. Run under a watchdog, so that a regression
+/// fails the test instead of hanging it.
+#[test]
+fn a_panicking_estimate_is_not_formed_and_the_pool_goes_on() {
+    let (sender, receiver) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = sender.send((after_a_panic(2), after_a_panic(1)));
+    });
+    let ((bad, good), (bad_alone, after)) = receiver
+        .recv_timeout(std::time::Duration::from_secs(300))
+        .expect("the pool answered within 5 minutes");
+    for bad in [bad, bad_alone] {
+        let bad = bad.expect("the panicking job is answered");
+        assert_eq!(bad.method, EstimateMethod::None);
+        assert!(bad.truncation.iter().all(|v| v.is_nan()), "{bad:?}");
+        assert!(bad.sampling.iter().all(|v| v.is_nan()), "{bad:?}");
+    }
+    let good = good.expect("the other worker estimates the next point");
+    assert_ne!(good.method, EstimateMethod::None, "{good:?}");
+    assert!(good.truncation.iter().all(|v| v.is_finite()), "{good:?}");
+    assert!(after.is_none(), "{after:?}");
 }

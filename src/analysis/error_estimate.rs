@@ -162,6 +162,25 @@ pub struct PointAccuracy {
     pub method: EstimateMethod,
 }
 
+impl PointAccuracy {
+    /// The estimate of a point where none could be formed: NaN for each of `outputs` output
+    /// DOFs, no method.
+    pub fn not_formed(outputs: usize) -> Self {
+        Self {
+            truncation: vec![f64::NAN; outputs],
+            sampling: vec![f64::NAN; outputs],
+            across_path: false,
+            path_normal: None,
+            both_truncation: None,
+            slide_and_step: (f64::NAN, f64::NAN),
+            estimate_harmonic: 0,
+            step_changes_regime: false,
+            contraction: f64::NAN,
+            method: EstimateMethod::None,
+        }
+    }
+}
+
 /// Where the path is at a converged point, for the estimate across it: the hyperplane normal
 /// to the path (see [`crate::numerics::Observer::accepted`]) and the arc-length step
 /// (Hz-equivalent) that reached the point.
@@ -699,18 +718,7 @@ impl<'p> ErrorEstimator<'p> {
         let stuck_contact = states.contains(&ContactState::Stuck);
         let n = self.problem.model.n_dofs();
         let base = amplitudes(self.problem, &self.set, x);
-        let nan = || PointAccuracy {
-            truncation: vec![f64::NAN; base.len()],
-            sampling: vec![f64::NAN; base.len()],
-            across_path: false,
-            path_normal: None,
-            both_truncation: None,
-            slide_and_step: (f64::NAN, f64::NAN),
-            estimate_harmonic: 0,
-            step_changes_regime: false,
-            contraction: f64::NAN,
-            method: EstimateMethod::None,
-        };
+        let nan = || PointAccuracy::not_formed(base.len());
         let xr = self.truncation.padded(n, x);
         let dim = xr.len();
         let mut r = vec![0.0; dim];

@@ -17,12 +17,18 @@
 //! owns an estimator, and each estimator factorises on a one-thread pool of its own
 //! ([`ErrorEstimator::estimate`]).
 //!
+//! A panic inside an estimator (a bug: the estimator does not panic on user data) gives that
+//! point a NaN estimate, as one that cannot be formed, and stops that worker; the others take
+//! the jobs still queued, and with none left the points still waiting go without an estimate
+//! ([`EstimatePool::wait`] returns None) instead of the run waiting for ever.
+//!
 //! Written by hand on the standard library's scoped threads and channels: the estimators
 //! borrow the problem, so the workers must be scoped to the run, and rayon's scoped spawns
 //! would run on its global pool, whose threads the estimate's factorisations are kept off.
 
 use std::cell::RefCell;
 use std::collections::HashMap;
+use std::panic::AssertUnwindSafe;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 use std::thread::Scope;
@@ -114,8 +120,17 @@ impl<'p> EstimatePool<'p> {
                         normal,
                         step: *step,
                     });
-                    let accuracy = estimator.estimate(&job.x, job.omega, path, &job.states);
-                    if report.send((job.ticket, accuracy)).is_err() {
+                    // A panic inside the estimator (a bug, not user data) must not leave the
+                    // run waiting for this ticket for ever: the point goes without an
+                    // estimate (NaN, as one that cannot be formed) and the worker, whose
+                    // estimator may be left half-updated, stops; the others go on.
+                    let estimated = std::panic::catch_unwind(AssertUnwindSafe(|| {
+                        estimator.estimate(&job.x, job.omega, path, &job.states)
+                    }));
+                    let panicked = estimated.is_err();
+                    let accuracy = estimated
+                        .unwrap_or_else(|_| PointAccuracy::not_formed(problem.outputs.len()));
+                    if report.send((job.ticket, accuracy)).is_err() || panicked {
                         return;
                     }
                 });

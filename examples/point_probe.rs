@@ -1,0 +1,70 @@
+//! Newton at fixed frequencies from one point of a run's `solution.json` (exploration aid).
+//! Usage: cargo run --release --example point_probe -- SCENE SOLUTION INDEX F1 [F2 ...] [-- FIELD=VALUE ...]
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let split = args.iter().position(|a| a == "--").unwrap_or(args.len());
+    let (head, overrides) = (
+        &args[..split],
+        args.get(split + 1..).unwrap_or(&[]).to_vec(),
+    );
+    let (_, problem) =
+        fricbound::scene::load_problem(std::path::Path::new(&head[0]), &overrides).unwrap();
+    let text = std::fs::read_to_string(&head[1]).unwrap();
+    let sol: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let index: usize = head[2].parse().unwrap();
+    let point = &sol["points"][index];
+    let x0: Vec<f64> = point["coefficients"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    println!(
+        "point {index}: {} Hz, {:?}",
+        point["freq_hz"], point["amplitudes"]
+    );
+    let mut solver = fricbound::analysis::frf::PointSolver::new(&problem).unwrap();
+    let mut x0 = x0;
+    let mut chain = false;
+    for f in &head[3..] {
+        if let Some(j) = f.strip_prefix("mirror") {
+            // Reflect the point through `index`: 2 x_index − x_j.
+            let j: usize = j.parse().unwrap();
+            let xj: Vec<f64> = sol["points"][j]["coefficients"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_f64().unwrap())
+                .collect();
+            x0 = x0.iter().zip(&xj).map(|(a, b)| 2.0 * a - b).collect();
+            println!("mirror of {j} ({} Hz)", sol["points"][j]["freq_hz"]);
+            continue;
+        }
+        if f == "chain" {
+            chain = true;
+            continue;
+        }
+        let f: f64 = f.parse().unwrap();
+        match solver.solve(&x0, f) {
+            Ok(q) => {
+                let d: f64 = q
+                    .coefficients
+                    .iter()
+                    .zip(&x0)
+                    .map(|(a, b)| (a - b) * (a - b))
+                    .sum::<f64>()
+                    .sqrt()
+                    / x0.iter().map(|a| a * a).sum::<f64>().sqrt();
+                println!(
+                    "{f} Hz: {:?} its {} distance {d:.3e}",
+                    q.amplitudes, q.newton_iterations
+                );
+                if chain {
+                    x0 = q.coefficients.clone();
+                }
+            }
+            Err(e) => println!("{f} Hz: {e}"),
+        }
+    }
+}
