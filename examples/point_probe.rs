@@ -1,5 +1,9 @@
 //! Newton at fixed frequencies from one point of a run's `solution.json` (exploration aid).
 //! Usage: cargo run --release --example point_probe -- SCENE SOLUTION INDEX F1 [F2 ...] [-- FIELD=VALUE ...]
+//!
+//! Each `F` (Hz) is solved from point INDEX of SOLUTION (its coefficients); `mirrorJ` replaces
+//! the start by the point reflected through INDEX, 2 x_INDEX − x_J, and `chain` starts each
+//! later solve from the previous solution. The overrides are the run's `--set` fields.
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
