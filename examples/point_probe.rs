@@ -18,12 +18,7 @@ fn main() {
     let sol: serde_json::Value = serde_json::from_str(&text).unwrap();
     let index: usize = head[2].parse().unwrap();
     let point = &sol["points"][index];
-    let x0: Vec<f64> = point["coefficients"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
+    let x0 = coefficients(point);
     println!(
         "point {index}: {} Hz, {:?}",
         point["freq_hz"], point["amplitudes"]
@@ -35,12 +30,7 @@ fn main() {
         if let Some(j) = f.strip_prefix("mirror") {
             // Reflect the point through `index`: 2 x_index − x_j.
             let j: usize = j.parse().unwrap();
-            let xj: Vec<f64> = sol["points"][j]["coefficients"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|v| v.as_f64().unwrap())
-                .collect();
+            let xj = coefficients(&sol["points"][j]);
             x0 = x0.iter().zip(&xj).map(|(a, b)| 2.0 * a - b).collect();
             println!("mirror of {j} ({} Hz)", sol["points"][j]["freq_hz"]);
             continue;
@@ -71,4 +61,14 @@ fn main() {
             Err(e) => println!("{f} Hz: {e}"),
         }
     }
+}
+
+/// The Fourier coefficients of a point of `solution.json`.
+fn coefficients(point: &serde_json::Value) -> Vec<f64> {
+    point["coefficients"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect()
 }
