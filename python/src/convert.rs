@@ -29,6 +29,14 @@ fn json_name<T: serde::Serialize>(value: &T) -> PyResult<String> {
     }
 }
 
+/// A serialisable value as `solution.json` writes it (serde_json), read back by Python's
+/// `json` module: the same keys, names and nulls as the file, with no field-by-field copy to
+/// keep in step.
+fn as_json<'py, T: serde::Serialize>(py: Python<'py>, value: &T) -> PyResult<Bound<'py, PyAny>> {
+    let text = serde_json::to_string(value).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+    py.import("json")?.call_method1("loads", (text,))
+}
+
 /// The response envelope (`[limits] envelope`): per grid frequency and output DOF the smallest
 /// and largest amplitude over the initial states (m; NaN where no state was solved), the m of
 /// each group attaining them, and the check of the two limit curves against it.
@@ -268,19 +276,7 @@ pub fn frf_dict<'py>(
     d.set_item("turning_points_hz", run.turning_points.clone())?;
     d.set_item("leaps_hz", run.leaps.clone())?;
     // The judgement of each leap, as `leap_checks` in solution.json.
-    let leap_checks = PyList::empty(py);
-    for c in &run.leap_checks {
-        let cd = PyDict::new(py);
-        cd.set_item("from_hz", c.from_hz)?;
-        cd.set_item("to_hz", c.to_hz)?;
-        cd.set_item("before_amplitude", c.before_amplitude)?;
-        cd.set_item("back_amplitude", c.back_amplitude)?;
-        cd.set_item("distance", c.distance)?;
-        cd.set_item("points", c.points)?;
-        cd.set_item("verdict", json_name(&c.verdict)?)?;
-        leap_checks.append(cd)?;
-    }
-    d.set_item("leap_checks", leap_checks)?;
+    d.set_item("leap_checks", as_json(py, &run.leap_checks)?)?;
     let jumps = PyList::empty(py);
     for j in &run.jumps {
         let jd = PyDict::new(py);
