@@ -40,6 +40,7 @@ fn run_writes_all_results() {
         assert!(top == 3 || top == 7, "{top}");
         extensions.insert(top);
         assert!(["step", "solved", "unsized"].contains(&r[9]), "{}", r[9]);
+        // `unsolved` only with `accuracy.beyond_linear_range = "flag"` (below).
         *methods.entry(r[9]).or_insert(0_usize) += 1;
     }
     println!("estimate_harmonic values: {extensions:?}, estimate_method counts: {methods:?}");
@@ -366,4 +367,69 @@ fn frf_peaks_are_the_linear_frf_extrema() {
     assert_eq!(passed.len(), 3, "{rows:?}");
     assert_eq!(part_rows, passed);
     assert_eq!(sol["peaks"].as_array().unwrap().len(), 3);
+}
+
+/// `accuracy.beyond_linear_range = "flag"`: the points whose estimate's step leaves its linear
+/// range are flagged `unsolved` instead of solved on the extended set, and every other cell is
+/// the default run's: the same path, the same steps and sampling estimates. `solution.json`
+/// counts them, and a run that is not quiet names their band and the field to change.
+#[test]
+fn flagging_beyond_the_linear_range_skips_only_the_solves() {
+    let dir = tempfile::tempdir().unwrap();
+    let solve = dir.path().join("solve");
+    let flag = dir.path().join("flag");
+    let zoom = scene("zoom-2nd.toml");
+    let h3 = "harmonics.max=3";
+    assert!(run_scene(&zoom, &solve, &[h3]).status.success());
+    let flagged = support::fricbound(&[
+        "run",
+        &zoom,
+        "--set",
+        h3,
+        "--set",
+        "accuracy.beyond_linear_range=flag",
+        "--out",
+        flag.to_str().unwrap(),
+    ]);
+    assert!(flagged.status.success(), "{}", text(&flagged.stderr));
+    let (header, by_solve) = csv(&solve.join("frf.csv"));
+    let (flag_header, by_flag) = csv(&flag.join("frf.csv"));
+    assert_eq!(header, flag_header);
+    assert_eq!(by_solve.len(), by_flag.len());
+    let column = |name: &str| header.split(',').position(|c| c == name).unwrap();
+    let (trunc, sampling, method) = (
+        column("y2_trunc_err"),
+        column("y2_sampling_err"),
+        column("estimate_method"),
+    );
+    let mut unsolved = 0_u64;
+    for (s, f) in by_solve.iter().zip(&by_flag) {
+        // The path and the points are the same.
+        assert_eq!(s[..trunc], f[..trunc]);
+        assert_eq!(s[sampling], f[sampling]);
+        match s[method].as_str() {
+            "step" => assert_eq!(s, f),
+            "solved" | "unsized" => {
+                assert_eq!(f[method], "unsolved", "{f:?}");
+                unsolved += 1;
+            }
+            other => panic!("unexpected estimate_method {other}"),
+        }
+    }
+    // Most points of this stretch leave the step's linear range at H = 3 (transitions of the
+    // contact law move between samples with the extra harmonics).
+    assert!(
+        unsolved as usize > by_flag.len() / 2,
+        "{unsolved} of {}",
+        by_flag.len()
+    );
+    let json = json(&flag.join("solution.json"));
+    assert_eq!(json["accuracy"]["unsolved_points"].as_u64(), Some(unsolved));
+    assert_eq!(json["accuracy"]["solved_points"].as_u64(), Some(0));
+    let stderr = text(&flagged.stderr);
+    assert!(
+        stderr.contains("was not sized between")
+            && stderr.contains("accuracy.beyond_linear_range = \"flag\""),
+        "{stderr}"
+    );
 }

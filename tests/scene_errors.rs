@@ -1492,3 +1492,13 @@ fn accuracy_threshold_must_be_a_relative_error() {
         );
     }
 }
+
+#[test]
+fn accuracy_beyond_linear_range_takes_solve_or_flag() {
+    let file = SceneFile::new(&paper_plus("[accuracy]\nbeyond_linear_range = \"skip\"\n"));
+    let err = library_error(&file, &[]);
+    let parts = ["unknown variant `skip`", "`solve` or `flag`"];
+    assert_parse(&err, &file.label(), &parts);
+    // The CLI names the line and column of the field in the scene.
+    assert_cli_rejects(&file.label(), &[], &parts);
+}

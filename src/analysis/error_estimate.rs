@@ -111,7 +111,7 @@ use crate::contact::harmonic::HarmonicSet;
 use crate::contact::point::ContactState;
 use crate::hbm::operator::HbmOperator;
 use crate::hbm::HbmError;
-use crate::model::{Formulation, Problem};
+use crate::model::{BeyondLinearRange, Formulation, Problem};
 use crate::numerics::continuation::Continuation;
 use crate::numerics::jacobian::AssembledJacobian;
 use crate::numerics::linalg::LinearSolveError;
@@ -571,6 +571,10 @@ pub enum EstimateMethod {
     /// across the path). The estimate is the step's and is not to be read as a size: the run
     /// warns.
     Unsized,
+    /// Not sized: the step left its linear range and the scene asked not to solve the
+    /// extended system there (`accuracy.beyond_linear_range = "flag"`). The estimate is the
+    /// step's and is not to be read as a size: the run warns, as for [`Self::Unsized`].
+    Unsolved,
     /// No estimate formed (NaN).
     None,
 }
@@ -582,6 +586,7 @@ impl EstimateMethod {
             Self::Step => "step",
             Self::Solved => "solved",
             Self::Unsized => "unsized",
+            Self::Unsolved => "unsolved",
             Self::None => "none",
         }
     }
@@ -962,6 +967,9 @@ impl<'p> ErrorEstimator<'p> {
         if contraction <= LinearRange::MAX_CONTRACTION {
             return EstimateMethod::Step;
         }
+        if self.problem.analysis.error_estimate.beyond_linear_range == BeyondLinearRange::Flag {
+            return EstimateMethod::Unsolved;
+        }
         let solved = match across {
             Some(normal) => {
                 self.converged_across(x, omega, wider, base, normal, (step, contraction))
@@ -1272,6 +1280,9 @@ pub enum EstimateKind {
     /// Points whose truncation error could not be sized ([`EstimateMethod::Unsized`]): the
     /// band holds them whatever their estimate.
     Unsized,
+    /// Points whose truncation error was not sized because the scene skips the solve beyond
+    /// the step's linear range ([`EstimateMethod::Unsolved`]).
+    Unsolved,
 }
 
 /// Bands of consecutive points (in path order) where an estimate exceeds `threshold`, per
@@ -1319,21 +1330,28 @@ fn bands(points: &[(f64, &PointAccuracy)], outputs: usize, threshold: f64) -> Ve
         EstimateKind::Truncation,
         EstimateKind::Sampling,
         EstimateKind::Unsized,
+        EstimateKind::Unsolved,
     ] {
         for output in 0..outputs {
             let mut band: Option<AccuracyWarning> = None;
             for &(freq_hz, acc) in points {
                 let values = match kind {
-                    EstimateKind::Truncation | EstimateKind::Unsized => &acc.truncation,
+                    EstimateKind::Truncation | EstimateKind::Unsized | EstimateKind::Unsolved => {
+                        &acc.truncation
+                    }
                     EstimateKind::Sampling => &acc.sampling,
                 };
                 let e = values.get(output).copied().unwrap_or(f64::NAN);
-                let not_sized = acc.method == EstimateMethod::Unsized;
+                let not_sized = matches!(
+                    acc.method,
+                    EstimateMethod::Unsized | EstimateMethod::Unsolved
+                );
                 let inside = match kind {
-                    // Unsized points warn in their own band, not as a size.
+                    // Points not sized warn in their own bands, not as a size.
                     EstimateKind::Truncation => !not_sized && (e > threshold || e.is_nan()),
                     EstimateKind::Sampling => e > threshold || e.is_nan(),
-                    EstimateKind::Unsized => not_sized,
+                    EstimateKind::Unsized => acc.method == EstimateMethod::Unsized,
+                    EstimateKind::Unsolved => acc.method == EstimateMethod::Unsolved,
                 };
                 if inside {
                     let b = band.get_or_insert(AccuracyWarning {
@@ -1400,6 +1418,20 @@ pub fn warning_text(w: &AccuracyWarning, output: &str, h_max: usize, samples: us
             "AFT sampling",
             format!("harmonics.samples > {samples} needed (try {})", 2 * samples),
         ),
+        EstimateKind::Unsolved => {
+            return format!(
+                "accuracy: the harmonic truncation error of {output}'s amplitude was not sized \
+                 between {:.4} and {:.4} Hz: the estimate's Newton step leaves its linear range \
+                 there (a contact changes regime with more harmonics) and \
+                 accuracy.beyond_linear_range = \"flag\" skips the solve on H = {} (or {}) \
+                 that sizes it; set it to \"solve\", or solve the band at harmonics.max > \
+                 {h_max} and compare",
+                w.from_hz,
+                w.to_hz,
+                extended_harmonic(h_max),
+                wider_harmonic(h_max)
+            );
+        }
         EstimateKind::Unsized => {
             return format!(
                 "accuracy: the harmonic truncation error of {output}'s amplitude could not be \
@@ -1566,6 +1598,37 @@ mod tests {
         assert!(text.contains("H = 7 (or 15)"), "{text}");
         assert!(text.contains("harmonics.max > 3"), "{text}");
         assert_eq!(EstimateMethod::Unsized.label(), "unsized");
+    }
+
+    #[test]
+    fn unsolved_points_warn_in_a_band_of_their_own() {
+        // Points flagged because the scene skips the solve (`beyond_linear_range = "flag"`)
+        // next to points whose solve failed: two bands, each with its own advice.
+        let mut a = [
+            acc(0.001, 0.0),
+            acc(0.002, 0.0),
+            acc(0.003, 0.0),
+            acc(0.004, 0.0),
+        ];
+        a[0].method = EstimateMethod::Unsized;
+        a[2].method = EstimateMethod::Unsolved;
+        a[3].method = EstimateMethod::Unsolved;
+        let points: Vec<(f64, &PointAccuracy)> =
+            [100.0, 150.0, 180.0, 200.0].into_iter().zip(&a).collect();
+        let w = warnings(&points, 1, 0.01);
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert_eq!(w[0].kind, EstimateKind::Unsized);
+        assert_eq!((w[0].from_hz, w[0].to_hz), (100.0, 100.0));
+        assert_eq!(w[1].kind, EstimateKind::Unsolved);
+        assert_eq!((w[1].from_hz, w[1].to_hz), (180.0, 200.0));
+        let text = warning_text(&w[1], "y2", 3, 256);
+        assert!(
+            text.contains("was not sized between 180.0000 and 200.0000 Hz")
+                && text.contains("accuracy.beyond_linear_range = \"flag\"")
+                && text.contains("set it to \"solve\""),
+            "{text}"
+        );
+        assert_eq!(EstimateMethod::Unsolved.label(), "unsolved");
     }
 
     #[test]

@@ -956,11 +956,15 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
             format!(
                 "error estimate on every point (truncation to H = {}, or {} where contacts \
                  stay stuck or the harmonics decay slowly; sampling at {} samples), warning \
-                 above {} %",
+                 above {} %; beyond the step's linear range: {}",
                 crate::analysis::error_estimate::extended_harmonic(h_max),
                 crate::analysis::error_estimate::wider_harmonic(h_max),
                 2 * problem.samples,
-                100.0 * estimate.warn_threshold
+                100.0 * estimate.warn_threshold,
+                match estimate.beyond_linear_range {
+                    crate::model::BeyondLinearRange::Solve => "solved to convergence",
+                    crate::model::BeyondLinearRange::Flag => "flagged, not solved",
+                }
             )
         } else {
             "error estimate off ([accuracy] estimate = false)".to_string()

@@ -15,7 +15,7 @@ pub mod problem;
 pub mod reduce;
 
 pub use problem::{
-    Analysis, Coupling, DofSplit, Effects, ErrorEstimateSettings, FeOrigin, Formulation,
-    HarmonicLoad, HillSolve, JacobianStrategy, LinearModel, Problem, StabilityMethod,
+    Analysis, BeyondLinearRange, Coupling, DofSplit, Effects, ErrorEstimateSettings, FeOrigin,
+    Formulation, HarmonicLoad, HillSolve, JacobianStrategy, LinearModel, Problem, StabilityMethod,
     CHORD_MIN_UNKNOWNS,
 };

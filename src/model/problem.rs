@@ -207,6 +207,9 @@ pub struct ErrorEstimateSettings {
     pub enabled: bool,
     /// Relative first-harmonic amplitude error above which the run warns (default 0.01).
     pub warn_threshold: f64,
+    /// What a point whose one-step estimate leaves its linear range gets (scene field
+    /// `accuracy.beyond_linear_range`).
+    pub beyond_linear_range: BeyondLinearRange,
 }
 
 impl Default for ErrorEstimateSettings {
@@ -214,8 +217,27 @@ impl Default for ErrorEstimateSettings {
         Self {
             enabled: true,
             warn_threshold: 0.01,
+            beyond_linear_range: BeyondLinearRange::Solve,
         }
     }
+}
+
+/// What the error estimate does at a point whose one Newton step on the extended harmonic set
+/// leaves the range where its linearisation holds (its residual contraction above 5 %,
+/// `crate::analysis::error_estimate::LinearRange`): the step's value is then no size of the
+/// error.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BeyondLinearRange {
+    /// Solve the extended system to convergence at the point (at its frequency, or across the
+    /// path next to a fold) and report that change; where the solve fails the point is not
+    /// sizeable. Costs Newton solves of the extended system at those points (on the larger
+    /// blade pair at H = 1, next to its small folds, most of the estimate's time).
+    #[default]
+    Solve,
+    /// Do not solve: flag the point as not sized (`unsolved`) and warn, at the cost of the
+    /// step alone.
+    Flag,
 }
 
 /// Default of [`ContinuationSettings::chord_min_unknowns`].

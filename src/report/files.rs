@@ -139,6 +139,10 @@ pub struct AccuracySummary {
     pub solved_points: usize,
     /// Points whose truncation error could not be sized (`estimate_method` `unsized`).
     pub unsized_points: usize,
+    /// Points whose truncation error was not sized because the scene skips the solve beyond
+    /// the step's linear range (`estimate_method` `unsolved`,
+    /// `accuracy.beyond_linear_range = "flag"`).
+    pub unsolved_points: usize,
     /// The warning threshold of the scene (relative).
     pub threshold: f64,
 }
@@ -167,6 +171,7 @@ pub fn accuracy_summary(
         max_estimate_harmonic: 0,
         solved_points: 0,
         unsized_points: 0,
+        unsolved_points: 0,
         threshold,
     };
     for (f, a) in with {
@@ -178,6 +183,7 @@ pub fn accuracy_summary(
         match a.method {
             EstimateMethod::Solved => s.solved_points += 1,
             EstimateMethod::Unsized => s.unsized_points += 1,
+            EstimateMethod::Unsolved => s.unsolved_points += 1,
             EstimateMethod::Step | EstimateMethod::None => {}
         }
         for o in 0..k.min(a.truncation.len()) {

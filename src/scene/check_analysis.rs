@@ -223,6 +223,7 @@ pub(super) fn error_estimate(
     Ok(ErrorEstimateSettings {
         enabled: spec.estimate,
         warn_threshold: threshold,
+        beyond_linear_range: spec.beyond_linear_range,
     })
 }
 

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 
 use crate::contact::NormalLoad;
-use crate::model::{Coupling, Formulation, JacobianStrategy};
+use crate::model::{BeyondLinearRange, Coupling, Formulation, JacobianStrategy};
 use crate::scene::fe_input::{
     ContactPatchSpec, MaterialSpec, MatrixMarketSpec, PlaneSpec, ReductionSpec,
 };
@@ -424,6 +424,11 @@ pub struct AccuracySpec {
     /// Relative error of a first-harmonic amplitude above which a run warns (default 0.01).
     #[serde(default = "default_warn_threshold")]
     pub threshold: f64,
+    /// What a point whose one-step estimate leaves its linear range gets: `"solve"` (default,
+    /// the extended system solved to convergence there) or `"flag"` (not solved, flagged as
+    /// not sized).
+    #[serde(default)]
+    pub beyond_linear_range: BeyondLinearRange,
 }
 
 impl Default for AccuracySpec {
@@ -431,6 +436,7 @@ impl Default for AccuracySpec {
         Self {
             estimate: true,
             threshold: default_warn_threshold(),
+            beyond_linear_range: BeyondLinearRange::default(),
         }
     }
 }
