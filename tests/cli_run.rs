@@ -39,7 +39,11 @@ fn run_writes_all_results() {
         let top: usize = r[8].parse().unwrap();
         assert!(top == 3 || top == 7, "{top}");
         extensions.insert(top);
-        assert!(["step", "solved", "unsized"].contains(&r[9]), "{}", r[9]);
+        assert!(
+            ["step", "solved", "unsized", "converged"].contains(&r[9]),
+            "{}",
+            r[9]
+        );
         // `unsolved` only with `accuracy.beyond_linear_range = "flag"` (below).
         *methods.entry(r[9]).or_insert(0_usize) += 1;
     }
@@ -408,7 +412,7 @@ fn flagging_beyond_the_linear_range_skips_only_the_solves() {
         assert_eq!(s[..trunc], f[..trunc]);
         assert_eq!(s[sampling], f[sampling]);
         match s[method].as_str() {
-            "step" => assert_eq!(s, f),
+            "step" | "converged" => assert_eq!(s, f),
             "solved" | "unsized" => {
                 assert_eq!(f[method], "unsolved", "{f:?}");
                 unsolved += 1;
@@ -416,13 +420,9 @@ fn flagging_beyond_the_linear_range_skips_only_the_solves() {
             other => panic!("unexpected estimate_method {other}"),
         }
     }
-    // Most points of this stretch leave the step's linear range at H = 3 (transitions of the
-    // contact law move between samples with the extra harmonics).
-    assert!(
-        unsolved as usize > by_flag.len() / 2,
-        "{unsolved} of {}",
-        by_flag.len()
-    );
+    // Around the resonance, where the contacts slip, the steps leave their linear range at
+    // H = 3 (the contact law's transitions move between samples with the extra harmonics).
+    assert!(unsolved >= 10, "{unsolved} of {}", by_flag.len());
     let json = json(&flag.join("solution.json"));
     assert_eq!(json["accuracy"]["unsolved_points"].as_u64(), Some(unsolved));
     assert_eq!(json["accuracy"]["solved_points"].as_u64(), Some(0));

@@ -232,3 +232,46 @@ fn truncation_estimate_tracks_the_true_error_on_the_paper_case() {
     );
     assert!(over.len() * 20 <= checked_large, "{over:?}");
 }
+
+/// Where the padded point already solves the extended system within the run's Newton
+/// tolerance (every contact stuck all period: the contact forces are linear in the motion and
+/// hold no harmonic the point lacks), the estimate is `converged`, 0, without a Newton step;
+/// the extended system solved to convergence across the path from that point moves each
+/// amplitude by no more than the run resolves.
+#[test]
+fn a_point_whose_padding_solves_the_extension_is_converged() {
+    use fricbound::analysis::error_estimate::{extended_harmonic, EstimateMethod};
+    let problem = zoom_2nd(&[
+        "harmonics.max=3".into(),
+        // A pre-load that keeps both contacts stuck over the whole range.
+        "static_loads.0.value=-1e5".into(),
+    ]);
+    let run = frf::solve(&problem, &mut Silent).expect("run solves");
+    assert!(run.is_complete());
+    let refined = EstimateProblems::new(&problem).expect("the estimate is on");
+    let mut estimator = ErrorEstimator::new(&problem, &refined).expect("estimator builds");
+    let mut largest_solved = 0.0_f64;
+    let mut solved = 0;
+    for p in &run.points {
+        assert!(p.states.iter().all(|s| s.label() == "stuck"), "{:?}", p.states);
+        let acc = p.accuracy.as_ref().expect("every point has an estimate");
+        assert_eq!(acc.method, EstimateMethod::Converged, "at {} Hz", p.freq_hz);
+        assert_eq!((acc.truncation[0], acc.sampling[0]), (0.0, 0.0));
+        let Some(normal) = &acc.path_normal else {
+            continue;
+        };
+        let omega = 2.0 * std::f64::consts::PI * p.freq_hz;
+        if let Some(change) =
+            estimator.solved_across(&p.coefficients, omega, normal, extended_harmonic(3))
+        {
+            largest_solved = largest_solved.max(change[0]);
+            solved += 1;
+        }
+    }
+    println!(
+        "{} points, {solved} solved across the path on H = 7: largest change {largest_solved:.2e}",
+        run.points.len()
+    );
+    assert!(solved > run.points.len() / 2, "{solved}");
+    assert!(largest_solved < 1e-8, "{largest_solved:e}");
+}

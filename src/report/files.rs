@@ -184,7 +184,7 @@ pub fn accuracy_summary(
             EstimateMethod::Solved => s.solved_points += 1,
             EstimateMethod::Unsized => s.unsized_points += 1,
             EstimateMethod::Unsolved => s.unsolved_points += 1,
-            EstimateMethod::Step | EstimateMethod::None => {}
+            EstimateMethod::Step | EstimateMethod::Converged | EstimateMethod::None => {}
         }
         for o in 0..k.min(a.truncation.len()) {
             if a.truncation[o] > s.max_trunc_err[o] {
