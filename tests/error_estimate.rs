@@ -253,7 +253,11 @@ fn a_point_whose_padding_solves_the_extension_is_converged() {
     let mut largest_solved = 0.0_f64;
     let mut solved = 0;
     for p in &run.points {
-        assert!(p.states.iter().all(|s| s.label() == "stuck"), "{:?}", p.states);
+        assert!(
+            p.states.iter().all(|s| s.label() == "stuck"),
+            "{:?}",
+            p.states
+        );
         let acc = p.accuracy.as_ref().expect("every point has an estimate");
         assert_eq!(acc.method, EstimateMethod::Converged, "at {} Hz", p.freq_hz);
         assert_eq!((acc.truncation[0], acc.sampling[0]), (0.0, 0.0));

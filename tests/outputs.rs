@@ -435,3 +435,46 @@ fn check_prints_the_cost_of_a_small_scene() {
         assert!(stdout.contains("): fits"), "{stdout}");
     }
 }
+
+/// `check` says on which extended sets the error estimate solves the points beyond its step's
+/// linear range: under `"auto"` the reduced blade pair at H = 11 solves on H = 23 and flags on
+/// H = 47, whose Newton iteration the cost model puts beyond the budget; `"solve"` solves on
+/// both, and at H = 1 `"auto"` solves on both.
+#[test]
+fn check_names_the_sets_the_estimate_solves_on() {
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("meshes/blade-pair/blade-pair-2d.toml")
+        .display()
+        .to_string();
+    let line = |overrides: &[&str]| {
+        let mut args = vec!["check", scene.as_str()];
+        for o in overrides {
+            args.extend(["--set", o]);
+        }
+        let o = fricbound(&args);
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        let stdout = text(&o.stdout);
+        stdout
+            .lines()
+            .find(|l| l.starts_with("accuracy "))
+            .unwrap_or_default()
+            .to_string()
+    };
+    let auto = line(&["harmonics.max=11"]);
+    assert!(
+        auto.contains("solved on H = 23")
+            && auto.contains("flagged on H = 47")
+            && auto.contains("[auto: "),
+        "{auto}"
+    );
+    let solve = line(&["harmonics.max=11", "accuracy.beyond_linear_range=solve"]);
+    assert!(
+        solve.contains("solved on H = 23") && solve.contains("solved on H = 47"),
+        "{solve}"
+    );
+    let low = line(&[]);
+    assert!(
+        low.contains("solved on H = 3") && low.contains("solved on H = 7"),
+        "{low}"
+    );
+}

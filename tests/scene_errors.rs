@@ -1497,7 +1497,7 @@ fn accuracy_threshold_must_be_a_relative_error() {
 fn accuracy_beyond_linear_range_takes_solve_or_flag() {
     let file = SceneFile::new(&paper_plus("[accuracy]\nbeyond_linear_range = \"skip\"\n"));
     let err = library_error(&file, &[]);
-    let parts = ["unknown variant `skip`", "`solve` or `flag`"];
+    let parts = ["unknown variant `skip`", "`auto`, `solve`, `flag`"];
     assert_parse(&err, &file.label(), &parts);
     // The CLI names the line and column of the field in the scene.
     assert_cli_rejects(&file.label(), &[], &parts);

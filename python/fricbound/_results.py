@@ -54,8 +54,9 @@ class ContinuationPath(_Result):
       ``estimate_harmonic`` (n,) int: the highest harmonic of the extended set the truncation
       estimate comes from (2H + 1, or 4H + 3 where widened; 0 where not formed), and
       ``estimate_method`` (n,) str: ``step``, ``solved``, ``unsized`` (the error is not sized),
-      ``unsolved`` (not sized: ``accuracy.beyond_linear_range = "flag"``) or ``none``, as the
-      CLI's ``frf.csv``;
+      ``unsolved`` (not sized: ``accuracy.beyond_linear_range = "flag"``), ``converged`` (the
+      point already solves the extended harmonic balance within the Newton tolerance: both
+      estimates 0) or ``none``, as the CLI's ``frf.csv``;
     - ``stable`` (n,) bool, ``floquet_re`` (n,) 1/s, ``floquet_freq_hz`` (n,) or None: the
       stability verdict, when the scene sets ``analysis.stability = true``;
       ``stability_method`` (n,) str: which method gave it (``hill``, ``monodromy``, or

@@ -153,7 +153,7 @@ pub fn problem_names(d: &Bound<'_, PyDict>, problem: &Problem) -> PyResult<()> {
 /// `states` (n lists of contact-state labels), `newton_iterations`, `residual`,
 /// `coefficients` (n × DOFs·blocks, harmonic-major), `trunc_err` and `sampling_err`
 /// (n × outputs, NaN where not estimated), `estimate_harmonic` (n) and `estimate_method` (n
-/// labels: `step`, `solved`, `unsized`, `unsolved`, `none`) (all four absent when the scene does not ask
+/// labels: `step`, `solved`, `unsized`, `unsolved`, `converged`, `none`) (all four absent when the scene does not ask
 /// for the estimate), `stable`, `floquet_re`, `floquet_freq_hz`, `stability_method`,
 /// `stability_reliable` (absent without `analysis.stability`).
 pub fn points_dict<'py>(py: Python<'py>, points: &[FrfPoint]) -> PyResult<Bound<'py, PyDict>> {

@@ -42,6 +42,21 @@
 //! 0.78-1.82 on the small blade pair (H = 1, 3; 129 points), formed at every point by the
 //! tests (`tests/error_estimate.rs`, `tests/error_estimate_fe.rs`).
 //!
+//! # Points that already solve the extension
+//!
+//! Where the padded point already solves the extended system, and the point the harmonic
+//! balance at twice the samples, within the run's Newton tolerance (`solves_padded`: e.g.
+//! every contact stuck or open all period, where the contact forces are linear in the motion
+//! and hold no harmonic the point lacks), the point is a converged solution of both by the
+//! run's own criterion: both estimates are 0, formed from those two residuals without a
+//! Jacobian ([`EstimateMethod::Converged`]). A step from such a point moves within round-off,
+//! and its contraction says nothing of linearity; it was taken for a step beyond its linear
+//! range before, and solved again at a cost: on the blade pair at H = 11 every point over
+//! 700-720 Hz (step estimates below 10⁻¹¹, their converged solves 1.5 × 10⁻¹² at most), at
+//! 5.1 s of CPU for a run of 0.38 s (now 0.42 s with the estimate). Where the sampling residual
+//! is above the tolerance the point takes the full estimate, and its truncation step counts
+//! as within its linear range ([`LinearRange::holds`]).
+//!
 //! # Sampling
 //!
 //! The same point put into the harmonic balance of the same harmonic set at twice the samples
@@ -261,6 +276,94 @@ impl EstimateProblems {
             wider: extended_to(wider_harmonic(h)),
             sampling,
         })
+    }
+}
+
+/// Which extended sets a point whose step leaves its linear range ([`LinearRange`]) is solved
+/// on (`accuracy.beyond_linear_range`): every set with `"solve"`, none with `"flag"`, and with
+/// `"auto"` (the default) those whose Newton iteration (one factorisation and one evaluation,
+/// [`crate::hbm::cost`]) is estimated at most [`Self::RUN_POINTS`] times a continuation point of
+/// the run. A solve takes 4-12 iterations where it converges and 12-36 where it fails
+/// (docs/accuracy.md), so a point solved on a set beyond the budget costs hundreds of run
+/// points: on the reduced blade pair at H = 11 (cost model: 21.9 ms per run point) the wider
+/// set, H = 47, is estimated at 3.2 s per iteration (147 run points), and its solves took the
+/// default run over 700-1100 Hz past 13 minutes for 138 of its 329 points (the run alone:
+/// 4.7 s of CPU). The sets measured fall well apart on either side of the budget: at most 18
+/// run points (that blade pair's H = 23 at H = 11; 1-6 on the paper case up to H = 7 and on
+/// the blade pair at H = 1 and 3), at least 147 beyond it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolveBudget {
+    /// The first extension (2H + 1).
+    pub truncation: SetBudget,
+    /// The wider set (4H + 3).
+    pub wider: SetBudget,
+}
+
+/// The budget decision for one extended set ([`SolveBudget`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SetBudget {
+    /// Its highest harmonic.
+    pub harmonic: usize,
+    /// Estimated time of one Newton iteration on it, in continuation points of the run.
+    pub run_points: f64,
+    /// Whether points beyond the step's linear range are solved on it.
+    pub solves: bool,
+}
+
+impl SolveBudget {
+    /// Newton iterations on an extended set at most this many run points each are solved under
+    /// `"auto"`.
+    pub const RUN_POINTS: f64 = 50.0;
+
+    /// The decision for `problem`'s refined problems `refined`.
+    pub fn new(problem: &Problem, refined: &EstimateProblems) -> Self {
+        let run_point = crate::hbm::cost::estimate(problem).seconds_per_point();
+        let h = problem.harmonics.iter().copied().max().unwrap_or(1);
+        let mode = problem.analysis.error_estimate.beyond_linear_range;
+        let set = |extended: &Problem, harmonic: usize| {
+            let run_points =
+                crate::hbm::cost::estimate(extended).seconds_per_iteration() / run_point;
+            SetBudget {
+                harmonic,
+                run_points,
+                solves: match mode {
+                    BeyondLinearRange::Solve => true,
+                    BeyondLinearRange::Flag => false,
+                    BeyondLinearRange::Auto => Self::within(run_points),
+                },
+            }
+        };
+        Self {
+            truncation: set(&refined.truncation, extended_harmonic(h)),
+            wider: set(&refined.wider, wider_harmonic(h)),
+        }
+    }
+
+    /// Whether an iteration of `run_points` run points is within the `"auto"` budget (NaN,
+    /// a cost that could not be estimated, is not).
+    pub fn within(run_points: f64) -> bool {
+        run_points <= Self::RUN_POINTS
+    }
+
+    /// What `fricbound check` says of it: "solved on H = 23 (…), flagged on H = 47 (…) […]".
+    pub fn summary(&self, mode: BeyondLinearRange) -> String {
+        let how = |s: &SetBudget| {
+            format!(
+                "{} on H = {} ({:.1} run points per iteration)",
+                if s.solves { "solved" } else { "flagged" },
+                s.harmonic,
+                s.run_points
+            )
+        };
+        let why = match mode {
+            BeyondLinearRange::Auto => format!(
+                "auto: solved where an iteration is estimated at most {} run points",
+                Self::RUN_POINTS
+            ),
+            BeyondLinearRange::Solve => "solve".to_string(),
+            BeyondLinearRange::Flag => "flag".to_string(),
+        };
+        format!("{}, {} [{why}]", how(&self.truncation), how(&self.wider))
     }
 }
 
@@ -576,7 +679,7 @@ impl LinearRange {
     /// Whether a step is kept: its `contraction` is at most [`Self::MAX_CONTRACTION`] (NaN,
     /// the residual after the step not formed, counts as beyond), or the padded point it
     /// starts from already solves the extended system within the Newton tolerance
-    /// (`padded_converged`, see [`solves_padded`]), where the contraction of a step within
+    /// (`padded_converged`, see `solves_padded`), where the contraction of a step within
     /// round-off tells nothing.
     pub fn holds(contraction: f64, padded_converged: bool) -> bool {
         padded_converged || contraction <= Self::MAX_CONTRACTION
@@ -604,7 +707,7 @@ pub enum EstimateMethod {
     Unsolved,
     /// The point padded with zero harmonics already solves the extended system, and the
     /// harmonic balance at twice the samples, within the run's Newton tolerance
-    /// ([`solves_padded`]): both estimates are 0 (below what the run resolves), formed from
+    /// (`solves_padded`): both estimates are 0 (below what the run resolves), formed from
     /// two residuals without a Newton step (e.g. every contact stuck or open all period,
     /// where the contact forces hold no harmonic the point lacks).
     Converged,
@@ -659,6 +762,11 @@ pub struct ErrorEstimator<'p> {
     /// A pool of one thread that every estimate runs on ([`Self::on_one_thread`]); None where
     /// the thread could not be started (the estimate then runs on the caller's thread).
     one_thread: Option<rayon::ThreadPool>,
+    /// Whether a point whose step leaves its linear range is solved to convergence on the
+    /// first extension (2H + 1) and on the wider set (4H + 3) ([`SolveBudget`]).
+    solve_truncation: bool,
+    /// See `solve_truncation`.
+    solve_wider: bool,
 }
 
 impl<'p> ErrorEstimator<'p> {
@@ -675,8 +783,11 @@ impl<'p> ErrorEstimator<'p> {
             .iter()
             .map(|&i| i as usize)
             .collect();
+        let budget = SolveBudget::new(problem, refined);
         Ok(Self {
             problem,
+            solve_truncation: budget.truncation.solves,
+            solve_wider: budget.wider.solves,
             truncation: Refined::new(&refined.truncation, &set)?,
             wider: Refined::new(&refined.wider, &set)?,
             h_max: problem.harmonics.iter().copied().max().unwrap_or(1),
@@ -1076,7 +1187,12 @@ impl<'p> ErrorEstimator<'p> {
         if LinearRange::holds(contraction, padded_converged) {
             return EstimateMethod::Step;
         }
-        if self.problem.analysis.error_estimate.beyond_linear_range == BeyondLinearRange::Flag {
+        let solves = if wider {
+            self.solve_wider
+        } else {
+            self.solve_truncation
+        };
+        if !solves {
             return EstimateMethod::Unsolved;
         }
         let solved = match across {
@@ -1534,10 +1650,11 @@ pub fn warning_text(w: &AccuracyWarning, output: &str, h_max: usize, samples: us
             return format!(
                 "accuracy: the harmonic truncation error of {output}'s amplitude was not sized \
                  between {:.4} and {:.4} Hz: the estimate's Newton step leaves its linear range \
-                 there (a contact changes regime with more harmonics) and \
-                 accuracy.beyond_linear_range = \"flag\" skips the solve on H = {} (or {}) \
-                 that sizes it; set it to \"solve\", or solve the band at harmonics.max > \
-                 {h_max} and compare",
+                 there (a contact changes regime with more harmonics) and the solve on H = {} \
+                 (or {}) that sizes it was skipped (accuracy.beyond_linear_range = \"flag\", \
+                 or \"auto\" where that system is too large to solve at every such point: \
+                 `fricbound check` says which); set it to \"solve\", or solve the band at \
+                 harmonics.max > {h_max} and compare",
                 w.from_hz,
                 w.to_hz,
                 extended_harmonic(h_max),
@@ -1741,6 +1858,32 @@ mod tests {
             "{text}"
         );
         assert_eq!(EstimateMethod::Unsolved.label(), "unsolved");
+    }
+
+    #[test]
+    fn the_solve_budget_is_a_number_of_run_points() {
+        assert!(SolveBudget::within(SolveBudget::RUN_POINTS));
+        assert!(SolveBudget::within(17.9));
+        assert!(!SolveBudget::within(144.7));
+        // A cost that could not be estimated is not within the budget.
+        assert!(!SolveBudget::within(f64::NAN));
+        let budget = SolveBudget {
+            truncation: SetBudget {
+                harmonic: 23,
+                run_points: 17.9,
+                solves: true,
+            },
+            wider: SetBudget {
+                harmonic: 47,
+                run_points: 144.7,
+                solves: false,
+            },
+        };
+        let text = budget.summary(BeyondLinearRange::Auto);
+        assert!(
+            text.starts_with("solved on H = 23 (17.9 run points per iteration), flagged on H = 47"),
+            "{text}"
+        );
     }
 
     #[test]

@@ -961,10 +961,11 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
                 crate::analysis::error_estimate::wider_harmonic(h_max),
                 2 * problem.samples,
                 100.0 * estimate.warn_threshold,
-                match estimate.beyond_linear_range {
-                    crate::model::BeyondLinearRange::Solve => "solved to convergence",
-                    crate::model::BeyondLinearRange::Flag => "flagged, not solved",
-                }
+                crate::analysis::error_estimate::EstimateProblems::new(&problem).map_or_else(
+                    String::new,
+                    |refined| crate::analysis::error_estimate::SolveBudget::new(&problem, &refined)
+                        .summary(estimate.beyond_linear_range)
+                )
             )
         } else {
             "error estimate off ([accuracy] estimate = false)".to_string()

@@ -217,7 +217,7 @@ impl Default for ErrorEstimateSettings {
         Self {
             enabled: true,
             warn_threshold: 0.01,
-            beyond_linear_range: BeyondLinearRange::Solve,
+            beyond_linear_range: BeyondLinearRange::Auto,
         }
     }
 }
@@ -229,11 +229,16 @@ impl Default for ErrorEstimateSettings {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum BeyondLinearRange {
+    /// [`Self::Solve`] on an extended set whose Newton iteration the cost model
+    /// (`crate::hbm::cost`) estimates at most
+    /// `crate::analysis::error_estimate::SolveBudget::RUN_POINTS` times a point of the run,
+    /// [`Self::Flag`] on a larger one (see `SolveBudget`).
+    #[default]
+    Auto,
     /// Solve the extended system to convergence at the point (at its frequency, or across the
     /// path next to a fold) and report that change; where the solve fails the point is not
     /// sizeable. Costs Newton solves of the extended system at those points (on the larger
     /// blade pair at H = 1, next to its small folds, most of the estimate's time).
-    #[default]
     Solve,
     /// Do not solve: flag the point as not sized (`unsolved`) and warn, at the cost of the
     /// step alone.
