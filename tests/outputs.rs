@@ -437,9 +437,9 @@ fn check_prints_the_cost_of_a_small_scene() {
 }
 
 /// `check` says on which extended sets the error estimate solves the points beyond its step's
-/// linear range: under `"auto"` the reduced blade pair at H = 11 solves on H = 23 and flags on
-/// H = 47, whose Newton iteration the cost model puts beyond the budget; `"solve"` solves on
-/// both, and at H = 1 `"auto"` solves on both.
+/// linear range: under `"auto"` the reduced blade pair at H = 11 solves on H = 23 and does not
+/// step on H = 47 (its points flagged), whose Newton iteration the cost model puts beyond the
+/// budget; `"solve"` solves on both, and at H = 1 `"auto"` solves on both.
 #[test]
 fn check_names_the_sets_the_estimate_solves_on() {
     let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -456,14 +456,14 @@ fn check_names_the_sets_the_estimate_solves_on() {
         let stdout = text(&o.stdout);
         stdout
             .lines()
-            .find(|l| l.starts_with("accuracy "))
+            .find(|l| l.starts_with("  beyond "))
             .unwrap_or_default()
             .to_string()
     };
     let auto = line(&["harmonics.max=11"]);
     assert!(
         auto.contains("solved on H = 23")
-            && auto.contains("flagged on H = 47")
+            && auto.contains("not stepped, its points flagged, on H = 47")
             && auto.contains("[auto: "),
         "{auto}"
     );

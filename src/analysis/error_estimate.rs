@@ -113,9 +113,10 @@
 //! Which extended sets a point beyond its step's linear range is solved on is the scene's
 //! choice (`accuracy.beyond_linear_range`): by default ([`SolveBudget`]) only those whose
 //! Newton iteration the cost model puts at most 50 run points; beyond that the point is
-//! flagged ([`EstimateMethod::Unsolved`]). On the reduced blade pair at H = 11 the solves on
-//! H = 47 had taken the run over 700-1100 Hz past 13 minutes for 138 of its 329 points; with
-//! the budget the run takes 67 s of wall time against 6.7 s without the estimate.
+//! flagged ([`EstimateMethod::Unsolved`]); a wider set beyond it is not stepped on either (its
+//! points flagged with their 2H + 1 estimate). On the reduced blade pair at H = 11 the solves
+//! on H = 47 had taken the run over 700-1100 Hz past 13 minutes for 138 of its 329 points;
+//! with the budget the run takes 29.8 s of wall time against 6.7 s without the estimate.
 //!
 //! Every estimate runs on a pool of one thread of the estimator's own
 //! (`ErrorEstimator::on_one_thread`): faer then factorises the extended systems (2-5× the
@@ -295,7 +296,9 @@ impl EstimateProblems {
 /// points: on the reduced blade pair at H = 11 (cost model: 21.9 ms per run point) the wider
 /// set, H = 47, is estimated at 3.2 s per iteration (147 run points), and its solves took the
 /// default run over 700-1100 Hz past 13 minutes for 138 of its 329 points (the run alone:
-/// 4.7 s of CPU). The sets measured fall well apart on either side of the budget: at most 18
+/// 4.7 s of CPU). A wider set beyond the budget is not stepped on either under `"auto"`
+/// ([`SetBudget::steps`]): its one step per point, a factorisation on H = 47, still made that
+/// run 10× the run alone. The sets measured fall well apart on either side of the budget: at most 18
 /// run points (that blade pair's H = 23 at H = 11; 1-6 on the paper case up to H = 7 and on
 /// the blade pair at H = 1 and 3), at least 147 beyond it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -315,6 +318,10 @@ pub struct SetBudget {
     pub run_points: f64,
     /// Whether points beyond the step's linear range are solved on it.
     pub solves: bool,
+    /// Whether points are stepped on it at all (the wider set: the points [`TailTest`] sends
+    /// there; the first extension is always stepped on). Under `"auto"` a set beyond the
+    /// budget is not: one step there is a Newton iteration beyond it.
+    pub steps: bool,
 }
 
 impl SolveBudget {
@@ -327,22 +334,24 @@ impl SolveBudget {
         let run_point = crate::hbm::cost::estimate(problem).seconds_per_point();
         let h = problem.harmonics.iter().copied().max().unwrap_or(1);
         let mode = problem.analysis.error_estimate.beyond_linear_range;
-        let set = |extended: &Problem, harmonic: usize| {
+        let set = |extended: &Problem, harmonic: usize, always_stepped: bool| {
             let run_points =
                 crate::hbm::cost::estimate(extended).seconds_per_iteration() / run_point;
+            let within = Self::within(run_points);
             SetBudget {
                 harmonic,
                 run_points,
                 solves: match mode {
                     BeyondLinearRange::Solve => true,
                     BeyondLinearRange::Flag => false,
-                    BeyondLinearRange::Auto => Self::within(run_points),
+                    BeyondLinearRange::Auto => within,
                 },
+                steps: always_stepped || mode != BeyondLinearRange::Auto || within,
             }
         };
         Self {
-            truncation: set(&refined.truncation, extended_harmonic(h)),
-            wider: set(&refined.wider, wider_harmonic(h)),
+            truncation: set(&refined.truncation, extended_harmonic(h), true),
+            wider: set(&refined.wider, wider_harmonic(h), false),
         }
     }
 
@@ -357,7 +366,11 @@ impl SolveBudget {
         let how = |s: &SetBudget| {
             format!(
                 "{} on H = {} ({:.1} run points per iteration)",
-                if s.solves { "solved" } else { "flagged" },
+                match (s.solves, s.steps) {
+                    (true, _) => "solved",
+                    (false, true) => "flagged",
+                    (false, false) => "not stepped, its points flagged,",
+                },
                 s.harmonic,
                 s.run_points
             )
@@ -640,6 +653,18 @@ fn solves_padded(problem: &Problem, operator: &HbmOperator<'_>, r_norm: f64) -> 
     scale > 0.0 && r_norm / scale <= problem.analysis.continuation.residual_tolerance
 }
 
+/// The method of a point that [`TailTest`] sends to the wider set where the scene's budget
+/// does not step on it ([`SetBudget::steps`]): its 2H + 1 estimate is no size of the error
+/// (the extension has not converged in its own harmonics), so it is flagged
+/// ([`EstimateMethod::Unsolved`]), or not formed where that estimate is not a number.
+fn beyond_budget(truncation: &[f64]) -> EstimateMethod {
+    if truncation.iter().any(|v| v.is_nan()) {
+        EstimateMethod::None
+    } else {
+        EstimateMethod::Unsolved
+    }
+}
+
 /// The truncation estimate on the wider set (4H + 3).
 struct Wider {
     /// Whether the padded point already solves the wider system within the Newton tolerance
@@ -774,6 +799,9 @@ pub struct ErrorEstimator<'p> {
     solve_truncation: bool,
     /// See `solve_truncation`.
     solve_wider: bool,
+    /// Whether the points [`TailTest`] and [`WidenGate`] send to the wider set are stepped on
+    /// it ([`SetBudget::steps`]); where not, they are flagged with their 2H + 1 estimate.
+    step_wider: bool,
 }
 
 impl<'p> ErrorEstimator<'p> {
@@ -795,6 +823,7 @@ impl<'p> ErrorEstimator<'p> {
             problem,
             solve_truncation: budget.truncation.solves,
             solve_wider: budget.wider.solves,
+            step_wider: budget.wider.steps,
             truncation: Refined::new(&refined.truncation, &set)?,
             wider: Refined::new(&refined.wider, &set)?,
             h_max: problem.harmonics.iter().copied().max().unwrap_or(1),
@@ -1045,9 +1074,9 @@ impl<'p> ErrorEstimator<'p> {
             let mut estimate_harmonic = top;
             let mut contraction = first.contraction;
             let mut reported_step = deltas[0][..dim].to_vec();
-            if first.needs_wider
-                && self.widens(&first.truncation, first.contraction, padded_converged)
-            {
+            let widens = first.needs_wider
+                && self.widens(&first.truncation, first.contraction, padded_converged);
+            if widens && self.step_wider {
                 if let Some(w) = self.wider_truncation(x, omega, None, &base) {
                     padded_converged = w.padded_converged;
                     truncation = w.fixed;
@@ -1056,18 +1085,22 @@ impl<'p> ErrorEstimator<'p> {
                     reported_step = w.fixed_step;
                 }
             }
-            let method = self.settle(
-                x,
-                omega,
-                &base,
-                (
-                    &mut truncation,
-                    estimate_harmonic,
-                    contraction,
-                    padded_converged,
-                ),
-                (None, &reported_step),
-            );
+            let method = if widens && !self.step_wider {
+                beyond_budget(&truncation)
+            } else {
+                self.settle(
+                    x,
+                    omega,
+                    &base,
+                    (
+                        &mut truncation,
+                        estimate_harmonic,
+                        contraction,
+                        padded_converged,
+                    ),
+                    (None, &reported_step),
+                )
+            };
             return PointAccuracy {
                 truncation,
                 sampling: first.sampling,
@@ -1091,9 +1124,9 @@ impl<'p> ErrorEstimator<'p> {
         // The across-path step with its δω (rad/s), for a converged solve across the path.
         let mut across_step = deltas[0].clone();
         let normal = path.map(|p| p.normal);
-        if reported.needs_wider
-            && self.widens(&reported.truncation, reported.contraction, padded_converged)
-        {
+        let widens = reported.needs_wider
+            && self.widens(&reported.truncation, reported.contraction, padded_converged);
+        if widens && self.step_wider {
             if let Some(w) = self.wider_truncation(x, omega, normal, &base) {
                 let wider_converged = w.padded_converged;
                 if let (Some((a, a_contraction)), Some(a_step)) = (w.across, w.across_step) {
@@ -1127,18 +1160,22 @@ impl<'p> ErrorEstimator<'p> {
         } else {
             (None, &reported_step)
         };
-        let method = self.settle(
-            x,
-            omega,
-            &base,
-            (
-                &mut truncation,
-                estimate_harmonic,
-                contraction,
-                padded_converged,
-            ),
-            (normal, settled_step),
-        );
+        let method = if widens && !self.step_wider {
+            beyond_budget(&truncation)
+        } else {
+            self.settle(
+                x,
+                omega,
+                &base,
+                (
+                    &mut truncation,
+                    estimate_harmonic,
+                    contraction,
+                    padded_converged,
+                ),
+                (normal, settled_step),
+            )
+        };
         if method == EstimateMethod::Solved {
             if across {
                 both.1 = truncation.clone();
@@ -1879,18 +1916,38 @@ mod tests {
                 harmonic: 23,
                 run_points: 17.9,
                 solves: true,
+                steps: true,
             },
             wider: SetBudget {
                 harmonic: 47,
                 run_points: 144.7,
                 solves: false,
+                steps: false,
             },
         };
         let text = budget.summary(BeyondLinearRange::Auto);
         assert!(
-            text.starts_with("solved on H = 23 (17.9 run points per iteration), flagged on H = 47"),
+            text.starts_with(
+                "solved on H = 23 (17.9 run points per iteration), not stepped, its points \
+                 flagged, on H = 47"
+            ),
             "{text}"
         );
+    }
+
+    #[test]
+    fn points_sent_beyond_the_budget_are_flagged_with_their_first_extension() {
+        assert_eq!(beyond_budget(&[0.02, 1e-9]), EstimateMethod::Unsolved);
+        assert_eq!(beyond_budget(&[0.02, f64::NAN]), EstimateMethod::None);
+        // Under "auto" the wider set is stepped on only within the budget; "solve" and
+        // "flag" step on it whatever it costs.
+        let problem = crate::scene::parse(crate::scene::paper_wedge_scene(), "paper", &[])
+            .unwrap()
+            .validate("paper")
+            .unwrap();
+        let refined = EstimateProblems::new(&problem).expect("the estimate is on");
+        let budget = SolveBudget::new(&problem, &refined);
+        assert!(budget.truncation.steps && budget.wider.steps, "{budget:?}");
     }
 
     #[test]

@@ -956,21 +956,24 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
             format!(
                 "error estimate on every point (truncation to H = {}, or {} where contacts \
                  stay stuck or the harmonics decay slowly; sampling at {} samples), warning \
-                 above {} %; beyond the step's linear range: {}",
+                 above {} %",
                 crate::analysis::error_estimate::extended_harmonic(h_max),
                 crate::analysis::error_estimate::wider_harmonic(h_max),
                 2 * problem.samples,
                 100.0 * estimate.warn_threshold,
-                crate::analysis::error_estimate::EstimateProblems::new(&problem).map_or_else(
-                    String::new,
-                    |refined| crate::analysis::error_estimate::SolveBudget::new(&problem, &refined)
-                        .summary(estimate.beyond_linear_range)
-                )
             )
         } else {
             "error estimate off ([accuracy] estimate = false)".to_string()
         }
     );
+    if let Some(refined) = crate::analysis::error_estimate::EstimateProblems::new(&problem) {
+        let budget = crate::analysis::error_estimate::SolveBudget::new(&problem, &refined);
+        let _ = writeln!(
+            s,
+            "  beyond     the step's linear range: {}",
+            budget.summary(estimate.beyond_linear_range)
+        );
+    }
     let _ = writeln!(
         s,
         "contacts     {} on {} damper side(s)",
