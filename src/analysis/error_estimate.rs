@@ -298,9 +298,10 @@ impl EstimateProblems {
 /// default run over 700-1100 Hz past 13 minutes for 138 of its 329 points (the run alone:
 /// 4.7 s of CPU). A wider set beyond the budget is not stepped on either under `"auto"`
 /// ([`SetBudget::steps`]): its one step per point, a factorisation on H = 47, still made that
-/// run 10× the run alone. The sets measured fall well apart on either side of the budget: at most 18
-/// run points (that blade pair's H = 23 at H = 11; 1-6 on the paper case up to H = 7 and on
-/// the blade pair at H = 1 and 3), at least 147 beyond it.
+/// run 10× the run alone. The sets measured fall well apart on either side of the budget: at
+/// most 18 run points (that blade pair's H = 23 at H = 11; 0.3-18 on the paper case up to
+/// H = 31 and on the blade pair at H = 1 and 3, 15 on the 3D blade pair's H = 7 at H = 1), at
+/// least 145 beyond it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolveBudget {
     /// The first extension (2H + 1).
@@ -361,7 +362,8 @@ impl SolveBudget {
         run_points <= Self::RUN_POINTS
     }
 
-    /// What `fricbound check` says of it: "solved on H = 23 (…), flagged on H = 47 (…) […]".
+    /// What `fricbound check` says of it: "solved on H = 23 (…), not stepped, its points
+    /// flagged, on H = 47 (…) […]".
     pub fn summary(&self, mode: BeyondLinearRange) -> String {
         let how = |s: &SetBudget| {
             format!(
