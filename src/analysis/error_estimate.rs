@@ -1845,18 +1845,24 @@ mod tests {
         assert!(!TailTest::extend(1.0, f64::NAN, f64::NAN, true));
     }
 
+    /// Points with the truncation estimates `truncation` (sampling 0) and, at the indices
+    /// given, the methods given.
+    fn marked(truncation: &[f64], methods: &[(usize, EstimateMethod)]) -> Vec<PointAccuracy> {
+        let mut a: Vec<PointAccuracy> = truncation.iter().map(|&t| acc(t, 0.0)).collect();
+        for &(i, method) in methods {
+            a[i].method = method;
+        }
+        a
+    }
+
     #[test]
     fn unsized_points_warn_in_their_own_band() {
         // Two points not sizeable with small estimates between sized ones, one of them above
         // the threshold: the unsized ones form their own band and do not count as a size.
-        let mut a = [
-            acc(0.001, 0.0),
-            acc(0.002, 0.0),
-            acc(0.003, 0.0),
-            acc(0.05, 0.0),
-        ];
-        a[1].method = EstimateMethod::Unsized;
-        a[2].method = EstimateMethod::Unsized;
+        let a = marked(
+            &[0.001, 0.002, 0.003, 0.05],
+            &[(1, EstimateMethod::Unsized), (2, EstimateMethod::Unsized)],
+        );
         let points: Vec<(f64, &PointAccuracy)> =
             [100.0, 110.0, 120.0, 200.0].into_iter().zip(&a).collect();
         let w = warnings(&points, 1, 0.01);
@@ -1879,15 +1885,14 @@ mod tests {
     fn unsolved_points_warn_in_a_band_of_their_own() {
         // Points flagged because the scene skips the solve (`beyond_linear_range = "flag"`)
         // next to points whose solve failed: two bands, each with its own advice.
-        let mut a = [
-            acc(0.001, 0.0),
-            acc(0.002, 0.0),
-            acc(0.003, 0.0),
-            acc(0.004, 0.0),
-        ];
-        a[0].method = EstimateMethod::Unsized;
-        a[2].method = EstimateMethod::Unsolved;
-        a[3].method = EstimateMethod::Unsolved;
+        let a = marked(
+            &[0.001, 0.002, 0.003, 0.004],
+            &[
+                (0, EstimateMethod::Unsized),
+                (2, EstimateMethod::Unsolved),
+                (3, EstimateMethod::Unsolved),
+            ],
+        );
         let points: Vec<(f64, &PointAccuracy)> =
             [100.0, 150.0, 180.0, 200.0].into_iter().zip(&a).collect();
         let w = warnings(&points, 1, 0.01);
