@@ -1087,22 +1087,19 @@ impl<'p> ErrorEstimator<'p> {
                     reported_step = w.fixed_step;
                 }
             }
-            let method = if widens && !self.step_wider {
-                beyond_budget(&truncation)
-            } else {
-                self.settle(
-                    x,
-                    omega,
-                    &base,
-                    (
-                        &mut truncation,
-                        estimate_harmonic,
-                        contraction,
-                        padded_converged,
-                    ),
-                    (None, &reported_step),
-                )
-            };
+            let method = self.settle(
+                x,
+                omega,
+                &base,
+                (
+                    &mut truncation,
+                    estimate_harmonic,
+                    contraction,
+                    padded_converged,
+                ),
+                (None, &reported_step),
+                widens && !self.step_wider,
+            );
             return PointAccuracy {
                 truncation,
                 sampling: first.sampling,
@@ -1162,22 +1159,19 @@ impl<'p> ErrorEstimator<'p> {
         } else {
             (None, &reported_step)
         };
-        let method = if widens && !self.step_wider {
-            beyond_budget(&truncation)
-        } else {
-            self.settle(
-                x,
-                omega,
-                &base,
-                (
-                    &mut truncation,
-                    estimate_harmonic,
-                    contraction,
-                    padded_converged,
-                ),
-                (normal, settled_step),
-            )
-        };
+        let method = self.settle(
+            x,
+            omega,
+            &base,
+            (
+                &mut truncation,
+                estimate_harmonic,
+                contraction,
+                padded_converged,
+            ),
+            (normal, settled_step),
+            widens && !self.step_wider,
+        );
         if method == EstimateMethod::Solved {
             if across {
                 both.1 = truncation.clone();
@@ -1208,7 +1202,9 @@ impl<'p> ErrorEstimator<'p> {
     /// the extension it comes from, its step's contraction, and whether the padded point
     /// already solves that extension within the Newton tolerance ([`solves_padded`]: then the
     /// point is the extension's converged solution, its step a move within round-off whose
-    /// contraction says nothing, and the step is kept). `across` is the path's normal
+    /// contraction says nothing, and the step is kept); `beyond_the_budget` when the point was
+    /// sent to a wider set the scene's budget does not step on ([`SetBudget::steps`]: then it
+    /// is flagged). `across` is the path's normal
     /// (run unknowns, then ω) when the point reports the step across the path, `step` the
     /// reported step on the extension (with its δω last when across the path).
     fn settle(
@@ -1223,9 +1219,13 @@ impl<'p> ErrorEstimator<'p> {
             bool,
         ),
         (across, step): (Option<&[f64]>, &[f64]),
+        beyond_the_budget: bool,
     ) -> EstimateMethod {
         if truncation.iter().any(|v| v.is_nan()) {
             return EstimateMethod::None;
+        }
+        if beyond_the_budget {
+            return beyond_budget(truncation);
         }
         let wider = estimate_harmonic == wider_harmonic(self.h_max);
         // A contraction that is not a number (the residual after the step failed) counts as
