@@ -796,14 +796,10 @@ pub struct ErrorEstimator<'p> {
     /// A pool of one thread that every estimate runs on ([`Self::on_one_thread`]); None where
     /// the thread could not be started (the estimate then runs on the caller's thread).
     one_thread: Option<rayon::ThreadPool>,
-    /// Whether a point whose step leaves its linear range is solved to convergence on the
-    /// first extension (2H + 1) and on the wider set (4H + 3) ([`SolveBudget`]).
-    solve_truncation: bool,
-    /// See `solve_truncation`.
-    solve_wider: bool,
-    /// Whether the points [`TailTest`] and [`WidenGate`] send to the wider set are stepped on
-    /// it ([`SetBudget::steps`]); where not, they are flagged with their 2H + 1 estimate.
-    step_wider: bool,
+    /// On which extended sets a point whose step leaves its linear range is solved, and
+    /// whether the points [`TailTest`] and [`WidenGate`] send to the wider set are stepped on
+    /// it (where not, they are flagged with their 2H + 1 estimate).
+    budget: SolveBudget,
 }
 
 impl<'p> ErrorEstimator<'p> {
@@ -820,12 +816,9 @@ impl<'p> ErrorEstimator<'p> {
             .iter()
             .map(|&i| i as usize)
             .collect();
-        let budget = SolveBudget::new(problem, refined);
         Ok(Self {
             problem,
-            solve_truncation: budget.truncation.solves,
-            solve_wider: budget.wider.solves,
-            step_wider: budget.wider.steps,
+            budget: SolveBudget::new(problem, refined),
             truncation: Refined::new(&refined.truncation, &set)?,
             wider: Refined::new(&refined.wider, &set)?,
             h_max: problem.harmonics.iter().copied().max().unwrap_or(1),
@@ -1078,7 +1071,7 @@ impl<'p> ErrorEstimator<'p> {
             let mut reported_step = deltas[0][..dim].to_vec();
             let widens = first.needs_wider
                 && self.widens(&first.truncation, first.contraction, padded_converged);
-            if widens && self.step_wider {
+            if widens && self.budget.wider.steps {
                 if let Some(w) = self.wider_truncation(x, omega, None, &base) {
                     padded_converged = w.padded_converged;
                     truncation = w.fixed;
@@ -1098,7 +1091,7 @@ impl<'p> ErrorEstimator<'p> {
                     padded_converged,
                 ),
                 (None, &reported_step),
-                widens && !self.step_wider,
+                widens && !self.budget.wider.steps,
             );
             return PointAccuracy {
                 truncation,
@@ -1125,7 +1118,7 @@ impl<'p> ErrorEstimator<'p> {
         let normal = path.map(|p| p.normal);
         let widens = reported.needs_wider
             && self.widens(&reported.truncation, reported.contraction, padded_converged);
-        if widens && self.step_wider {
+        if widens && self.budget.wider.steps {
             if let Some(w) = self.wider_truncation(x, omega, normal, &base) {
                 let wider_converged = w.padded_converged;
                 if let (Some((a, a_contraction)), Some(a_step)) = (w.across, w.across_step) {
@@ -1170,7 +1163,7 @@ impl<'p> ErrorEstimator<'p> {
                 padded_converged,
             ),
             (normal, settled_step),
-            widens && !self.step_wider,
+            widens && !self.budget.wider.steps,
         );
         if method == EstimateMethod::Solved {
             if across {
@@ -1233,12 +1226,12 @@ impl<'p> ErrorEstimator<'p> {
         if LinearRange::holds(contraction, padded_converged) {
             return EstimateMethod::Step;
         }
-        let solves = if wider {
-            self.solve_wider
+        let set = if wider {
+            &self.budget.wider
         } else {
-            self.solve_truncation
+            &self.budget.truncation
         };
-        if !solves {
+        if !set.solves {
             return EstimateMethod::Unsolved;
         }
         let solved = match across {
