@@ -433,3 +433,53 @@ fn flagging_beyond_the_linear_range_skips_only_the_solves() {
         "{stderr}"
     );
 }
+
+/// Under `"auto"` the wider set (4H + 3) is not stepped on where a widened point's two steps
+/// cost more than `SolveBudget::STEP_RUN_POINTS` run points: on the paper case at H = 15 the
+/// wider set is H = 63 (1.9 + 14.5 run points), and the points sent there (a contact stuck
+/// all period) are flagged `unsolved` with their estimate on H = 31, where `"solve"` steps on
+/// H = 63; every other cell is the same in both runs. `check` says so.
+#[test]
+fn a_wider_set_beyond_the_step_budget_is_not_stepped_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let auto = dir.path().join("auto");
+    let solve = dir.path().join("solve");
+    let zoom = scene("zoom-2nd.toml");
+    let h15 = "harmonics.max=15";
+    let checked = support::fricbound(&["check", &zoom, "--set", h15]);
+    assert!(checked.status.success(), "{}", text(&checked.stderr));
+    let summary = text(&checked.stdout);
+    assert!(
+        summary.contains("solved on H = 31")
+            && summary.contains("not stepped, its points flagged, on H = 63"),
+        "{summary}"
+    );
+    assert!(run_scene(&zoom, &auto, &[h15]).status.success());
+    let solved = run_scene(&zoom, &solve, &[h15, "accuracy.beyond_linear_range=solve"]);
+    assert!(solved.status.success(), "{}", text(&solved.stderr));
+    let (header, by_auto) = csv(&auto.join("frf.csv"));
+    let (solve_header, by_solve) = csv(&solve.join("frf.csv"));
+    assert_eq!(header, solve_header);
+    assert_eq!(by_auto.len(), by_solve.len());
+    let column = |name: &str| header.split(',').position(|c| c == name).unwrap();
+    let (trunc, harmonic, method) = (
+        column("y2_trunc_err"),
+        column("estimate_harmonic"),
+        column("estimate_method"),
+    );
+    let mut flagged = 0_u64;
+    for (a, s) in by_auto.iter().zip(&by_solve) {
+        assert_eq!(a[..trunc], s[..trunc], "the same path");
+        if s[harmonic] == "63" {
+            assert_eq!(a[harmonic], "31", "{a:?}");
+            assert_eq!(a[method], "unsolved", "{a:?}");
+            flagged += 1;
+        } else {
+            assert_eq!(a, s);
+            assert_ne!(a[method], "unsolved", "{a:?}");
+        }
+    }
+    assert!(flagged >= 1, "no point of {} widened", by_auto.len());
+    let json = json(&auto.join("solution.json"));
+    assert_eq!(json["accuracy"]["unsolved_points"].as_u64(), Some(flagged));
+}

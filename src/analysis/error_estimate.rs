@@ -110,13 +110,16 @@
 //! points on 2H + 1, since 417 of its 450 widened points have 2H + 1 estimates above the 1 %
 //! threshold itself (docs/accuracy.md, "What the estimate costs, and where the time goes").
 //!
-//! Which extended sets a point beyond its step's linear range is solved on is the scene's
-//! choice (`accuracy.beyond_linear_range`): by default ([`SolveBudget`]) only those whose
-//! Newton iteration the cost model puts at most 50 run points; beyond that the point is
-//! flagged ([`EstimateMethod::Unsolved`]); a wider set beyond it is not stepped on either (its
-//! points flagged with their 2H + 1 estimate). On the reduced blade pair at H = 11 the solves
-//! on H = 47 had taken the run over 700-1100 Hz past 13 minutes for 138 of its 329 points;
-//! with the budget the run takes 29.8 s of wall time against 6.7 s without the estimate.
+//! Which extended sets a point beyond its step's linear range is solved on, and whether the
+//! wider set is stepped on at all, is the scene's choice (`accuracy.beyond_linear_range`): by
+//! default ([`SolveBudget`]) a set is solved on only where the cost model puts a solve at the
+//! iteration limit at most 100 run points, and the wider set stepped on only where a point's
+//! two steps cost at most 10; beyond that the point is flagged ([`EstimateMethod::Unsolved`];
+//! a point sent to a wider set that is not stepped on is flagged with its 2H + 1 estimate). On
+//! the 3D blade pair at H = 1 the steps and solves on H = 7 at every point (38-45 of its 56
+//! contact points stay stuck all period, so every point is widened) had a 2.5-minute run past
+//! 33 minutes at 217 of its 1174 points; with the budget the run takes 1.03× its wall time
+//! without the estimate, every point flagged.
 //!
 //! Every estimate runs on a pool of one thread of the estimator's own
 //! (`ErrorEstimator::on_one_thread`): faer then factorises the extended systems (2-5× the
@@ -287,27 +290,43 @@ impl EstimateProblems {
     }
 }
 
-/// Which extended sets a point whose step leaves its linear range ([`LinearRange`]) is solved
-/// on (`accuracy.beyond_linear_range`): every set with `"solve"`, none with `"flag"`, and with
-/// `"auto"` (the default) those whose Newton iteration (one factorisation and one evaluation,
-/// [`crate::hbm::cost`]) is estimated at most [`Self::RUN_POINTS`] times a continuation point of
-/// the run. A solve takes 4-12 iterations where it converges and 12-36 where it fails
-/// (docs/accuracy.md), so a point solved on a set beyond the budget costs hundreds of run
-/// points: on the reduced blade pair at H = 11 (cost model: 21.9 ms per run point) the wider
-/// set, H = 47, is estimated at 3.2 s per iteration (147 run points), and its solves took the
-/// default run over 700-1100 Hz past 13 minutes for 138 of its 329 points (the run alone:
-/// 4.7 s of CPU). A wider set beyond the budget is not stepped on either under `"auto"`
-/// ([`SetBudget::steps`]): its one step per point, a factorisation on H = 47, still made that
-/// run 10× the run alone. The sets measured fall well apart on either side of the budget: at
-/// most 18 run points (that blade pair's H = 23 at H = 11; 0.3-18 on the paper case up to
-/// H = 31 and on the blade pair at H = 1 and 3, 15 on the 3D blade pair's H = 7 at H = 1), at
-/// least 145 beyond it.
+/// What the estimate may spend on one point under `accuracy.beyond_linear_range = "auto"` (the
+/// default), in continuation points of the run ("run points", [`crate::hbm::cost`]): the
+/// cost model's time of one Newton iteration (a factorisation and an evaluation) on each
+/// extended set, against two budgets that bound the worst case of one point, whatever the
+/// number of points that reach it.
+///
+/// - **Solves** ([`Self::SOLVE_RUN_POINTS`]): a point whose step leaves its linear range
+///   ([`LinearRange`]) is solved on its set only where a solve at the continuation's
+///   iteration limit (`max_iterations`, 12 by default; converging solves take 4-12
+///   iterations, across the path they stop there) is estimated within the budget; elsewhere it
+///   is flagged ([`EstimateMethod::Unsolved`]). With `"solve"` every set is solved, with
+///   `"flag"` none.
+/// - **The wider set** ([`Self::STEP_RUN_POINTS`]): a point [`TailTest`] sends there takes a
+///   step on 2H + 1 and one on 4H + 3; where the two together are estimated beyond the budget
+///   the wider set is not stepped on under `"auto"` ([`SetBudget::steps`]) and those points
+///   are flagged with their 2H + 1 estimate. Its steps apply to every such point, and on a 3D
+///   FE model with many contact points that is nearly every point: 38-45 of the 3D blade pair's
+///   56 points stay stuck all period.
+///
+/// Measured, before these budgets (when every set whose single iteration was estimated at most
+/// 50 run points was stepped on and solved): the 3D blade pair at H = 1 over 880-890 Hz (H = 3
+/// at 1.8 run points per iteration, H = 7 at 14.7) sent all of its points to H = 7, where a
+/// step costs about 3 s of CPU and the fixed-frequency solves up to 36 iterations; the run,
+/// 2.5 minutes without the estimate, had estimated 217 of its 1174 points after 33 minutes.
+/// The sets measured fall apart on either side: at most 6.2 run points per iteration (a solve
+/// at most 74) and at most 7.1 for the two steps (the paper case up to H = 31; the small and
+/// the larger 2D blade pair at H = 1, the small one at H = 3) against at least 12.2 per
+/// iteration (146 per solve) and 13.8 for the two steps (the larger 2D blade pair at H = 3,
+/// the 3D one at H = 1, the 2D one at H = 11 with H = 23 at 17.9 and H = 47 at 144.7).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolveBudget {
     /// The first extension (2H + 1).
     pub truncation: SetBudget,
     /// The wider set (4H + 3).
     pub wider: SetBudget,
+    /// The Newton iterations a solve is costed at (the continuation's `max_iterations`).
+    pub solve_iterations: usize,
 }
 
 /// The budget decision for one extended set ([`SolveBudget`]).
@@ -320,58 +339,68 @@ pub struct SetBudget {
     /// Whether points beyond the step's linear range are solved on it.
     pub solves: bool,
     /// Whether points are stepped on it at all (the wider set: the points [`TailTest`] sends
-    /// there; the first extension is always stepped on). Under `"auto"` a set beyond the
-    /// budget is not: one step there is a Newton iteration beyond it.
+    /// there; the first extension is always stepped on).
     pub steps: bool,
 }
 
 impl SolveBudget {
-    /// Newton iterations on an extended set at most this many run points each are solved under
-    /// `"auto"`.
-    pub const RUN_POINTS: f64 = 50.0;
+    /// Under `"auto"` a set is solved on where a solve at the iteration limit is estimated at
+    /// most this many run points.
+    pub const SOLVE_RUN_POINTS: f64 = 100.0;
+    /// Under `"auto"` the wider set is stepped on where the steps of a point sent there (on
+    /// 2H + 1 and on 4H + 3) are estimated at most this many run points.
+    pub const STEP_RUN_POINTS: f64 = 10.0;
 
     /// The decision for `problem`'s refined problems `refined`.
     pub fn new(problem: &Problem, refined: &EstimateProblems) -> Self {
         let run_point = crate::hbm::cost::estimate(problem).seconds_per_point();
         let h = problem.harmonics.iter().copied().max().unwrap_or(1);
         let mode = problem.analysis.error_estimate.beyond_linear_range;
-        let set = |extended: &Problem, harmonic: usize, always_stepped: bool| {
-            let run_points =
-                crate::hbm::cost::estimate(extended).seconds_per_iteration() / run_point;
-            let within = Self::within(run_points);
-            SetBudget {
-                harmonic,
-                run_points,
-                solves: match mode {
-                    BeyondLinearRange::Solve => true,
-                    BeyondLinearRange::Flag => false,
-                    BeyondLinearRange::Auto => within,
-                },
-                steps: always_stepped || mode != BeyondLinearRange::Auto || within,
-            }
+        let solve_iterations = problem.analysis.continuation.max_iterations.max(1);
+        let per_iteration = |extended: &Problem| {
+            crate::hbm::cost::estimate(extended).seconds_per_iteration() / run_point
         };
+        let (first, wider) = (
+            per_iteration(&refined.truncation),
+            per_iteration(&refined.wider),
+        );
+        let set = |harmonic: usize, run_points: f64, steps: bool| SetBudget {
+            harmonic,
+            run_points,
+            solves: match mode {
+                BeyondLinearRange::Solve => true,
+                BeyondLinearRange::Flag => false,
+                BeyondLinearRange::Auto => {
+                    Self::within(run_points * solve_iterations as f64, Self::SOLVE_RUN_POINTS)
+                }
+            },
+            steps,
+        };
+        let wider_steps =
+            mode != BeyondLinearRange::Auto || Self::within(first + wider, Self::STEP_RUN_POINTS);
         Self {
-            truncation: set(&refined.truncation, extended_harmonic(h), true),
-            wider: set(&refined.wider, wider_harmonic(h), false),
+            truncation: set(extended_harmonic(h), first, true),
+            wider: set(wider_harmonic(h), wider, wider_steps),
+            solve_iterations,
         }
     }
 
-    /// Whether an iteration of `run_points` run points is within the `"auto"` budget (NaN,
-    /// a cost that could not be estimated, is not).
-    pub fn within(run_points: f64) -> bool {
-        run_points <= Self::RUN_POINTS
+    /// Whether an estimated cost of `run_points` run points is within `budget` (NaN, a cost
+    /// that could not be estimated, is not).
+    pub fn within(run_points: f64, budget: f64) -> bool {
+        run_points <= budget
     }
 
-    /// What `fricbound check` says of it: "solved on H = 23 (…), not stepped, its points
-    /// flagged, on H = 47 (…) […]".
+    /// What `fricbound check` says of it: "solved on H = 3 (1.8 run points per iteration),
+    /// not stepped, its points flagged, on H = 7 (14.7 …) […]".
     pub fn summary(&self, mode: BeyondLinearRange) -> String {
         let how = |s: &SetBudget| {
             format!(
                 "{} on H = {} ({:.1} run points per iteration)",
                 match (s.solves, s.steps) {
-                    (true, _) => "solved",
+                    (_, false) => "not stepped, its points flagged,",
+                    (true, true) => "solved",
                     (false, true) => "flagged",
-                    (false, false) => "not stepped, its points flagged,",
                 },
                 s.harmonic,
                 s.run_points
@@ -379,8 +408,11 @@ impl SolveBudget {
         };
         let why = match mode {
             BeyondLinearRange::Auto => format!(
-                "auto: solved where an iteration is estimated at most {} run points",
-                Self::RUN_POINTS
+                "auto: solved where {} iterations are estimated at most {} run points, the \
+                 wider set stepped on where a point's two steps are at most {}",
+                self.solve_iterations,
+                Self::SOLVE_RUN_POINTS,
+                Self::STEP_RUN_POINTS
             ),
             BeyondLinearRange::Solve => "solve".to_string(),
             BeyondLinearRange::Flag => "flag".to_string(),
@@ -1689,14 +1721,17 @@ pub fn warning_text(w: &AccuracyWarning, output: &str, h_max: usize, samples: us
             return format!(
                 "accuracy: the harmonic truncation error of {output}'s amplitude was not sized \
                  between {:.4} and {:.4} Hz: the estimate's Newton step leaves its linear range \
-                 there (a contact changes regime with more harmonics) and the solve on H = {} \
-                 (or {}) that sizes it was skipped (accuracy.beyond_linear_range = \"flag\", \
-                 or \"auto\" where that system is too large to solve at every such point: \
-                 `fricbound check` says which); set it to \"solve\", or solve the band at \
-                 harmonics.max > {h_max} and compare",
+                 there (a contact changes regime with more harmonics), or the error lies beyond \
+                 H = {} (a contact stuck all period), and the solve on H = {} (or {}) or the step \
+                 on H = {} that sizes it was skipped (accuracy.beyond_linear_range = \"flag\", \
+                 or \"auto\" where it costs more than its budget: `fricbound check` says which \
+                 and how much); set it to \"solve\", or solve the band at harmonics.max > \
+                 {h_max} and compare",
                 w.from_hz,
                 w.to_hz,
                 extended_harmonic(h_max),
+                extended_harmonic(h_max),
+                wider_harmonic(h_max),
                 wider_harmonic(h_max)
             );
         }
@@ -1906,31 +1941,51 @@ mod tests {
 
     #[test]
     fn the_solve_budget_is_a_number_of_run_points() {
-        assert!(SolveBudget::within(SolveBudget::RUN_POINTS));
-        assert!(SolveBudget::within(17.9));
-        assert!(!SolveBudget::within(144.7));
+        let solve = SolveBudget::SOLVE_RUN_POINTS;
+        assert!(SolveBudget::within(solve, solve));
+        // The paper case at H = 7 solves on H = 31 (6.2 run points per iteration, 12
+        // iterations), the 2D blade pair at H = 3 does not on H = 15 (12.2).
+        assert!(SolveBudget::within(6.2 * 12.0, solve));
+        assert!(!SolveBudget::within(12.2 * 12.0, solve));
         // A cost that could not be estimated is not within the budget.
-        assert!(!SolveBudget::within(f64::NAN));
+        assert!(!SolveBudget::within(f64::NAN, solve));
         let budget = SolveBudget {
             truncation: SetBudget {
-                harmonic: 23,
-                run_points: 17.9,
+                harmonic: 3,
+                run_points: 1.8,
                 solves: true,
                 steps: true,
             },
             wider: SetBudget {
-                harmonic: 47,
-                run_points: 144.7,
+                harmonic: 7,
+                run_points: 14.7,
                 solves: false,
                 steps: false,
             },
+            solve_iterations: 12,
         };
         let text = budget.summary(BeyondLinearRange::Auto);
         assert!(
             text.starts_with(
-                "solved on H = 23 (17.9 run points per iteration), not stepped, its points \
-                 flagged, on H = 47"
+                "solved on H = 3 (1.8 run points per iteration), not stepped, its points \
+                 flagged, on H = 7 (14.7 run points per iteration) [auto: solved where 12 \
+                 iterations are estimated at most 100 run points"
             ),
+            "{text}"
+        );
+        // With "solve" a wider set is solved and stepped on whatever it costs.
+        let solved = SetBudget {
+            solves: true,
+            steps: true,
+            ..budget.wider
+        };
+        let text = SolveBudget {
+            wider: solved,
+            ..budget
+        }
+        .summary(BeyondLinearRange::Solve);
+        assert!(
+            text.ends_with("solved on H = 7 (14.7 run points per iteration) [solve]"),
             "{text}"
         );
     }

@@ -229,10 +229,12 @@ impl Default for ErrorEstimateSettings {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum BeyondLinearRange {
-    /// [`Self::Solve`] on an extended set whose Newton iteration the cost model
-    /// (`crate::hbm::cost`) estimates at most
-    /// `crate::analysis::error_estimate::SolveBudget::RUN_POINTS` times a point of the run,
-    /// [`Self::Flag`] on a larger one (see `SolveBudget`).
+    /// [`Self::Solve`] on an extended set where the cost model (`crate::hbm::cost`) estimates
+    /// a solve at the iteration limit at most
+    /// `crate::analysis::error_estimate::SolveBudget::SOLVE_RUN_POINTS` points of the run,
+    /// [`Self::Flag`] on a costlier one; and the wider set (4H + 3) stepped on only where a
+    /// point's two steps are estimated at most `SolveBudget::STEP_RUN_POINTS` (see
+    /// `SolveBudget`).
     #[default]
     Auto,
     /// Solve the extended system to convergence at the point (at its frequency, or across the
