@@ -397,3 +397,64 @@ fn a_leap_over_a_corner_at_a_low_preload_is_covered_as_newton_finds() {
     }
     assert!(run.is_complete(), "{:?}", run.incomplete_reason());
 }
+
+/// Leaps inside the fills after a jump and inside the bridges are listed and judged as the
+/// main path's are. At F0 = 15 N and H = 3 with a smallest step of 1 Hz (so that a corrector
+/// failing twice leaps instead of cutting the step further) the path leaps over 14 spots, ten
+/// of them on the fill after the bridge at 210.60 Hz, which is reported in reverse (falling
+/// from the jump target, listed rising): each leap's two points are consecutive in the report,
+/// in either order, and followed back from its landing the path reaches the point before it
+/// (checked here again by Newton at the frequency before the leap from the landing).
+#[test]
+fn leaps_inside_fills_are_listed_and_judged() {
+    let p = paper(&[
+        "static_loads.0.value=-15",
+        "harmonics.max=3",
+        "analysis.min_step=1",
+        "accuracy.estimate=false",
+    ]);
+    let run = frf::solve(&p, &mut Silent).unwrap();
+    assert_eq!(run.leap_checks.len(), run.leaps.len());
+    let first_jump = run.jumps.first().expect("the path jumps").first_point;
+    let mut solver = PointSolver::new(&p).unwrap();
+    let mut in_reverse = 0;
+    for (&(from_hz, to_hz), check) in run.leaps.iter().zip(&run.leap_checks) {
+        eprintln!("{check:?}");
+        assert_eq!((check.from_hz, check.to_hz), (from_hz, to_hz));
+        let at = |a: f64, b: f64| {
+            (1..run.points.len())
+                .find(|&i| run.points[i - 1].freq_hz == a && run.points[i].freq_hz == b)
+        };
+        let (before, landing) = match (at(from_hz, to_hz), at(to_hz, from_hz)) {
+            (Some(i), _) => (i - 1, i),
+            (None, Some(i)) => {
+                in_reverse += 1;
+                assert!(
+                    i > first_jump,
+                    "a main-path leap reported in reverse at {i}"
+                );
+                (i, i - 1)
+            }
+            (None, None) => panic!("leap {from_hz} -> {to_hz}: its points are not consecutive"),
+        };
+        assert_eq!(check.verdict, CutVerdict::Covered, "{check:?}");
+        let there = solver
+            .solve(&run.points[landing].coefficients, from_hz)
+            .unwrap();
+        let own = &run.points[before].coefficients;
+        let norm = own.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let apart = there
+            .coefficients
+            .iter()
+            .zip(own)
+            .map(|(a, b)| (a - b).powi(2))
+            .sum::<f64>()
+            .sqrt()
+            / norm;
+        assert!(
+            apart <= frf::RETRACE_TOLERANCE,
+            "{from_hz} -> {to_hz}: {apart}"
+        );
+    }
+    assert!(in_reverse >= 1, "no leap on a fill: {:?}", run.leaps);
+}

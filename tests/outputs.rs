@@ -437,9 +437,11 @@ fn check_prints_the_cost_of_a_small_scene() {
 }
 
 /// `check` says on which extended sets the error estimate solves the points beyond its step's
-/// linear range: under `"auto"` the reduced blade pair at H = 11 solves on H = 23 and does not
-/// step on H = 47 (its points flagged), whose Newton iteration the cost model puts beyond the
-/// budget; `"solve"` solves on both, and at H = 1 `"auto"` solves on both.
+/// linear range: under `"auto"` the reduced blade pair at H = 11 flags on H = 23 (a solve of 12
+/// iterations at 17.9 run points each is beyond the budget) and does not step on H = 47 (its
+/// points flagged); at H = 3 it solves on H = 7 and does not step on H = 15 (a widened point's
+/// two steps 1.6 + 12.2 run points); `"solve"` solves on both, and at H = 1 `"auto"` solves on
+/// both.
 #[test]
 fn check_names_the_sets_the_estimate_solves_on() {
     let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -462,10 +464,15 @@ fn check_names_the_sets_the_estimate_solves_on() {
     };
     let auto = line(&["harmonics.max=11"]);
     assert!(
-        auto.contains("solved on H = 23")
+        auto.contains("flagged on H = 23")
             && auto.contains("not stepped, its points flagged, on H = 47")
             && auto.contains("[auto: "),
         "{auto}"
+    );
+    let h3 = line(&["harmonics.max=3"]);
+    assert!(
+        h3.contains("solved on H = 7") && h3.contains("not stepped, its points flagged, on H = 15"),
+        "{h3}"
     );
     let solve = line(&["harmonics.max=11", "accuracy.beyond_linear_range=solve"]);
     assert!(

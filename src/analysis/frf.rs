@@ -689,7 +689,10 @@ pub struct FrfRun {
     pub turning_points: Vec<f64>,
     /// Number of cut steps.
     pub rejected_steps: usize,
-    /// Stretches leapt over: (last point before, first point after), Hz.
+    /// Stretches leapt over: (last point before, first point after), Hz, in the direction the
+    /// continuation travelled; on every path of the run: the main path's branches, the fills
+    /// after its jumps and the bridges (whose ways down, and the fills, are reported in
+    /// reverse, the landing before the point before it).
     pub leaps: Vec<(f64, f64)>,
     /// The judgement of each leap, in the order of [`FrfRun::leaps`] ([`judge_leaps`]).
     pub leap_checks: Vec<LeapCheck>,
@@ -1446,10 +1449,6 @@ fn solve_in<'scope, 'p, O: FrfObserver>(
                 summary.turning_points.last().copied(),
             )
         });
-        if let Some(summary) = &summary {
-            run.turning_points.extend(&summary.turning_points);
-            run.rejected_steps += summary.rejected_steps;
-        }
         // A stretch neither branch reached: solve branches inside it, between the highest
         // point before the jump and the lowest point of the new branch.
         let top = adapter
@@ -1486,9 +1485,31 @@ fn solve_in<'scope, 'p, O: FrfObserver>(
         };
         // How the branch before ended, now that the branches solved past it are known (a
         // branch given up whose last point one of them passes through abandoned nothing).
+        // What the bridges and the fill met, in the order they are reported (bridges first);
+        // their turning points and leaps go to the observer too (`solution.json` lists them),
+        // its leaps in the order of `run.leaps`, which the leaps' judgements follow.
+        let met = bridges
+            .iter()
+            .map(|b| (&b.turning_points, b.rejected_steps, &b.leaps))
+            .chain(
+                summary
+                    .as_ref()
+                    .map(|s| (&s.turning_points, s.rejected_steps, &s.leaps)),
+            );
+        for (turning_points, rejected_steps, leaps) in met {
+            for &freq_hz in turning_points {
+                run.turning_points.push(freq_hz);
+                adapter.report(Held::TurningPoint(freq_hz));
+            }
+            run.rejected_steps += rejected_steps;
+            for &(from_hz, to_hz) in leaps {
+                run.leaps.push((from_hz, to_hz));
+                adapter.report(Held::Leap(from_hz, to_hz));
+            }
+        }
         let later: Vec<&[FrfPoint]> = bridges
             .iter()
-            .map(|(b, _)| b.as_slice())
+            .map(|b| b.points.as_slice())
             .chain([followed_fill.as_slice()])
             .collect();
         let branch_end = branch_end(
@@ -1510,10 +1531,10 @@ fn solve_in<'scope, 'p, O: FrfObserver>(
         // A bridge's cuts: its way down's, then its way up's.
         let cuts: Vec<[Option<GivenUp>; 2]> = bridges
             .iter()
-            .map(|(_, c)| *c)
+            .map(|b| b.cuts)
             .chain([[cut, None]])
             .collect();
-        let branches = bridges.into_iter().map(|(b, _)| b).chain([fill]);
+        let branches = bridges.into_iter().map(|b| b.points).chain([fill]);
         for (branch, cuts) in branches.zip(cuts) {
             let (cut, second_cut) = bridge_cuts(cuts);
             let lowest = branch
@@ -1836,8 +1857,17 @@ fn judge_leaps<O: FrfObserver>(
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1.0);
     for k in 0..run.leaps.len() {
         let (from_hz, to_hz) = run.leaps[k];
-        let at = (1..run.points.len()).find(|&i| {
-            close(run.points[i - 1].freq_hz, from_hz) && close(run.points[i].freq_hz, to_hz)
+        // (before, landing): consecutive points of the report, the landing after the point
+        // before it, or before it on a way reported in reverse (a fill, a bridge's way down).
+        let at = (1..run.points.len()).find_map(|i| {
+            let (a, b) = (run.points[i - 1].freq_hz, run.points[i].freq_hz);
+            if close(a, from_hz) && close(b, to_hz) {
+                Some((i - 1, i))
+            } else if close(a, to_hz) && close(b, from_hz) {
+                Some((i, i - 1))
+            } else {
+                None
+            }
         });
         let mut check = LeapCheck {
             from_hz,
@@ -1848,8 +1878,8 @@ fn judge_leaps<O: FrfObserver>(
             points: 0,
             verdict: CutVerdict::Unjudged,
         };
-        if let Some(i) = at {
-            let (before, landing) = (&run.points[i - 1], &run.points[i]);
+        if let Some((b, l)) = at {
+            let (before, landing) = (&run.points[b], &run.points[l]);
             check.before_amplitude = before.amplitudes.first().copied();
             let x = system.restrict(&landing.coefficients);
             let (back, summary) =
@@ -2300,8 +2330,8 @@ impl Branching<'_> {
         budget: usize,
         estimates: Option<&EstimatePool<'_>>,
         (followed, branch_starts): (&[FrfPoint], &[usize]),
-    ) -> Vec<(Vec<FrfPoint>, [Option<GivenUp>; 2])> {
-        let mut branches: Vec<(Vec<FrfPoint>, [Option<GivenUp>; 2])> = Vec::new();
+    ) -> Vec<BridgeBranch> {
+        let mut branches: Vec<BridgeBranch> = Vec::new();
         let mut gaps = vec![(below.clone(), above.clone())];
         let mut used = 0;
         let solver = Continuation::new(self.settings, self.x_scale.to_vec());
@@ -2363,11 +2393,33 @@ impl Branching<'_> {
             if gap_above.uncovered_hz() > 0.0 {
                 gaps.push((high.clone(), hi.clone()));
             }
-            branches.push((branch, cuts));
+            let ways = [&down_end, &up_end];
+            let summaries = || ways.iter().filter_map(|w| w.as_ref());
+            branches.push(BridgeBranch {
+                points: branch,
+                cuts,
+                turning_points: summaries()
+                    .flat_map(|s| s.turning_points.iter().copied())
+                    .collect(),
+                rejected_steps: summaries().map(|s| s.rejected_steps).sum(),
+                leaps: summaries().flat_map(|s| s.leaps.iter().copied()).collect(),
+            });
         }
-        branches.sort_by(|(a, _), (b, _)| a[0].freq_hz.total_cmp(&b[0].freq_hz));
+        branches.sort_by(|a, b| a.points[0].freq_hz.total_cmp(&b.points[0].freq_hz));
         branches
     }
+}
+
+/// One branch solved inside a stretch no branch reached ([`Branching::bridge`]): its points
+/// from its lowest up, the cuts of its way down and of its way up ([`fill_cut`]), and what the
+/// continuation met on the two ways: turning points (Hz), rejected steps and leaps (each as
+/// (last point before, first point after) in the way's own direction of travel, Hz).
+struct BridgeBranch {
+    points: Vec<FrfPoint>,
+    cuts: [Option<GivenUp>; 2],
+    turning_points: Vec<f64>,
+    rejected_steps: usize,
+    leaps: Vec<(f64, f64)>,
 }
 
 /// A converged point strictly between `lo` and `hi` (Hz and operator unknowns), by Newton at
