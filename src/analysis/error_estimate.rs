@@ -318,7 +318,9 @@ impl EstimateProblems {
 /// at most 74) and at most 7.1 for the two steps (the paper case up to H = 31; the small and
 /// the larger 2D blade pair at H = 1, the small one at H = 3) against at least 12.2 per
 /// iteration (146 per solve) and 13.8 for the two steps (the larger 2D blade pair at H = 3,
-/// the 3D one at H = 1, the 2D one at H = 11 with H = 23 at 17.9 and H = 47 at 144.7).
+/// the 3D one at H = 1, the 2D one at H = 11 with H = 23 at 17.9 and H = 47 at 144.7, the
+/// paper case at H = 15 with H = 63 at 14.5: `tests/cli_run.rs` compares that run with
+/// `"solve"`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolveBudget {
     /// The first extension (2H + 1).
