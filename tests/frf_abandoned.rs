@@ -34,6 +34,17 @@ fn paper(overrides: &[&str]) -> Problem {
         .unwrap_or_else(|e| panic!("{overrides:?}: {e}"))
 }
 
+/// ‖x − reference‖ / ‖reference‖ over all Fourier coefficients.
+fn coefficients_apart(x: &[f64], reference: &[f64]) -> f64 {
+    let norm = reference.iter().map(|v| v * v).sum::<f64>().sqrt();
+    x.iter()
+        .zip(reference)
+        .map(|(a, b)| (a - b).powi(2))
+        .sum::<f64>()
+        .sqrt()
+        / norm
+}
+
 /// The points given up of a run, with the index of each one's point in the run.
 fn given_up(run: &FrfRun) -> Vec<(BranchEnd, GivenUp, usize)> {
     run.jumps
@@ -375,20 +386,7 @@ fn a_leap_over_a_corner_at_a_low_preload_is_covered_as_newton_finds() {
         let there = solver
             .solve(&run.points[i].coefficients, check.from_hz)
             .unwrap();
-        let norm = before
-            .coefficients
-            .iter()
-            .map(|v| v * v)
-            .sum::<f64>()
-            .sqrt();
-        let apart = there
-            .coefficients
-            .iter()
-            .zip(&before.coefficients)
-            .map(|(a, b)| (a - b).powi(2))
-            .sum::<f64>()
-            .sqrt()
-            / norm;
+        let apart = coefficients_apart(&there.coefficients, &before.coefficients);
         eprintln!(
             "Newton at {:.4} Hz from the landing: {apart:.3e} from the point before",
             check.from_hz
@@ -441,16 +439,7 @@ fn leaps_inside_fills_are_listed_and_judged() {
         let there = solver
             .solve(&run.points[landing].coefficients, from_hz)
             .unwrap();
-        let own = &run.points[before].coefficients;
-        let norm = own.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let apart = there
-            .coefficients
-            .iter()
-            .zip(own)
-            .map(|(a, b)| (a - b).powi(2))
-            .sum::<f64>()
-            .sqrt()
-            / norm;
+        let apart = coefficients_apart(&there.coefficients, &run.points[before].coefficients);
         assert!(
             apart <= frf::RETRACE_TOLERANCE,
             "{from_hz} -> {to_hz}: {apart}"
