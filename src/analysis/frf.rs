@@ -421,8 +421,8 @@ pub enum GiveUpCause {
     /// [`PathEnd::DeadEnd`]: the corrector failed at every step down to the minimum, and the
     /// only way on found led back along the path already followed, or behind a fold.
     DeadEnd,
-    /// [`PathEnd::NoProgress`]: the path wandered back and forth without reaching a higher
-    /// frequency for a fifth of the point budget.
+    /// [`PathEnd::NoProgress`]: the path wandered back and forth over ground it had covered
+    /// (frequency and response) for a fifth of the point budget.
     NoProgress,
     /// The fill of a branch past a jump, followed down toward the highest frequency of the
     /// branch before, turned back up at a fold of its own and stopped on reaching that
@@ -447,8 +447,8 @@ impl GiveUpCause {
                  no further"
             }
             GiveUpCause::NoProgress => {
-                "no progress: the path wandered back and forth without reaching a higher \
-                 frequency"
+                "no progress: the path wandered back and forth over ground it had covered \
+                 already"
             }
             GiveUpCause::PointBudget => {
                 "its point budget: the fill or bridge used up the points allowed for it before \
