@@ -1483,8 +1483,6 @@ fn solve_in<'scope, 'p, O: FrfObserver>(
             }
             _ => Vec::new(),
         };
-        // How the branch before ended, now that the branches solved past it are known (a
-        // branch given up whose last point one of them passes through abandoned nothing).
         // What the bridges and the fill met, in the order they are reported (bridges first);
         // their turning points and leaps go to the observer too (`solution.json` lists them),
         // its leaps in the order of `run.leaps`, which the leaps' judgements follow.
@@ -1507,6 +1505,8 @@ fn solve_in<'scope, 'p, O: FrfObserver>(
                 adapter.report(Held::Leap(from_hz, to_hz));
             }
         }
+        // How the branch before ended, now that the branches solved past it are known (a
+        // branch given up whose last point one of them passes through abandoned nothing).
         let later: Vec<&[FrfPoint]> = bridges
             .iter()
             .map(|b| b.points.as_slice())
