@@ -197,7 +197,10 @@ fn the_cli_says_which_branch_a_run_abandoned() {
     let out = run_scene(scene_file.to_str().unwrap(), &out_dir, &overrides);
     let stderr = text(&out.stderr);
     assert_eq!(out.status.code(), Some(3), "{stderr}");
-    assert!(stderr.contains("ABANDONED: the branch given up at"), "{stderr}");
+    assert!(
+        stderr.contains("ABANDONED: the branch given up at"),
+        "{stderr}"
+    );
     let sol = json(&out_dir.join("solution.json"));
     assert_eq!(sol["status"], format!("incomplete: {reason}"));
     let flagged: Vec<&serde_json::Value> = sol["jumps"]

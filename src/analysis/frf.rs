@@ -2428,7 +2428,7 @@ impl Branching<'_> {
                 cut_check: None,
                 second_cut: None,
                 second_cut_check: None,
-            end_check: None,
+                end_check: None,
             };
             if gap_below.uncovered_hz() > 0.0 {
                 gaps.push((lo.clone(), low.clone()));
@@ -3004,6 +3004,46 @@ mod tests {
         run.jumps[0].to_hz = 111.0;
         let reason = run.incomplete_reason().unwrap();
         assert!(reason.contains("110.0000-111.0000 Hz") && reason.contains("abandoned at"));
+        run.jumps[0].to_hz = 110.0;
+        // Judged once the run is over (`end_check`): Newton past the point landing on a
+        // stretch of the run covers it, the run is complete; landing off the run, or nowhere,
+        // it stays abandoned and the reason says where Newton landed.
+        let covered = CutCheck {
+            landing: Landing {
+                freq_hz: 108.9,
+                amplitude: Some(3.1),
+                distance: Some(1e-4),
+                resolved_distance: Some(1e-12),
+            },
+            own_side: false,
+            newton_iterations: 2,
+            beyond_fold: None,
+            verdict: CutVerdict::Covered,
+        };
+        run.jumps[0].end_check = Some(covered);
+        assert!(!run.jumps[0].abandons_branch());
+        assert!(run.is_complete(), "{:?}", run.incomplete_reason());
+        let json = serde_json::to_value(run.jumps[0]).unwrap();
+        assert_eq!(json["abandoned"], false);
+        assert_eq!(json["end_check"]["verdict"], "covered");
+        for verdict in [CutVerdict::Abandoned, CutVerdict::Unjudged] {
+            run.jumps[0].end_check = Some(CutCheck {
+                landing: Landing {
+                    distance: Some(3e-2),
+                    resolved_distance: None,
+                    ..covered.landing
+                },
+                verdict,
+                ..covered
+            });
+            assert!(run.jumps[0].abandons_branch());
+            let reason = run.incomplete_reason().unwrap();
+            assert!(
+                reason.contains("abandoned at 109.0000 Hz")
+                    && reason.contains("Newton just past the point given up"),
+                "{reason}"
+            );
+        }
     }
 
     /// A branch given up where it was retracing the stretch already followed (the points
@@ -3026,7 +3066,7 @@ mod tests {
                 cut_check: None,
                 second_cut: None,
                 second_cut_check: None,
-            end_check: None,
+                end_check: None,
             }]);
             run.points = points;
             assert!(run.is_complete(), "{:?}", run.incomplete_reason());
@@ -3375,6 +3415,7 @@ mod tests {
             cut_check: Some(covered),
             second_cut: Some(second_cut),
             second_cut_check: Some(covered),
+            end_check: None,
         }]);
         run.points = points;
         assert!(run.is_complete(), "{:?}", run.incomplete_reason());
