@@ -170,7 +170,13 @@ class FrfResult(ContinuationPath):
       ``retrace``, ``outside-range``, ``bridge``) and, for a branch given up, ``given_up_hz``,
       ``given_up_amplitude`` (m), ``given_up_rising``, ``given_up_fold_hz`` and
       ``given_up_cause`` (``dead-end`` or ``no-progress``, as ``cause`` in ``solution.json``;
-      None otherwise), and
+      None otherwise), for a branch given up off every stretch followed (``before``
+      ``abandoned``) its judgement by Newton just past its last point once the run is over
+      (``end_check`` in ``solution.json``): ``given_up_verdict`` (``covered``: the landing
+      lies on a stretch of the run, nothing is missing and ``abandoned`` is False;
+      ``abandoned`` or ``unjudged``), ``given_up_check_hz``, ``given_up_check_amplitude`` (m,
+      where Newton landed) and ``given_up_check_distance`` (relative distance of the landing's
+      coefficients from the nearest stretch of the run; all None otherwise), and
       ``fill_cut_hz``, ``fill_cut_amplitude`` (m), ``fill_cut_fold_hz`` where the branch
       after the jump (a fill or a bridge) was left off every stretch followed before (at the
       edge of its stretch after a fold of its own, given up before it, or out of points;

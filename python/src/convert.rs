@@ -311,6 +311,22 @@ pub fn frf_dict<'py>(
             "given_up_cause",
             given_up.map(|g| json_name(&g.cause)).transpose()?,
         )?;
+        // The judgement of an abandoned branch's last point (`end_check` in solution.json):
+        // its verdict and where Newton landed just past it.
+        let end = j.end_check.as_ref();
+        jd.set_item(
+            "given_up_verdict",
+            end.map(|c| json_name(&c.verdict)).transpose()?,
+        )?;
+        jd.set_item("given_up_check_hz", end.map(|c| c.landing.freq_hz))?;
+        jd.set_item(
+            "given_up_check_amplitude",
+            end.and_then(|c| c.landing.amplitude),
+        )?;
+        jd.set_item(
+            "given_up_check_distance",
+            end.and_then(|c| c.landing.distance),
+        )?;
         // The first cut under its own keys, the second (a bridge cut on both sides) under
         // the same keys prefixed `second_`.
         let cuts = [

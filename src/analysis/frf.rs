@@ -108,6 +108,14 @@ pub struct Jump {
     pub second_cut: Option<GivenUp>,
     /// How [`Jump::second_cut`] was judged, as [`Jump::cut_check`] for [`Jump::fill_cut`].
     pub second_cut_check: Option<CutCheck>,
+    /// How the branch before the jump, given up inside the range off every stretch followed
+    /// ([`BranchEnd::Abandoned`]), was judged once the run was over: as a cut is
+    /// ([`judge_cuts`]), by Newton just past its last point, the way the path was going. A
+    /// landing on a stretch of the run covers it (the branch beyond the point given up is one
+    /// the run has: nothing is missing, [`Jump::abandons_branch`] is false); a landing on no
+    /// stretch, or no landing, leaves it abandoned. None for other branch ends, and for jumps
+    /// reported before the judgement.
+    pub end_check: Option<CutCheck>,
 }
 
 /// The judgement of a cut ([`Jump::fill_cut`]): Newton at a fixed frequency just past the cut,
@@ -234,19 +242,25 @@ impl CutCheck {
     /// solution …: the landing lies on a branch beyond the fold …, not followed", for status
     /// lines and messages.
     pub fn describe(&self) -> String {
+        self.describe_past("the cut")
+    }
+
+    /// [`CutCheck::describe`] for a judgement past `what` ("the cut", "the point given up"
+    /// for a [`Jump::end_check`]).
+    pub fn describe_past(&self, what: &str) -> String {
         let Some(a) = self
             .landing
             .amplitude
             .filter(|_| self.verdict != CutVerdict::Unjudged || self.beyond_fold.is_some())
         else {
             return format!(
-                "Newton just past the cut converged at none of the frequencies tried (the last \
+                "Newton just past {what} converged at none of the frequencies tried (the last \
                  {:.4} Hz): whether the branch goes on there is not known",
                 self.landing.freq_hz
             );
         };
         let landing = format!(
-            "Newton just past the cut, at {:.4} Hz, lands at {a:.3e} m (first output)",
+            "Newton just past {what}, at {:.4} Hz, lands at {a:.3e} m (first output)",
             self.landing.freq_hz
         );
         let Some(d) = self.landing.distance else {
@@ -255,7 +269,7 @@ impl CutCheck {
             );
         };
         let stretch = if self.own_side {
-            "the cut branch's own side of its fold"
+            "the branch's own side of its fold"
         } else {
             "another stretch of the run"
         };
@@ -300,7 +314,7 @@ impl CutCheck {
                 ),
                 _ => format!(
                     "{past}, on no stretch of the run and above it ({run}): a branch beyond the \
-                     fold of the fill or bridge, not followed"
+                     fold of that branch, not followed"
                 ),
             };
         }
@@ -312,8 +326,8 @@ impl CutCheck {
             (CutVerdict::Covered, None) => format!("{place}: covered"),
             (_, Some(r)) if self.own_side => format!(
                 "{place}, but Newton from that side at the same frequency converges to another \
-                 solution ({r:.1e} apart): the landing lies on a branch beyond the fold of the \
-                 fill or bridge, not followed"
+                 solution ({r:.1e} apart): the landing lies on a branch beyond the fold of \
+                 that branch, not followed"
             ),
             (_, Some(r)) => format!(
                 "{place}, but Newton from that stretch at the same frequency converges to \
@@ -332,7 +346,7 @@ impl CutCheck {
 impl serde::Serialize for Jump {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         use serde::ser::SerializeStruct;
-        let mut record = serializer.serialize_struct("Jump", 10)?;
+        let mut record = serializer.serialize_struct("Jump", 11)?;
         record.serialize_field("from_hz", &self.from_hz)?;
         record.serialize_field("to_hz", &self.to_hz)?;
         record.serialize_field("first_point", &self.first_point)?;
@@ -343,6 +357,7 @@ impl serde::Serialize for Jump {
         record.serialize_field("cut_check", &self.cut_check)?;
         record.serialize_field("second_cut", &self.second_cut)?;
         record.serialize_field("second_cut_check", &self.second_cut_check)?;
+        record.serialize_field("end_check", &self.end_check)?;
         record.end()
     }
 }
@@ -421,8 +436,8 @@ pub enum GiveUpCause {
     /// [`PathEnd::DeadEnd`]: the corrector failed at every step down to the minimum, and the
     /// only way on found led back along the path already followed, or behind a fold.
     DeadEnd,
-    /// [`PathEnd::NoProgress`]: the path wandered back and forth without reaching a higher
-    /// frequency for a fifth of the point budget.
+    /// [`PathEnd::NoProgress`]: the path wandered back and forth over ground it had covered
+    /// (frequency and response) for a fifth of the point budget.
     NoProgress,
     /// The fill of a branch past a jump, followed down toward the highest frequency of the
     /// branch before, turned back up at a fold of its own and stopped on reaching that
@@ -447,8 +462,8 @@ impl GiveUpCause {
                  no further"
             }
             GiveUpCause::NoProgress => {
-                "no progress: the path wandered back and forth without reaching a higher \
-                 frequency"
+                "no progress: the path wandered back and forth over ground it had covered \
+                 already"
             }
             GiveUpCause::PointBudget => {
                 "its point budget: the fill or bridge used up the points allowed for it before \
@@ -524,6 +539,7 @@ impl Jump {
     /// [`Jump::fill_cut`] does not count here (see [`Jump::cut_uncovered`]).
     pub fn abandons_branch(&self) -> bool {
         matches!(self.before, BranchEnd::Abandoned(_))
+            && self.end_check.is_none_or(|c| c.uncovered())
     }
 
     /// The cuts of the branch after the jump ([`Jump::fill_cut`], then [`Jump::second_cut`]),
@@ -794,9 +810,13 @@ impl FrfRun {
             .iter()
             .filter(|j| j.abandons_branch())
             .filter_map(|j| {
+                let judged = j.end_check.map_or(String::new(), |c| {
+                    format!("; {}", c.describe_past("the point given up"))
+                });
                 j.before.words().map(|words| {
                     format!(
-                        "a branch was {words} (the run went on on a branch found past {:.4} Hz)",
+                        "a branch was {words}{judged} (the run went on on a branch found past \
+                         {:.4} Hz)",
                         j.from_hz
                     )
                 })
@@ -1552,6 +1572,7 @@ fn solve_in<'scope, 'p, O: FrfObserver>(
                 cut_check: None,
                 second_cut,
                 second_cut_check: None,
+                end_check: None,
             };
             adapter.report(Held::Jump(Box::new(jump)));
             run.jumps.push(jump);
@@ -1786,9 +1807,15 @@ pub const CUT_CHECK_OFFSETS: &[f64] = &[1.0, 0.25, 0.0625];
 /// to 5·10⁻⁴ past it, a landing on the run at 10⁻³).
 pub const CUT_CHECK_FALLBACKS: &[f64] = &[1e-4, 1e-3];
 
-/// Judges the cuts of every jump of `run` ([`Jump::fill_cut`], [`Jump::second_cut`]) now that
-/// every branch of the run is known, sets their [`Jump::cut_check`] and
-/// [`Jump::second_cut_check`] and tells `observer` ([`FrfObserver::cut_judged`]).
+/// Judges the cuts of every jump of `run` ([`Jump::fill_cut`], [`Jump::second_cut`]), and the
+/// last point of every branch abandoned before a jump ([`BranchEnd::Abandoned`]), now that
+/// every branch of the run is known, sets their [`Jump::cut_check`],
+/// [`Jump::second_cut_check`] and [`Jump::end_check`] and tells `observer`
+/// ([`FrfObserver::cut_judged`]). A branch given up at a dead end or for want of progress
+/// off every stretch followed is judged as a cut is: the point given up, like a cut, is where
+/// the run stopped following a branch, and only Newton past it tells whether that branch goes
+/// on off the run (on the paper's system at F0 = 2 N a dead end at 153.0743 Hz whose landing
+/// past it lies on the run, covered).
 ///
 /// Newton at a fixed frequency just past the cut, in the direction its stretch was going at
 /// its last step (away from the point before it on the branch; by its fold when the branch
@@ -1816,7 +1843,27 @@ fn judge_cuts<O: FrfObserver>(
     let starts = run.branch_starts();
     for k in 0..run.jumps.len() {
         let jump = run.jumps[k];
+        // The branch before the jump, given up off every stretch followed: its last point is
+        // the last of the branch that ends at the jump.
+        let end_check = match &jump.before {
+            BranchEnd::Abandoned(given_up) => {
+                let branch = k.checked_sub(1).map_or(0, |j| starts[j])..jump.first_point;
+                Some(judge_cut(
+                    system,
+                    newton,
+                    &run.points,
+                    &starts,
+                    branch,
+                    given_up,
+                ))
+            }
+            _ => None,
+        };
+        run.jumps[k].end_check = end_check;
         if jump.fill_cut.is_none() && jump.second_cut.is_none() {
+            if end_check.is_some() {
+                observer.cut_judged(k, &run.jumps[k]);
+            }
             continue;
         }
         let first = jump.first_point;
@@ -2381,6 +2428,7 @@ impl Branching<'_> {
                 cut_check: None,
                 second_cut: None,
                 second_cut_check: None,
+                end_check: None,
             };
             if gap_below.uncovered_hz() > 0.0 {
                 gaps.push((lo.clone(), low.clone()));
@@ -2844,6 +2892,7 @@ mod tests {
             cut_check: None,
             second_cut: None,
             second_cut_check: None,
+            end_check: None,
         }]);
         reference.points = points;
         let point = FrfPoint {
@@ -2882,6 +2931,7 @@ mod tests {
             cut_check: None,
             second_cut: None,
             second_cut_check: None,
+            end_check: None,
         };
         assert!(run_with_jumps(vec![jump(66.0, 66.0)]).is_complete());
         assert!(run_with_jumps(vec![jump(66.0, 66.0 + 1e-12)]).is_complete());
@@ -2930,6 +2980,7 @@ mod tests {
             cut_check: None,
             second_cut: None,
             second_cut_check: None,
+            end_check: None,
         }]);
         run.points = points;
         assert!(!run.is_complete());
@@ -2953,6 +3004,46 @@ mod tests {
         run.jumps[0].to_hz = 111.0;
         let reason = run.incomplete_reason().unwrap();
         assert!(reason.contains("110.0000-111.0000 Hz") && reason.contains("abandoned at"));
+        run.jumps[0].to_hz = 110.0;
+        // Judged once the run is over (`end_check`): Newton past the point landing on a
+        // stretch of the run covers it, the run is complete; landing off the run, or nowhere,
+        // it stays abandoned and the reason says where Newton landed.
+        let covered = CutCheck {
+            landing: Landing {
+                freq_hz: 108.9,
+                amplitude: Some(3.1),
+                distance: Some(1e-4),
+                resolved_distance: Some(1e-12),
+            },
+            own_side: false,
+            newton_iterations: 2,
+            beyond_fold: None,
+            verdict: CutVerdict::Covered,
+        };
+        run.jumps[0].end_check = Some(covered);
+        assert!(!run.jumps[0].abandons_branch());
+        assert!(run.is_complete(), "{:?}", run.incomplete_reason());
+        let json = serde_json::to_value(run.jumps[0]).unwrap();
+        assert_eq!(json["abandoned"], false);
+        assert_eq!(json["end_check"]["verdict"], "covered");
+        for verdict in [CutVerdict::Abandoned, CutVerdict::Unjudged] {
+            run.jumps[0].end_check = Some(CutCheck {
+                landing: Landing {
+                    distance: Some(3e-2),
+                    resolved_distance: None,
+                    ..covered.landing
+                },
+                verdict,
+                ..covered
+            });
+            assert!(run.jumps[0].abandons_branch());
+            let reason = run.incomplete_reason().unwrap();
+            assert!(
+                reason.contains("abandoned at 109.0000 Hz")
+                    && reason.contains("Newton just past the point given up"),
+                "{reason}"
+            );
+        }
     }
 
     /// A branch given up where it was retracing the stretch already followed (the points
@@ -2975,6 +3066,7 @@ mod tests {
                 cut_check: None,
                 second_cut: None,
                 second_cut_check: None,
+                end_check: None,
             }]);
             run.points = points;
             assert!(run.is_complete(), "{:?}", run.incomplete_reason());
@@ -3051,6 +3143,7 @@ mod tests {
             cut_check: None,
             second_cut: None,
             second_cut_check: None,
+            end_check: None,
         }]);
         run.points = rising.clone();
         assert!(run.is_complete(), "{:?}", run.incomplete_reason());
@@ -3105,6 +3198,7 @@ mod tests {
             cut_check: None,
             second_cut: None,
             second_cut_check: None,
+            end_check: None,
         }]);
         run.points = points.clone();
         // Not judged yet (a jump as reported during the run): not counted in the status.
@@ -3321,6 +3415,7 @@ mod tests {
             cut_check: Some(covered),
             second_cut: Some(second_cut),
             second_cut_check: Some(covered),
+            end_check: None,
         }]);
         run.points = points;
         assert!(run.is_complete(), "{:?}", run.incomplete_reason());

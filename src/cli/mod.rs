@@ -37,7 +37,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use sha2::{Digest, Sha256};
 
 use crate::analysis::frf::{
-    self, CutCheck, FrfError, FrfObserver, FrfPoint, GivenUp, Jump, JumpKind, LeapCheck,
+    self, BranchEnd, CutCheck, FrfError, FrfObserver, FrfPoint, GivenUp, Jump, JumpKind, LeapCheck,
 };
 use crate::analysis::limits::LimitSettings;
 use crate::analysis::linear::{self, LinearCase};
@@ -347,7 +347,8 @@ impl FrfObserver for RunObserver<'_> {
         let before = match (jump.before.words(), jump.abandons_branch()) {
             (Some(words), true) => format!(
                 "\nABANDONED: the branch before it was {words}, and the run will be reported \
-                 incomplete"
+                 incomplete unless Newton past that point, once the run is over, lands on a \
+                 stretch of the run (the jump's end_check)"
             ),
             (Some(words), false) => format!("\nthe branch before it was {words}"),
             (None, _) => String::new(),
@@ -393,6 +394,21 @@ impl FrfObserver for RunObserver<'_> {
     fn cut_judged(&mut self, index: usize, jump: &Jump) {
         self.writer.cut_judged(index, jump);
         // Always said, as the jump was.
+        if let (BranchEnd::Abandoned(g), Some(check)) = (&jump.before, &jump.end_check) {
+            let msg = format!(
+                "{}the branch given up at {:.4} Hz before the jump at {:.4} Hz: {}{}",
+                if check.uncovered() { "ABANDONED: " } else { "" },
+                g.freq_hz,
+                jump.from_hz,
+                check.describe_past("the point given up"),
+                if check.uncovered() {
+                    "; the run will be reported incomplete"
+                } else {
+                    "; nothing is missing there"
+                }
+            );
+            self.say(msg);
+        }
         let judged: Vec<(GivenUp, CutCheck)> = jump
             .cuts()
             .filter_map(|(g, check)| check.map(|c| (*g, *c)))

@@ -247,6 +247,53 @@ const CORNER_STEPS: &[f64] = &[4.0, 64.0, 1024.0];
 /// Fewest points a path may take without progress before it is given up (see
 /// [`Continuation::stagnation_points`]).
 const MIN_STAGNATION_POINTS: usize = 200;
+
+/// The ground a path has covered, for its no-progress test ([`Continuation::stagnation_points`]):
+/// the cells of frequency ([`Self::FREQUENCY_CELLS`] across the range) and of the size of the
+/// unknowns (ln ‖x‖ in steps of [`Self::SIZE_CELL`]) its points have entered. A path makes
+/// progress where a point enters a cell no point entered before: a branch climbing toward the
+/// end frequency, and as well one running back after a fold toward a resonance below it (the
+/// middle branch of the 2D blade pair runs down from a fold at 878.9 Hz to its peak at
+/// 865.3 Hz over about 2000 points, the corners of its 14 contact points making the steps
+/// short), or climbing from it on the upper branch; a path wandering back and forth over the
+/// same stretch, or going round a loop it went round before, enters none. (Counting only a new
+/// highest frequency as progress gave that middle branch up at 866.9 Hz, above its peak.)
+struct VisitedGround {
+    cells: std::collections::HashSet<(i64, i64)>,
+    cell_hz: f64,
+}
+
+impl VisitedGround {
+    /// Frequency cells across the run's range.
+    const FREQUENCY_CELLS: f64 = 4000.0;
+    /// Width of a size cell in ln ‖x‖ (about 5 %).
+    const SIZE_CELL: f64 = 0.05;
+
+    fn new(freq_start_hz: f64, freq_end_hz: f64) -> Self {
+        let range = (freq_end_hz - freq_start_hz).abs();
+        Self {
+            cells: std::collections::HashSet::new(),
+            cell_hz: if range > 0.0 {
+                range / Self::FREQUENCY_CELLS
+            } else {
+                1.0
+            },
+        }
+    }
+
+    /// Whether the point at `freq_hz` with unknowns `x` enters a cell no point entered before
+    /// (and marks it entered).
+    fn enters_new(&mut self, freq_hz: f64, x: &[f64]) -> bool {
+        let size = norm(x);
+        let size_cell = if size > 0.0 && size.is_finite() {
+            (size.ln() / Self::SIZE_CELL).floor() as i64
+        } else {
+            i64::MIN
+        };
+        let freq_cell = (freq_hz / self.cell_hz).floor() as i64;
+        self.cells.insert((freq_cell, size_cell))
+    }
+}
 /// A point found past a corner whose chord from the corner makes a cosine above this with the
 /// reversed incoming tangent, and whose tangent makes a cosine above
 /// [`CORNER_SAME_PIECE_COSINE`] with the incoming one, lies back on the incoming piece of the
@@ -1203,9 +1250,9 @@ impl Continuation {
         self.direction() * (predicted[n] - self.settings.freq_end_hz) >= 0.0
     }
 
-    /// Points a path may take without reaching a frequency above the highest one so far before
-    /// it is given up as wandering ([`PathEnd::NoProgress`]): a fifth of the point budget, at
-    /// least [`MIN_STAGNATION_POINTS`].
+    /// Points a path may take without entering ground it had not covered ([`VisitedGround`])
+    /// before it is given up as wandering ([`PathEnd::NoProgress`]): a fifth of the point
+    /// budget, at least [`MIN_STAGNATION_POINTS`].
     fn stagnation_points(&self) -> usize {
         (self.settings.max_points / 5).max(MIN_STAGNATION_POINTS)
     }
@@ -1441,10 +1488,12 @@ impl Continuation {
         };
         let mut ds = a.initial_step.clamp(a.min_step, a.max_step);
         let mut previous_quality: Option<f64> = None;
-        // The frequency furthest toward the end reached (times the direction) and the point
-        // count when it was reached.
+        // The frequency furthest toward the end reached (times the direction), and the point
+        // count when the path last entered ground it had not covered ([`VisitedGround`]).
         let dir = self.direction();
-        let mut furthest = (dir * a.freq_start_hz, 1usize);
+        let mut furthest = dir * a.freq_start_hz;
+        let mut ground = VisitedGround::new(a.freq_start_hz, a.freq_end_hz);
+        let mut progressed_at = 1usize;
         while summary.points.len() < a.max_points {
             if crate::numerics::interrupt::requested() {
                 let last = summary.points.last().expect("at least the first point");
@@ -1452,18 +1501,15 @@ impl Continuation {
                     freq_hz: last.freq_hz(),
                 });
             }
-            if summary.points.len() - furthest.1 > self.stagnation_points() {
+            let last = summary.points.last().expect("at least the first point");
+            if ground.enters_new(last.freq_hz(), &last.x) {
+                progressed_at = summary.points.len();
+            }
+            if summary.points.len() - progressed_at > self.stagnation_points() {
                 self.end_path(&mut held, &mut summary, PathEnd::NoProgress);
                 return Ok(summary);
             }
-            let reached = summary
-                .points
-                .last()
-                .map_or(f64::NEG_INFINITY, |p| dir * p.freq_hz());
-            if reached > furthest.0 {
-                furthest = (reached, summary.points.len());
-            }
-            let last = summary.points.last().expect("at least the first point");
+            furthest = furthest.max(dir * last.freq_hz());
             let y: Vec<f64> = last
                 .x
                 .iter()
@@ -1646,7 +1692,7 @@ impl Continuation {
                             // bouncing between corners of the sampled law (the loop the dead
                             // end is there to end) and ends there without windows (see
                             // `frequency_reversals`). Otherwise it is a stall.
-                            let behind = dir * from < furthest.0 - a.min_step;
+                            let behind = dir * from < furthest - a.min_step;
                             let dead_end = refused_retrace || behind;
                             let bouncing = held.is_none() && frequency_reversals(recent) > 0;
                             if dead_end && (behind || next.is_none() || bouncing) {

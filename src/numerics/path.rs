@@ -157,9 +157,10 @@ pub enum PathEnd {
     LeftRangeBelow,
     /// The point budget was used up.
     MaxPoints,
-    /// The path wandered without reaching a higher frequency for
-    /// `Continuation::stagnation_points` points (back and forth through folds of the sampled
-    /// contact law): the range above was not covered.
+    /// The path wandered for `Continuation::stagnation_points` points without entering ground
+    /// it had not covered (a frequency and size of the unknowns no point had reached before:
+    /// back and forth through folds of the sampled contact law, or round a loop again): the
+    /// range above was not covered.
     NoProgress,
     /// The path met a spot it could not pass (the corrector failed at every step down to the
     /// minimum, and neither the corner search nor a leap found a way on) where the only way on
