@@ -799,12 +799,21 @@ mod tests {
         // A folded top near 100 Hz: a bump at 101 Hz (1.1) beside the top at 98 Hz (1.5).
         let folded = result(vec![(98.0, 1.5), (101.0, 1.1), (149.0, 0.5), (204.0, 2.2)]);
         let e = errors(&folded, &reference).peaks;
-        assert!((e[0].0 - 0.5).abs() < 1e-12 && (e[0].1 - 0.02).abs() < 1e-12, "{e:?}");
-        assert!((e[1].0 - 0.1).abs() < 1e-12 && (e[1].1 - 0.02).abs() < 1e-12, "{e:?}");
+        assert!(
+            (e[0].0 - 0.5).abs() < 1e-12 && (e[0].1 - 0.02).abs() < 1e-12,
+            "{e:?}"
+        );
+        assert!(
+            (e[1].0 - 0.1).abs() < 1e-12 && (e[1].1 - 0.02).abs() < 1e-12,
+            "{e:?}"
+        );
         // Nothing above 150 Hz: the second reference peak takes the nearest, at 149 Hz.
         let low = result(vec![(98.0, 1.5), (149.0, 0.5)]);
         let e = errors(&low, &reference).peaks;
-        assert!((e[1].0 - 0.75).abs() < 1e-12 && (e[1].1 - 0.255).abs() < 1e-12, "{e:?}");
+        assert!(
+            (e[1].0 - 0.75).abs() < 1e-12 && (e[1].1 - 0.255).abs() < 1e-12,
+            "{e:?}"
+        );
         assert_eq!(peak_basin(&[100.0, 200.0], 100.0), f64::NEG_INFINITY..150.0);
         assert_eq!(peak_basin(&[100.0, 200.0], 200.0), 150.0..f64::INFINITY);
     }
