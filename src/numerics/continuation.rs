@@ -1833,6 +1833,33 @@ mod tests {
     use super::*;
     use crate::numerics::path::NoObserver;
 
+    /// New ground is a frequency cell (a 4000th of the range) or a size cell (5 % in ‖x‖) no
+    /// point entered before: a path running back down a stretch at a growing size (a middle
+    /// branch toward a resonance below its fold) enters new cells; one going back and forth
+    /// over a stretch it covered does not.
+    #[test]
+    fn new_ground_is_a_frequency_or_size_no_point_reached() {
+        let mut ground = VisitedGround::new(100.0, 140.0);
+        // Cells of 0.01 Hz; up the range at one size.
+        for k in 0..10 {
+            assert!(ground.enters_new(120.0 + 0.01 * f64::from(k) + 0.005, &[1.0]));
+        }
+        // Back down the same frequencies at the same size: covered ground.
+        for k in (0..10).rev() {
+            assert!(!ground.enters_new(120.0 + 0.01 * f64::from(k) + 0.002, &[1.0, 0.0]));
+        }
+        // Back down at a size 6 % larger each step: new ground at every point.
+        for k in (0..10).rev() {
+            let size = 1.06_f64.powi(10 - k);
+            assert!(ground.enters_new(120.0 + 0.01 * f64::from(k) + 0.005, &[0.0, size]));
+        }
+        // 1 % larger than a size entered at that frequency, in the same size cell: covered.
+        assert!(!ground.enters_new(120.005, &[1.06_f64.powi(10) * 1.01]));
+        // A point without a finite size has a cell of its own.
+        assert!(ground.enters_new(120.005, &[f64::NAN]));
+        assert!(!ground.enters_new(120.005, &[f64::NAN]));
+    }
+
     /// R(x, ω) = ω/2π − g(x): a path whose frequency is the piecewise-linear g of the single
     /// unknown x. g rises to 15 Hz at x = 1, falls steeply to 13 Hz at x = 1.2 and rises on:
     /// a Z with two folds that are sharp corners (the tangent turns by about 163°), as a
