@@ -343,8 +343,9 @@ fn curve_section(
     let mut md = format!(
         "## Curve `{}`\n\n{} Reference: {} ({} points, {:.2} s). Reference converged to: curve \
          L2 {:.2e}, peak amplitude {:.2e}, peak frequency {:.2e} (against {}, {}). Errors are \
-         relative to this curve's reference, for the first output ({output}). A setting whose \
-         run is not `complete` has its peak errors measured on the curve as followed and is \
+         relative to this curve's reference, for the first output ({output}); each reference \
+         peak is compared with the setting's highest peak in its basin (the frequencies nearer \
+         to it than to another reference peak). A setting whose run is not `complete` has its peak errors measured on the curve as followed and is \
          never on the Pareto front.\n\n\
          | group | setting | status | unknowns | points | Newton its | time (s) | curve L2 err | \
          peak amp err | peak freq err | Pareto |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
