@@ -729,9 +729,15 @@ mod tests {
         assert_eq!(pareto_front(&p), vec![3, 0, 1, 4]);
     }
 
-    #[test]
-    fn incomplete_settings_are_never_on_the_pareto_front() {
-        let result = |label: &str, status: &str, time_s: f64| SettingResult {
+    /// A harmonics setting's result without a path: its label, status, time (s) and peaks
+    /// (Hz, m).
+    fn setting_result(
+        label: &str,
+        status: &str,
+        time_s: f64,
+        peaks: &[(f64, f64)],
+    ) -> SettingResult {
+        SettingResult {
             curve: "frf".into(),
             setting: Setting {
                 group: "harmonics",
@@ -744,8 +750,14 @@ mod tests {
             newton_iterations: 1,
             time_s,
             path: Vec::new(),
-            peaks: Vec::new(),
-        };
+            peaks: peaks.to_vec(),
+        }
+    }
+
+    #[test]
+    fn incomplete_settings_are_never_on_the_pareto_front() {
+        let result =
+            |label: &str, status: &str, time_s: f64| setting_result(label, status, time_s, &[]);
         let errors = |peak: f64| SettingErrors {
             curve_l2: peak,
             peaks: vec![(peak, 0.0)],
@@ -780,21 +792,7 @@ mod tests {
     /// frequency; a basin without a peak of the setting falls back on the nearest one.
     #[test]
     fn each_reference_peak_is_compared_with_the_highest_peak_of_its_basin() {
-        let result = |peaks: Vec<(f64, f64)>| SettingResult {
-            curve: "frf".into(),
-            setting: Setting {
-                group: "harmonics",
-                label: "H = 1".into(),
-                overrides: Vec::new(),
-            },
-            status: "complete".into(),
-            unknowns: 1,
-            points: 1,
-            newton_iterations: 1,
-            time_s: 1.0,
-            path: Vec::new(),
-            peaks,
-        };
+        let result = |peaks: Vec<(f64, f64)>| setting_result("H = 1", "complete", 1.0, &peaks);
         let reference = result(vec![(100.0, 1.0), (200.0, 2.0)]);
         // A folded top near 100 Hz: a bump at 101 Hz (1.1) beside the top at 98 Hz (1.5).
         let folded = result(vec![(98.0, 1.5), (101.0, 1.1), (149.0, 0.5), (204.0, 2.2)]);
