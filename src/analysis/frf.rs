@@ -2840,6 +2840,30 @@ pub fn amplitude_across_path(
 mod tests {
     use super::*;
 
+    /// A judgement that covers its cut or point: Newton landed at `freq_hz` (Hz) with the first
+    /// output's amplitude `amplitude` (m), `distance` from the nearest stretch and
+    /// `resolved_distance` from Newton's solution from it, in `newton_iterations`.
+    fn covered_check(
+        freq_hz: f64,
+        amplitude: f64,
+        distance: f64,
+        resolved_distance: f64,
+        newton_iterations: usize,
+    ) -> CutCheck {
+        CutCheck {
+            landing: Landing {
+                freq_hz,
+                amplitude: Some(amplitude),
+                distance: Some(distance),
+                resolved_distance: Some(resolved_distance),
+            },
+            own_side: false,
+            newton_iterations,
+            beyond_fold: None,
+            verdict: CutVerdict::Covered,
+        }
+    }
+
     fn run_with_jumps(jumps: Vec<Jump>) -> FrfRun {
         FrfRun {
             points: Vec::new(),
@@ -3010,18 +3034,7 @@ mod tests {
         // Judged once the run is over (`end_check`): Newton past the point landing on a
         // stretch of the run covers it, the run is complete; landing off the run, or nowhere,
         // it stays abandoned and the reason says where Newton landed.
-        let covered = CutCheck {
-            landing: Landing {
-                freq_hz: 108.9,
-                amplitude: Some(3.1),
-                distance: Some(1e-4),
-                resolved_distance: Some(1e-12),
-            },
-            own_side: false,
-            newton_iterations: 2,
-            beyond_fold: None,
-            verdict: CutVerdict::Covered,
-        };
+        let covered = covered_check(108.9, 3.1, 1e-4, 1e-12, 2);
         run.jumps[0].end_check = Some(covered);
         assert!(!run.jumps[0].abandons_branch());
         assert!(run.is_complete(), "{:?}", run.incomplete_reason());
@@ -3212,18 +3225,7 @@ mod tests {
         assert!(json["cut_check"].is_null());
         // Judged covered: still complete; judged abandoned or unjudged: incomplete, and the
         // status says where and what Newton found.
-        let check = CutCheck {
-            landing: Landing {
-                freq_hz: 110.01,
-                amplitude: Some(3.6),
-                distance: Some(2e-3),
-                resolved_distance: Some(1e-9),
-            },
-            own_side: false,
-            newton_iterations: 3,
-            beyond_fold: None,
-            verdict: CutVerdict::Covered,
-        };
+        let check = covered_check(110.01, 3.6, 2e-3, 1e-9, 3);
         run.jumps[0].cut_check = Some(check);
         assert!(run.is_complete(), "{:?}", run.incomplete_reason());
         assert!(!run.jumps[0].abandons_branch());
@@ -3387,18 +3389,7 @@ mod tests {
         // One way cut: it is the jump's `fill_cut`, whichever way.
         assert_eq!(bridge_cuts([None, cuts[1]]), (cuts[1], None));
         assert_eq!(bridge_cuts([cuts[0], None]), (cuts[0], None));
-        let covered = CutCheck {
-            landing: Landing {
-                freq_hz: 104.9,
-                amplitude: Some(3.41),
-                distance: Some(1e-4),
-                resolved_distance: Some(1e-12),
-            },
-            own_side: false,
-            newton_iterations: 2,
-            beyond_fold: None,
-            verdict: CutVerdict::Covered,
-        };
+        let covered = covered_check(104.9, 3.41, 1e-4, 1e-12, 2);
         let abandoned = CutCheck {
             landing: Landing {
                 amplitude: Some(3.11),
