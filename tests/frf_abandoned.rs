@@ -184,28 +184,38 @@ fn branches_given_up_at_a_low_preload_are_classified_as_newton_finds_them() {
     }
 }
 
-/// The paper's system at F0 = 2 N (50-350 Hz, H = 1): climbing from a fold at 152.98 Hz the
-/// path meets a dead end at 153.07 Hz and jumps past it. Newton just past the point given up
-/// lands 0.36 % (on the coefficients) from the nearest stretch of the run, and Newton from that
-/// stretch at the same frequency converges to another solution: the branch goes on there, not
-/// followed, and the run is incomplete (checked again by `PointSolver`). The CLI says so: exit
-/// 3, ABANDONED on stderr with the judgement, and `solution.json` holds the library's status,
-/// marks the same jumps abandoned and records each judgement (`end_check`).
+/// The 2D FE blade pair's m = +1 limit curve at a tenth of its pre-load (5 N), run as an FRF
+/// (700-1100 Hz, H = 1): running down from a fold at 875.87 Hz with the amplitude rising, the
+/// path meets a dead end at 875.50 Hz and jumps past it; Newton past the point given up
+/// converges at none of the frequencies tried, so whether the branch goes on is not known
+/// (`unjudged`) and the run is incomplete (checked again by `PointSolver`). The CLI says so:
+/// exit 3, ABANDONED on stderr with the judgement, and `solution.json` holds the library's
+/// status, marks the same jumps abandoned and records each judgement (`end_check`).
 #[test]
 fn the_cli_says_which_branch_a_run_abandoned() {
-    let overrides = ["static_loads.0.value=-2"];
-    let p = paper(&overrides);
+    let scene_file = format!(
+        "{}/meshes/blade-pair/blade-pair-2d-limits.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let overrides = [
+        "limits=",
+        "static_loads.0.value=5",
+        "contact_patches.0.initial_state=1",
+        "contact_patches.1.initial_state=1",
+        "accuracy.estimate=false",
+    ];
+    let owned: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let (_, p) = scene::load_problem(Path::new(&scene_file), &owned).unwrap();
     let run = frf::solve(&p, &mut Silent).unwrap();
     let reason = run.incomplete_reason().expect("an abandoned branch");
     assert!(reason.contains("a branch was abandoned at"), "{reason}");
-    let abandoned = common::abandoned::abandoned_branches_are_off_the_run(&p, &run, "F0 = 2 N");
+    let label = "blade pair, m = +1 at 5 N";
+    let abandoned = common::abandoned::abandoned_branches_are_off_the_run(&p, &run, label);
     assert!(!abandoned.is_empty(), "{:?}", run.jumps);
 
     let dir = tempfile::tempdir().unwrap();
-    let scene_file = dir.path().join("paper.toml");
-    std::fs::write(&scene_file, paper_wedge_scene()).unwrap();
     let out_dir = dir.path().join("out");
-    let out = run_scene(scene_file.to_str().unwrap(), &out_dir, &overrides);
+    let out = run_scene(&scene_file, &out_dir, &overrides);
     let stderr = text(&out.stderr);
     assert_eq!(out.status.code(), Some(3), "{stderr}");
     assert!(

@@ -1806,6 +1806,12 @@ pub const CUT_CHECK_OFFSETS: &[f64] = &[1.0, 0.25, 0.0625];
 /// F0 = 1 N on the paper's system a bridge given up at 152.2176 Hz: no convergence from 10⁻⁷
 /// to 5·10⁻⁴ past it, a landing on the run at 10⁻³).
 pub const CUT_CHECK_FALLBACKS: &[f64] = &[1e-4, 1e-3];
+/// The step, relative to the frequency, of which [`CUT_CHECK_OFFSETS`] are taken past a point
+/// given up at a dead end ([`GiveUpCause::DeadEnd`]; see [`judge_cut`]): the largest a cut's
+/// last step is clamped to. On the paper's system at F0 = 2 N Newton from the dead end at
+/// 153.0743 Hz converges 6·10⁻⁹ of the frequency past it (the branch's own next bit, 2 Newton
+/// iterations), at none of 10⁻⁷ to 5·10⁻⁴, and on the run 10⁻³ past it.
+pub const DEAD_END_CHECK_STEP: f64 = 5e-4;
 
 /// Judges the cuts of every jump of `run` ([`Jump::fill_cut`], [`Jump::second_cut`]), and the
 /// last point of every branch abandoned before a jump ([`BranchEnd::Abandoned`]), now that
@@ -1814,10 +1820,11 @@ pub const CUT_CHECK_FALLBACKS: &[f64] = &[1e-4, 1e-3];
 /// ([`FrfObserver::cut_judged`]). A branch given up at a dead end or for want of progress
 /// off every stretch followed is judged as a cut is: the point given up, like a cut, is where
 /// the run stopped following a branch, and only Newton past it tells whether that branch goes
-/// on off the run (on the paper's system at F0 = 2 N the dead end at 153.0743 Hz: Newton just
-/// past it lands 0.36 % from the nearest stretch of the run, and Newton from that stretch
-/// converges to another solution, so the branch is abandoned; on the 3D blade pair's m = −1
-/// limit curve Newton converges nowhere past its dead end at 869.0841 Hz, unjudged).
+/// on off the run (on the paper's system at F0 = 2 N the dead end at 153.0743 Hz: Newton 10⁻³
+/// of the frequency past it lands 0.24 % from the nearest stretch of the run, and Newton from
+/// that stretch's nearer point converges to the landing: covered; on the 2D blade pair's
+/// m = +1 limit curve at 5 N, and on the 3D blade pair's m = −1 one, Newton converges nowhere
+/// past the dead ends at 875.5021 and 869.0841 Hz: unjudged). Past a dead end the offsets are taken of [`DEAD_END_CHECK_STEP`].
 ///
 /// Newton at a fixed frequency just past the cut, in the direction its stretch was going at
 /// its last step (away from the point before it on the branch; by its fold when the branch
@@ -2004,6 +2011,15 @@ fn judge_cut(
             let down = cut.fold_hz.is_some_and(|fold| fold >= f);
             (if down { -1.0 } else { 1.0 }, 1e-4 * f)
         }
+    };
+    // At a dead end the corrector failed at every step down to the minimum, so the last
+    // step is tiny, and a landing that close past the point is the branch's own next bit,
+    // which no stretch holds by construction: there the judgement steps as far as a cut's
+    // largest step.
+    let step = if cut.cause == GiveUpCause::DeadEnd {
+        DEAD_END_CHECK_STEP * f
+    } else {
+        step
     };
     let (freq_hz, landing) = land_past(system, newton, &points[i].coefficients, f, direction, step);
     let Some(landing) = landing else {
@@ -2255,10 +2271,13 @@ struct Crossing {
 }
 
 /// ‖c − c_N‖ / ‖c‖ between `landing` (converged at ω = `omega`, rad/s) and Newton's solution
-/// c_N at the same ω from `crossing` (its coefficients interpolated along the segment, else
-/// those of the segment's nearer point when Newton does not converge from them): the same
-/// solution to solver precision when at most [`SAME_SOLUTION_TOLERANCE`]. None when Newton
-/// converges from neither.
+/// c_N at the same ω from `crossing`: from its coefficients interpolated along the segment,
+/// and, unless that solution is the landing, from those of the segment's nearer point; the
+/// smaller of the two. The same solution to solver precision when at most
+/// [`SAME_SOLUTION_TOLERANCE`]: where neighbouring pieces of the sampled contact law lie a few
+/// 10⁻³ apart, the two starts can reach different ones (on the paper's system at F0 = 2 N, at
+/// 153.2274 Hz, the interpolated start a solution 3.2·10⁻³ from the landing, the nearer point
+/// the landing itself). None when Newton converges from neither.
 fn resolve_crossing(
     system: &mut HbmOperator<'_>,
     newton: &Continuation,
@@ -2276,12 +2295,17 @@ fn resolve_crossing(
         .map(|(a, b)| a + t * (b - a))
         .collect();
     let nearer = if t < 0.5 { p } else { q };
+    let mut apart: Option<f64> = None;
     for start in [interpolated.as_slice(), nearer.coefficients.as_slice()] {
         if let Some(c) = newton_at(system, newton, start, omega) {
-            return Some(relative_distance(&c, &landing.coefficients));
+            let d = relative_distance(&c, &landing.coefficients);
+            apart = Some(apart.map_or(d, |a| a.min(d)));
+            if d <= SAME_SOLUTION_TOLERANCE {
+                break;
+            }
         }
     }
-    None
+    apart
 }
 
 /// Newton's solution at ω = `omega` (rad/s) from the full coefficients `start`, on full
