@@ -373,6 +373,20 @@ fn frf_peaks_are_the_linear_frf_extrema() {
     assert_eq!(sol["peaks"].as_array().unwrap().len(), 3);
 }
 
+/// The rows of the `frf.csv` of two runs of one scene (written into `a` and `b`), whose headers
+/// and row counts agree, with the index of a column by its name.
+fn paired_frf_rows(
+    a: &std::path::Path,
+    b: &std::path::Path,
+) -> (impl Fn(&str) -> usize, Vec<Vec<String>>, Vec<Vec<String>>) {
+    let (header, rows_a) = csv(&a.join("frf.csv"));
+    let (header_b, rows_b) = csv(&b.join("frf.csv"));
+    assert_eq!(header, header_b);
+    assert_eq!(rows_a.len(), rows_b.len());
+    let column = move |name: &str| header.split(',').position(|c| c == name).unwrap();
+    (column, rows_a, rows_b)
+}
+
 /// `accuracy.beyond_linear_range = "flag"`: the points whose estimate's step leaves its linear
 /// range are flagged `unsolved` instead of solved on the extended set, and every other cell is
 /// the default run's: the same path, the same steps and sampling estimates. `solution.json`
@@ -396,11 +410,7 @@ fn flagging_beyond_the_linear_range_skips_only_the_solves() {
         flag.to_str().unwrap(),
     ]);
     assert!(flagged.status.success(), "{}", text(&flagged.stderr));
-    let (header, by_solve) = csv(&solve.join("frf.csv"));
-    let (flag_header, by_flag) = csv(&flag.join("frf.csv"));
-    assert_eq!(header, flag_header);
-    assert_eq!(by_solve.len(), by_flag.len());
-    let column = |name: &str| header.split(',').position(|c| c == name).unwrap();
+    let (column, by_solve, by_flag) = paired_frf_rows(&solve, &flag);
     let (trunc, sampling, method) = (
         column("y2_trunc_err"),
         column("y2_sampling_err"),
@@ -457,11 +467,7 @@ fn a_wider_set_beyond_the_step_budget_is_not_stepped_on() {
     assert!(run_scene(&zoom, &auto, &[h15]).status.success());
     let solved = run_scene(&zoom, &solve, &[h15, "accuracy.beyond_linear_range=solve"]);
     assert!(solved.status.success(), "{}", text(&solved.stderr));
-    let (header, by_auto) = csv(&auto.join("frf.csv"));
-    let (solve_header, by_solve) = csv(&solve.join("frf.csv"));
-    assert_eq!(header, solve_header);
-    assert_eq!(by_auto.len(), by_solve.len());
-    let column = |name: &str| header.split(',').position(|c| c == name).unwrap();
+    let (column, by_auto, by_solve) = paired_frf_rows(&auto, &solve);
     let (trunc, harmonic, method) = (
         column("y2_trunc_err"),
         column("estimate_harmonic"),
