@@ -373,12 +373,15 @@ fn frf_peaks_are_the_linear_frf_extrema() {
     assert_eq!(sol["peaks"].as_array().unwrap().len(), 3);
 }
 
+/// The rows of a CSV file, each split into its cells.
+type CsvRows = Vec<Vec<String>>;
+
 /// The rows of the `frf.csv` of two runs of one scene (written into `a` and `b`), whose headers
 /// and row counts agree, with the index of a column by its name.
 fn paired_frf_rows(
     a: &std::path::Path,
     b: &std::path::Path,
-) -> (impl Fn(&str) -> usize, Vec<Vec<String>>, Vec<Vec<String>>) {
+) -> (impl Fn(&str) -> usize, CsvRows, CsvRows) {
     let (header, rows_a) = csv(&a.join("frf.csv"));
     let (header_b, rows_b) = csv(&b.join("frf.csv"));
     assert_eq!(header, header_b);
