@@ -3,7 +3,9 @@
 //!
 //! Each `F` (Hz) is solved from point INDEX of SOLUTION (its coefficients); `mirrorJ` replaces
 //! the start by the point reflected through INDEX, 2 x_INDEX − x_J, and `chain` starts each
-//! later solve from the previous solution. The overrides are the run's `--set` fields.
+//! later solve from the previous solution; `xchordJ@T` solves with the frequency free on the
+//! hyperplane normal to the chord from J to INDEX in the unknowns alone, T chord lengths from
+//! J (the way round a fold at INDEX). The overrides are the run's `--set` fields.
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -33,6 +35,27 @@ fn main() {
             let xj = coefficients(&sol["points"][j]);
             x0 = x0.iter().zip(&xj).map(|(a, b)| 2.0 * a - b).collect();
             println!("mirror of {j} ({} Hz)", sol["points"][j]["freq_hz"]);
+            continue;
+        }
+        if let Some(spec) = f.strip_prefix("xchord") {
+            // `xchordJ@T`: the point on the hyperplane normal to the chord from J to INDEX in
+            // the unknowns alone (the frequency left free), at T chord lengths from J (T > 1
+            // goes on past INDEX): the way on past a fold of the frequency.
+            let (j, t) = spec.split_once('@').unwrap();
+            let (j, t): (usize, f64) = (j.parse().unwrap(), t.parse().unwrap());
+            let mut a = point_of(&sol["points"][j]);
+            let b = point_of(point);
+            a.freq_hz = b.freq_hz;
+            match solver.solve_on_chord(&a, &b, t) {
+                Ok(q) => println!(
+                    "xchord {j}@{t}: {} Hz {:?} its {} distance from INDEX {:.3e}",
+                    q.freq_hz,
+                    q.amplitudes,
+                    q.newton_iterations,
+                    distance(&q.coefficients, &b.coefficients)
+                ),
+                Err(e) => println!("xchord {j}@{t}: {e}"),
+            }
             continue;
         }
         if f == "chain" {
@@ -71,4 +94,30 @@ fn coefficients(point: &serde_json::Value) -> Vec<f64> {
         .iter()
         .map(|v| v.as_f64().unwrap())
         .collect()
+}
+
+/// A point of `solution.json` as an FRF point (frequency, amplitudes and coefficients).
+fn point_of(point: &serde_json::Value) -> fricbound::analysis::frf::FrfPoint {
+    fricbound::analysis::frf::FrfPoint {
+        freq_hz: point["freq_hz"].as_f64().unwrap(),
+        amplitudes: vec![],
+        peaks: vec![],
+        states: vec![],
+        newton_iterations: 0,
+        residual: 0.0,
+        coefficients: coefficients(point),
+        accuracy: None,
+        pending_estimate: None,
+        stability: None,
+    }
+}
+
+/// ‖a − b‖ / ‖b‖.
+fn distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| (p - q) * (p - q))
+        .sum::<f64>()
+        .sqrt()
+        / b.iter().map(|q| q * q).sum::<f64>().sqrt()
 }

@@ -8,6 +8,9 @@
 //! - The paper's system at F0 = 1 N (50-350 Hz): every branch given up is classified, and each
 //!   classification is checked by Newton at a frequency just past the point given up (in the
 //!   direction the path was going), seeded from that point.
+//! - The paper's system at −5 N and H = 3: a dead end past which Newton converges nowhere,
+//!   judged on the other side of the fold it turns back at; at F0 = 10 N and H = 3 with a
+//!   coarse smallest step, a leap onto another branch whose branch before goes on on the run.
 
 mod common;
 mod support;
@@ -187,7 +190,8 @@ fn branches_given_up_at_a_low_preload_are_classified_as_newton_finds_them() {
 /// The 2D FE blade pair's m = +1 limit curve at a tenth of its pre-load (5 N), run as an FRF
 /// (700-1100 Hz, H = 1): running down from a fold at 875.87 Hz with the amplitude rising, the
 /// path meets a dead end at 875.50 Hz and jumps past it; Newton past the point given up
-/// converges at none of the frequencies tried, so whether the branch goes on is not known
+/// converges at none of the frequencies tried, nor with the frequency free round a fold
+/// there, so whether the branch goes on is not known
 /// (`unjudged`) and the run is incomplete (checked again by `PointSolver`). The CLI says so:
 /// exit 3, ABANDONED on stderr with the judgement, and `solution.json` holds the library's
 /// status, marks the same jumps abandoned and records each judgement (`end_check`).
@@ -459,4 +463,169 @@ fn leaps_inside_fills_are_listed_and_judged() {
         );
     }
     assert!(in_reverse >= 1, "no leap on a fill: {:?}", run.leaps);
+}
+
+/// At a pre-load of −5 N and H = 3 (50-350 Hz) the fill solved past the jump at 78.50 Hz
+/// comes up to a dead end at 92.0992 Hz in halving steps (the corrector failing past it at
+/// every step), and Newton at fixed frequencies past it converges nowhere: the branch turns
+/// back there, at a corner of the sampled contact law. The judgement seeks the other side of
+/// that fold with the frequency free, on the stretch's chord in the unknowns
+/// (`judge_round_dead_end`), lands just behind the dead end, below the run's largest
+/// amplitude there, and covers the cut. Checked again: fixed-frequency Newton from the cut
+/// point fails at the frequency the judgement tried past it and converges at the landing's
+/// frequency behind it to the stretch's own side there, not the landing (which Newton from
+/// the stretch does not reach: `resolved_distance`); `PointSolver` finds the landing again
+/// from the same two points, and Newton at the landing's fixed frequency from it stays there
+/// (a solution of the harmonic balance, another than the stretch's own); the run's crossings
+/// there reach above the landing. The rest of the run stays `incomplete` for the stretch
+/// 78.50-90.15 Hz that no branch reached.
+#[test]
+fn a_dead_end_that_turns_back_at_a_fold_is_judged_on_its_other_side() {
+    let p = paper(&[
+        "static_loads.0.value=-5",
+        "harmonics.max=3",
+        "accuracy.estimate=false",
+    ]);
+    let run = frf::solve(&p, &mut Silent).unwrap();
+    let (k, jump) = run
+        .jumps
+        .iter()
+        .enumerate()
+        .find(|(_, j)| {
+            j.fill_cut
+                .is_some_and(|c| (c.freq_hz - 92.0992).abs() < 1e-3)
+        })
+        .unwrap_or_else(|| panic!("no cut at 92.0992 Hz: {:?}", run.jumps));
+    let cut = jump.fill_cut.unwrap();
+    assert_eq!(cut.cause, frf::GiveUpCause::DeadEnd);
+    let check = jump.cut_check.expect("judged");
+    eprintln!("{check:?}");
+    assert_eq!(check.verdict, CutVerdict::Covered, "{check:?}");
+    assert!(check.landing.amplitude.is_none(), "{check:?}");
+    let fold = check.beyond_fold.expect("judged round the fold");
+    assert_eq!(fold.fold_hz, cut.freq_hz);
+    assert_eq!(fold.verdict, CutVerdict::Covered);
+    let landing_hz = fold.landing.freq_hz;
+    let amplitude = fold.landing.amplitude.expect("a landing");
+    // Behind the dead end (the stretch came up to it), next to it.
+    assert!(landing_hz < cut.freq_hz && landing_hz > cut.freq_hz * (1.0 - 1e-3));
+    // Another solution than the stretch's own there.
+    assert!(
+        fold.landing.resolved_distance.is_some_and(|d| d > 1e-8),
+        "{fold:?}"
+    );
+    let starts = run.branch_starts();
+    let end = starts.get(k + 1).copied().unwrap_or(run.points.len());
+    let i = (jump.first_point..end)
+        .find(|&i| run.points[i].freq_hz == cut.freq_hz)
+        .expect("the cut point is on its branch");
+    let mut solver = PointSolver::new(&p).unwrap();
+    let cut_point = &run.points[i];
+    assert!(solver
+        .solve(&cut_point.coefficients, check.landing.freq_hz)
+        .is_err());
+    let own = solver
+        .solve(&cut_point.coefficients, landing_hz)
+        .expect("the stretch's own side behind the dead end");
+    assert!(
+        (own.amplitudes[0] - amplitude).abs() > 1e-6 * amplitude,
+        "{} m is the landing's {amplitude} m",
+        own.amplitudes[0]
+    );
+    // The same construction through the public solver (the chord from the first point of the
+    // stretch at least 5·10⁻⁵ of the frequency back), and the landing confirmed by Newton at
+    // its fixed frequency: a solution there, not the stretch's own.
+    // The stretch into the cut, nearest point first.
+    let into: Vec<usize> = if i == jump.first_point {
+        (i + 1..end).collect()
+    } else {
+        (jump.first_point..i).rev().collect()
+    };
+    let back = into
+        .into_iter()
+        .find(|&j| {
+            (run.points[j].freq_hz - cut.freq_hz).abs() >= frf::ROUND_FOLD_CHORD * cut.freq_hz
+        })
+        .expect("a point that far back");
+    let again = solver
+        .solve_round_fold(&run.points[back], cut_point)
+        .expect("the landing again");
+    assert_eq!(again.freq_hz, landing_hz);
+    assert_eq!(again.amplitudes[0], amplitude);
+    let fixed = solver
+        .solve(&again.coefficients, landing_hz)
+        .expect("Newton at the landing's frequency");
+    assert!(
+        coefficients_apart(&fixed.coefficients, &again.coefficients) < 1e-8,
+        "the landing is not a fixed-frequency solution"
+    );
+    assert!(coefficients_apart(&fixed.coefficients, &own.coefficients) > 1e-6);
+    let largest = run
+        .crossings(landing_hz, 0)
+        .iter()
+        .map(|c| c.amplitude)
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert!(amplitude < largest, "{amplitude} not below {largest}");
+    assert_eq!(fold.run_amplitude, Some(largest));
+    let reason = run
+        .incomplete_reason()
+        .expect("the stretch no branch reached");
+    assert!(
+        reason.contains("no solution was found at 78.5010-90.1522 Hz"),
+        "{reason}"
+    );
+    assert!(!reason.contains("92.0992"), "{reason}");
+}
+
+/// A leap onto another branch whose branch before goes on onto the run. At F0 = 10 N and
+/// H = 3 with a smallest step of 1 Hz the path leaps from 207.5087 to 207.5248 Hz, and
+/// followed back from the landing it reaches 207.5087 Hz 2.4 % from the point before the leap:
+/// another branch. The branch through that point is then judged as a branch given up at a dead
+/// end (`LeapCheck::past`): Newton past it, the way the path was going, lands on a stretch of
+/// the run (Newton from that stretch converges to the landing), so nothing is missing and the
+/// leap is covered. Checked again by `PointSolver`: from the point before the leap at the
+/// judgement's frequency it lands at the judgement's amplitude, and from the nearest crossing
+/// of the run there on the same solution.
+#[test]
+fn a_leap_onto_another_branch_is_covered_where_the_branch_it_left_goes_on_on_the_run() {
+    let p = paper(&[
+        "static_loads.0.value=-10",
+        "harmonics.max=3",
+        "analysis.min_step=1",
+        "accuracy.estimate=false",
+    ]);
+    let run = frf::solve(&p, &mut Silent).unwrap();
+    let check = run
+        .leap_checks
+        .iter()
+        .find(|c| (c.from_hz - 207.5087).abs() < 1e-3)
+        .unwrap_or_else(|| panic!("no leap from 207.5087 Hz: {:?}", run.leap_checks));
+    eprintln!("{check:?}");
+    assert!(
+        check.distance.is_some_and(|d| d > frf::RETRACE_TOLERANCE),
+        "{check:?}"
+    );
+    assert_eq!(check.verdict, CutVerdict::Covered);
+    let past = check.past.expect("the branch before the leap judged");
+    assert_eq!(past.verdict, CutVerdict::Covered);
+    let amplitude = past.landing.amplitude.expect("Newton lands past the point");
+    let f = past.landing.freq_hz;
+    assert!(f > check.from_hz && f < check.from_hz * (1.0 + 1e-3), "{f}");
+    let before = run
+        .points
+        .iter()
+        .find(|q| q.freq_hz == check.from_hz)
+        .expect("the point before the leap");
+    let mut solver = PointSolver::new(&p).unwrap();
+    let landing = solver
+        .solve(&before.coefficients, f)
+        .expect("Newton past it");
+    assert!((landing.amplitudes[0] - amplitude).abs() <= 1e-6 * amplitude);
+    let on_run = run.crossings(f, 0).iter().any(|c| {
+        (c.amplitude - amplitude).abs() <= 1e-2 * amplitude
+            && solver
+                .solve(&run.points[c.nearest_point].coefficients, f)
+                .is_ok_and(|q| coefficients_apart(&q.coefficients, &landing.coefficients) < 1e-8)
+    });
+    assert!(on_run, "no crossing of the run at {f} Hz holds the landing");
 }

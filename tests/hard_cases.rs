@@ -423,7 +423,8 @@ fn limit_scene_at_a_low_preload_covers_the_range() {
 /// amplitude rising, it meets a dead end at 875.50 Hz (the corrector fails at every step, its
 /// residual stalling near 10⁻⁸ of the loads) and the run jumps past 876.18 Hz. Newton past the
 /// point given up converges at none of the frequencies tried (3·10⁻⁵ to 10⁻³ of the frequency
-/// below it): whether the branch goes on there is not known (`unjudged`), so the curve ends
+/// below it), nor with the frequency free round a fold there: whether the branch goes on
+/// there is not known (`unjudged`), so the curve ends
 /// `incomplete` and says so.
 #[test]
 fn fe_blade_pair_limits_at_a_low_preload_reach_the_end_and_say_what_they_abandon() {

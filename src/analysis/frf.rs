@@ -207,6 +207,32 @@ pub struct FoldCheck {
     pub verdict: CutVerdict,
 }
 
+impl FoldCheck {
+    /// `past` (where Newton landed beyond the fold) followed by how that landing compares with
+    /// the run and the verdict; `fold` names the fold for an abandoned landing.
+    fn describe_landing(&self, past: &str, fold: &str) -> String {
+        let run = self.run_amplitude.map_or(
+            "no stretch of the run crosses that frequency".to_string(),
+            |m| format!("the run's largest amplitude there is {m:.3e} m"),
+        );
+        let on_run = self
+            .landing
+            .resolved_distance
+            .is_some_and(|d| d <= SAME_SOLUTION_TOLERANCE);
+        match self.verdict {
+            CutVerdict::Covered if on_run => format!("{past}, on a stretch of the run: covered"),
+            CutVerdict::Covered => format!(
+                "{past}, on no stretch of the run but below it ({run}): a lower branch beside \
+                 the response the run has, covered"
+            ),
+            _ => format!(
+                "{past}, on no stretch of the run and above it ({run}): a branch beyond {fold}, \
+                 not followed"
+            ),
+        }
+    }
+}
+
 /// What a [`CutCheck`] says (`verdict` in `solution.json`: `covered`, `abandoned`,
 /// `unjudged`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -253,11 +279,25 @@ impl CutCheck {
             .amplitude
             .filter(|_| self.verdict != CutVerdict::Unjudged || self.beyond_fold.is_some())
         else {
-            return format!(
+            let nowhere = format!(
                 "Newton just past {what} converged at none of the frequencies tried (the last \
-                 {:.4} Hz): whether the branch goes on there is not known",
+                 {:.4} Hz)",
                 self.landing.freq_hz
             );
+            let Some(fold) = &self.beyond_fold else {
+                return format!("{nowhere}: whether the branch goes on there is not known");
+            };
+            // The other side of a fold at the dead end ([`judge_round_dead_end`]).
+            let Some(b) = fold.landing.amplitude else {
+                return format!("{nowhere}: whether the branch goes on there is not known");
+            };
+            let past = format!(
+                "{nowhere}, and with the frequency free, on the stretch's chord in the unknowns \
+                 past the point, Newton lands behind it at {:.4} Hz, {b:.3e} m: the branch \
+                 turns back there at a fold",
+                fold.landing.freq_hz
+            );
+            return fold.describe_landing(&past, "that fold");
         };
         let landing = format!(
             "Newton just past {what}, at {:.4} Hz, lands at {a:.3e} m (first output)",
@@ -296,27 +336,7 @@ impl CutCheck {
                 "{back}; Newton past the fold, at {:.4} Hz, lands at {b:.3e} m",
                 fold.landing.freq_hz
             );
-            let run = fold.run_amplitude.map_or(
-                "no stretch of the run crosses that frequency".to_string(),
-                |m| format!("the run's largest amplitude there is {m:.3e} m"),
-            );
-            let on_run = fold
-                .landing
-                .resolved_distance
-                .is_some_and(|d| d <= SAME_SOLUTION_TOLERANCE);
-            return match fold.verdict {
-                CutVerdict::Covered if on_run => {
-                    format!("{past}, on a stretch of the run: covered")
-                }
-                CutVerdict::Covered => format!(
-                    "{past}, on no stretch of the run but below it ({run}): a lower branch \
-                     beside the response the run has, covered"
-                ),
-                _ => format!(
-                    "{past}, on no stretch of the run and above it ({run}): a branch beyond the \
-                     fold of that branch, not followed"
-                ),
-            };
+            return fold.describe_landing(&past, "the fold of that branch");
         }
         match (self.verdict, self.landing.resolved_distance) {
             (CutVerdict::Covered, Some(r)) => format!(
@@ -642,8 +662,15 @@ pub struct LeapCheck {
     /// a solution further off, so the leap crossed onto another branch and the branch through the point before
     /// it goes on beyond it unfollowed (possibly to a fold and a resonance peak); `unjudged`:
     /// it did not get back to that frequency within [`LEAP_CHECK_POINTS`] points. The last
-    /// two make the run incomplete.
+    /// two make the run incomplete. A leap onto another branch is `covered` after all when
+    /// [`Self::past`] finds the branch through the point before it on the run.
     pub verdict: CutVerdict,
+    /// For a leap onto another branch: the branch through the point before the leap judged as
+    /// a branch given up at a dead end is ([`judge_cuts`]): Newton at a fixed frequency past
+    /// that point, the way the path was going, compared with the run, or, where it converges
+    /// nowhere, the other side of a fold there ([`judge_round_dead_end`]). Its verdict is the
+    /// leap's. None otherwise.
+    pub past: Option<CutCheck>,
 }
 
 impl LeapCheck {
@@ -662,6 +689,17 @@ impl LeapCheck {
         let before = self
             .before_amplitude
             .map_or(String::new(), |a| format!(" ({a:.3e} m)"));
+        if let (Some(past), Some(a), Some(d)) = (&self.past, self.back_amplitude, self.distance) {
+            return format!(
+                "{leapt}, onto another branch: followed back from {:.4} Hz the path reaches \
+                 {:.4} Hz at {a:.3e} m (first output), {:.1} % from the point before the \
+                 leap{before} on the coefficients; for the branch through that point, {}",
+                self.to_hz,
+                self.from_hz,
+                100.0 * d,
+                past.describe_past("the point before the leap")
+            );
+        }
         match (self.verdict, self.back_amplitude, self.distance) {
             (CutVerdict::Covered, _, Some(d)) if d <= SAME_SOLUTION_TOLERANCE => format!(
                 "{leapt}; followed back from {:.4} Hz the path reaches the point before the leap \
@@ -1822,9 +1860,13 @@ pub const DEAD_END_CHECK_STEP: f64 = 5e-4;
 /// the run stopped following a branch, and only Newton past it tells whether that branch goes
 /// on off the run (on the paper's system at F0 = 2 N the dead end at 153.0743 Hz: Newton 10⁻³
 /// of the frequency past it lands 0.24 % from the nearest stretch of the run, and Newton from
-/// that stretch's nearer point converges to the landing: covered; on the 2D blade pair's
-/// m = +1 limit curve at 5 N, and on the 3D blade pair's m = −1 one, Newton converges nowhere
-/// past the dead ends at 875.5021 and 869.0841 Hz: unjudged). Past a dead end the offsets are taken of [`DEAD_END_CHECK_STEP`].
+/// that stretch's nearer point converges to the landing: covered). Past a dead end the
+/// offsets are taken of [`DEAD_END_CHECK_STEP`]; where Newton converges at none of them, the
+/// other side of a fold at the dead end is sought with the frequency free
+/// ([`judge_round_dead_end`]: on the 3D blade pair's m = −1 limit curve the dead end at
+/// 869.0841 Hz turns back there, its other side at 869.0661 Hz below the run: covered; on the
+/// 2D blade pair's m = +1 limit curve at 5 N neither converges past the dead end at 875.5021
+/// Hz: unjudged).
 ///
 /// Newton at a fixed frequency just past the cut, in the direction its stretch was going at
 /// its last step (away from the point before it on the branch; by its fold when the branch
@@ -1911,6 +1953,7 @@ fn judge_leaps<O: FrfObserver>(
     observer: &mut O,
 ) {
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1.0);
+    let starts = run.branch_starts();
     for k in 0..run.leaps.len() {
         let (from_hz, to_hz) = run.leaps[k];
         // (before, landing): consecutive points of the report, the landing after the point
@@ -1933,6 +1976,7 @@ fn judge_leaps<O: FrfObserver>(
             distance: None,
             points: 0,
             verdict: CutVerdict::Unjudged,
+            past: None,
         };
         if let Some((b, l)) = at {
             let (before, landing) = (&run.points[b], &run.points[l]);
@@ -1955,10 +1999,67 @@ fn judge_leaps<O: FrfObserver>(
                     };
                 }
             }
+            if check.verdict == CutVerdict::Abandoned {
+                let past = judge_past_leap(system, newton, &run.points, &starts, (b, l));
+                if let Some(past) = past {
+                    check.verdict = past.verdict;
+                    check.past = Some(past);
+                }
+            }
         }
         observer.leap_judged(&check);
         run.leap_checks.push(check);
     }
+}
+
+/// The branch through the point before a leap onto another branch (`before`, `landing`:
+/// indices of the point before the leap and of the landing in `points`), judged as a branch
+/// given up at a dead end ([`judge_cut`]): the corrector failed at every step past that point,
+/// as at a dead end. None when the point is the first of its stretch (no direction to go on
+/// in).
+fn judge_past_leap(
+    system: &mut HbmOperator<'_>,
+    newton: &Continuation,
+    points: &[FrfPoint],
+    starts: &[usize],
+    (before, landing): (usize, usize),
+) -> Option<CutCheck> {
+    // The stretch into the point before the leap, within its branch: the point before it
+    // along the path is on the side away from the landing.
+    let branch_start = starts
+        .iter()
+        .copied()
+        .filter(|&s| s <= before)
+        .max()
+        .unwrap_or(0);
+    let branch_end = starts
+        .iter()
+        .copied()
+        .filter(|&s| s > before)
+        .min()
+        .unwrap_or(points.len());
+    let stretch = if landing > before {
+        branch_start..before + 1
+    } else {
+        before..branch_end
+    };
+    if stretch.len() < 2 {
+        return None;
+    }
+    let given_up = GivenUp {
+        freq_hz: points[before].freq_hz,
+        amplitude: points[before]
+            .amplitudes
+            .first()
+            .copied()
+            .unwrap_or(f64::NAN),
+        amplitude_rising: false,
+        fold_hz: None,
+        cause: GiveUpCause::DeadEnd,
+    };
+    Some(judge_cut(
+        system, newton, points, starts, stretch, &given_up,
+    ))
 }
 
 /// The judgement of one cut `cut` of the branch `points[branch]` (see [`judge_cuts`]).
@@ -2023,6 +2124,15 @@ fn judge_cut(
     };
     let (freq_hz, landing) = land_past(system, newton, &points[i].coefficients, f, direction, step);
     let Some(landing) = landing else {
+        // Nothing past a dead end: the branch may turn back there, at a fold whose other side
+        // runs back beside the stretch into it.
+        if cut.cause == GiveUpCause::DeadEnd {
+            if let Some(check) =
+                judge_round_dead_end(system, newton, (points, starts), branch, i, freq_hz)
+            {
+                return check;
+            }
+        }
         return unjudged(freq_hz, 0);
     };
     // The cut's own stretch and the one before it on its branch (the other side of the fold
@@ -2098,6 +2208,148 @@ fn judge_cut(
         beyond_fold,
         verdict,
     }
+}
+
+/// How far back along the stretch into a dead end, relative to its frequency, the chord of
+/// [`judge_round_dead_end`] reaches: the first point at least this far from the dead end in
+/// frequency (or the stretch's first point). On the 3D blade pair's m = −1 curve the stretch
+/// reaches its dead end at 869.0841 Hz in halving steps (the last ones 10⁻⁸ Hz apart): the
+/// chord reaches back to 869.0123 Hz, and a quarter of it past the dead end lands on the other
+/// side of its fold at 869.0661 Hz; on the paper's system at −5 N and H = 3 a fill's dead end
+/// at 92.0992 Hz, reached the same way, turns back a few 10⁻⁵ Hz behind it
+/// (`tests/frf_abandoned.rs`).
+pub const ROUND_FOLD_CHORD: f64 = 5e-5;
+/// Steps past a dead end along the chord of [`judge_round_dead_end`], in chord lengths, in
+/// the order tried.
+pub const ROUND_FOLD_STEPS: &[f64] = &[0.25, 1.0, 0.0625];
+
+/// The judgement of a dead end past which Newton at a fixed frequency converges nowhere
+/// (`past_hz` the last frequency tried): the stretch may have met a fold of the sampled
+/// contact law, a corner where the branch turns back, whose other side the path could not
+/// turn onto. That side is sought by Newton with the frequency free on the hyperplane normal
+/// to the stretch's chord in the unknowns alone ([`ROUND_FOLD_CHORD`] back, stepped
+/// [`ROUND_FOLD_STEPS`] past the dead end): where the unknowns go on past the dead-end point,
+/// a branch that turned back at a fold lies at a lower frequency (higher on a stretch running
+/// down). A landing behind the dead end is judged as the landing past a cut stretch's fold
+/// ([`judge_beyond_fold`]: on the run, or below the run's largest amplitude there, is
+/// covered). Recorded as a [`CutCheck`] whose own landing is nowhere and whose
+/// [`CutCheck::beyond_fold`] is that judgement, the fold at the dead end. None where no such
+/// landing converges.
+fn judge_round_dead_end(
+    system: &mut HbmOperator<'_>,
+    newton: &Continuation,
+    (points, starts): (&[FrfPoint], &[usize]),
+    branch: std::ops::Range<usize>,
+    i: usize,
+    past_hz: f64,
+) -> Option<CutCheck> {
+    let f = points[i].freq_hz;
+    let into: Vec<usize> = if i == branch.start {
+        (i + 1..branch.end).collect()
+    } else {
+        (branch.start..i).rev().collect()
+    };
+    let a = into
+        .iter()
+        .copied()
+        .find(|&k| (points[k].freq_hz - f).abs() >= ROUND_FOLD_CHORD * f)
+        .or_else(|| into.last().copied())?;
+    let landing = land_round_fold(system, newton.settings, &points[a], &points[i])?;
+    let own = a.min(i)..=a.max(i);
+    let fold = judge_beyond_fold(
+        system,
+        newton,
+        points,
+        starts,
+        &own,
+        f,
+        landing.freq_hz,
+        Some(landing),
+    );
+    Some(CutCheck {
+        landing: Landing::nowhere(past_hz),
+        own_side: false,
+        newton_iterations: 0,
+        beyond_fold: Some(fold),
+        verdict: fold.verdict,
+    })
+}
+
+/// The other side of a fold at the point `b`, reached from the point `a` before it on the
+/// same stretch: Newton with the frequency free (the corrector of `settings`) on the
+/// hyperplane normal to the chord from `a` to `b` in the unknowns alone, through `b` plus
+/// [`ROUND_FOLD_STEPS`] chord lengths along it; the first landing behind `b` in frequency (on
+/// the side of `a`) is returned. The unknowns are Fourier coefficients of displacements, all in
+/// metres, and the chord is taken in that metric (one scale for all of them, the largest
+/// coefficient of `b`), not in the run's arc-length scales, which grow along the run: the
+/// landing depends on the two points only ([`PointSolver::solve_round_fold`] finds it again).
+fn land_round_fold(
+    system: &mut HbmOperator<'_>,
+    settings: ContinuationSettings,
+    a: &FrfPoint,
+    b: &FrfPoint,
+) -> Option<FrfPoint> {
+    let size = system
+        .restrict(&b.coefficients)
+        .iter()
+        .fold(0.0_f64, |m, v| m.max(v.abs()));
+    if !(size > 0.0 && size.is_finite()) {
+        return None;
+    }
+    let newton = Continuation::new(settings, vec![size; system.dim()]);
+    let scale = &newton.x_scale;
+    let scaled = |p: &FrfPoint, system: &HbmOperator<'_>| -> Vec<f64> {
+        system
+            .restrict(&p.coefficients)
+            .iter()
+            .zip(scale)
+            .map(|(v, s)| v / s)
+            .collect()
+    };
+    let (ya, yb) = (scaled(a, system), scaled(b, system));
+    let mut chord: Vec<f64> = yb.iter().zip(&ya).map(|(q, p)| q - p).collect();
+    let length = crate::numerics::linalg::norm(&chord);
+    if !(length > 0.0 && length.is_finite()) {
+        return None;
+    }
+    chord.iter_mut().for_each(|v| *v /= length);
+    // The frequency is free: the hyperplane's normal has no component on it.
+    chord.push(0.0);
+    let n = yb.len();
+    let back = (a.freq_hz - b.freq_hz).signum();
+    for &steps in ROUND_FOLD_STEPS {
+        let mut predicted: Vec<f64> = yb
+            .iter()
+            .zip(&chord)
+            .map(|(y, c)| y + steps * length * c)
+            .collect();
+        predicted.push(b.freq_hz);
+        let Ok((y, iterations, residual)) = newton.correct(system, &predicted, &chord) else {
+            continue;
+        };
+        let freq_hz = y[n];
+        if (freq_hz - b.freq_hz) * back <= 0.0 {
+            continue;
+        }
+        let x: Vec<f64> = y[..n].iter().zip(scale).map(|(v, s)| v * s).collect();
+        let omega = 2.0 * PI * freq_hz;
+        let mut r = vec![0.0; n];
+        if system.residual(&x, omega, &mut r).is_err() {
+            continue;
+        }
+        let path_point = PathPoint {
+            omega,
+            x,
+            iterations,
+            residual,
+            step: 0.0,
+        };
+        if let Ok(mut point) = full_point(system, &path_point) {
+            point.freq_hz = freq_hz;
+            return Some(point);
+        }
+    }
+    None
 }
 
 /// Newton at fixed frequencies past `f` (Hz) in `direction` (±1) from the coefficients
@@ -2702,6 +2954,13 @@ impl<'p> PointSolver<'p> {
             .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
         point.freq_hz = freq_hz;
         Ok(point)
+    }
+
+    /// The other side of a fold at `b`, as the judgement of a dead end seeks it from the point
+    /// `a` before it on the stretch into it (see `judge_round_dead_end`): None where no landing
+    /// behind `b` converges.
+    pub fn solve_round_fold(&mut self, a: &FrfPoint, b: &FrfPoint) -> Option<FrfPoint> {
+        land_round_fold(&mut self.system, self.continuation.settings, a, b)
     }
 
     /// Solves the path point on the hyperplane through `a + t (b − a)` normal to the chord
