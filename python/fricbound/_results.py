@@ -162,7 +162,10 @@ class FrfResult(ContinuationPath):
       Fourier coefficients, between the two), ``points`` (of the path back) and ``verdict``
       (``covered`` within 1 %, ``abandoned`` beyond: the leap crossed onto another branch,
       ``unjudged``: the path back did not reach ``from_hz``; the last two make ``status``
-      ``incomplete``);
+      ``incomplete``) and ``past`` (None, or for a leap onto another branch the judgement of
+      the branch through the point before it, a dict with the fields of ``end_check`` in
+      ``solution.json``; its verdict is the leap's: ``covered`` where that branch goes on on
+      the run, or turns back at a fold whose other side lies below the run);
       each jump is a dict ``from_hz``, ``to_hz``, ``first_point``, ``kind``
       (``past-fold``, ``past-dead-end``, ``bridge``), ``abandoned`` (True when the branch
       before it was abandoned inside the range: the response beyond its last point is
@@ -173,8 +176,9 @@ class FrfResult(ContinuationPath):
       None otherwise), for a branch given up off every stretch followed (``before``
       ``abandoned``) its judgement by Newton just past its last point once the run is over
       (``end_check`` in ``solution.json``): ``given_up_verdict`` (``covered``: the landing
-      lies on a stretch of the run, nothing is missing and ``abandoned`` is False;
-      ``abandoned`` or ``unjudged``), ``given_up_check_hz``, ``given_up_check_amplitude`` (m,
+      lies on a stretch of the run, or, where Newton converged nowhere past the point, the
+      branch turns back there at a fold whose other side lies on or below the run: nothing
+      is missing and ``abandoned`` is False; ``abandoned`` or ``unjudged``), ``given_up_check_hz``, ``given_up_check_amplitude`` (m,
       where Newton landed) and ``given_up_check_distance`` (relative distance of the landing's
       coefficients from the nearest stretch of the run; all None otherwise), and
       ``fill_cut_hz``, ``fill_cut_amplitude`` (m), ``fill_cut_fold_hz`` where the branch
@@ -189,7 +193,9 @@ class FrfResult(ContinuationPath):
       the tolerance) and ``cut_check_resolved_distance`` (relative distance between the
       landing and Newton's solution at its frequency from that stretch: at most 1e-6, the
       same solution), and, when the landing is that own side (the stretch came back along
-      it), the judgement past that fold: ``cut_check_beyond_fold_hz`` (the fold),
+      it), or when Newton converged nowhere past a dead end and the other side of a fold at
+      the dead end was found (the fold is the dead end), the judgement past that fold:
+      ``cut_check_beyond_fold_hz`` (the fold),
       ``cut_check_beyond_fold_amplitude`` (m, where Newton landed past it; None when it
       converged nowhere) and ``cut_check_beyond_fold_run_amplitude`` (m, the run's largest
       amplitude there; a landing above it on no stretch makes the cut ``abandoned``); a
