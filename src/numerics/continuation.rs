@@ -399,9 +399,25 @@ impl Continuation {
         self
     }
 
-    /// Whether the solve with relative residuals `history` is to be given up for stagnation.
-    fn stagnates(&self, history: &[f64]) -> bool {
-        self.stagnation.is_some_and(|exit| exit.stagnated(history))
+    /// Whether the solve with relative residuals `history` (one per step) is to be given up for
+    /// stagnation. With `chord` steps [`CHORD_STEPS_PER_ITERATION`] of them count as one
+    /// iteration of [`StagnationExit::after`] and of its window, as of the iteration limit.
+    fn stagnates(&self, history: &[f64], chord: bool) -> bool {
+        self.stagnation.is_some_and(|exit| {
+            if chord {
+                // Every third step back from the current one.
+                let iterations: Vec<f64> = history
+                    .iter()
+                    .rev()
+                    .step_by(CHORD_STEPS_PER_ITERATION)
+                    .rev()
+                    .copied()
+                    .collect();
+                exit.stagnated(&iterations)
+            } else {
+                exit.stagnated(history)
+            }
+        })
     }
 
     /// This driver with steps that also follow the amplitudes ‖x_g‖ of these groups of
@@ -643,7 +659,7 @@ impl Continuation {
             let tolerance = self.tolerance_at(system, (&x, omega), rel);
             let at_tolerance = rel <= tolerance;
             history.push(rel);
-            if !at_tolerance && self.stagnates(&history) {
+            if !at_tolerance && self.stagnates(&history, chord) {
                 return Err(NewtonFailure::MaxIterations {
                     iterations: it,
                     residual: rel,
@@ -853,7 +869,7 @@ impl Continuation {
                 return Err(NewtonFailure::Diverged { residual: rel });
             }
             history.push(rel);
-            if rel > tolerance && self.stagnates(&history) {
+            if rel > tolerance && self.stagnates(&history, chord) {
                 return Err(NewtonFailure::MaxIterations {
                     iterations: it,
                     residual: rel,
@@ -2032,6 +2048,31 @@ mod tests {
                 );
             }
             other => panic!("expected the stagnation exit, got {other:?}"),
+        }
+        // With chord steps (three to an iteration) the guaranteed iterations count three steps
+        // each, as the limit does.
+        let mut chord_settings = settings(10.0, 20.0);
+        chord_settings.chord_min_unknowns = 1;
+        let chord = Continuation::new(chord_settings, vec![1.0]);
+        let chord_stopping =
+            Continuation::new(chord_settings, vec![1.0]).with_stagnation_exit(exit);
+        match (
+            chord.solve_fixed(&mut ZPath, &[1.1], omega),
+            chord_stopping.solve_fixed(&mut ZPath, &[1.1], omega),
+        ) {
+            (
+                Err(NewtonFailure::MaxIterations {
+                    iterations: all, ..
+                }),
+                Err(NewtonFailure::MaxIterations {
+                    iterations: given_up,
+                    ..
+                }),
+            ) => {
+                assert_eq!(all, 108);
+                assert_eq!(given_up, 37, "given up at the first step past the 36th");
+            }
+            other => panic!("expected both to fail, got {other:?}"),
         }
         // A converging solve on the third piece (g = 16 at x = 1.8) is the same either way.
         let a = plain
