@@ -2256,16 +2256,13 @@ fn judge_round_dead_end(
         .or_else(|| into.last().copied())?;
     let landing = land_round_fold(system, newton.settings, &points[a], &points[i])?;
     let own = a.min(i)..=a.max(i);
-    let fold = judge_beyond_fold(
-        system,
-        newton,
-        points,
-        starts,
-        &own,
-        f,
-        landing.freq_hz,
-        Some(landing),
-    );
+    let compared = compare_with_run(system, newton, points, starts, &own, &landing);
+    // A landing on the stretch into the dead end itself (the chord's hyperplane crossing it
+    // again behind the point) is no other side: no fold was found.
+    if compared.covered && compared.own_side {
+        return None;
+    }
+    let fold = fold_check(f, &compared);
     Some(CutCheck {
         landing: Landing::nowhere(past_hz),
         own_side: false,
@@ -2407,6 +2404,12 @@ fn judge_beyond_fold(
         };
     };
     let compared = compare_with_run(system, newton, points, starts, own, &landing);
+    fold_check(fold_hz, &compared)
+}
+
+/// The judgement past the fold at `fold_hz` (Hz) of a landing `compared` with the run: on a
+/// stretch, or below the run's largest amplitude there, covered; else abandoned.
+fn fold_check(fold_hz: f64, compared: &Comparison) -> FoldCheck {
     let below_run = |run: f64| compared.landing.amplitude.is_some_and(|a| a <= run);
     let verdict = match compared.run_amplitude {
         _ if compared.covered => CutVerdict::Covered,
