@@ -418,7 +418,8 @@ fn a_leap_over_a_corner_at_a_low_preload_is_covered_as_newton_finds() {
 /// failing twice leaps instead of cutting the step further) the path leaps over 14 spots, ten
 /// of them on the fill after the bridge at 210.60 Hz, which is reported in reverse (falling
 /// from the jump target, listed rising): each leap's two points are consecutive in the report,
-/// in either order, and followed back from its landing the path reaches the point before it
+/// in either order, where the run recorded them (`FrfRun::leap_points`), and followed back
+/// from its landing the path reaches the point before it
 /// (checked here again by Newton at the frequency before the leap from the landing).
 #[test]
 fn leaps_inside_fills_are_listed_and_judged() {
@@ -433,7 +434,10 @@ fn leaps_inside_fills_are_listed_and_judged() {
     let first_jump = run.jumps.first().expect("the path jumps").first_point;
     let mut solver = PointSolver::new(&p).unwrap();
     let mut in_reverse = 0;
-    for (&(from_hz, to_hz), check) in run.leaps.iter().zip(&run.leap_checks) {
+    assert_eq!(run.leap_points.len(), run.leaps.len());
+    for ((&(from_hz, to_hz), check), &recorded) in
+        run.leaps.iter().zip(&run.leap_checks).zip(&run.leap_points)
+    {
         eprintln!("{check:?}");
         assert_eq!((check.from_hz, check.to_hz), (from_hz, to_hz));
         let at = |a: f64, b: f64| {
@@ -452,6 +456,8 @@ fn leaps_inside_fills_are_listed_and_judged() {
             }
             (None, None) => panic!("leap {from_hz} -> {to_hz}: its points are not consecutive"),
         };
+        // The indices the run recorded are the two points found by frequency.
+        assert_eq!(recorded, Some((before, landing)), "{from_hz} -> {to_hz}");
         assert_eq!(check.verdict, CutVerdict::Covered, "{check:?}");
         let there = solver
             .solve(&run.points[landing].coefficients, from_hz)

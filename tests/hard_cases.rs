@@ -368,6 +368,7 @@ fn limits_cover(path: &str, overrides: &[&str], label: &str, abandoning: &[&str]
             turning_points: curve.turning_points.clone(),
             rejected_steps: 0,
             leaps: Vec::new(),
+            leap_points: Vec::new(),
             leap_checks: Vec::new(),
             jumps: curve.jumps.clone(),
             end: PathEnd::EndFrequency,

@@ -748,6 +748,11 @@ pub struct FrfRun {
     /// after its jumps and the bridges (whose ways down, and the fills, are reported in
     /// reverse, the landing before the point before it).
     pub leaps: Vec<(f64, f64)>,
+    /// The indices in [`FrfRun::points`] of each leap's point before and landing, in the order
+    /// of [`FrfRun::leaps`] (the landing before the point before it on a way reported in
+    /// reverse), as the continuation recorded the landing and the run placed the path's
+    /// points in its report.
+    pub leap_points: Vec<Option<(usize, usize)>>,
     /// The judgement of each leap, in the order of [`FrfRun::leaps`] ([`judge_leaps`]).
     pub leap_checks: Vec<LeapCheck>,
     /// Jumps to another branch after a fold the path did not come back from.
@@ -1413,6 +1418,7 @@ fn solve_in<'scope, 'p, O: FrfObserver>(
         turning_points: Vec::new(),
         rejected_steps: 0,
         leaps: Vec::new(),
+        leap_points: Vec::new(),
         leap_checks: Vec::new(),
         jumps: Vec::new(),
         end: PathEnd::MaxPoints,
@@ -1430,6 +1436,8 @@ fn solve_in<'scope, 'p, O: FrfObserver>(
         let mut continuation = Continuation::new(segment, x_scale.clone())
             .with_adaptive_scale(adaptive.clone())
             .with_amplitude_steps(amplitude_groups.clone());
+        // Where this branch's points go in the report (one per point of its path).
+        let offset = adapter.points.len();
         let outcome = continuation.run(&mut system, &guess, &mut adapter);
         // The next branch starts with the scale this one grew to.
         x_scale.clone_from(&continuation.x_scale);
@@ -1442,6 +1450,8 @@ fn solve_in<'scope, 'p, O: FrfObserver>(
                 run.turning_points.extend(summary.turning_points);
                 run.rejected_steps += summary.rejected_steps;
                 run.leaps.extend(summary.leaps);
+                run.leap_points
+                    .extend(forward_leaps(&summary.leap_landings, 0, offset));
                 run.end = summary.end;
             }
             // A stall is not a fold: the path goes on past it, but could not be followed. (A
@@ -1544,24 +1554,46 @@ fn solve_in<'scope, 'p, O: FrfObserver>(
         // What the bridges and the fill met, in the order they are reported (bridges first);
         // their turning points and leaps go to the observer too (`solution.json` lists them),
         // its leaps in the order of `run.leaps`, which the leaps' judgements follow.
+        // The fill's leaps as placed in its report: followed down from the jump target and
+        // reported in reverse without that first point, which the next branch solves again
+        // and reports right after the fill.
+        let fill_leaps = summary.as_ref().map_or(Vec::new(), |s| {
+            reversed_leaps(&s.leap_landings, followed_fill.len())
+        });
         let met = bridges
             .iter()
-            .map(|b| (&b.turning_points, b.rejected_steps, &b.leaps))
-            .chain(
-                summary
-                    .as_ref()
-                    .map(|s| (&s.turning_points, s.rejected_steps, &s.leaps)),
-            );
-        for (turning_points, rejected_steps, leaps) in met {
+            .map(|b| {
+                (
+                    &b.turning_points,
+                    b.rejected_steps,
+                    &b.leaps,
+                    &b.leap_points,
+                    b.points.len(),
+                )
+            })
+            .chain(summary.as_ref().map(|s| {
+                (
+                    &s.turning_points,
+                    s.rejected_steps,
+                    &s.leaps,
+                    &fill_leaps,
+                    fill.len(),
+                )
+            }));
+        let mut offset = adapter.points.len();
+        for (turning_points, rejected_steps, leaps, places, length) in met {
             for &freq_hz in turning_points {
                 run.turning_points.push(freq_hz);
                 adapter.report(Held::TurningPoint(freq_hz));
             }
             run.rejected_steps += rejected_steps;
-            for &(from_hz, to_hz) in leaps {
+            for (&(from_hz, to_hz), place) in leaps.iter().zip(places) {
                 run.leaps.push((from_hz, to_hz));
+                run.leap_points
+                    .push(place.map(|(before, landing)| (offset + before, offset + landing)));
                 adapter.report(Held::Leap(from_hz, to_hz));
             }
+            offset += length;
         }
         // How the branch before ended, now that the branches solved past it are known (a
         // branch given up whose last point one of them passes through abandoned nothing).
@@ -1956,16 +1988,11 @@ fn judge_leaps<O: FrfObserver>(
     let starts = run.branch_starts();
     for k in 0..run.leaps.len() {
         let (from_hz, to_hz) = run.leaps[k];
-        // (before, landing): consecutive points of the report, the landing after the point
-        // before it, or before it on a way reported in reverse (a fill, a bridge's way down).
-        let at = (1..run.points.len()).find_map(|i| {
-            let (a, b) = (run.points[i - 1].freq_hz, run.points[i].freq_hz);
-            if close(a, from_hz) && close(b, to_hz) {
-                Some((i - 1, i))
-            } else if close(a, to_hz) && close(b, from_hz) {
-                Some((i, i - 1))
-            } else {
-                None
+        // (before, landing) as recorded, checked against the leap's frequencies.
+        let at = run.leap_points.get(k).copied().flatten().filter(|&(b, l)| {
+            match (run.points.get(b), run.points.get(l)) {
+                (Some(b), Some(l)) => close(b.freq_hz, from_hz) && close(l.freq_hz, to_hz),
+                _ => false,
             }
         });
         let mut check = LeapCheck {
@@ -2689,6 +2716,17 @@ impl Branching<'_> {
                 })
             };
             let cuts = [cut_of(&down, true, &down_end), cut_of(&up, false, &up_end)];
+            // The leaps of both ways as placed in the branch: the way down reversed, then the
+            // way up without its first point (the way down's first).
+            let down_len = down.len();
+            let mut leap_points = down_end
+                .as_ref()
+                .map_or(Vec::new(), |s| reversed_leaps(&s.leap_landings, down_len));
+            leap_points.extend(
+                up_end
+                    .as_ref()
+                    .map_or(Vec::new(), |s| forward_leaps(&s.leap_landings, 1, down_len)),
+            );
             down.reverse();
             // Both directions start with the point at `freq_hz`: keep one.
             let branch: Vec<FrfPoint> = down.into_iter().chain(up.into_iter().skip(1)).collect();
@@ -2732,6 +2770,7 @@ impl Branching<'_> {
                     .collect(),
                 rejected_steps: summaries().map(|s| s.rejected_steps).sum(),
                 leaps: summaries().flat_map(|s| s.leaps.iter().copied()).collect(),
+                leap_points,
             });
         }
         branches.sort_by(|a, b| a.points[0].freq_hz.total_cmp(&b.points[0].freq_hz));
@@ -2749,6 +2788,35 @@ struct BridgeBranch {
     turning_points: Vec<f64>,
     rejected_steps: usize,
     leaps: Vec<(f64, f64)>,
+    /// The indices in `points` of each leap's point before and landing, in the order of
+    /// `leaps`.
+    leap_points: Vec<Option<(usize, usize)>>,
+}
+
+/// The (point before, landing) indices of the leaps of a path of `len` points, whose landings
+/// are the path's points `landings` ([`PathSummary::leap_landings`]), in a report that lists
+/// the path in reverse: path point k at `len − 1 − k` (the path's first point last; where the
+/// report leaves that point out, the index `len − 1` is the point reported right after).
+fn reversed_leaps(landings: &[usize], len: usize) -> Vec<Option<(usize, usize)>> {
+    landings
+        .iter()
+        .map(|&l| Some((len.checked_sub(l)?, len.checked_sub(l + 1)?)))
+        .collect()
+}
+
+/// The (point before, landing) indices of the leaps of a path whose landings are its points
+/// `landings`, in a report that lists the path in order from its point `first` at index
+/// `offset` (the points before `first` left out).
+fn forward_leaps(landings: &[usize], first: usize, offset: usize) -> Vec<Option<(usize, usize)>> {
+    landings
+        .iter()
+        .map(|&l| {
+            Some((
+                (l.checked_sub(1)? + offset).checked_sub(first)?,
+                (l + offset).checked_sub(first)?,
+            ))
+        })
+        .collect()
 }
 
 /// A converged point strictly between `lo` and `hi` (Hz and operator unknowns), by Newton at
@@ -3150,12 +3218,36 @@ mod tests {
         }
     }
 
+    /// A leap's recorded landing placed in the report: a path reported in order from its
+    /// point `first` at `offset`, or in reverse (its first point last, or left out with the
+    /// point reported after the path in its place); a point before that the report does not
+    /// hold gives none.
+    #[test]
+    fn leap_landings_are_placed_where_the_report_puts_the_path() {
+        // The main path at offset 10: landing 1 and 3 (before 0 and 2).
+        assert_eq!(
+            forward_leaps(&[1, 3], 0, 10),
+            vec![Some((10, 11)), Some((12, 13))]
+        );
+        // A bridge's way up after its way down of 4 points, its first point (the way down's
+        // first) not repeated: path point k at 4 − 1 + k.
+        assert_eq!(
+            forward_leaps(&[1, 3], 1, 4),
+            vec![Some((3, 4)), Some((5, 6))]
+        );
+        // A way up with no way down before it: the point before its first leap is not there.
+        assert_eq!(forward_leaps(&[1, 2], 1, 0), vec![None, Some((0, 1))]);
+        // A path of 5 points in reverse: path point k at 4 − k.
+        assert_eq!(reversed_leaps(&[1, 3], 5), vec![Some((4, 3)), Some((2, 1))]);
+    }
+
     fn run_with_jumps(jumps: Vec<Jump>) -> FrfRun {
         FrfRun {
             points: Vec::new(),
             turning_points: Vec::new(),
             rejected_steps: 0,
             leaps: Vec::new(),
+            leap_points: Vec::new(),
             leap_checks: Vec::new(),
             jumps,
             end: PathEnd::EndFrequency,

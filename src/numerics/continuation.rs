@@ -1436,6 +1436,7 @@ impl Continuation {
         summary.points.truncate(held.points);
         summary.turning_points.truncate(held.turning_points);
         summary.leaps.truncate(held.leaps);
+        summary.leap_landings.truncate(held.leaps);
         summary.rejected_steps = held.rejected_steps;
         self.x_scale = held.x_scale;
         self.adaptive = held.adaptive;
@@ -1505,6 +1506,10 @@ impl Continuation {
                         .is_err()
                     {
                         summary.points.truncate(index);
+                        // The leaps whose landing was dropped with it go too.
+                        let kept = summary.leap_landings.iter().filter(|&&l| l < index).count();
+                        summary.leaps.truncate(kept);
+                        summary.leap_landings.truncate(kept);
                         summary.end = PathEnd::DeadEnd;
                         return true;
                     }
@@ -1573,6 +1578,7 @@ impl Continuation {
             turning_points: Vec::new(),
             rejected_steps: 0,
             leaps: Vec::new(),
+            leap_landings: Vec::new(),
             end: PathEnd::MaxPoints,
         };
         let mut ds = a.initial_step.clamp(a.min_step, a.max_step);
@@ -1751,6 +1757,7 @@ impl Continuation {
                                     let call = ObserverCall::Leap(from, point.freq_hz());
                                     report(&mut held, observer, call);
                                     summary.leaps.push((from, point.freq_hz()));
+                                    summary.leap_landings.push(summary.points.len());
                                 }
                                 leapt
                             }

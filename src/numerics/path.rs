@@ -143,6 +143,9 @@ pub struct PathSummary {
     pub rejected_steps: usize,
     /// Stretches of the path leapt over: (last point before, first point after), Hz.
     pub leaps: Vec<(f64, f64)>,
+    /// The index in `points` of each leap's first point after (its landing; the point before
+    /// it is the one before), in the order of `leaps`.
+    pub leap_landings: Vec<usize>,
     /// Why the run stopped.
     pub end: PathEnd,
 }
