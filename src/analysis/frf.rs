@@ -2339,7 +2339,6 @@ fn land_round_fold(
     chord.iter_mut().for_each(|v| *v /= length);
     // The frequency is free: the hyperplane's normal has no component on it.
     chord.push(0.0);
-    let n = yb.len();
     let back = (a.freq_hz - b.freq_hz).signum();
     for &steps in ROUND_FOLD_STEPS {
         let mut predicted: Vec<f64> = yb
@@ -2348,32 +2347,49 @@ fn land_round_fold(
             .map(|(y, c)| y + steps * length * c)
             .collect();
         predicted.push(b.freq_hz);
-        let Ok((y, iterations, residual)) = newton.correct(system, &predicted, &chord) else {
+        let Ok(point) = correct_on_hyperplane(system, &newton, &predicted, &chord) else {
             continue;
         };
-        let freq_hz = y[n];
-        if (freq_hz - b.freq_hz) * back <= 0.0 {
-            continue;
-        }
-        let x: Vec<f64> = y[..n].iter().zip(scale).map(|(v, s)| v * s).collect();
-        let omega = 2.0 * PI * freq_hz;
-        let mut r = vec![0.0; n];
-        if system.residual(&x, omega, &mut r).is_err() {
-            continue;
-        }
-        let path_point = PathPoint {
-            omega,
-            x,
-            iterations,
-            residual,
-            step: 0.0,
-        };
-        if let Ok(mut point) = full_point(system, &path_point) {
-            point.freq_hz = freq_hz;
+        if (point.freq_hz - b.freq_hz) * back > 0.0 {
             return Some(point);
         }
     }
     None
+}
+
+/// The point on the hyperplane through `predicted` normal to `normal` (both in the scaled
+/// space of `newton`: unknowns over its `x_scale`, then the frequency in Hz), by its corrector
+/// from `predicted`, with the operator left evaluated at it (its contact states those of the
+/// point).
+fn correct_on_hyperplane(
+    system: &mut HbmOperator<'_>,
+    newton: &Continuation,
+    predicted: &[f64],
+    normal: &[f64],
+) -> Result<FrfPoint, NewtonFailure> {
+    let (y, iterations, residual) = newton.correct(system, predicted, normal)?;
+    let n = y.len() - 1;
+    let x: Vec<f64> = y[..n]
+        .iter()
+        .zip(&newton.x_scale)
+        .map(|(v, s)| v * s)
+        .collect();
+    let omega = 2.0 * PI * y[n];
+    let mut r = vec![0.0; n];
+    system
+        .residual(&x, omega, &mut r)
+        .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
+    let path_point = PathPoint {
+        omega,
+        x,
+        iterations,
+        residual,
+        step: 0.0,
+    };
+    let mut point =
+        full_point(system, &path_point).map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
+    point.freq_hz = y[n];
+    Ok(point)
 }
 
 /// Newton at fixed frequencies past `f` (Hz) in `direction` (±1) from the coefficients
@@ -3063,28 +3079,7 @@ impl<'p> PointSolver<'p> {
         }
         chord.iter_mut().for_each(|v| *v /= length);
         let predicted: Vec<f64> = ya.iter().zip(&yb).map(|(p, q)| p + t * (q - p)).collect();
-        let (y, iterations, residual) =
-            self.continuation
-                .correct(&mut self.system, &predicted, &chord)?;
-        let n = y.len() - 1;
-        let x: Vec<f64> = y[..n].iter().zip(&scale).map(|(v, s)| v * s).collect();
-        let omega = 2.0 * PI * y[n];
-        // Leave the operator (and its contact states) evaluated at the returned point.
-        let mut r = vec![0.0; n];
-        self.system
-            .residual(&x, omega, &mut r)
-            .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
-        let path_point = PathPoint {
-            omega,
-            x,
-            iterations,
-            residual,
-            step: 0.0,
-        };
-        let mut point = full_point(&mut self.system, &path_point)
-            .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
-        point.freq_hz = y[n];
-        Ok(point)
+        correct_on_hyperplane(&mut self.system, &self.continuation, &predicted, &chord)
     }
 }
 
