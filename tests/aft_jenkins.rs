@@ -308,3 +308,192 @@ proptest! {
         prop_assert!(err < 1e-6, "relative error {}", err);
     }
 }
+
+// ---------------------------------------------------------------------------------------
+// The event-resolved law (`AftWorkspace::evaluate_events`): exact where the sampled law is
+// O(1/N), and smooth, so central differences check its Jacobian everywhere.
+
+/// First harmonic of T for u = q cos τ and constant N0 with the event-resolved law.
+fn first_harmonic_events(ratio: f64, normal_load: NormalLoad, samples: usize) -> (f64, f64) {
+    let (kt, kn, mu, n0) = (2.0e5, 1.0e5, 0.4, 50.0);
+    let q = mu * n0 / (kt * ratio);
+    let mut aft = AftWorkspace::new(&HarmonicSet::up_to(1), samples);
+    let effects = ContactEffects {
+        normal_load,
+        liftoff: true,
+    };
+    let report = aft
+        .evaluate_events(
+            &law(kt, kn, mu, 0.0),
+            effects,
+            &[0.0, q, 0.0],
+            &[n0 / kn, 0.0, 0.0],
+            false,
+        )
+        .unwrap();
+    let expected = if ratio < 1.0 {
+        ContactState::StickSlip
+    } else {
+        ContactState::Stuck
+    };
+    assert_eq!(report.state, expected, "ratio {ratio}");
+    (aft.t_hat[1] / q, -aft.t_hat[2] / q)
+}
+
+#[test]
+fn event_law_equals_the_describing_function_to_round_off() {
+    let (kt, mu, n0) = (2.0e5, 0.4, 50.0);
+    for i in 0..=40 {
+        let ratio = 0.01 + (1.2 - 0.01) * i as f64 / 40.0;
+        let q = mu * n0 / (kt * ratio);
+        let (k_ref, c_ref) = jenkins_describing_function(kt, mu, n0, q);
+        for model in [NormalLoad::Variable, NormalLoad::Constant] {
+            // A coarse bracketing grid gives the same values: it only brackets the events.
+            for samples in [16, 256] {
+                let (k, c) = first_harmonic_events(ratio, model, samples);
+                assert!(
+                    (k - k_ref).abs() <= 1e-11 * kt,
+                    "k_eq at ratio {ratio}, {samples} samples: {k} vs {k_ref}"
+                );
+                assert!(
+                    (c - c_ref).abs() <= 1e-11 * kt,
+                    "c_eq at ratio {ratio}, {samples} samples: {c} vs {c_ref}"
+                );
+            }
+        }
+    }
+}
+
+/// Largest |analytic − central difference| of the event law's Jacobian, relative to the
+/// largest entry (each column scaled by its coefficient scale), at H = 3 with a coarse
+/// bracketing grid. The law is C¹, so central differences apply whatever the regime.
+fn event_jacobian_error(
+    l: JenkinsLaw,
+    effects: ContactEffects,
+    u: &[f64],
+    v: &[f64],
+) -> (f64, ContactState) {
+    let set = HarmonicSet::up_to(3);
+    let nb = set.n_blocks();
+    let mut aft = AftWorkspace::new(&set, 32);
+    let state = aft.evaluate_events(&l, effects, u, v, true).unwrap().state;
+    let (tu, tv, nv) = (aft.dt_du.clone(), aft.dt_dv.clone(), aft.dn_dv.clone());
+    let scale_u = u.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+    let scale_v = v.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+    let max_entry = (0..nb * nb)
+        .map(|k| (tu[k].abs() * scale_u).max((tv[k].abs().max(nv[k].abs())) * scale_v))
+        .fold(f64::MIN_POSITIVE, f64::max);
+    let mut max_err = 0.0_f64;
+    for i in 0..nb {
+        for (which, scale) in [(0, scale_u), (1, scale_v)] {
+            let h = 1e-6 * scale;
+            let mut forces = |sign: f64| {
+                let (mut up, mut vp) = (u.to_vec(), v.to_vec());
+                if which == 0 {
+                    up[i] += sign * h;
+                } else {
+                    vp[i] += sign * h;
+                }
+                aft.evaluate_events(&l, effects, &up, &vp, false).unwrap();
+                (aft.t_hat.clone(), aft.n_hat.clone())
+            };
+            let (tp, np) = forces(1.0);
+            let (tm, nm) = forces(-1.0);
+            for j in 0..nb {
+                let (at, an) = if which == 0 {
+                    (tu[j * nb + i], 0.0)
+                } else {
+                    (tv[j * nb + i], nv[j * nb + i])
+                };
+                let ct = (tp[j] - tm[j]) / (2.0 * h);
+                let cn = (np[j] - nm[j]) / (2.0 * h);
+                max_err = max_err.max((ct - at).abs().max((cn - an).abs()) * scale);
+            }
+        }
+    }
+    (max_err / max_entry, state)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    #[test]
+    fn event_jacobian_stuck((s, m, mu) in regime_strategy(), constant in any::<bool>()) {
+        let (u, v) = coefficients(&s, 1e-6, 1e-3, 1e-5);
+        let (err, state) = event_jacobian_error(law(1e5, 1e5, mu, m), effects(constant, true), &u, &v);
+        prop_assert_eq!(state, ContactState::Stuck);
+        prop_assert!(err < 1e-6, "relative error {}", err);
+    }
+
+    #[test]
+    fn event_jacobian_stick_slip((s, m, mu) in regime_strategy(), constant in any::<bool>()) {
+        let (mut u, v) = coefficients(&s, 1e-4, 1e-4, 3e-5);
+        u[1] += 5e-4;
+        let (err, state) = event_jacobian_error(law(1e5, 1e5, mu, m), effects(constant, true), &u, &v);
+        prop_assert_eq!(state, ContactState::StickSlip);
+        prop_assert!(err < 1e-6, "relative error {}", err);
+    }
+
+    #[test]
+    fn event_jacobian_stick_slip_liftoff((s, m, mu) in regime_strategy()) {
+        let (mut u, mut v) = coefficients(&s, 1e-4, 2e-5, 2e-5);
+        u[1] += 2e-4;
+        v[2] += 1e-4;
+        let (err, state) = event_jacobian_error(law(1e5, 1e5, mu, m), effects(false, true), &u, &v);
+        prop_assert_eq!(state, ContactState::StickSlipLiftoff);
+        prop_assert!(err < 1e-6, "relative error {}", err);
+    }
+
+    #[test]
+    fn event_jacobian_open((s, m, mu) in regime_strategy()) {
+        let (u, v) = coefficients(&s, 1e-4, -1e-3, 1e-4);
+        let mut aft = AftWorkspace::new(&HarmonicSet::up_to(3), 32);
+        let report = aft.evaluate_events(&law(1e5, 1e5, mu, m), effects(false, true), &u, &v, true).unwrap();
+        prop_assert_eq!(report.state, ContactState::Open);
+        prop_assert!(aft.dt_du.iter().chain(&aft.dt_dv).chain(&aft.dn_dv).all(|x| *x == 0.0));
+        prop_assert!(aft.t_hat.iter().chain(&aft.n_hat).all(|x| *x == 0.0));
+    }
+
+    #[test]
+    fn event_jacobian_grazing((s, m, mu) in regime_strategy(), touch in 0.97..1.03f64) {
+        // The contact just touches or just separates once per period: no input is excluded,
+        // the closing instant being located, not sampled.
+        let mut u = vec![0.0; 7];
+        let mut v = vec![0.0; 7];
+        v[1] = 3e-5;
+        v[0] = 3e-5 * touch;
+        for j in 0..7 { u[j] = 1e-5 * s[j]; }
+        u[1] += 1e-4;
+        let (err, _) = event_jacobian_error(law(1e5, 1e5, mu, m), effects(false, true), &u, &v);
+        prop_assert!(err < 1e-5, "relative error {}", err);
+    }
+
+    #[test]
+    fn event_jacobian_without_liftoff((s, m, mu) in regime_strategy()) {
+        let (mut u, mut v) = coefficients(&s, 1e-4, 2e-5, 2e-5);
+        u[1] += 2e-4;
+        v[2] += 4e-5;
+        let (err, _) = event_jacobian_error(law(1e5, 1e5, mu, m), effects(false, false), &u, &v);
+        prop_assert!(err < 1e-6, "relative error {}", err);
+    }
+
+    #[test]
+    fn event_law_tends_to_the_sampled_law((s, m, mu) in regime_strategy()) {
+        // Both laws on the same stick-slip-liftoff input: the sampled law's error falls like
+        // 1/N (each transition snapped to the grid), so at 8 192 samples the two agree to a
+        // few 1e-4 of the force scale.
+        let (mut u, mut v) = coefficients(&s, 1e-4, 2e-5, 2e-5);
+        u[1] += 2e-4;
+        v[2] += 1e-4;
+        let l = law(1e5, 1e5, mu, m);
+        let set = HarmonicSet::up_to(3);
+        let mut events = AftWorkspace::new(&set, 64);
+        events.evaluate_events(&l, effects(false, true), &u, &v, false).unwrap();
+        let mut sampled = AftWorkspace::new(&set, 8192);
+        sampled.evaluate(&l, effects(false, true), &u, &v, false).unwrap();
+        let scale = events.n_hat.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+        for (a, b) in events.t_hat.iter().chain(&events.n_hat).zip(sampled.t_hat.iter().chain(&sampled.n_hat)) {
+            prop_assert!((a - b).abs() < 2e-3 * scale, "{} vs {} (scale {})", a, b, scale);
+        }
+    }
+}

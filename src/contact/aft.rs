@@ -29,12 +29,15 @@
 //! Everything here is allocation-free after [`AftWorkspace::new`]: plans, scratch and all
 //! buffers live in the workspace.
 
+mod resolved;
+
 use std::sync::Arc;
 
 use realfft::num_complex::Complex;
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 
-use crate::contact::harmonic::{Block, HarmonicSet, SampleBasis};
+use crate::contact::events::EventSolver;
+use crate::contact::harmonic::{product_integral, Block, HarmonicSet, SampleBasis};
 use crate::contact::{ContactEffects, ContactState, JenkinsLaw, NormalLoad};
 
 /// Limits of the periodic march.
@@ -88,6 +91,12 @@ pub enum AftError {
     /// A displacement sample was NaN or infinite.
     #[error("non-finite relative displacement in the contact march")]
     NonFinite,
+    /// The event-resolved law met more transitions in one period than its bracketing grid
+    /// can separate.
+    #[error(
+        "contact transitions too dense to locate on the bracketing grid (raise harmonics.samples)"
+    )]
+    TooManyEvents,
 }
 
 /// What happened at one sample of the final period (kept for the Jacobian and for outputs).
@@ -149,6 +158,8 @@ pub struct AftWorkspace {
     pub dn_dv: Vec<f64>,
     /// March limits.
     pub settings: MarchSettings,
+    /// Buffers of the event-resolved law ([`Self::evaluate_events`]).
+    events: EventSolver,
 }
 
 impl AftWorkspace {
@@ -197,6 +208,7 @@ impl AftWorkspace {
             dt_dv: vec![0.0; nb * nb],
             dn_dv: vec![0.0; nb * nb],
             settings: MarchSettings::default(),
+            events: EventSolver::new(set, n_samples),
         }
     }
 
@@ -210,27 +222,19 @@ impl AftWorkspace {
         self.n_samples
     }
 
-    /// Coefficients → samples (inverse real FFT), into `out`.
+    /// Coefficients → samples (inverse real FFT), into [`Self::u`] or [`Self::v`].
     fn synthesize(&mut self, coefficients: &[f64], which: Signal) {
-        for c in self.spectrum.iter_mut() {
-            *c = Complex::new(0.0, 0.0);
-        }
-        for (b, &c) in self.set.blocks().iter().zip(coefficients) {
-            match *b {
-                Block::Constant => self.spectrum[0].re += c,
-                Block::Cos(h) => self.spectrum[h].re += 0.5 * c,
-                Block::Sin(h) => self.spectrum[h].im -= 0.5 * c,
-            }
-        }
         let out = match which {
             Signal::U => &mut self.u,
             Signal::V => &mut self.v,
         };
-        // Validated sample counts keep every harmonic below Nyquist, so the DC and Nyquist
-        // bins are real and the transform cannot fail.
-        self.inverse
-            .process_with_scratch(&mut self.spectrum, out, &mut self.scratch_inv)
-            .expect("inverse real FFT with real DC/Nyquist bins");
+        synthesize_into(
+            &self.set,
+            self.inverse.as_ref(),
+            (&mut self.spectrum, &mut self.scratch_inv),
+            coefficients,
+            out,
+        );
     }
 
     /// Samples → coefficients (forward real FFT).
@@ -607,23 +611,15 @@ impl AftWorkspace {
     }
 }
 
-/// Σ_k g_k b_j(τ_k) b_i(τ_k) from the real FFT X of g (X_m = Σ_k g_k e^{−imτ_k}), using
-/// cos a cos b = ½[cos(a−b) + cos(a+b)], sin a sin b = ½[cos(a−b) − cos(a+b)],
-/// cos a sin b = ½[sin(a+b) − sin(a−b)].
+/// Σ_k g_k b_j(τ_k) b_i(τ_k) from the real FFT X of g (X_m = Σ_k g_k e^{−imτ_k}):
+/// Σ g cos(mτ) = Re X_m and Σ g sin(mτ) = −Im X_m in [`product_integral`].
 fn gram_entry(spectrum: &[Complex<f64>], n: usize, bj: Block, bi: Block) -> f64 {
-    // Σ g cos(mτ) and Σ g sin(mτ) for any integer m (aliased into 0..n).
-    let c = |m: i64| -> f64 { spectrum_at(spectrum, n, m).re };
-    let s = |m: i64| -> f64 { -spectrum_at(spectrum, n, m).im };
-    use Block::{Constant, Cos, Sin};
-    match (bj, bi) {
-        (Constant, Constant) => c(0),
-        (Constant, Cos(h)) | (Cos(h), Constant) => c(h as i64),
-        (Constant, Sin(h)) | (Sin(h), Constant) => s(h as i64),
-        (Cos(a), Cos(b)) => 0.5 * (c(a as i64 - b as i64) + c(a as i64 + b as i64)),
-        (Sin(a), Sin(b)) => 0.5 * (c(a as i64 - b as i64) - c(a as i64 + b as i64)),
-        (Cos(a), Sin(b)) => 0.5 * (s(a as i64 + b as i64) - s(a as i64 - b as i64)),
-        (Sin(a), Cos(b)) => 0.5 * (s(a as i64 + b as i64) + s(a as i64 - b as i64)),
-    }
+    product_integral(
+        |m| spectrum_at(spectrum, n, m).re,
+        |m| -spectrum_at(spectrum, n, m).im,
+        bj,
+        bi,
+    )
 }
 
 /// X_m of a real signal of length n for any integer m, from the half spectrum 0..=n/2.
@@ -634,6 +630,32 @@ fn spectrum_at(spectrum: &[Complex<f64>], n: usize, m: i64) -> Complex<f64> {
     } else {
         spectrum[n - r].conj()
     }
+}
+
+/// Coefficients on the blocks of `set` → N samples of the signal (inverse real FFT), with the
+/// plan's spectrum and scratch buffers.
+fn synthesize_into(
+    set: &HarmonicSet,
+    inverse: &dyn ComplexToReal<f64>,
+    (spectrum, scratch): (&mut [Complex<f64>], &mut [Complex<f64>]),
+    coefficients: &[f64],
+    out: &mut [f64],
+) {
+    for c in spectrum.iter_mut() {
+        *c = Complex::new(0.0, 0.0);
+    }
+    for (b, &c) in set.blocks().iter().zip(coefficients) {
+        match *b {
+            Block::Constant => spectrum[0].re += c,
+            Block::Cos(h) => spectrum[h].re += 0.5 * c,
+            Block::Sin(h) => spectrum[h].im -= 0.5 * c,
+        }
+    }
+    // Validated sample counts keep every harmonic below Nyquist, so the DC and Nyquist bins
+    // are real and the transform cannot fail.
+    inverse
+        .process_with_scratch(spectrum, out, scratch)
+        .expect("inverse real FFT with real DC/Nyquist bins");
 }
 
 #[derive(Clone, Copy)]

@@ -142,6 +142,29 @@ impl HarmonicSet {
     }
 }
 
+/// ∫ g b_j b_i (or Σ_k g_k b_j(τ_k) b_i(τ_k)) for a weight g given by its cosine and sine
+/// moments c(m) = ∫ g cos(mτ), s(m) = ∫ g sin(mτ) at integer m (any sign), using
+/// cos a cos b = ½[cos(a−b) + cos(a+b)], sin a sin b = ½[cos(a−b) − cos(a+b)],
+/// cos a sin b = ½[sin(a+b) − sin(a−b)]. Shared by the sampled AFT's Jacobian (moments from
+/// one real FFT of g) and the event-resolved law (moments integrated over its phases).
+pub fn product_integral(
+    c: impl Fn(i64) -> f64,
+    s: impl Fn(i64) -> f64,
+    bj: Block,
+    bi: Block,
+) -> f64 {
+    use Block::{Constant, Cos, Sin};
+    match (bj, bi) {
+        (Constant, Constant) => c(0),
+        (Constant, Cos(h)) | (Cos(h), Constant) => c(h as i64),
+        (Constant, Sin(h)) | (Sin(h), Constant) => s(h as i64),
+        (Cos(a), Cos(b)) => 0.5 * (c(a as i64 - b as i64) + c(a as i64 + b as i64)),
+        (Sin(a), Sin(b)) => 0.5 * (c(a as i64 - b as i64) - c(a as i64 + b as i64)),
+        (Cos(a), Sin(b)) => 0.5 * (s(a as i64 + b as i64) - s(a as i64 - b as i64)),
+        (Sin(a), Cos(b)) => 0.5 * (s(a as i64 + b as i64) + s(a as i64 - b as i64)),
+    }
+}
+
 /// Dense sampled basis and projection for a harmonic set at N samples per period.
 #[derive(Debug, Clone)]
 pub struct SampleBasis {

@@ -10,11 +10,13 @@
 //! | [`harmonic`] | `HarmonicSet`, `Block`, `SampleBasis` | real Fourier basis, unknown ordering (harmonic-major), time sampling |
 //! | [`aft`] | `AftWorkspace`, `MarchSettings`, `AftError` | the alternating frequency/time march of the Jenkins law (paper Eqs. 4-6) and its analytic Jacobian |
 //! | [`aft2d`] | `Aft2dWorkspace` | the march of the isotropic 2D Jenkins element in a contact's tangent plane (radial return onto the friction circle) and its analytic Jacobian through the periodic steady state |
+//! | [`events`] | `EventSolver`, `march::periodic_orbit` | the event-resolved Jenkins law: stick, slip, opening and closing located in continuous time, forces integrated exactly between them (a C¹ residual), and its analytic Jacobian |
 //! | [`describing_function`] | [`jenkins_describing_function`] | the exact first harmonic under constant normal load (paper Eqs. 17-18), the AFT's reference |
 
 pub mod aft;
 pub mod aft2d;
 pub mod describing_function;
+pub mod events;
 pub mod harmonic;
 pub mod point;
 

@@ -1,0 +1,159 @@
+//! The event-resolved evaluation of the 1D Jenkins law into the AFT workspace's outputs
+//! ([`crate::contact::events`] does the work): the same force coefficients, Jacobian, time
+//! samples and contact state as the sampled march, so every caller reads either alike.
+
+use super::{AftError, AftWorkspace, MarchReport, SampleKind, Signal};
+use crate::contact::events::march::{periodic_orbit, Anchor, Grid, LawParams, Phase, Signals};
+use crate::contact::events::{ForceOutputs, MarchFailure};
+use crate::contact::{ContactEffects, ContactState, JenkinsLaw};
+use std::f64::consts::PI;
+
+impl AftWorkspace {
+    /// Evaluates the contact forces (and, if asked, their Jacobian) for coefficients û, v̂ with
+    /// the transitions located in continuous time ([`crate::contact::events`]); the samples
+    /// (N of them) only bracket the events and carry the time histories for outputs.
+    ///
+    /// `v_coefficients` already include the gap in the constant block. Results are left where
+    /// [`Self::evaluate`] leaves them.
+    pub fn evaluate_events(
+        &mut self,
+        law: &JenkinsLaw,
+        effects: ContactEffects,
+        u_coefficients: &[f64],
+        v_coefficients: &[f64],
+        jacobian: bool,
+    ) -> Result<MarchReport, AftError> {
+        if u_coefficients
+            .iter()
+            .chain(v_coefficients)
+            .any(|x| !x.is_finite())
+        {
+            return Err(AftError::NonFinite);
+        }
+        self.synthesize(u_coefficients, Signal::U);
+        self.synthesize(v_coefficients, Signal::V);
+        self.events
+            .differentiate(&self.set, u_coefficients, v_coefficients);
+        for i in 0..4 {
+            super::synthesize_into(
+                &self.set,
+                self.inverse.as_ref(),
+                (&mut self.spectrum, &mut self.scratch_inv),
+                &self.events.derivative_coefficients[i],
+                &mut self.events.derivative_samples[i],
+            );
+        }
+        let constant_v = self
+            .set
+            .constant_block()
+            .map(|j| v_coefficients[j])
+            .unwrap_or(0.0);
+        self.normal_forces(law, effects, constant_v);
+        let params = LawParams::new(law, effects, constant_v);
+        let signals = Signals {
+            blocks: self.set.blocks(),
+            u: u_coefficients,
+            v: v_coefficients,
+        };
+        let (umin, umax) = self
+            .u
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                (a.min(x), b.max(x))
+            });
+        let nmax = self.n.iter().fold(0.0_f64, |a, &x| a.max(x.abs()));
+        let scale = (umax - umin) + law.mu * nmax / law.kt + f64::MIN_POSITIVE;
+        let tolerance =
+            self.settings.periodicity_tolerance * self.settings.length_scale(scale, law.kt);
+        let mut pieces = std::mem::take(&mut self.events.pieces);
+        let orbit = {
+            let [du, ddu, dv, ddv] = &self.events.derivative_samples;
+            let grid = Grid {
+                u: [&self.u, du, ddu],
+                v: [&self.v, dv, ddv],
+            };
+            periodic_orbit(
+                &params,
+                &signals,
+                &grid,
+                self.settings.max_periods,
+                tolerance,
+                &mut pieces,
+            )
+        };
+        self.events.pieces = pieces;
+        let periods = orbit.map_err(|failure| match failure {
+            MarchFailure::NotSettled { periods, drift } => AftError::NotSettled { periods, drift },
+            MarchFailure::TooManyEvents => AftError::TooManyEvents,
+        })?;
+        let jacobian = jacobian.then_some([
+            self.dt_du.as_mut_slice(),
+            self.dt_dv.as_mut_slice(),
+            self.dn_dv.as_mut_slice(),
+        ]);
+        self.events.integrate(
+            &self.set,
+            &params,
+            effects,
+            &signals,
+            ForceOutputs {
+                t_hat: &mut self.t_hat,
+                n_hat: &mut self.n_hat,
+                jacobian,
+            },
+        );
+        self.sample_orbit(&params);
+        let pieces = &self.events.pieces;
+        self.initial_anchor = pieces.iter().any(|p| {
+            matches!(
+                p.phase,
+                Phase::Stick {
+                    anchor: Anchor::Initial,
+                    ..
+                }
+            )
+        });
+        let open = pieces.iter().filter(|p| p.phase == Phase::Open).count();
+        let state = if open == pieces.len() {
+            ContactState::Open
+        } else if open > 0 {
+            ContactState::StickSlipLiftoff
+        } else if pieces.iter().any(|p| matches!(p.phase, Phase::Slip { .. })) {
+            ContactState::StickSlip
+        } else {
+            ContactState::Stuck
+        };
+        Ok(MarchReport { state, periods })
+    }
+
+    /// The tangential force samples T(τₖ) and sample kinds of the orbit in the event buffers
+    /// (the normal force samples are set by `normal_forces`).
+    fn sample_orbit(&mut self, params: &LawParams) {
+        let ns = self.n_samples;
+        let pieces = &self.events.pieces;
+        let mut p = 0;
+        for k in 0..ns {
+            let tau = 2.0 * PI * k as f64 / ns as f64;
+            while p + 1 < pieces.len() && pieces[p].end <= tau {
+                p += 1;
+            }
+            let limit = match params.constant_limit {
+                Some(l) => l,
+                None => params.mu_kn * self.v[k].max(0.0),
+            };
+            let (t, kind) = match pieces.get(p).map(|q| q.phase) {
+                Some(Phase::Stick { w, .. }) => (
+                    params.kt * (self.u[k] - w),
+                    SampleKind::Stick {
+                        anchor: 0,
+                        sign: 0.0,
+                    },
+                ),
+                Some(Phase::Slip { sign }) => (sign * limit, SampleKind::Slip { sign }),
+                Some(Phase::Open) | None => (0.0, SampleKind::Open),
+            };
+            self.t[k] = t;
+            self.kinds[k] = kind;
+        }
+    }
+}

@@ -1,0 +1,512 @@
+//! The event march: the Jenkins element driven by trigonometric polynomials u(τ), v(τ), its
+//! stick, slip and open phases and the instants where one gives way to the next.
+//!
+//! Each phase has *exit functions* f(τ) that are negative while the phase holds; an event is
+//! the first instant where one of them turns positive. They are bracketed on the sample grid
+//! (values and rates from the grid signals), grazes inside a cell are caught by the sign
+//! change of f′ across it, and every root is refined by Brent's method on direct evaluations
+//! of the trigonometric polynomials, to round-off of τ.
+
+use super::roots::brent;
+use crate::contact::harmonic::Block;
+use std::f64::consts::PI;
+
+/// u, v and their first two τ-derivatives at one instant (m, m/rad, m/rad²).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Kinematics {
+    /// [u, u′, u″] of the tangential relative displacement.
+    pub u: [f64; 3],
+    /// [v, v′, v″] of the normal relative displacement (gap included).
+    pub v: [f64; 3],
+}
+
+/// Coefficients of u and v on the force blocks, evaluated at any τ by direct summation.
+pub struct Signals<'a> {
+    /// Blocks of the coefficients.
+    pub blocks: &'a [Block],
+    /// û (m).
+    pub u: &'a [f64],
+    /// v̂ including the gap (m).
+    pub v: &'a [f64],
+}
+
+impl Signals<'_> {
+    /// u, v and their derivatives at τ.
+    pub fn at(&self, tau: f64) -> Kinematics {
+        let mut k = Kinematics::default();
+        for (j, block) in self.blocks.iter().enumerate() {
+            let (cu, cv) = (self.u[j], self.v[j]);
+            match *block {
+                Block::Constant => {
+                    k.u[0] += cu;
+                    k.v[0] += cv;
+                }
+                Block::Cos(h) | Block::Sin(h) => {
+                    let h = h as f64;
+                    let (s, c) = (h * tau).sin_cos();
+                    // d/dτ cos hτ = −h sin hτ, d/dτ sin hτ = h cos hτ.
+                    let (b0, b1, b2) = match *block {
+                        Block::Cos(_) => (c, -h * s, -h * h * c),
+                        _ => (s, h * c, -h * h * s),
+                    };
+                    for (out, coef) in [(&mut k.u, cu), (&mut k.v, cv)] {
+                        out[0] += coef * b0;
+                        out[1] += coef * b1;
+                        out[2] += coef * b2;
+                    }
+                }
+            }
+        }
+        k
+    }
+}
+
+/// The grid values of [`Kinematics`] over one period, N samples at τₖ = 2πk/N.
+pub struct Grid<'a> {
+    /// [u, u′, u″] samples.
+    pub u: [&'a [f64]; 3],
+    /// [v, v′, v″] samples.
+    pub v: [&'a [f64]; 3],
+}
+
+impl Grid<'_> {
+    fn len(&self) -> usize {
+        self.u[0].len()
+    }
+
+    fn at(&self, k: usize) -> Kinematics {
+        let k = k % self.len();
+        Kinematics {
+            u: [self.u[0][k], self.u[1][k], self.u[2][k]],
+            v: [self.v[0][k], self.v[1][k], self.v[2][k]],
+        }
+    }
+}
+
+/// The Jenkins law's parameters as the march needs them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LawParams {
+    /// Tangential stiffness kₜ (N/m).
+    pub kt: f64,
+    /// Normal stiffness kₙ (N/m).
+    pub kn: f64,
+    /// μ kₙ (N/m): the friction limit per unit compression.
+    pub mu_kn: f64,
+    /// Initial tangential state m ∈ [−1, 1].
+    pub m: f64,
+    /// The constant friction limit μ max(kₙ v̂₀, 0) (N) with a constant normal load; `None`
+    /// with a variable one, whose limit is μ kₙ v(τ) while closed.
+    pub constant_limit: Option<f64>,
+}
+
+impl LawParams {
+    /// Friction limit L = μN and its first two τ-derivatives (N, N/rad, N/rad²) while closed
+    /// (unclamped: the exit functions stay smooth through v = 0).
+    fn limit(&self, k: &Kinematics) -> [f64; 3] {
+        match self.constant_limit {
+            Some(l) => [l, 0.0, 0.0],
+            None => [
+                self.mu_kn * k.v[0],
+                self.mu_kn * k.v[1],
+                self.mu_kn * k.v[2],
+            ],
+        }
+    }
+
+    /// Whether the contact carries friction at this instant (L > 0).
+    pub fn closed(&self, k: &Kinematics) -> bool {
+        self.limit(k)[0] > 0.0
+    }
+
+    /// Slider position w (m) of a stick phase anchored at `anchor` (`at` gives the kinematics
+    /// at any τ): T = kₜ (u − w) during that phase.
+    pub fn slider(&self, anchor: Anchor, at: impl Fn(f64) -> Kinematics) -> f64 {
+        match anchor {
+            Anchor::Initial => {
+                let k = at(0.0);
+                k.u[0] - self.m * self.limit(&k)[0] / self.kt
+            }
+            Anchor::SlipEnd { tau, sign } => {
+                let k = at(tau);
+                k.u[0] - sign * self.limit(&k)[0] / self.kt
+            }
+            Anchor::Closing { tau } => at(tau).u[0],
+        }
+    }
+}
+
+/// What fixed the slider of a stick phase.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Anchor {
+    /// The initial condition T(0) = m μ N(0) (paper Eqs. 14-15).
+    Initial,
+    /// The end of a slip of sign `sign` at `tau`: w = u − sign μN / kₜ there.
+    SlipEnd {
+        /// τ of the event (rad, on the march's time line).
+        tau: f64,
+        /// Sign of the slip that ended.
+        sign: f64,
+    },
+    /// The closing of the contact at `tau`: w = u there (T = 0).
+    Closing {
+        /// τ of the event (rad).
+        tau: f64,
+    },
+}
+
+/// The state of the element over a stretch of time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Phase {
+    /// Stuck: T = kₜ (u − w) with the slider w (m) set by `anchor`.
+    Stick {
+        /// What set the slider.
+        anchor: Anchor,
+        /// Slider position (m).
+        w: f64,
+    },
+    /// Slipping: T = sign · μN.
+    Slip {
+        /// ±1.
+        sign: f64,
+    },
+    /// No friction force (separated, or a non-positive normal load).
+    Open,
+}
+
+/// One phase over [start, end] (rad).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Piece {
+    /// Start τ (rad).
+    pub start: f64,
+    /// End τ (rad).
+    pub end: f64,
+    /// The phase.
+    pub phase: Phase,
+}
+
+/// What ends a phase.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Event {
+    /// |kₜ(u − w)| reaches μN with T of this sign: stick → slip.
+    SlipOnset(f64),
+    /// The slip of this sign stops (kₜ s u′ falls below the rate of μN): slip → stick.
+    StickOnset(f64),
+    /// v falls through 0: → open.
+    Opening,
+    /// v rises through 0: open → stick (or straight into slip).
+    Closing,
+}
+
+/// Errors of the event march.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MarchFailure {
+    /// The state did not repeat within the allowed periods; the last slider change (m).
+    NotSettled {
+        /// Periods marched.
+        periods: usize,
+        /// Last change of the slider over one period (m).
+        drift: f64,
+    },
+    /// More events in one period than the grid can resolve (a chattering state).
+    TooManyEvents,
+}
+
+/// The periodic orbit of one contact.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Orbit {
+    /// Phases over one period, shifted to start at τ = 0 and end at 2π, in order.
+    pub pieces: Vec<Piece>,
+    /// Periods marched, the periodic one included.
+    pub periods: usize,
+}
+
+/// Marches the element from τ = 0 until one period's end state equals its start state, and
+/// returns the pieces of that period.
+///
+/// The element forgets its past at every slip or opening (the slider is then set by u and μN
+/// alone), so once one period's last reset repeats, every later period repeats it exactly:
+/// the one-period map of the slider is piecewise constant wherever it resets. The march thus
+/// stops after two or three periods with an exactly periodic event sequence, or after the
+/// first with a contact stuck all period from its initial state.
+pub fn periodic_orbit(
+    law: &LawParams,
+    signals: &Signals<'_>,
+    grid: &Grid<'_>,
+    max_periods: usize,
+    tolerance: f64,
+    pieces: &mut Vec<Piece>,
+) -> Result<usize, MarchFailure> {
+    let marcher = Marcher {
+        law,
+        signals,
+        grid,
+        cell: 2.0 * PI / grid.len() as f64,
+    };
+    let mut state = marcher.initial_phase();
+    let mut drift = f64::INFINITY;
+    let max_events = 4 * grid.len() + 16;
+    for period in 1..=max_periods.max(2) {
+        pieces.clear();
+        let start = state;
+        let (mut t, end) = (2.0 * PI * (period - 1) as f64, 2.0 * PI * period as f64);
+        loop {
+            match marcher.next_event(state, t, end) {
+                None => {
+                    pieces.push(Piece {
+                        start: t,
+                        end,
+                        phase: state,
+                    });
+                    break;
+                }
+                Some((tau, event)) => {
+                    pieces.push(Piece {
+                        start: t,
+                        end: tau,
+                        phase: state,
+                    });
+                    state = marcher.after(event, tau);
+                    t = tau;
+                }
+            }
+            if pieces.len() > max_events {
+                return Err(MarchFailure::TooManyEvents);
+            }
+        }
+        let repeats = match (start, state) {
+            (Phase::Slip { sign: a }, Phase::Slip { sign: b }) => a == b,
+            (Phase::Open, Phase::Open) => true,
+            (Phase::Stick { w: a, .. }, Phase::Stick { w: b, .. }) => {
+                drift = (a - b).abs();
+                drift <= tolerance
+            }
+            _ => false,
+        };
+        if repeats {
+            let shift = 2.0 * PI * (period - 1) as f64;
+            pieces.retain(|p| p.end > p.start);
+            for p in pieces.iter_mut() {
+                p.start -= shift;
+                p.end -= shift;
+                if let Phase::Stick { anchor, .. } = &mut p.phase {
+                    match anchor {
+                        Anchor::SlipEnd { tau, .. } | Anchor::Closing { tau } => *tau -= shift,
+                        Anchor::Initial => {}
+                    }
+                }
+            }
+            return Ok(period);
+        }
+    }
+    Err(MarchFailure::NotSettled {
+        periods: max_periods.max(2),
+        drift,
+    })
+}
+
+struct Marcher<'a> {
+    law: &'a LawParams,
+    signals: &'a Signals<'a>,
+    grid: &'a Grid<'a>,
+    /// Grid spacing (rad).
+    cell: f64,
+}
+
+impl Marcher<'_> {
+    /// The phase at τ = 0: open without a friction limit there, else stuck with the slider
+    /// at T(0) = m μN(0), or slipping at once when |m| = 1 and the trial force leaves the
+    /// friction cone immediately.
+    fn initial_phase(&self) -> Phase {
+        let k = self.signals.at(0.0);
+        if !self.law.closed(&k) {
+            return Phase::Open;
+        }
+        let w = self.law.slider(Anchor::Initial, |t| self.signals.at(t));
+        let sign = self.law.m.signum();
+        if self.law.m.abs() >= 1.0 - 1e-12 && self.exit(Event::SlipOnset(sign), w, &k).1 > 0.0 {
+            return Phase::Slip { sign };
+        }
+        Phase::Stick {
+            anchor: Anchor::Initial,
+            w,
+        }
+    }
+
+    /// The phase that starts at an event at τ.
+    fn after(&self, event: Event, tau: f64) -> Phase {
+        match event {
+            Event::SlipOnset(sign) => Phase::Slip { sign },
+            Event::Opening => Phase::Open,
+            Event::StickOnset(sign) => {
+                let anchor = Anchor::SlipEnd { tau, sign };
+                Phase::Stick {
+                    anchor,
+                    w: self.law.slider(anchor, |t| self.signals.at(t)),
+                }
+            }
+            Event::Closing => {
+                // T = 0 at closing; the contact slips at once where the trial force grows
+                // faster than μN (|kₜ u′| > μ kₙ v′).
+                let k = self.signals.at(tau);
+                let w = k.u[0];
+                let sign = k.u[1].signum();
+                if self.exit(Event::SlipOnset(sign), w, &k).1 > 0.0 {
+                    Phase::Slip { sign }
+                } else {
+                    Phase::Stick {
+                        anchor: Anchor::Closing { tau },
+                        w,
+                    }
+                }
+            }
+        }
+    }
+
+    /// The events that can end `phase`.
+    fn exits(&self, phase: Phase) -> ([Event; 2], usize) {
+        let variable = self.law.constant_limit.is_none();
+        match phase {
+            Phase::Stick { .. } => ([Event::SlipOnset(1.0), Event::SlipOnset(-1.0)], 2),
+            Phase::Slip { sign } if variable => ([Event::StickOnset(sign), Event::Opening], 2),
+            Phase::Slip { sign } => ([Event::StickOnset(sign), Event::Opening], 1),
+            Phase::Open if variable => ([Event::Closing, Event::Closing], 1),
+            Phase::Open => ([Event::Closing, Event::Closing], 0),
+        }
+    }
+
+    /// Exit function f and its rate f′ of `event` at kinematics k (slider w for a stick).
+    fn exit(&self, event: Event, w: f64, k: &Kinematics) -> (f64, f64) {
+        let kt = self.law.kt;
+        let l = self.law.limit(k);
+        match event {
+            Event::SlipOnset(s) => (s * kt * (k.u[0] - w) - l[0], s * kt * k.u[1] - l[1]),
+            Event::StickOnset(s) => (l[1] - s * kt * k.u[1], l[2] - s * kt * k.u[2]),
+            Event::Opening => (-k.v[0], -k.v[1]),
+            Event::Closing => (k.v[0], k.v[1]),
+        }
+    }
+
+    /// The size of f for `event` below which it counts as zero (round-off of its terms).
+    fn zero_level(&self, event: Event, w: f64, k: &Kinematics) -> f64 {
+        let kt = self.law.kt;
+        let l = self.law.limit(k);
+        let size = match event {
+            Event::SlipOnset(_) => kt * (k.u[0].abs() + w.abs()) + l[0].abs(),
+            Event::StickOnset(_) => l[1].abs() + kt * k.u[1].abs(),
+            Event::Opening | Event::Closing => k.v[0].abs(),
+        };
+        1e-12 * size
+    }
+
+    /// The first event of `phase` in (t0, t_end], with its time.
+    fn next_event(&self, phase: Phase, t0: f64, t_end: f64) -> Option<(f64, Event)> {
+        let (events, count) = self.exits(phase);
+        let events = &events[..count];
+        if events.is_empty() {
+            return None;
+        }
+        let w = match phase {
+            Phase::Stick { w, .. } => w,
+            _ => 0.0,
+        };
+        let mut a = t0;
+        let mut ka = self.signals.at(t0);
+        let mut first = true;
+        let mut k = (t0 / self.cell).floor() as usize + 1;
+        loop {
+            let grid_b = k as f64 * self.cell;
+            let (b, kb) = if grid_b < t_end {
+                (grid_b, self.grid.at(k))
+            } else {
+                (t_end, self.signals.at(t_end))
+            };
+            if b > a {
+                let mut best: Option<(f64, Event)> = None;
+                for &event in events {
+                    let root = self.crossing(event, w, (a, &ka), (b, &kb), first);
+                    if let Some(tau) = root {
+                        if best.is_none_or(|(t, _)| tau < t) {
+                            best = Some((tau, event));
+                        }
+                    }
+                }
+                if best.is_some() {
+                    return best;
+                }
+                first = false;
+            }
+            if b >= t_end {
+                return None;
+            }
+            a = b;
+            ka = kb;
+            k += 1;
+        }
+    }
+
+    /// The first root in (a, b] at which `event`'s exit function turns positive, if any: a
+    /// sign change across the cell, or a graze (f′ falls from positive to negative inside the
+    /// cell at a positive maximum of f). At a phase's first cell f(a) is zero by construction
+    /// (the event that started it), and f is known to fall first.
+    fn crossing(
+        &self,
+        event: Event,
+        w: f64,
+        (a, ka): (f64, &Kinematics),
+        (b, kb): (f64, &Kinematics),
+        first: bool,
+    ) -> Option<f64> {
+        let (fa, dfa) = self.exit(event, w, ka);
+        let (fb, dfb) = self.exit(event, w, kb);
+        let zero = self.zero_level(event, w, ka);
+        let f = |t: f64| self.exit(event, w, &self.signals.at(t)).0;
+        if fb > 0.0 {
+            if fa < -zero {
+                return Some(brent(f, a, b, fa, fb));
+            }
+            if first || fa <= 0.0 {
+                return Some(self.rising_root(&f, a, b, fb));
+            }
+            // Positive at a cell start past the first: a root missed before; stop here.
+            return Some(a);
+        }
+        if dfa > 0.0 && dfb < 0.0 {
+            let df = |t: f64| self.exit(event, w, &self.signals.at(t)).1;
+            let peak = brent(df, a, b, dfa, dfb);
+            let f_peak = f(peak);
+            if f_peak > zero && peak > a {
+                if fa < -zero {
+                    return Some(brent(f, a, peak, fa, f_peak));
+                }
+                return Some(self.rising_root(&f, a, peak, f_peak));
+            }
+        }
+        None
+    }
+
+    /// The first rise of f through zero in (a, b] where f(a) ≈ 0 and f(b) > 0: a point where
+    /// f is negative is sought on a fine subdivision, then the root is refined from it; with
+    /// none, f rises from a itself.
+    fn rising_root(&self, f: &impl Fn(f64) -> f64, a: f64, b: f64, fb: f64) -> f64 {
+        const SUBDIVISIONS: usize = 16;
+        let mut negative: Option<(f64, f64)> = None;
+        for i in 1..=SUBDIVISIONS {
+            let t = if i == SUBDIVISIONS {
+                b
+            } else {
+                a + (b - a) * i as f64 / SUBDIVISIONS as f64
+            };
+            let ft = if i == SUBDIVISIONS { fb } else { f(t) };
+            if ft > 0.0 {
+                return match negative {
+                    Some((tn, fneg)) => brent(f, tn, t, fneg, ft),
+                    None => a,
+                };
+            }
+            if ft < 0.0 {
+                negative = Some((t, ft));
+            }
+        }
+        b
+    }
+}
