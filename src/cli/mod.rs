@@ -996,17 +996,20 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
         problem.contacts.len(),
         problem.sides.len()
     );
+    let laws = contact_laws(&problem);
+    let _ = writeln!(s, "  laws       {laws}");
     for c in problem.contacts.iter().take(CHECK_LISTED) {
         let _ = writeln!(
             s,
-            "  {:<12} side {:<8} kt {:.3e} N/m  kn {:.3e} N/m  mu {}  gap {:.3e} m  m {}",
+            "  {:<12} side {:<8} kt {:.3e} N/m  kn {:.3e} N/m  mu {}  gap {:.3e} m  m {}  law {}",
             c.name,
             problem.sides[c.side].name,
             c.law.kt,
             c.law.kn,
             c.law.mu,
             c.gap,
-            c.law.initial_state
+            c.law.initial_state,
+            c.friction_law().name()
         );
     }
     more_line(&mut s, problem.contacts.len());
@@ -1122,6 +1125,36 @@ pub fn abbreviated_list<T: std::fmt::Display>(items: &[T]) -> String {
             join(&items[items.len() - LIST_ENDS..])
         )
     }
+}
+
+/// Which contact laws a problem uses and how each resolves time, e.g. `jenkins-1d × 2
+/// (transitions located in continuous time, the samples bracket them)`.
+fn contact_laws(problem: &Problem) -> String {
+    use crate::contact::FrictionLaw;
+    [
+        FrictionLaw::Jenkins1d,
+        FrictionLaw::Jenkins1dSampled,
+        FrictionLaw::Jenkins2d,
+    ]
+    .into_iter()
+    .filter_map(|law| {
+        let count = problem
+            .contacts
+            .iter()
+            .filter(|c| c.friction_law() == law)
+            .count();
+        (count > 0).then(|| {
+            let how = match law {
+                FrictionLaw::Jenkins1d => {
+                    "transitions located in continuous time, the samples bracket them"
+                }
+                _ => "marched on the samples",
+            };
+            format!("{} × {count} ({how})", law.name())
+        })
+    })
+    .collect::<Vec<_>>()
+    .join(", ")
 }
 
 /// The line after a list cut at [`CHECK_LISTED`] items.

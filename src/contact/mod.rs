@@ -23,5 +23,5 @@ pub mod point;
 pub use describing_function::jenkins_describing_function;
 pub use point::{
     ContactEffects, ContactPoint, ContactState, DamperSide, FrictionLaw, Jenkins2dLaw, JenkinsLaw,
-    NormalLoad, SecondTangent,
+    NormalLoad, SecondTangent, TimeResolution,
 };

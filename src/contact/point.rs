@@ -110,20 +110,63 @@ pub struct ContactPoint {
     /// The second tangent direction of a point with the 2D Jenkins law (`jenkins-2d`), None
     /// for the paper's 1D law (`jenkins-1d`, the default).
     pub second_tangent: Option<SecondTangent>,
+    /// How a 1D point's law is resolved in time (events for `jenkins-1d`, samples for
+    /// `jenkins-1d-sampled`); a 2D point is always marched on the samples.
+    pub resolution: TimeResolution,
 }
 
 /// Which tangential friction law a contact point follows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum FrictionLaw {
-    /// The paper's Jenkins element along one tangent direction (Eqs. 4-6).
+    /// The paper's Jenkins element along one tangent direction (Eqs. 4-6), its transitions
+    /// located in continuous time ([`crate::contact::events`]): a C¹ residual.
     #[default]
     #[serde(rename = "jenkins-1d")]
     Jenkins1d,
+    /// The same element sampled on `harmonics.samples` instants per period (the paper's AFT,
+    /// [`crate::contact::aft`]), for comparison with the paper and with codes that sample.
+    #[serde(rename = "jenkins-1d-sampled")]
+    Jenkins1dSampled,
     /// The isotropic Jenkins element in the tangent plane, radial return onto the friction
     /// circle ([`crate::contact::aft2d`]).
     #[serde(rename = "jenkins-2d")]
     Jenkins2d,
+}
+
+impl FrictionLaw {
+    /// Whether the law acts in the tangent plane (`jenkins-2d`, 3 DOFs per point).
+    pub fn is_2d(self) -> bool {
+        self == FrictionLaw::Jenkins2d
+    }
+
+    /// How a 1D point with this law resolves its transitions in time.
+    pub fn time_resolution(self) -> TimeResolution {
+        match self {
+            FrictionLaw::Jenkins1dSampled => TimeResolution::Samples,
+            _ => TimeResolution::Events,
+        }
+    }
+
+    /// The scene's name of the law.
+    pub fn name(self) -> &'static str {
+        match self {
+            FrictionLaw::Jenkins1d => "jenkins-1d",
+            FrictionLaw::Jenkins1dSampled => "jenkins-1d-sampled",
+            FrictionLaw::Jenkins2d => "jenkins-2d",
+        }
+    }
+}
+
+/// How the 1D Jenkins law of a point is resolved in time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TimeResolution {
+    /// Transitions located in continuous time, forces integrated exactly between them
+    /// (`jenkins-1d`).
+    #[default]
+    Events,
+    /// The law marched on the sample grid (`jenkins-1d-sampled`, the paper's AFT).
+    Samples,
 }
 
 /// The second tangential relative displacement of a 2D-friction point and its share of the
@@ -140,9 +183,10 @@ pub struct SecondTangent {
 impl ContactPoint {
     /// The point's tangential friction law.
     pub fn friction_law(&self) -> FrictionLaw {
-        match self.second_tangent {
-            None => FrictionLaw::Jenkins1d,
-            Some(_) => FrictionLaw::Jenkins2d,
+        match (&self.second_tangent, self.resolution) {
+            (Some(_), _) => FrictionLaw::Jenkins2d,
+            (None, TimeResolution::Events) => FrictionLaw::Jenkins1d,
+            (None, TimeResolution::Samples) => FrictionLaw::Jenkins1dSampled,
         }
     }
 

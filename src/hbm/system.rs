@@ -19,7 +19,7 @@
 use crate::contact::aft::AftWorkspace;
 use crate::contact::aft2d::Aft2dWorkspace;
 use crate::contact::harmonic::{Block, HarmonicSet};
-use crate::contact::{ContactState, Jenkins2dLaw, JenkinsLaw};
+use crate::contact::{ContactState, Jenkins2dLaw, JenkinsLaw, TimeResolution};
 use crate::hbm::error::HbmError;
 use crate::hbm::pattern::{ContactSlots, JacobianLayout};
 use crate::hbm::schur::RelativeCoordinates;
@@ -352,7 +352,8 @@ impl<'p> HbmSystem<'p> {
 
     /// Marches contact `c` from the coefficients û, û₂, v̂ in the system's buffers (filled by
     /// [`Self::contact_coefficients`], v̂ including the gap) with the march its law needs: the
-    /// 2D workspace for a `jenkins-2d` point, the 1D one otherwise. The forces (and, with
+    /// 2D workspace for a `jenkins-2d` point, the 1D one otherwise (event-resolved for
+    /// `jenkins-1d`, sampled for `jenkins-1d-sampled`). The forces (and, with
     /// `jacobian`, their derivatives) stay in that workspace. The one place that chooses
     /// between the two marches.
     fn march_contact(&mut self, c: usize, jacobian: bool) -> Result<ContactState, HbmError> {
@@ -367,9 +368,16 @@ impl<'p> HbmSystem<'p> {
                 &self.v_coef,
                 jacobian,
             ),
-            _ => self
-                .aft
-                .evaluate(&law, effects, &self.u_coef, &self.v_coef, jacobian),
+            _ => match contact.resolution {
+                TimeResolution::Events => {
+                    self.aft
+                        .evaluate_events(&law, effects, &self.u_coef, &self.v_coef, jacobian)
+                }
+                TimeResolution::Samples => {
+                    self.aft
+                        .evaluate(&law, effects, &self.u_coef, &self.v_coef, jacobian)
+                }
+            },
         }
         .map_err(|source| HbmError::Aft {
             contact: contact.name.clone(),

@@ -2,7 +2,7 @@
 //! every `[[contact_patches]]` entry of an FE mesh built into [`ContactPoint`]s, grouped into
 //! the [`DamperSide`]s they belong to.
 
-use crate::contact::{ContactPoint, DamperSide, FrictionLaw, JenkinsLaw, SecondTangent};
+use crate::contact::{ContactPoint, DamperSide, JenkinsLaw, SecondTangent};
 use crate::scene::checker::{Checker, DofNames};
 use crate::scene::error::SceneError;
 use crate::scene::fe_input::{self, FeStructure};
@@ -51,7 +51,7 @@ pub(super) fn contact_set(
         ck.positive(&f("tolerance"), p.tolerance)?;
         ck.initial_state(&f("initial_state"), p.initial_state)?;
         ck.finite(&f("initial_state2"), p.initial_state2)?;
-        if p.law == FrictionLaw::Jenkins1d && p.initial_state2 != 0.0 {
+        if !p.law.is_2d() && p.initial_state2 != 0.0 {
             return Err(ck.err(
                 f("initial_state2"),
                 "only a `law = \"jenkins-2d\"` patch has a second initial-state component",
@@ -190,6 +190,7 @@ fn contact_point(
             row: tangential2,
             initial_state: c.initial_state2,
         }),
+        resolution: c.law.time_resolution(),
     })
 }
 
@@ -205,7 +206,7 @@ fn second_tangent(
     nv: &[f64],
 ) -> Result<Option<Vec<f64>>, SceneError> {
     let f = |name: &str| format!("contacts[{ci}].{name}");
-    if c.law == FrictionLaw::Jenkins1d {
+    if !c.law.is_2d() {
         if c.tangent2.is_some() {
             return Err(ck.err(
                 f("tangent2"),

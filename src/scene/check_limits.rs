@@ -70,21 +70,20 @@ pub(super) fn limit_settings(
     if let Some(mode) = l.envelope {
         // A group with 2D-friction points searches its m = (m₁, m₂) in the unit disc: two
         // variables.
-        let two_d = crate::contact::FrictionLaw::Jenkins2d;
         let two_d_sides = side_names
             .iter()
             .filter(|side| {
                 scene
                     .contacts
                     .iter()
-                    .any(|c| c.law == two_d && &c.side_name() == *side)
+                    .any(|c| c.law.is_2d() && &c.side_name() == *side)
                     || scene
                         .contact_patches
                         .iter()
-                        .any(|p| p.law == two_d && &p.side == *side)
+                        .any(|p| p.law.is_2d() && &p.side == *side)
             })
             .count();
-        let two_d_points = scene.contacts.iter().filter(|c| c.law == two_d).count();
+        let two_d_points = scene.contacts.iter().filter(|c| c.law.is_2d()).count();
         let k = match mode {
             crate::analysis::limits::EnvelopeMode::Sides => sides + two_d_sides,
             crate::analysis::limits::EnvelopeMode::Points => scene.contacts.len() + two_d_points,
@@ -162,7 +161,6 @@ pub(super) fn limit_settings(
         }
         // m₂ of 2D points: per side (for its `jenkins-2d` points) and per `jenkins-2d` contact,
         // each (m₁, m₂) in the unit disc.
-        let two_d = crate::contact::FrictionLaw::Jenkins2d;
         let mut side_states2 = Vec::new();
         for (name, &m2) in &c.sides2 {
             let field = format!("{}.{name}", f("sides2"));
@@ -172,7 +170,7 @@ pub(super) fn limit_settings(
             let mut firsts: Vec<f64> = scene
                 .contacts
                 .iter()
-                .filter(|k| k.law == two_d && &k.side_name() == name)
+                .filter(|k| k.law.is_2d() && &k.side_name() == name)
                 .map(|k| {
                     c.contacts
                         .get(&k.name)
@@ -185,7 +183,7 @@ pub(super) fn limit_settings(
                 scene
                     .contact_patches
                     .iter()
-                    .filter(|p| p.law == two_d && &p.side == name)
+                    .filter(|p| p.law.is_2d() && &p.side == name)
                     .map(|p| c.sides.get(name).copied().unwrap_or(p.initial_state)),
             );
             if firsts.is_empty() {
@@ -209,7 +207,7 @@ pub(super) fn limit_settings(
                 return Err(ck.err(field, format!("unknown contact `{name}`")));
             };
             let k = &scene.contacts[contact];
-            if k.law != two_d {
+            if !k.law.is_2d() {
                 return Err(ck.err(
                     field,
                     format!("contact `{name}` is not `jenkins-2d`: m₂ needs 2D friction"),

@@ -380,7 +380,7 @@ pub fn patch_contacts(
             "the patch has no node pair",
         ));
     }
-    if spec.law == FrictionLaw::Jenkins2d {
+    if spec.law.is_2d() {
         if let Some(pair) = patch.pairs.iter().find(|p| p.damper_dofs.len() != 3) {
             return Err(SceneError::invalid(
                 file,
@@ -430,7 +430,7 @@ pub fn patch_contacts(
                     mu: spec.mu,
                     initial_state: spec.initial_state,
                 },
-                second_tangent: (spec.law == FrictionLaw::Jenkins2d).then(|| {
+                second_tangent: spec.law.is_2d().then(|| {
                     let (n, t) = (&pair.normal, &pair.tangent);
                     let t2 = [
                         n[1] * t[2] - n[2] * t[1],
@@ -442,6 +442,7 @@ pub fn patch_contacts(
                         initial_state: spec.initial_state2,
                     }
                 }),
+                resolution: spec.law.time_resolution(),
             }
         })
         .collect())
