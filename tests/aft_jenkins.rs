@@ -497,3 +497,87 @@ proptest! {
         }
     }
 }
+
+/// Largest second difference |F(s+h) − 2F(s) + F(s−h)| / h² of the force coefficients
+/// F = (T̂, N̂) along the line x(s) = x₀ + s·d, over s on [0, 0.2) in steps of 1e-3.
+fn largest_second_difference(
+    evaluate: &mut dyn FnMut(&[f64], &[f64]) -> Vec<f64>,
+    (u0, v0): (&[f64], &[f64]),
+    (du, dv): (&[f64], &[f64]),
+    h: f64,
+) -> f64 {
+    let mut at = |s: f64| {
+        let u: Vec<f64> = u0.iter().zip(du).map(|(a, b)| a + s * b).collect();
+        let v: Vec<f64> = v0.iter().zip(dv).map(|(a, b)| a + s * b).collect();
+        evaluate(&u, &v)
+    };
+    (0..200)
+        .map(|i| {
+            let s = 1e-3 * i as f64;
+            let (m, c, p) = (at(s - h), at(s), at(s + h));
+            (0..c.len())
+                .map(|j| ((p[j] - 2.0 * c[j] + m[j]) / (h * h)).abs())
+                .fold(0.0, f64::max)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Along a line in the unknowns that moves a stick-slip transition (the tangential amplitude
+/// grows) and one that moves the lift-off instants (the mean gap shrinks), the event law's
+/// second differences stay bounded as the step shrinks: the forces are C¹ with a bounded
+/// second derivative on each side of a transition. The sampled law's grow like 1/h: each time
+/// a transition crosses a sample the forces have a kink.
+#[test]
+fn event_law_forces_have_no_kinks_along_a_line() {
+    let set = HarmonicSet::up_to(2);
+    let l = law(1e5, 1e5, 0.5, 0.0);
+    let lines: [(&str, [f64; 5], [f64; 5], [f64; 5], [f64; 5]); 2] = [
+        (
+            "stick-slip",
+            [0.0, 2e-4, 0.0, 0.0, 3e-5],
+            [1e-4, 0.0, 2e-5, 0.0, 0.0],
+            [0.0, 2e-4, 0.0, 0.0, 0.0],
+            [0.0; 5],
+        ),
+        (
+            "lift-off",
+            [0.0, 3e-4, 0.0, 0.0, 3e-5],
+            [2e-5, 0.0, 3e-5, 0.0, 0.0],
+            [0.0; 5],
+            [-1e-5, 0.0, 0.0, 0.0, 0.0],
+        ),
+    ];
+    let mut events = AftWorkspace::new(&set, 64);
+    let mut sampled = AftWorkspace::new(&set, 256);
+    for (name, u0, v0, du, dv) in lines {
+        let mut by_event = |u: &[f64], v: &[f64]| {
+            events
+                .evaluate_events(&l, effects(false, true), u, v, false)
+                .unwrap();
+            [events.t_hat.clone(), events.n_hat.clone()].concat()
+        };
+        let event: Vec<f64> = [1e-3, 1e-4, 1e-5]
+            .iter()
+            .map(|&h| largest_second_difference(&mut by_event, (&u0, &v0), (&du, &dv), h))
+            .collect();
+        let mut by_sample = |u: &[f64], v: &[f64]| {
+            sampled
+                .evaluate(&l, effects(false, true), u, v, false)
+                .unwrap();
+            [sampled.t_hat.clone(), sampled.n_hat.clone()].concat()
+        };
+        let sample: Vec<f64> = [1e-3, 1e-4, 1e-5]
+            .iter()
+            .map(|&h| largest_second_difference(&mut by_sample, (&u0, &v0), (&du, &dv), h))
+            .collect();
+        eprintln!("{name}: event law {event:.3e?}, sampled law {sample:.3e?}");
+        assert!(
+            event[2] < 2.0 * event[0],
+            "{name}: the event law's second differences grow as the step shrinks: {event:?}"
+        );
+        assert!(
+            sample[2] > 20.0 * sample[0],
+            "{name}: the sampled law's kinks are not seen: {sample:?}"
+        );
+    }
+}

@@ -85,3 +85,114 @@ fn jacobian_strategies_give_the_same_curve() {
         );
     }
 }
+
+/// The single-DOF oscillator of `docs/scene.md` (m = 1 kg, k = 1e4 N/m, c = 2 N·s/m, a Jenkins
+/// contact to the ground with kₜ = 1e5 N/m, μN₀ = 3 N, F = 5 N) at H = 1 with a constant
+/// normal load.
+const JENKINS_OSCILLATOR: &str = r#"
+[model]
+dofs = ["x"]
+mass = [[1.0]]
+stiffness = [[1.0e4]]
+damping = [[2.0]]
+
+[[contacts]]
+name = "ground"
+damper = ["x"]
+tangent = [1.0]
+normal = [0.0]
+kt = 1.0e5
+kn = 1.0e5
+mu = 0.3
+gap = -1.0e-4
+
+[[harmonic_loads]]
+dof = "x"
+harmonic = 1
+cos = 5.0
+
+[harmonics]
+max = 1
+samples = 256
+
+[effects]
+normal_load = "constant"
+
+[analysis]
+freq_start_hz = 5.0
+freq_end_hz = 40.0
+
+[output]
+dofs = ["x"]
+"#;
+
+/// The resonance peak (frequency in Hz, amplitude in m) of that oscillator at H = 1 from the
+/// describing function (paper Appendix, Eqs. 17-18): the response is x = A cos(ωt − φ) with
+/// A² [(k + k_eq(A) − mω²)² + (cω + c_eq(A))²] = F², and the peak is the largest A for which
+/// some ω solves it: the minimum over ω of the bracket equals F²/A² there.
+fn describing_function_peak() -> (f64, f64) {
+    let (m, k, c, kt, mu, n0, force) = (1.0, 1.0e4, 2.0, 1.0e5, 0.3, 10.0, 5.0);
+    // min over ω of G(ω) = (K − mω²)² + (cω + D)²: G′ = −4mω(K − mω²) + 2c(cω + D) = 0.
+    let minimum = |a: f64| -> (f64, f64) {
+        let (k_eq, c_eq) = fricbound::contact::jenkins_describing_function(kt, mu, n0, a);
+        let (kk, d) = (k + k_eq, c_eq);
+        let mut w = (kk / m).sqrt();
+        for _ in 0..100 {
+            let g1 = -4.0 * m * w * (kk - m * w * w) + 2.0 * c * (c * w + d);
+            let g2 = -4.0 * m * kk + 12.0 * m * m * w * w + 2.0 * c * c;
+            let step = g1 / g2;
+            w -= step;
+            if step.abs() < 1e-15 * w {
+                break;
+            }
+        }
+        ((kk - m * w * w).powi(2) + (c * w + d).powi(2), w)
+    };
+    let h = |a: f64| a * a * minimum(a).0 - force * force;
+    // A bracket: small amplitudes lie below the curve's top, h < 0; large ones above.
+    let (mut lo, mut hi) = (1e-4, 1.0);
+    assert!(h(lo) < 0.0 && h(hi) > 0.0);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if h(mid) < 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let a = 0.5 * (lo + hi);
+    (minimum(a).1 / std::f64::consts::TAU, a)
+}
+
+/// A 1-DOF Jenkins oscillator at H = 1 with a constant normal load: the refined resonance
+/// peak of the event-resolved law equals the describing function's to 1e-9; the sampled law
+/// at 256 samples is off by its sampling error (about 1e-4).
+#[test]
+fn jenkins_oscillator_peak_equals_the_describing_function() {
+    let (f_ref, a_ref) = describing_function_peak();
+    let mut errors = Vec::new();
+    for law in ["jenkins-1d", "jenkins-1d-sampled"] {
+        let overrides = [format!("contacts.0.law=\"{law}\"")];
+        let overrides: Vec<&str> = overrides.iter().map(|s| s.as_str()).collect();
+        let problem = scenes::problem(JENKINS_OSCILLATOR, &overrides);
+        let run = frf::solve(&problem, &mut Silent).unwrap();
+        assert!(run.is_complete(), "{law}: {:?}", run.incomplete_reason());
+        let peaks = fricbound::analysis::peaks::path_peaks(&problem, &run.points).unwrap();
+        assert_eq!(peaks[0].len(), 1, "{law}: {:?}", peaks[0]);
+        let peak = &peaks[0][0];
+        assert!(peak.refined, "{law}");
+        let error = (peak.amplitude - a_ref).abs() / a_ref;
+        eprintln!(
+            "{law}: peak {:.12e} m at {:.9} Hz; describing function {a_ref:.12e} m at \
+             {f_ref:.9} Hz; relative error {error:.2e}",
+            peak.amplitude, peak.freq_hz
+        );
+        errors.push(error);
+    }
+    assert!(errors[0] < 1e-9, "event law: {:.2e}", errors[0]);
+    assert!(
+        errors[1] > 1e-6,
+        "the sampled law's error is its sampling error: {:.2e}",
+        errors[1]
+    );
+}
