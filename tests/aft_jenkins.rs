@@ -570,7 +570,7 @@ fn event_law_forces_have_no_kinks_along_a_line() {
             .iter()
             .map(|&h| largest_second_difference(&mut by_sample, (&u0, &v0), (&du, &dv), h))
             .collect();
-        eprintln!("{name}: event law {event:.3e?}, sampled law {sample:.3e?}");
+        eprintln!("{name}: event law {event:?}, sampled law {sample:?}");
         assert!(
             event[2] < 2.0 * event[0],
             "{name}: the event law's second differences grow as the step shrinks: {event:?}"
