@@ -499,7 +499,8 @@ proptest! {
 }
 
 /// Largest second difference |F(s+h) − 2F(s) + F(s−h)| / h² of the force coefficients
-/// F = (T̂, N̂) along the line x(s) = x₀ + s·d, over s on [0, 0.2) in steps of 1e-3.
+/// F = (T̂, N̂) along the line x(s) = x₀ + s·d, over every s = i·h on [0, 0.2]: with the step
+/// as the spacing, every kink on the stretch lies within ±h of some s.
 fn largest_second_difference(
     evaluate: &mut dyn FnMut(&[f64], &[f64]) -> Vec<f64>,
     (u0, v0): (&[f64], &[f64]),
@@ -511,12 +512,14 @@ fn largest_second_difference(
         let v: Vec<f64> = v0.iter().zip(dv).map(|(a, b)| a + s * b).collect();
         evaluate(&u, &v)
     };
-    (0..200)
-        .map(|i| {
-            let s = 1e-3 * i as f64;
-            let (m, c, p) = (at(s - h), at(s), at(s + h));
-            (0..c.len())
-                .map(|j| ((p[j] - 2.0 * c[j] + m[j]) / (h * h)).abs())
+    let values: Vec<Vec<f64>> = (0..=(0.2 / h).round() as usize)
+        .map(|i| at(i as f64 * h))
+        .collect();
+    values
+        .windows(3)
+        .map(|w| {
+            (0..w[1].len())
+                .map(|j| ((w[2][j] - 2.0 * w[1][j] + w[0][j]) / (h * h)).abs())
                 .fold(0.0, f64::max)
         })
         .fold(0.0, f64::max)
@@ -580,4 +583,85 @@ fn event_law_forces_have_no_kinks_along_a_line() {
             "{name}: the sampled law's kinks are not seen: {sample:?}"
         );
     }
+}
+
+/// The limit cases' stuck orbits touch ±μN where they start (paper Eqs. 14-15): with u and N
+/// moving in phase the touch is a double root of |T| − μN at τ = 0 and 2π, which the event
+/// law must not take for a slip (the sampled law's "slip by rounding"). Without friction
+/// (μ = 0, a retaining spring) the normal force still follows the compression.
+#[test]
+fn event_law_limit_cases_touch_the_cone_and_stay_stuck() {
+    let set = HarmonicSet::up_to(1);
+    let mut aft = AftWorkspace::new(&set, 64);
+    let (kt, kn, mu) = (3.3e6, 3.3e6, 0.3);
+    let v = [2.5e-6, 4.7e-7, 0.0];
+    // m = +1 touches +μN where T is largest; m = −1 touches −μN where T is smallest, so its
+    // tangential motion is in antiphase.
+    for m in [-1.0, 1.0] {
+        let u = [-1.0e-5, m * 1.8e-7, 0.0];
+        let r = aft
+            .evaluate_events(&law(kt, kn, mu, m), ContactEffects::default(), &u, &v, true)
+            .unwrap();
+        assert_eq!(r.state, ContactState::Stuck, "m = {m}");
+        // T = kₜ(u − u(0)) + m μ kₙ v(0): its cosine part is kₜ û_c1, its mean kₜ(û₀ − u(0))
+        // + m μN(0).
+        let t0 = kt * (u[0] - (u[0] + u[1])) + m * mu * kn * (v[0] + v[1]);
+        assert!((aft.t_hat[0] - t0).abs() < 1e-9 * t0.abs(), "m = {m}");
+        assert!(
+            (aft.t_hat[1] - kt * u[1]).abs() < 1e-9 * kt * u[1].abs(),
+            "m = {m}"
+        );
+    }
+    let u = [-1.0e-5, 1.8e-7, 0.0];
+    let r = aft
+        .evaluate_events(
+            &law(kt, kn, 0.0, 1.0),
+            ContactEffects::default(),
+            &u,
+            &v,
+            true,
+        )
+        .unwrap();
+    assert!(aft.t_hat.iter().all(|t| *t == 0.0));
+    assert!(
+        (aft.n_hat[0] - kn * v[0]).abs() < 1e-12 * kn * v[0],
+        "{:?}",
+        aft.n_hat
+    );
+    assert!(
+        (aft.n_hat[1] - kn * v[1]).abs() < 1e-12 * kn * v[0],
+        "{:?}",
+        aft.n_hat
+    );
+    assert!((aft.dn_dv[0] - kn).abs() < 1e-12 * kn, "{:?}", r);
+}
+
+/// A frictionless contact (μ = 0) that opens and closes: the normal force follows the
+/// compression where v > 0 only, and the contact is reported as lifting off (the stick phase
+/// with T = 0 ends at the opening, which no slip onset precedes).
+#[test]
+fn event_law_frictionless_contact_opens_and_closes() {
+    let set = HarmonicSet::up_to(1);
+    let mut aft = AftWorkspace::new(&set, 64);
+    let v = [1e-5, 2e-5, 0.0];
+    let r = aft
+        .evaluate_events(
+            &law(1e5, 1e5, 0.0, 0.0),
+            ContactEffects::default(),
+            &[0.0; 3],
+            &v,
+            true,
+        )
+        .unwrap();
+    assert_eq!(r.state, ContactState::StickSlipLiftoff);
+    // N = kₙ max(v, 0) with v = v₀ + v₁ cos τ: closed for |τ| < θ, cos θ = −v₀/v₁.
+    let theta = (-v[0] / v[1]).acos();
+    let pi = std::f64::consts::PI;
+    let n0 = 1e5 * (v[0] * theta + v[1] * theta.sin()) / pi;
+    assert!(
+        (aft.n_hat[0] - n0).abs() < 1e-12 * n0,
+        "{} vs {n0}",
+        aft.n_hat[0]
+    );
+    assert!(aft.t_hat.iter().all(|t| *t == 0.0));
 }

@@ -20,7 +20,7 @@ use fricbound::scene;
 mod common;
 use common::blade_pair::coarse_blade_pair;
 use common::envelope::{as_seeds, limit_states, LimitState};
-use common::{problem, PLANAR, SPATIAL};
+use common::{planar, problem, PLANAR, SPATIAL};
 
 #[test]
 fn the_disc_map_is_one_to_one_and_its_jacobian_matches_central_differences() {
@@ -166,7 +166,7 @@ fn the_sensitivity_to_both_components_of_a_stuck_2d_point_matches_central_differ
 
 #[test]
 fn the_disc_envelope_of_the_constrained_3d_system_equals_the_planar_one() {
-    let planar = problem(PLANAR, &[]);
+    let planar = planar(&[]);
     let spatial = problem(SPATIAL, &[]);
     let freqs = [205.0, 215.0, 219.0];
     let planar_seeds = limit_states(&planar, &freqs);

@@ -12,6 +12,11 @@
 //!   judged on the other side of the fold it turns back at; at F0 = 10 N and H = 3 with a
 //!   coarse smallest step, a leap onto another branch whose branch before goes on on the run.
 
+//!
+//! Dead ends, leaps and jumps arise where the path meets the corners of the sampled contact
+//! law; the event-resolved law (`jenkins-1d`) has none on these cases (its paths through them
+//! are complete without a jump), so every case here runs `jenkins-1d-sampled`.
+
 mod common;
 mod support;
 
@@ -30,8 +35,27 @@ fn liftoff_fold() -> String {
         .to_string()
 }
 
+/// The paper scene's two contacts on the sampled law.
+const SAMPLED: [&str; 2] = [
+    "contacts.0.law=\"jenkins-1d-sampled\"",
+    "contacts.1.law=\"jenkins-1d-sampled\"",
+];
+
+/// The FE scenes' two contact patches on the sampled law.
+const SAMPLED_PATCHES: [&str; 2] = [
+    "contact_patches.0.law=\"jenkins-1d-sampled\"",
+    "contact_patches.1.law=\"jenkins-1d-sampled\"",
+];
+
+/// The lift-off oscillator's contact on the sampled law.
+const SAMPLED_STOP: &str = "contacts.0.law=\"jenkins-1d-sampled\"";
+
 fn paper(overrides: &[&str]) -> Problem {
-    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let overrides: Vec<String> = SAMPLED
+        .iter()
+        .chain(overrides)
+        .map(|s| s.to_string())
+        .collect();
     scene::parse(paper_wedge_scene(), "paper", &overrides)
         .and_then(|s| s.validate("paper"))
         .unwrap_or_else(|e| panic!("{overrides:?}: {e}"))
@@ -91,7 +115,10 @@ fn newton_past(p: &Problem, run: &FrfRun, g: &GivenUp, index: usize) -> Option<(
 fn a_dead_end_on_a_stretch_already_followed_abandons_nothing() {
     let (_, p) = scene::load_problem(
         Path::new(&liftoff_fold()),
-        &["analysis.stability=false".to_string()],
+        &[
+            "analysis.stability=false".to_string(),
+            SAMPLED_STOP.to_string(),
+        ],
     )
     .unwrap();
     let run = frf::solve(&p, &mut Silent).unwrap();
@@ -103,7 +130,11 @@ fn a_dead_end_on_a_stretch_already_followed_abandons_nothing() {
     assert!((g.freq_hz - 32.52).abs() < 0.01, "{g:?}");
 
     let dir = tempfile::tempdir().unwrap();
-    let out = run_scene(&liftoff_fold(), dir.path(), &["analysis.stability=false"]);
+    let out = run_scene(
+        &liftoff_fold(),
+        dir.path(),
+        &["analysis.stability=false", SAMPLED_STOP],
+    );
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     let sol = json(&dir.path().join("solution.json"));
     assert_eq!(sol["status"], "complete");
@@ -156,7 +187,7 @@ fn branches_given_up_at_a_low_preload_are_classified_as_newton_finds_them() {
     let out = run_scene(
         scene_file.to_str().unwrap(),
         &out_dir,
-        &["static_loads.0.value=-1"],
+        &["static_loads.0.value=-1", SAMPLED[0], SAMPLED[1]],
     );
     let sol = json(&out_dir.join("solution.json"));
     let status = sol["status"].as_str().unwrap().to_string();
@@ -207,6 +238,8 @@ fn the_cli_says_which_branch_a_run_abandoned() {
         "contact_patches.0.initial_state=1",
         "contact_patches.1.initial_state=1",
         "accuracy.estimate=false",
+        SAMPLED_PATCHES[0],
+        SAMPLED_PATCHES[1],
     ];
     let owned: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let (_, p) = scene::load_problem(Path::new(&scene_file), &owned).unwrap();

@@ -17,14 +17,14 @@ use fricbound::scene;
 mod common;
 use common::blade_pair::coarse_blade_pair;
 use common::{
-    assert_formulations_agree, compare_on_planar_path, excited_out_of_plane, problem,
+    assert_formulations_agree, compare_on_planar_path, excited_out_of_plane, planar, problem,
     OUT_OF_PLANE_RUN, PLANAR, SPATIAL,
 };
 
 #[test]
 fn the_3d_paper_system_with_2d_friction_equals_the_planar_one() {
     let range = ["analysis.freq_start_hz=200", "analysis.freq_end_hz=235"];
-    let planar = problem(PLANAR, &range);
+    let planar = planar(&range);
     let spatial = problem(SPATIAL, &range);
     assert!(spatial
         .contacts

@@ -419,21 +419,15 @@ fn limit_scene_at_a_low_preload_covers_the_range() {
 
 /// The 2D FE blade pair (Craig-Bampton, a patch of contact pairs per damper side) with a
 /// tenth of its pre-load (5 N instead of 50 N): pairs open and close along the patches, and a
-/// user sees both limit curves and the intermediate one reach 1100 Hz from 700 Hz. The m = +1
-/// curve abandons a branch on the way: running down from a fold at 875.87 Hz with the
-/// amplitude rising, it meets a dead end at 875.50 Hz (the corrector fails at every step, its
-/// residual stalling near 10⁻⁸ of the loads) and the run jumps past 876.18 Hz. Newton past the
-/// point given up converges at none of the frequencies tried (3·10⁻⁵ to 10⁻³ of the frequency
-/// below it), nor with the frequency free round a fold there: whether the branch goes on
-/// there is not known (`unjudged`), so the curve ends
-/// `incomplete` and says so.
+/// user sees both limit curves and the intermediate one reach 1100 Hz from 700 Hz, complete.
+/// (With the sampled law the m = +1 curve meets a dead end at 875.50 Hz, running down from a
+/// fold, past which Newton converges nowhere: `tests/frf_abandoned.rs`.)
 #[test]
-fn fe_blade_pair_limits_at_a_low_preload_reach_the_end_and_say_what_they_abandon() {
-    limits_cover(
+fn fe_blade_pair_limits_at_a_low_preload_reach_the_end() {
+    limits_complete(
         "meshes/blade-pair/blade-pair-2d-limits.toml",
         &["static_loads.0.value=5"],
         "FE blade pair, 5 N",
-        &["m+1"],
     );
 }
 

@@ -202,7 +202,7 @@ fn a_failed_run_leaves_no_results_of_an_earlier_run() {
         &scene("zoom-2nd.toml"),
         &out,
         &[
-            "analysis.max_iterations=2",
+            "analysis.max_iterations=1",
             "analysis.min_step=0.05",
             "analysis.initial_step=0.1",
         ],

@@ -14,8 +14,8 @@ use fricbound::model::{Formulation, Problem};
 
 mod common;
 use common::{
-    assert_formulations_agree, compare_on_planar_path, excited_out_of_plane, problem, IN_PLANE,
-    OUT_OF_PLANE, OUT_OF_PLANE_RUN, PLANAR, SPATIAL,
+    assert_formulations_agree, compare_on_planar_path, excited_out_of_plane, planar, problem,
+    IN_PLANE, OUT_OF_PLANE, OUT_OF_PLANE_RUN, PLANAR, SPATIAL,
 };
 
 /// The damper's out-of-plane DOF (zD) in the 3D scene.
@@ -190,7 +190,7 @@ fn uncoupled_3d_paper_system_equals_the_planar_one() {
         "analysis.freq_start_hz=200",
         "analysis.freq_end_hz=235",
     ];
-    let planar = problem(PLANAR, &overrides);
+    let planar = planar(&overrides);
     let spatial = problem(SPATIAL, &overrides);
     // Static solutions.
     let a = static_solve(&planar).unwrap();

@@ -17,7 +17,7 @@ use fricbound::contact::ContactState;
 use fricbound::model::{HarmonicLoad, Problem};
 
 mod common;
-use common::{problem, IN_PLANE, PLANAR, SPATIAL};
+use common::{planar, problem, IN_PLANE, PLANAR, SPATIAL};
 
 /// The HBM point at `freq_hz` from the stuck linear guess: (harmonic set, coefficients,
 /// output amplitudes).
@@ -31,7 +31,7 @@ fn hbm_point(problem: &Problem, freq_hz: f64) -> (HarmonicSet, Vec<f64>, Vec<f64
 
 #[test]
 fn the_constrained_3d_system_integrates_to_the_planar_steady_state() {
-    let planar = problem(PLANAR, &[]);
+    let planar = planar(&[]);
     let spatial = problem(SPATIAL, &[]);
     let settings = VerifySettings {
         steps_per_period: 256,

@@ -10,6 +10,18 @@ pub const PLANAR: &str = include_str!("../../meshes/paper-wedge/fig13-3rd.toml")
 /// Its 3D version with 2D friction and the out-of-plane motion constrained.
 pub const SPATIAL: &str = include_str!("../../meshes/paper-wedge-3d/fig13-3rd-3d.toml");
 
+/// The planar scene with overrides, its 1D contacts on the sampled law: `jenkins-2d` is
+/// marched on the samples, so the two scenes agree to round-off only on the same time
+/// resolution (the event-resolved `jenkins-1d` differs from both by the sampling error).
+pub fn planar(overrides: &[&str]) -> Problem {
+    let mut all = vec![
+        "contacts.0.law=\"jenkins-1d-sampled\"",
+        "contacts.1.law=\"jenkins-1d-sampled\"",
+    ];
+    all.extend_from_slice(overrides);
+    super::scenes::problem(PLANAR, &all)
+}
+
 /// In-plane DOFs of the 3D scene, in the order of the planar scene's DOFs.
 pub const IN_PLANE: [usize; 6] = [0, 1, 3, 4, 6, 7];
 /// Out-of-plane DOFs of the 3D scene.

@@ -3,7 +3,9 @@
 //! samples and contact state as the sampled march, so every caller reads either alike.
 
 use super::{AftError, AftWorkspace, MarchReport, SampleKind, Signal};
-use crate::contact::events::march::{periodic_orbit, Anchor, Grid, LawParams, Phase, Signals};
+use crate::contact::events::march::{
+    closed_intervals, periodic_orbit, Anchor, Grid, LawParams, Phase, Signals,
+};
 use crate::contact::events::{ForceOutputs, MarchFailure};
 use crate::contact::{ContactEffects, ContactState, JenkinsLaw};
 use std::f64::consts::PI;
@@ -66,12 +68,16 @@ impl AftWorkspace {
         let tolerance =
             self.settings.periodicity_tolerance * self.settings.length_scale(scale, law.kt);
         let mut pieces = std::mem::take(&mut self.events.pieces);
+        let mut intervals = std::mem::take(&mut self.events.closed_intervals);
         let orbit = {
             let [du, ddu, dv, ddv] = &self.events.derivative_samples;
             let grid = Grid {
                 u: [&self.u, du, ddu],
                 v: [&self.v, dv, ddv],
             };
+            if params.constant_limit.is_none() && effects.liftoff {
+                closed_intervals(&signals, &grid, &mut intervals);
+            }
             periodic_orbit(
                 &params,
                 &signals,
@@ -82,6 +88,7 @@ impl AftWorkspace {
             )
         };
         self.events.pieces = pieces;
+        self.events.closed_intervals = intervals;
         let periods = orbit.map_err(|failure| match failure {
             MarchFailure::NotSettled { periods, drift } => AftError::NotSettled { periods, drift },
             MarchFailure::TooManyEvents => AftError::TooManyEvents,

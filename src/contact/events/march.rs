@@ -323,7 +323,7 @@ impl Marcher<'_> {
         }
         let w = self.law.slider(Anchor::Initial, |t| self.signals.at(t));
         let sign = self.law.m.signum();
-        if self.law.m.abs() >= 1.0 - 1e-12 && self.exit(Event::SlipOnset(sign), w, &k).1 > 0.0 {
+        if self.law.m.abs() >= 1.0 - 1e-12 && self.leaves_at_once(Event::SlipOnset(sign), w, &k) {
             return Phase::Slip { sign };
         }
         Phase::Stick {
@@ -350,7 +350,7 @@ impl Marcher<'_> {
                 let k = self.signals.at(tau);
                 let w = k.u[0];
                 let sign = k.u[1].signum();
-                if self.exit(Event::SlipOnset(sign), w, &k).1 > 0.0 {
+                if self.leaves_at_once(Event::SlipOnset(sign), w, &k) {
                     Phase::Slip { sign }
                 } else {
                     Phase::Stick {
@@ -362,15 +362,23 @@ impl Marcher<'_> {
         }
     }
 
-    /// The events that can end `phase`.
-    fn exits(&self, phase: Phase) -> ([Event; 2], usize) {
+    /// The events that can end `phase`, and how many of the three slots are used. A stick
+    /// ends at a slip onset, and (with a variable load) at an opening: where T is zero as N
+    /// falls to 0 (no friction, μ = 0, or no tangential motion) no slip onset precedes it.
+    fn exits(&self, phase: Phase) -> ([Event; 3], usize) {
         let variable = self.law.constant_limit.is_none();
+        let stick = [
+            Event::SlipOnset(1.0),
+            Event::SlipOnset(-1.0),
+            Event::Opening,
+        ];
         match phase {
-            Phase::Stick { .. } => ([Event::SlipOnset(1.0), Event::SlipOnset(-1.0)], 2),
-            Phase::Slip { sign } if variable => ([Event::StickOnset(sign), Event::Opening], 2),
-            Phase::Slip { sign } => ([Event::StickOnset(sign), Event::Opening], 1),
-            Phase::Open if variable => ([Event::Closing, Event::Closing], 1),
-            Phase::Open => ([Event::Closing, Event::Closing], 0),
+            Phase::Stick { .. } => (stick, if variable { 3 } else { 2 }),
+            Phase::Slip { sign } => (
+                [Event::StickOnset(sign), Event::Opening, Event::Opening],
+                if variable { 2 } else { 1 },
+            ),
+            Phase::Open => ([Event::Closing; 3], usize::from(variable)),
         }
     }
 
@@ -386,7 +394,20 @@ impl Marcher<'_> {
         }
     }
 
-    /// The size of f for `event` below which it counts as zero (round-off of its terms).
+    /// Whether a phase that starts with `event`'s exit function at zero leaves at once: f′ is
+    /// positive beyond round-off of its terms (a rate of zero to round-off, as where u and N
+    /// move in phase and T touches ±μN at a maximum, keeps the phase).
+    fn leaves_at_once(&self, event: Event, w: f64, k: &Kinematics) -> bool {
+        let rate = self.exit(event, w, k).1;
+        let l = self.law.limit(k);
+        let size = self.law.kt * (k.u[1].abs() + k.u[2].abs()) + l[1].abs() + l[2].abs();
+        rate > 1e-12 * size
+    }
+
+    /// The size of f for `event` below which it counts as zero (round-off of its terms): a
+    /// crossing is an event only where f rises above it, so that a phase touching its limit
+    /// (the limit cases' stuck orbits touch ±μN where they start and end) does not leave it
+    /// by rounding.
     fn zero_level(&self, event: Event, w: f64, k: &Kinematics) -> f64 {
         let kt = self.law.kt;
         let l = self.law.limit(k);
@@ -460,14 +481,14 @@ impl Marcher<'_> {
         let (fb, dfb) = self.exit(event, w, kb);
         let zero = self.zero_level(event, w, ka);
         let f = |t: f64| self.exit(event, w, &self.signals.at(t)).0;
-        if fb > 0.0 {
+        if fb > zero {
             if fa < -zero {
                 return Some(brent(f, a, b, fa, fb));
             }
-            if first || fa <= 0.0 {
+            if first || fa <= zero {
                 return Some(self.rising_root(&f, a, b, fb));
             }
-            // Positive at a cell start past the first: a root missed before; stop here.
+            // Above zero at a cell start past the first: a root missed before; stop here.
             return Some(a);
         }
         if dfa > 0.0 && dfb < 0.0 {
@@ -508,5 +529,55 @@ impl Marcher<'_> {
             }
         }
         b
+    }
+}
+
+/// The stretches of one period [0, 2π] where v > 0 (the normal spring is compressed), in order:
+/// the roots of v bracketed on the grid (a double crossing inside a cell is caught by the sign
+/// change of v′ across it) and refined by Brent's method. The normal force's own phases, apart
+/// from the tangential ones (which coincide with them only where μ > 0).
+pub fn closed_intervals(signals: &Signals<'_>, grid: &Grid<'_>, out: &mut Vec<(f64, f64)>) {
+    out.clear();
+    let n = grid.len();
+    let cell = 2.0 * PI / n as f64;
+    let v = |t: f64| signals.at(t).v[0];
+    let dv = |t: f64| signals.at(t).v[1];
+    let at = |k: usize| {
+        if k == n {
+            (2.0 * PI, grid.v[0][0], grid.v[1][0])
+        } else {
+            (k as f64 * cell, grid.v[0][k], grid.v[1][k])
+        }
+    };
+    let mut closed = grid.v[0][0] > 0.0;
+    let mut start = 0.0;
+    let switch = |tau: f64, now_closed: bool, start: &mut f64, out: &mut Vec<(f64, f64)>| {
+        if now_closed {
+            *start = tau;
+        } else {
+            out.push((*start, tau));
+        }
+    };
+    for k in 0..n {
+        let ((a, va, da), (b, vb, db)) = (at(k), at(k + 1));
+        if (va > 0.0) != (vb > 0.0) {
+            let tau = brent(v, a, b, va, vb);
+            closed = vb > 0.0;
+            switch(tau, closed, &mut start, out);
+        } else if da.signum() != db.signum() && da != 0.0 && db != 0.0 {
+            // An extremum inside the cell: a short closing (peak above 0 between two points
+            // at or below it) or a short opening (trough at or below 0 between two above it).
+            let extremum = brent(dv, a, b, da, db);
+            let ve = v(extremum);
+            if (va > 0.0) != (ve > 0.0) {
+                let first = brent(v, a, extremum, va, ve);
+                let second = brent(v, extremum, b, ve, vb);
+                switch(first, !closed, &mut start, out);
+                switch(second, closed, &mut start, out);
+            }
+        }
+    }
+    if closed {
+        out.push((start, 2.0 * PI));
     }
 }

@@ -126,6 +126,8 @@ pub struct EventSolver {
     pub derivative_samples: [Vec<f64>; 4],
     /// Phases of the last periodic orbit over [0, 2π].
     pub pieces: Vec<Piece>,
+    /// Stretches of [0, 2π] where v > 0 (variable normal load with lift-off).
+    pub closed_intervals: Vec<(f64, f64)>,
     stick: Moments,
     slip: Moments,
     closed: Moments,
@@ -162,8 +164,9 @@ impl EventSolver {
         }
     }
 
-    /// Integrates the forces of the orbit in [`Self::pieces`] into `out` (see the module
-    /// doc): T̂, N̂ and, when asked, their Jacobian.
+    /// Integrates the forces of the orbit in [`Self::pieces`] and of the normal spring over
+    /// [`Self::closed_intervals`] into `out` (see the module doc): T̂, N̂ and, when asked,
+    /// their Jacobian.
     pub fn integrate(
         &mut self,
         set: &HarmonicSet,
@@ -195,6 +198,7 @@ impl EventSolver {
                 .for_each(|m| m.iter_mut().for_each(|x| *x = 0.0));
         }
         let variable = law.constant_limit.is_none();
+        let normal_gram = variable && effects.liftoff;
         let constant_block = set.constant_block();
         for p in &self.pieces {
             self.piece.interval(p.start, p.end);
@@ -234,11 +238,15 @@ impl EventSolver {
                     }
                 }
             }
-            self.closed.add(1.0, &self.piece);
+        }
+        if normal_gram {
+            for &(t0, t1) in &self.closed_intervals {
+                self.piece.interval(t0, t1);
+                self.closed.add(1.0, &self.piece);
+            }
         }
 
         // Phase integrals of kₜ u (stick), s μkₙ v (slip) and kₙ v (closed).
-        let normal_gram = variable && effects.liftoff;
         let constant_v = constant_block.map_or(0.0, |c| signals.v[c]);
         for j in 0..nb {
             for i in 0..nb {
