@@ -339,12 +339,16 @@ fn figure_titles_name_the_overrides() {
         svg.contains("[static_loads.0.value=-100, analysis.freq_end_hz=152]"),
         "the title names the overrides"
     );
+    // The title states the pre-load solved with, never the scene file's.
+    assert!(svg.contains("F0 = 100 N"), "the title shows the actual F0");
+    assert!(!svg.contains("F0 = 120 N"), "no stale F0 in the title");
     // Without overrides, the scene's title alone.
     let plain = dir.path().join("plain");
     let o = run_scene(&scene("zoom-2nd.toml"), &plain, &[]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let svg = std::fs::read_to_string(plain.join("frf_y2.svg")).unwrap();
     assert!(!svg.contains("static_loads.0.value"));
+    assert!(svg.contains("F0 = 120 N"), "the scene's own F0");
 }
 
 /// The case: H = 10 000 with 32 768 samples aborted on a 5 GB allocation. It is now

@@ -460,4 +460,38 @@ mod tests {
     fn points_of(lines: &[Line]) -> impl Iterator<Item = f64> + '_ {
         points(lines).map(|p| p.1)
     }
+
+    /// The font size of the SVG `<text>` element whose text starts with `start`.
+    fn font_size(svg: &str, start: &str) -> f64 {
+        let at = svg
+            .find(&format!(">\n{start}"))
+            .or_else(|| svg.find(&format!(">{start}")));
+        let element = &svg[..at.unwrap_or_else(|| panic!("no text {start:?}"))];
+        let tag = &element[element.rfind("<text").unwrap()..];
+        let size = tag.split("font-size=\"").nth(1).unwrap();
+        size[..size.find('"').unwrap()].parse().unwrap()
+    }
+
+    /// A sweep's title with many overrides wraps, the overrides on lines of their own, at no
+    /// less than the axis descriptions' size instead of shrinking to an unreadable font.
+    #[test]
+    fn long_titles_wrap_at_a_readable_size() {
+        let dir = tempfile::tempdir().unwrap();
+        let names = vec!["c1".to_string()];
+        let points = synthetic_points();
+        let (open, stuck) = (curve(120.0, 0.01), curve(190.0, 0.01));
+        let title = "Fig. 16b: optimal curves near the optimum with intermediate states, beta = \
+                     120 deg [analysis.max_step=0.25, sweep.values=[36.0, 44.0, 52.0, 60.0, \
+                     68.0], limits.grid_points=41, limits.bound_scan=[-0.5, 0.5]]: F0 = 60 N";
+        let fig = figure(title, (0, "y2"), &names, &points, (&open, &stuck));
+        let svg = drawn(dir.path(), "long", |png, svg| plot_frf(&fig, png, svg));
+        let head = "Fig. 16b: optimal curves near the optimum with intermediate states, beta = \
+                    120 deg";
+        assert!(svg.contains(&format!("{head}\n")), "the title's first line");
+        let desc = font_size(&svg, "y2 first-harmonic amplitude (m)");
+        let first = font_size(&svg, head);
+        assert!(first >= desc, "title {first} < axis description {desc}");
+        assert_eq!(font_size(&svg, "[analysis.max_step=0.25,"), first);
+        assert!(svg.contains("F0 = 60 N"), "nothing cut");
+    }
 }
