@@ -302,6 +302,17 @@ fn overrides_get_their_own_default_folder() {
     assert!(dir.path().join(&expected).join("frf.csv").is_file());
     assert!(!dir.path().join("out/zoom-2nd").exists());
 
+    // With --quiet, stdout is the output folder alone, one line, for scripts to find it.
+    let mut quiet = vec!["run", "--quiet"];
+    let scene_arg = scene("zoom-2nd.toml");
+    quiet.push(&scene_arg);
+    for o in &overrides {
+        quiet.extend(["--set", o]);
+    }
+    let o = fricbound_in(dir.path(), &quiet);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(text(&o.stdout), format!("{}\n", expected.display()));
+
     // The library function agrees, and tells other override sets and no overrides apart.
     let scene_path = PathBuf::from("meshes/zoom-2nd.toml");
     let owned: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
