@@ -25,7 +25,7 @@ enum Command {
         /// Override a scene field by its dotted path, e.g. --set harmonics.max=5
         #[arg(long = "set", value_name = "FIELD=VALUE")]
         overrides: Vec<String>,
-        /// No progress bar or step messages.
+        /// No progress bar or step messages; stdout is then the output folder alone, one line.
         #[arg(long)]
         quiet: bool,
     },
@@ -37,7 +37,7 @@ enum Command {
         /// Coarser sweeps and grids: seconds instead of minutes.
         #[arg(long)]
         quick: bool,
-        /// No progress bars or messages.
+        /// No progress bars or messages; stdout is then the output folder alone, one line.
         #[arg(long)]
         quiet: bool,
     },
@@ -164,7 +164,10 @@ fn main() -> ExitCode {
             };
             fricbound::cli::run(&options)
                 .map(|r| {
-                    if !quiet {
+                    // Quiet or not, stdout names the output folder, for scripts to find it.
+                    if quiet {
+                        println!("{}", r.dir.display());
+                    } else {
                         println!("{}", fricbound::cli::run_summary(&r));
                     }
                     incomplete = r.incomplete;
@@ -175,7 +178,9 @@ fn main() -> ExitCode {
             let options = fricbound::cli::paper::PaperOptions { out, quick, quiet };
             fricbound::cli::paper::paper(&options)
                 .map(|r| {
-                    if !quiet {
+                    if quiet {
+                        println!("{}", r.dir.display());
+                    } else {
                         println!("{}", fricbound::cli::paper::paper_summary_line(&r));
                     }
                 })

@@ -302,6 +302,17 @@ fn overrides_get_their_own_default_folder() {
     assert!(dir.path().join(&expected).join("frf.csv").is_file());
     assert!(!dir.path().join("out/zoom-2nd").exists());
 
+    // With --quiet, stdout is the output folder alone, one line, for scripts to find it.
+    let mut quiet = vec!["run", "--quiet"];
+    let scene_arg = scene("zoom-2nd.toml");
+    quiet.push(&scene_arg);
+    for o in &overrides {
+        quiet.extend(["--set", o]);
+    }
+    let o = fricbound_in(dir.path(), &quiet);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(text(&o.stdout), format!("{}\n", expected.display()));
+
     // The library function agrees, and tells other override sets and no overrides apart.
     let scene_path = PathBuf::from("meshes/zoom-2nd.toml");
     let owned: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
@@ -339,12 +350,16 @@ fn figure_titles_name_the_overrides() {
         svg.contains("[static_loads.0.value=-100, analysis.freq_end_hz=152]"),
         "the title names the overrides"
     );
+    // The title states the pre-load solved with, never the scene file's.
+    assert!(svg.contains("F0 = 100 N"), "the title shows the actual F0");
+    assert!(!svg.contains("F0 = 120 N"), "no stale F0 in the title");
     // Without overrides, the scene's title alone.
     let plain = dir.path().join("plain");
     let o = run_scene(&scene("zoom-2nd.toml"), &plain, &[]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let svg = std::fs::read_to_string(plain.join("frf_y2.svg")).unwrap();
     assert!(!svg.contains("static_loads.0.value"));
+    assert!(svg.contains("F0 = 120 N"), "the scene's own F0");
 }
 
 /// The case: H = 10 000 with 32 768 samples aborted on a 5 GB allocation. It is now

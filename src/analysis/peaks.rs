@@ -388,11 +388,22 @@ pub struct PathExtremum {
 /// when it is the branch's first or last point. This never fails:
 /// when no point solver can be built for the problem, or a refinement fails, the path point is
 /// reported with `refined = false`.
+///
+/// Only extrema inside the analysis range (`freq_start_hz` to `freq_end_hz`) are reported: a
+/// path may follow a fold out of the range (below its start), and what it finds there is not
+/// a resonance of the range asked for. An extremum whose path point lies outside is not
+/// refined; one refined to a frequency outside is left out.
 pub fn path_extrema(
     problem: &Problem,
     points: &[FrfPoint],
     branch_starts: &[usize],
 ) -> Vec<PathExtremum> {
+    let range = &problem.analysis.continuation;
+    let (lo, hi) = (
+        range.freq_start_hz.min(range.freq_end_hz),
+        range.freq_start_hz.max(range.freq_end_hz),
+    );
+    let in_range = |f: f64| (lo..=hi).contains(&f);
     let mut solver = PointSolver::new(problem).ok();
     let spans = branches(points.len(), branch_starts);
     let mut found = Vec::new();
@@ -409,11 +420,14 @@ pub fn path_extrema(
                     })
                     .collect();
             at.sort_by_key(|&(i, _)| i);
-            for (i, kind) in at {
+            for (i, kind) in at.into_iter().filter(|&(i, _)| in_range(branch[i].freq_hz)) {
                 let peak = match solver.as_mut() {
                     Some(solver) => refine_extremum_at(solver, branch, output, i, kind),
                     None => Peak::from_point(&branch[i], output, false),
                 };
+                if !in_range(peak.freq_hz) {
+                    continue;
+                }
                 found.push(PathExtremum {
                     output,
                     kind,
@@ -434,6 +448,9 @@ pub fn path_extrema(
                 continue;
             };
             let (branch, i) = (&points[span.clone()], index - span.start);
+            if !in_range(branch[i].freq_hz) {
+                continue;
+            }
             let interior = i > 0 && i + 1 < branch.len();
             let peak = match solver.as_mut() {
                 Some(solver) if interior => {
@@ -441,6 +458,9 @@ pub fn path_extrema(
                 }
                 _ => Peak::from_point(&branch[i], output, false),
             };
+            if !in_range(peak.freq_hz) {
+                continue;
+            }
             found.push(PathExtremum {
                 output,
                 kind: ExtremumKind::Resonance,
@@ -593,6 +613,41 @@ mod tests {
             worst_raw = worst_raw.max((e.path_amplitude - a).abs() / a);
         }
         assert!(worst_raw > 1e-2, "the coarse path is off: {worst_raw:.2e}");
+    }
+
+    /// A path that runs out of the analysis range (a fold followed below its start) reports
+    /// only the extrema inside the range: with the range starting at 15 Hz, the resonances at
+    /// 13.6 Hz of the same path are left out and the others kept as they were.
+    #[test]
+    fn extrema_outside_the_range_are_left_out() {
+        let p = problem();
+        let points = coarse_path(&p);
+        let whole = path_extrema(&p, &points, &[]);
+        let narrowed =
+            crate::scene::parse(TWO_DOF, "two-dof", &["analysis.freq_start_hz=15".into()])
+                .and_then(|s| s.validate("two-dof"))
+                .unwrap();
+        let inside = path_extrema(&narrowed, &points, &[]);
+        let expected: Vec<&PathExtremum> =
+            whole.iter().filter(|e| e.peak.freq_hz >= 15.0).collect();
+        assert_eq!(
+            expected.len() + 2,
+            whole.len(),
+            "one resonance per output below 15 Hz"
+        );
+        // The same extrema (their refinement starts from another solver state: equal to
+        // round-off).
+        let key = |e: &PathExtremum| (e.output, e.kind, e.path_index);
+        assert_eq!(
+            inside.iter().map(key).collect::<Vec<_>>(),
+            expected.iter().map(|e| key(e)).collect::<Vec<_>>()
+        );
+        for (a, b) in inside.iter().zip(&expected) {
+            assert!(
+                (a.peak.freq_hz - b.peak.freq_hz).abs() < 1e-6,
+                "{a:?} {b:?}"
+            );
+        }
     }
 
     /// A break between branches is no extremum: the same path cut in two at x1's

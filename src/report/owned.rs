@@ -77,6 +77,44 @@ pub fn clear_results(dir: &Path) -> Result<Vec<PathBuf>, WriteError> {
     Ok(removed)
 }
 
+/// Removes what an earlier study of several runs (`fricbound paper`) left in `dir`: in each of
+/// its `sub_folders` (one run each) the result files [`clear_results`] removes, and the
+/// sub-folder itself when left empty; in `dir` the study's own `files` (and their partials).
+/// Files of other names stay, as for a single run. Returns what was removed.
+pub fn clear_study_results(
+    dir: &Path,
+    sub_folders: &[&str],
+    files: &[&str],
+) -> Result<Vec<PathBuf>, WriteError> {
+    let mut removed = Vec::new();
+    for sub in sub_folders {
+        let path = dir.join(sub);
+        removed.extend(clear_results(&path)?);
+        if std::fs::read_dir(&path).is_ok_and(|mut d| d.next().is_none()) {
+            std::fs::remove_dir(&path).map_err(|source| WriteError {
+                path: path.display().to_string(),
+                source,
+            })?;
+            removed.push(path);
+        }
+    }
+    for name in files {
+        for path in [dir.join(name), dir.join(format!("{name}{PARTIAL}"))] {
+            match std::fs::remove_file(&path) {
+                Ok(()) => removed.push(path),
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+                Err(source) => {
+                    return Err(WriteError {
+                        path: path.display().to_string(),
+                        source,
+                    })
+                }
+            }
+        }
+    }
+    Ok(removed)
+}
+
 /// Removes the owned files of `dir`; with `top`, also looks into its sub-folders that hold a
 /// `limits.json` (a sweep value's limit analysis) and removes them when left empty.
 fn clear_folder(dir: &Path, top: bool, removed: &mut Vec<PathBuf>) -> Result<(), WriteError> {
@@ -178,5 +216,39 @@ mod tests {
         assert!(d.join("old").join("frf.csv").is_file());
         // A missing folder has nothing to clear.
         assert!(clear_results(&d.join("missing")).unwrap().is_empty());
+    }
+
+    /// A study's folder: each run's sub-folder loses its results (and goes when left empty),
+    /// the study's own files go, and everything else stays.
+    #[test]
+    fn a_study_clears_its_runs_and_its_own_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        for (path, text) in [
+            ("summary.md", "old"),
+            ("summary.json.partial", "old"),
+            ("notes.txt", "mine"),
+            ("fig12/frf.csv", "old"),
+            ("fig12/frf_y2.png", "old"),
+            ("fig13/limits.json", "old"),
+            ("fig13/keep.txt", "mine"),
+            ("other/frf.csv", "not the study's"),
+        ] {
+            std::fs::create_dir_all(d.join(path).parent().unwrap()).unwrap();
+            std::fs::write(d.join(path), text).unwrap();
+        }
+        let removed = clear_study_results(
+            d,
+            &["fig12", "fig13", "fig19"],
+            &["summary.md", "summary.json"],
+        )
+        .unwrap();
+        assert_eq!(removed.len(), 6, "{removed:?}");
+        assert!(!d.join("fig12").exists());
+        assert!(!d.join("summary.md").exists() && !d.join("summary.json.partial").exists());
+        assert!(!d.join("fig13/limits.json").exists());
+        for kept in ["notes.txt", "fig13/keep.txt", "other/frf.csv"] {
+            assert!(d.join(kept).exists(), "{kept}");
+        }
     }
 }

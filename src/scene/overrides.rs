@@ -27,8 +27,8 @@ pub fn parse(text: &str, file: &str, overrides: &[String]) -> Result<Scene, Scen
         file: file.to_string(),
         message: parse_message(&e, text),
     };
-    let scene: Scene = toml::from_str(text).map_err(parse_err)?;
-    if overrides.is_empty() {
+    let mut scene: Scene = toml::from_str(text).map_err(parse_err)?;
+    if overrides.is_empty() && !scene.title.contains('{') {
         return Ok(scene);
     }
     let mut table: toml::Table = text.parse().map_err(parse_err)?;
@@ -43,12 +43,77 @@ pub fn parse(text: &str, file: &str, overrides: &[String]) -> Result<Scene, Scen
             .try_into::<Scene>()
             .map_err(|e| override_err(one_line(&e.to_string())))?;
     }
-    toml::Value::Table(table)
-        .try_into()
-        .map_err(|e: toml::de::Error| SceneError::Parse {
-            file: file.to_string(),
-            message: format!("after --set overrides: {}", one_line(&e.to_string())),
-        })
+    if !overrides.is_empty() {
+        scene = toml::Value::Table(table.clone())
+            .try_into()
+            .map_err(|e: toml::de::Error| SceneError::Parse {
+                file: file.to_string(),
+                message: format!("after --set overrides: {}", one_line(&e.to_string())),
+            })?;
+    }
+    scene.title = resolve_title(&scene.title, &table)
+        .map_err(|reason| SceneError::invalid(file, "title", reason))?;
+    Ok(scene)
+}
+
+/// The title with each `{FIELD}` replaced by the value of the scene field at that dotted path
+/// (the `--set` syntax) after the overrides, and each `{-FIELD}` by the negated number, so
+/// that a title states the value solved with, never a stale one: `F0 = {-static_loads.0.value}
+/// N` reads `F0 = 120 N` for a pre-load of -120 N along y. `{{` and `}}` are literal braces.
+pub(crate) fn resolve_title(title: &str, table: &toml::Table) -> Result<String, String> {
+    let mut out = String::new();
+    let mut rest = title;
+    while let Some(i) = rest.find(['{', '}']) {
+        out.push_str(&rest[..i]);
+        let brace = &rest[i..i + 1];
+        if rest[i + 1..].starts_with(brace) {
+            out.push_str(brace);
+            rest = &rest[i + 2..];
+            continue;
+        }
+        if brace == "}" {
+            return Err("`}` without `{` (write `}}` for a brace)".to_string());
+        }
+        let Some(end) = rest[i..].find('}') else {
+            return Err("`{` without `}` (write `{{` for a brace)".to_string());
+        };
+        let inner = rest[i + 1..i + end].trim();
+        let (negate, path) = match inner.strip_prefix('-') {
+            Some(p) => (true, p.trim()),
+            None => (false, inner),
+        };
+        let value = field_value(table, path)
+            .ok_or_else(|| format!("`{{{inner}}}`: the scene has no field `{path}` to show"))?;
+        let number = value
+            .as_float()
+            .or_else(|| value.as_integer().map(|v| v as f64));
+        let text = match (number, value) {
+            (Some(v), _) => format!("{}", if negate { -v } else { v }),
+            (None, _) if negate => {
+                return Err(format!("`{{{inner}}}`: `{path}` is not a number to negate"));
+            }
+            (None, toml::Value::String(s)) => s.clone(),
+            (None, other) => other.to_string(),
+        };
+        out.push_str(&text);
+        rest = &rest[i + end + 1..];
+    }
+    out.push_str(rest);
+    Ok(out)
+}
+
+/// The value at a dotted path (table keys, array indices) of a scene table.
+fn field_value<'a>(table: &'a toml::Table, path: &str) -> Option<&'a toml::Value> {
+    let mut segments = path.split('.');
+    let mut node = table.get(segments.next()?)?;
+    for segment in segments {
+        node = match node {
+            toml::Value::Table(t) => t.get(segment)?,
+            toml::Value::Array(a) => a.get(segment.parse::<usize>().ok()?)?,
+            _ => return None,
+        };
+    }
+    Some(node)
 }
 
 /// A parser error as `line L, column C: message` (one line, so that the first line of the
@@ -166,4 +231,64 @@ fn set_path(
         }
     };
     set_path(child, rest, value, full)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table(text: &str) -> toml::Table {
+        text.parse().unwrap()
+    }
+
+    /// Placeholders show the field's value (negated with `-`), braces doubled are literal,
+    /// and a placeholder naming no field, or negating text, is refused.
+    #[test]
+    fn title_placeholders_show_the_scene_values() {
+        let t = table(
+            "title = \"x\"\n[[static_loads]]\ndof = \"yD\"\nvalue = -120.0\n\
+             [harmonics]\nmax = 3\n",
+        );
+        let resolve = |title: &str| resolve_title(title, &t);
+        assert_eq!(
+            resolve("F0 = {-static_loads.0.value} N, H = {harmonics.max}").unwrap(),
+            "F0 = 120 N, H = 3"
+        );
+        assert_eq!(
+            resolve("load on {static_loads.0.dof}").unwrap(),
+            "load on yD"
+        );
+        assert_eq!(resolve("{{not}} a {{field}}").unwrap(), "{not} a {field}");
+        assert_eq!(resolve("plain").unwrap(), "plain");
+        for (bad, says) in [
+            ("{static_loads.1.value}", "no field `static_loads.1.value`"),
+            ("{-static_loads.0.dof}", "not a number"),
+            ("open {", "without `}`"),
+            ("close }", "without `{`"),
+        ] {
+            let e = resolve(bad).unwrap_err();
+            assert!(e.contains(says), "{bad}: {e}");
+        }
+    }
+
+    /// The title is resolved after the overrides, and a bad placeholder is an error on `title`.
+    #[test]
+    fn titles_follow_the_overrides() {
+        let text = crate::scene::PAPER_DEFAULT_SCENE;
+        let scene = parse(text, "paper", &[]).unwrap();
+        assert!(scene.title.contains("F0 = 120 N"), "{}", scene.title);
+        let scene = parse(text, "paper", &["static_loads.0.value=-1".to_string()]).unwrap();
+        assert!(scene.title.contains("F0 = 1 N"), "{}", scene.title);
+        let e = parse(
+            text,
+            "paper",
+            &["title=\"F0 = {static_loads.9.value}\"".to_string()],
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("title") && e.contains("static_loads.9.value"),
+            "{e}"
+        );
+    }
 }

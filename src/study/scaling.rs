@@ -94,6 +94,11 @@ impl ModelSize {
 }
 
 /// The blade-pair scene text for a mesh file (the physics of `meshes/blade-pair/`).
+///
+/// `mesh_file` is written into the scene's `model.mesh` as given, and a scene resolves a
+/// relative path against its own folder (docs/scene.md): pass the mesh's path relative to
+/// the folder the scene is labelled in (its file name when both share a folder) or an
+/// absolute path, never a path relative to the working folder.
 pub fn blade_pair_scene(mesh_file: &Path, three_d: bool, harmonics: usize) -> String {
     let thickness = if three_d { "" } else { "thickness = 0.01\n" };
     let tangents = if three_d {
@@ -141,12 +146,15 @@ pub fn full_problem(
 ) -> Result<Problem, ScalingError> {
     let params = size.params();
     let mesh = blade_pair::generate(&params).map_err(setup)?;
-    let file = dir.join(format!(
+    let name = format!(
         "blade-pair-{}.msh",
         size.label().replace(' ', "-").to_lowercase()
-    ));
+    );
+    let file = dir.join(&name);
     write_msh(&file, &mesh, MshFormat::Binary).map_err(setup)?;
-    let text = blade_pair_scene(&file, size.three_d, harmonics);
+    // The scene is labelled in `dir`, beside the mesh: it names the mesh by its file name,
+    // which resolves to `file` whether `dir` is absolute or relative to the working folder.
+    let text = blade_pair_scene(Path::new(&name), size.three_d, harmonics);
     let label = dir.join("scaling.toml").display().to_string();
     scene::parse(&text, &label, &[])
         .and_then(|s| s.validate(&label))
@@ -157,7 +165,8 @@ pub fn full_problem(
 /// share: the generator's coarsest mesh with 2 contact pairs per side (its mesh written into
 /// `dir` as `blade-pair-2d-r1-p2.msh`), 8 interior Craig-Bampton modes and 0.2 % modal damping,
 /// H = 1; its resonance is near 918-934 Hz. Small enough for a test, yet with the folds and
-/// stick-slip transitions of an FE damper.
+/// stick-slip transitions of an FE damper. The scene names its mesh by file name: it is to be
+/// written into (or labelled in) `dir`.
 pub fn small_reduced_blade_pair_scene(dir: &Path) -> Result<String, ScalingError> {
     let size = ModelSize {
         contact_pairs: Some(2),
@@ -165,10 +174,10 @@ pub fn small_reduced_blade_pair_scene(dir: &Path) -> Result<String, ScalingError
     };
     // Writes the mesh `blade-pair-2d-r1-p2.msh` into the folder.
     full_problem(size, 1, dir)?;
-    let mesh = dir.join("blade-pair-2d-r1-p2.msh");
+    let mesh = Path::new("blade-pair-2d-r1-p2.msh");
     Ok(format!(
         "{}\n[reduction]\nmodes = 8\nmodal_damping = 0.002\n",
-        blade_pair_scene(&mesh, false, 1)
+        blade_pair_scene(mesh, false, 1)
     ))
 }
 
@@ -528,5 +537,39 @@ struct Collect<'a>(&'a mut Vec<frf::FrfPoint>);
 impl frf::FrfObserver for Collect<'_> {
     fn point(&mut self, point: &frf::FrfPoint) {
         self.0.push(point.clone());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+
+    /// A work folder given relative to the working folder (as `out/…` is by default): the
+    /// generated scene still finds its mesh, as it names the mesh relative to its own folder.
+    #[test]
+    fn a_relative_work_folder_finds_its_mesh() {
+        let tmp = tempfile::tempdir().unwrap();
+        let cwd = std::env::current_dir().unwrap();
+        // The same folder as a relative path: up to the root, then down to it.
+        let mut relative = PathBuf::new();
+        for _ in cwd.components().skip(1) {
+            relative.push("..");
+        }
+        relative.push(tmp.path().strip_prefix("/").unwrap());
+        assert!(relative.is_relative());
+        for sub in ["work", "small"] {
+            std::fs::create_dir_all(relative.join(sub)).unwrap();
+        }
+        let size = ModelSize {
+            contact_pairs: Some(2),
+            ..ModelSize::uniform(false, 1)
+        };
+        let problem = full_problem(size, 1, &relative.join("work"));
+        assert!(problem.is_ok(), "{}", problem.unwrap_err());
+        let text = small_reduced_blade_pair_scene(&relative.join("small")).unwrap();
+        let label = relative.join("small/blade-pair.toml").display().to_string();
+        let scene = scene::parse(&text, &label, &[]).unwrap();
+        assert!(scene.validate(&label).is_ok());
     }
 }

@@ -26,7 +26,8 @@ pub fn coarse_blade_pair(dir: &Path, three_d: bool, patch_fields: &str) -> Resul
     .unwrap();
     let file = dir.join("blade-pair.msh");
     write_msh(&file, &mesh, MshFormat::Binary).unwrap();
-    let base = blade_pair_scene(&file, three_d, 1);
+    // Named relative to the scene's folder (`dir`), where both live.
+    let base = blade_pair_scene(Path::new("blade-pair.msh"), three_d, 1);
     let anchor = "tolerance = 1e-6\n";
     assert_eq!(base.matches(anchor).count(), 2, "one anchor per patch");
     let text = base.replace(anchor, &format!("{anchor}{patch_fields}"));

@@ -8,9 +8,13 @@ use std::time::Instant;
 use super::figures::{FigureResult, FIGURES};
 use super::from_runs::key_numbers;
 use super::markdown::markdown;
-use super::stability::{stability_markdown, stability_study, StabilityStudy};
+use super::stability::{stability_folders, stability_markdown, stability_study, StabilityStudy};
 use crate::cli::{create_dir, run, CommandError, RunOptions, RunOutcome};
-use crate::report::files;
+use crate::report::{files, owned};
+
+/// The files `paper` writes into its output folder itself (each figure's run writes its own
+/// into the figure's sub-folder).
+const PAPER_FILES: &[&str] = &["summary.md", "summary.json", "stability.json"];
 
 /// Options of `fricbound paper`.
 #[derive(Debug, Clone, Default)]
@@ -39,12 +43,23 @@ pub struct PaperReport {
 /// `fricbound paper`: runs every figure scene into `<out>/<figure id>/` and writes
 /// `<out>/summary.md` and `<out>/summary.json`. Returns an error naming the failed figures
 /// (after writing everything the others produced) if any figure failed.
+///
+/// Like `run`, it owns its output folder: before the first figure runs, the results of an
+/// earlier study are removed ([`owned::clear_study_results`]: every figure's and stability
+/// run's sub-folder is cleared as `run` clears its folder, and the summaries are removed), so
+/// that an interrupted study never leaves an earlier one's files beside its own.
 pub fn paper(options: &PaperOptions) -> Result<PaperReport, CommandError> {
     let dir = options
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join("paper"));
     create_dir(&dir)?;
+    let sub_folders: Vec<&str> = FIGURES
+        .iter()
+        .map(|f| f.id)
+        .chain(stability_folders())
+        .collect();
+    owned::clear_study_results(&dir, &sub_folders, PAPER_FILES)?;
     let started = Instant::now();
     let mut figures: Vec<FigureResult> = Vec::new();
     for job in &FIGURES {

@@ -25,6 +25,11 @@ struct StabilityJob {
     overrides: &'static [&'static str],
 }
 
+/// The sub-folders of the stability runs, for clearing an earlier study's.
+pub(super) fn stability_folders() -> impl Iterator<Item = &'static str> {
+    JOBS.iter().map(|j| j.id)
+}
+
 const JOBS: [StabilityJob; 2] = [
     StabilityJob {
         id: "stability-3rd",

@@ -100,12 +100,18 @@ pub(super) fn format_log(v: f64) -> String {
     }
 }
 
-/// Tick label of a linear axis whose values reach `scale` in magnitude.
+/// Below this fraction of an axis's largest magnitude, a tick value is zero to round-off: the
+/// ticks are computed as start + k·step, so the zero tick of a range such as -1.6e-4..1e-4
+/// comes out as 5.42e-20, while a real tick is at least a few thousandths of the scale.
+const ZERO_TICK: f64 = 1e-9;
+
+/// Tick label of a linear axis whose values reach `scale` in magnitude; a tick zero to
+/// round-off of the scale ([`ZERO_TICK`]) reads `0`.
 pub(super) fn format_linear(v: f64, scale: f64) -> String {
+    if v == 0.0 || v.abs() <= ZERO_TICK * scale.abs() {
+        return "0".to_string();
+    }
     if scale != 0.0 && !(1e-2..1e5).contains(&scale) {
-        if v == 0.0 {
-            return "0".to_string();
-        }
         let s = format!("{v:.2e}");
         match s.split_once('e') {
             Some((m, e)) => {
@@ -166,6 +172,10 @@ mod tests {
         assert_eq!(format_log(2.5e-7), "2.5e-7");
         assert_eq!(format_linear(0.5, 1.0), "0.5");
         assert_eq!(format_linear(2.5e-5, 1e-4), "2.5e-5");
+        // The zero tick of a range computed as start + k·step is zero to round-off.
+        assert_eq!(format_linear(5.42e-20, 1.6e-4), "0");
+        assert_eq!(format_linear(-3e-17, 20.0), "0");
+        assert_eq!(format_linear(2e-7, 1.6e-4), "2e-7");
         let (lo, hi) = log_range([3e-5, 3e-5].into_iter());
         assert!(hi / lo >= 4.0);
         assert_eq!(log_range(std::iter::empty()), (1e-6, 1e-3));

@@ -125,7 +125,14 @@ where
                     .map(|r| PathElement::new(r.clone(), style)),
             )?
         };
-        if curve.label.is_empty() || curve.is_empty() {
+        if !curve.in_legend() {
+            continue;
+        }
+        if curve.is_empty() {
+            // Listed but not drawn: the label alone says why.
+            drawn
+                .label(curve.label.as_str())
+                .legend(|(x, y)| EmptyElement::at((x, y)));
             continue;
         }
         let (color, dashed, markers) = (curve.color, curve.dashed, curve.markers);
@@ -167,7 +174,7 @@ where
         .chain(
             spec.curves
                 .iter()
-                .filter(|c| !c.label.is_empty() && !c.is_empty())
+                .filter(|c| c.in_legend())
                 .map(|c| c.label.as_str()),
         )
         .collect();

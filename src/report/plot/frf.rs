@@ -110,28 +110,22 @@ fn unstable_line(fig: &FrfFigure, out: usize, in_range: &dyn Fn(f64) -> bool) ->
         color: UNSTABLE_COLOR,
         dashed: true,
         markers: true,
+        listed: false,
     }
 }
 
-/// Draws the nonlinear FRF (first-harmonic amplitude, path order, as a line with markers) over the
-/// linear open and stuck references (dashed lines), on a log amplitude axis, and below the main
-/// chart one horizontal strip per contact showing its state at each point (colour legend: stuck,
-/// stick-slip, stick-slip-liftoff, open). Writes both files.
-///
-/// The frequency axis spans the analysis range (the references' grid): points a path reached
-/// outside it (a fold followed below the start) are left out, and the line is broken there and
-/// at every branch start.
-pub fn plot_frf(fig: &FrfFigure, png: &Path, svg: &Path) -> Result<(), PlotError> {
-    let out = fig.output_index;
-    let range = fig
-        .open
-        .freqs_hz
-        .iter()
-        .chain(&fig.stuck.freqs_hz)
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &f| {
-            (lo.min(f), hi.max(f))
-        });
-    let in_range = |f: f64| range.0 > range.1 || (range.0..=range.1).contains(&f);
+/// Fraction of the nonlinear response's largest amplitude below which a linear reference is
+/// numerically zero (the open-contact reference at a blade that only the contacts excite is
+/// round-off, 1e-20 m): such a reference is not drawn, as it would stretch the log axis over
+/// a dozen decades of nothing, and its legend entry says so.
+pub(super) const NEGLIGIBLE_REFERENCE: f64 = 1e-9;
+
+/// The lines of the FRF figure of output `out`, back to front: the open and stuck references,
+/// the nonlinear line (points outside the frequency range left out) and, when some point is
+/// unstable, its overlay. A reference whose largest amplitude is below
+/// [`NEGLIGIBLE_REFERENCE`] of the nonlinear line's is not drawn and is listed in the legend
+/// as `<name>: below 1e-9 of the response, not drawn`.
+fn frf_lines(fig: &FrfFigure, out: usize, in_range: &dyn Fn(f64) -> bool) -> Vec<Line> {
     let nonlinear = Line {
         label: "nonlinear (harmonic balance)".to_string(),
         runs: valid_runs(
@@ -147,30 +141,77 @@ pub fn plot_frf(fig: &FrfFigure, png: &Path, svg: &Path) -> Result<(), PlotError
         color: NONLINEAR_COLOR,
         dashed: false,
         markers: true,
+        listed: false,
     };
-    let reference = |curve: &LinearCurve, label: &str, color: RGBColor| Line {
-        label: label.to_string(),
-        runs: valid_runs(
-            curve
-                .freqs_hz
-                .iter()
-                .zip(&curve.amplitudes)
-                .map(|(&f, row)| (f, row.get(out).copied().unwrap_or(f64::NAN))),
-            true,
-        ),
-        color,
-        dashed: true,
-        markers: false,
+    let response_max = nonlinear
+        .runs
+        .iter()
+        .flatten()
+        .map(|p| p.1)
+        .fold(f64::NAN, f64::max);
+    let reference = |curve: &LinearCurve, label: &str, color: RGBColor| {
+        let values = curve
+            .freqs_hz
+            .iter()
+            .zip(&curve.amplitudes)
+            .map(|(&f, row)| (f, row.get(out).copied().unwrap_or(f64::NAN)));
+        // NaN when the curve has no finite value (nothing to leave out then).
+        let largest = values
+            .clone()
+            .map(|(_, a)| a.abs())
+            .filter(|a| a.is_finite())
+            .fold(f64::NAN, f64::max);
+        let negligible = largest < NEGLIGIBLE_REFERENCE * response_max;
+        Line {
+            label: if negligible {
+                format!("{label}: below {NEGLIGIBLE_REFERENCE:e} of the response, not drawn")
+            } else {
+                label.to_string()
+            },
+            runs: if negligible {
+                Vec::new()
+            } else {
+                valid_runs(values, true)
+            },
+            color,
+            dashed: true,
+            markers: false,
+            listed: negligible,
+        }
     };
     let mut curves = vec![
         reference(fig.open, "linear, contacts open", OPEN_COLOR),
         reference(fig.stuck, "linear, contacts stuck", STUCK_COLOR),
         nonlinear,
     ];
-    let unstable = unstable_line(fig, out, &in_range);
+    let unstable = unstable_line(fig, out, in_range);
     if !unstable.is_empty() {
         curves.push(unstable);
     }
+    curves
+}
+
+/// Draws the nonlinear FRF (first-harmonic amplitude, path order, as a line with markers) over the
+/// linear open and stuck references (dashed lines), on a log amplitude axis, and below the main
+/// chart one horizontal strip per contact showing its state at each point (colour legend: stuck,
+/// stick-slip, stick-slip-liftoff, open). Writes both files.
+///
+/// The frequency axis spans the analysis range (the references' grid): points a path reached
+/// outside it (a fold followed below the start) are left out, and the line is broken there and
+/// at every branch start. The amplitude axis spans the nonlinear line and the references drawn
+/// (a numerically zero reference is not, see [`frf_lines`]).
+pub fn plot_frf(fig: &FrfFigure, png: &Path, svg: &Path) -> Result<(), PlotError> {
+    let out = fig.output_index;
+    let range = fig
+        .open
+        .freqs_hz
+        .iter()
+        .chain(&fig.stuck.freqs_hz)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &f| {
+            (lo.min(f), hi.max(f))
+        });
+    let in_range = |f: f64| range.0 > range.1 || (range.0..=range.1).contains(&f);
+    let curves = frf_lines(fig, out, &in_range);
 
     let freqs: Vec<f64> = points(&curves).map(|p| p.0).collect();
     let x = linear_range(freqs.iter().copied(), 0.0);
@@ -372,5 +413,85 @@ mod tests {
         let (open, stuck) = (curve(120.0, 0.01), curve(190.0, 0.01));
         let fig = figure("many contacts", (1, "y1"), &names, &points, (&open, &stuck));
         drawn(dir.path(), "m", |png, svg| plot_frf(&fig, png, svg));
+    }
+
+    /// A reference numerically zero at the output (the open-contact reference at a blade only
+    /// the contacts excite) is not drawn and does not set the amplitude axis; its legend entry
+    /// says why. A reference merely far below the response is still drawn.
+    #[test]
+    fn a_numerically_zero_reference_is_left_out_and_said() {
+        let dir = tempfile::tempdir().unwrap();
+        let names = vec!["c1".to_string()];
+        let points = synthetic_points();
+        let stuck = curve(190.0, 0.01);
+        let mut open = curve(120.0, 0.01);
+        for row in &mut open.amplitudes {
+            row[0] *= 1e-16;
+        }
+        let fig = figure("zero open", (0, "y2"), &names, &points, (&open, &stuck));
+        let lines = frf_lines(&fig, 0, &|_| true);
+        assert!(
+            lines[0].is_empty() && lines[0].in_legend(),
+            "{}",
+            lines[0].label
+        );
+        assert_eq!(
+            lines[0].label,
+            "linear, contacts open: below 1e-9 of the response, not drawn"
+        );
+        assert_eq!(lines[1].label, "linear, contacts stuck");
+        assert!(!lines[1].is_empty());
+        let lowest = points_of(&lines).fold(f64::INFINITY, f64::min);
+        assert!(lowest > 1e-9, "{lowest:e}");
+        let svg_text = drawn(dir.path(), "zero", |png, svg| plot_frf(&fig, png, svg));
+        assert!(svg_text.contains("below 1e-9 of the response, not drawn"));
+
+        // Some 3e-8 of the response's largest amplitude: kept.
+        for row in &mut open.amplitudes {
+            row[0] *= 1e8;
+        }
+        let fig = figure("small open", (0, "y2"), &names, &points, (&open, &stuck));
+        let lines = frf_lines(&fig, 0, &|_| true);
+        assert_eq!(lines[0].label, "linear, contacts open");
+        assert!(!lines[0].is_empty());
+    }
+
+    /// The amplitudes of every drawn point of `lines`.
+    fn points_of(lines: &[Line]) -> impl Iterator<Item = f64> + '_ {
+        points(lines).map(|p| p.1)
+    }
+
+    /// The font size of the SVG `<text>` element whose text starts with `start`.
+    fn font_size(svg: &str, start: &str) -> f64 {
+        let at = svg
+            .find(&format!(">\n{start}"))
+            .or_else(|| svg.find(&format!(">{start}")));
+        let element = &svg[..at.unwrap_or_else(|| panic!("no text {start:?}"))];
+        let tag = &element[element.rfind("<text").unwrap()..];
+        let size = tag.split("font-size=\"").nth(1).unwrap();
+        size[..size.find('"').unwrap()].parse().unwrap()
+    }
+
+    /// A sweep's title with many overrides wraps, the overrides on lines of their own, at no
+    /// less than the axis descriptions' size instead of shrinking to an unreadable font.
+    #[test]
+    fn long_titles_wrap_at_a_readable_size() {
+        let dir = tempfile::tempdir().unwrap();
+        let names = vec!["c1".to_string()];
+        let points = synthetic_points();
+        let (open, stuck) = (curve(120.0, 0.01), curve(190.0, 0.01));
+        let title = "Fig. 16b: optimal curves near the optimum with intermediate states, beta = \
+                     120 deg [analysis.max_step=0.25, sweep.values=[36.0, 44.0, 52.0, 60.0, \
+                     68.0], limits.grid_points=41, limits.bound_scan=[-0.5, 0.5]]: F0 = 60 N";
+        let fig = figure(title, (0, "y2"), &names, &points, (&open, &stuck));
+        let svg = drawn(dir.path(), "long", |png, svg| plot_frf(&fig, png, svg));
+        let head = "Fig. 16b: optimal curves near the optimum with intermediate states, beta = \
+                    120 deg";
+        assert!(svg.contains(&format!("{head}\n")), "the title's first line");
+        let desc = font_size(&svg, "y2 first-harmonic amplitude (m)");
+        let first = font_size(&svg, head);
+        assert!(first >= desc, "title {first} < axis description {desc}");
+        assert_eq!(font_size(&svg, "[analysis.max_step=0.25,"), first);
+        assert!(svg.contains("F0 = 60 N"), "nothing cut");
     }
 }

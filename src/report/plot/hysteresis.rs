@@ -43,6 +43,7 @@ pub fn plot_hysteresis(
                 color: l.color,
                 dashed: false,
                 markers: false,
+                listed: false,
             }
         })
         .collect();

@@ -32,12 +32,21 @@ pub(super) struct Line {
     pub(super) dashed: bool,
     /// A filled circle at every point.
     pub(super) markers: bool,
+    /// Listed in the legend (its label, without a line sample) even when nothing of it is
+    /// drawn: a curve left out on purpose, whose label says why.
+    pub(super) listed: bool,
 }
 
 impl Line {
-    /// Whether nothing of the line can be drawn (then it has no legend entry).
+    /// Whether nothing of the line can be drawn (then it has no legend entry unless
+    /// [`Line::listed`]).
     pub(super) fn is_empty(&self) -> bool {
         self.runs.is_empty()
+    }
+    /// Whether the line has an entry in the legend: a label, and something drawn or
+    /// [`Line::listed`].
+    pub(super) fn in_legend(&self) -> bool {
+        !self.label.is_empty() && (!self.is_empty() || self.listed)
     }
     /// Stroke of the line (and of its legend sample).
     pub(super) fn style(&self) -> ShapeStyle {
@@ -75,6 +84,7 @@ pub(super) fn lines(curves: &[Curve], log_y: bool) -> Vec<Line> {
             color: c.color,
             dashed: c.dashed,
             markers: c.markers,
+            listed: false,
         })
         .collect()
 }

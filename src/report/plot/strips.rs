@@ -11,8 +11,8 @@ use super::axes::format_linear;
 use super::backend::Figure;
 use super::chart::{draw_chart, ChartSpec};
 use super::style::{
-    font, state_color, DESC_SIZE, LABEL_SIZE, LEGEND_SIZE, RIGHT_MARGIN, STATES, TITLE_SIZE,
-    X_LABELS,
+    font, state_color, DESC_SIZE, LABEL_SIZE, LEGEND_SIZE, RIGHT_MARGIN, STATES, TITLE_MAX_LINES,
+    TITLE_MIN_SIZE, TITLE_SIZE, X_LABELS,
 };
 
 /// One row of coloured markers below the chart, e.g. the states of one contact.
@@ -71,13 +71,7 @@ impl Figure for StripChart {
         let body = if self.title.trim().is_empty() {
             root
         } else {
-            // Long titles shrink to fit the width rather than run off the figure.
-            let width = root.dim_in_pixel().0;
-            let mut size = TITLE_SIZE;
-            while size > 14.0 && root.estimate_text_size(&self.title, &font(size))?.0 + 10 > width {
-                size -= 1.0;
-            }
-            root.titled(&self.title, font(size))?
+            draw_title(&root, &self.title)?
         };
         let (_, body_h) = body.dim_in_pixel();
 
@@ -119,6 +113,104 @@ impl Figure for StripChart {
         }
         Ok(())
     }
+}
+
+/// Draws the title centred on top of `area` and returns the area below it. A long title
+/// shrinks from [`TITLE_SIZE`] to at most [`TITLE_MIN_SIZE`] to fit on one line, and is
+/// otherwise wrapped at that size onto up to [`TITLE_MAX_LINES`] lines ([`wrap_title`]).
+fn draw_title<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    title: &str,
+) -> DrawResult<DrawingArea<DB, Shift>, DB> {
+    let width = area.dim_in_pixel().0.saturating_sub(10);
+    let fits = |text: &str, size: f64| -> DrawResult<bool, DB> {
+        Ok(area.estimate_text_size(text, &font(size))?.0 <= width)
+    };
+    let mut size = TITLE_SIZE;
+    while size > TITLE_MIN_SIZE && !fits(title, size)? {
+        size -= 1.0;
+    }
+    let mut error = None;
+    let lines = wrap_title(title, TITLE_MAX_LINES, |text| {
+        fits(text, size).unwrap_or_else(|e| {
+            error.get_or_insert(e);
+            true
+        })
+    });
+    if let Some(e) = error {
+        return Err(e);
+    }
+    let line_h = (size * 1.25).ceil() as i32;
+    let style = font(size).pos(Pos::new(HPos::Center, VPos::Top));
+    let centre = area.dim_in_pixel().0 as i32 / 2;
+    for (i, line) in lines.iter().enumerate() {
+        area.draw_text(line, &style, (centre, 5 + i as i32 * line_h))?;
+    }
+    let used = 10 + lines.len() as i32 * line_h;
+    Ok(area.split_vertically(used).1)
+}
+
+/// A title as lines that each `fits`: words (split at spaces) filled greedily onto at most
+/// `max_lines` lines, the overrides a title ends with (` [a=1, b=2]`) starting a line of their
+/// own when the title does not fit on one. What does not fit on them (more words, or a word
+/// too wide for a line of its own) is left out and the last line ends in "…", so that the
+/// title never runs off the figure.
+pub(super) fn wrap_title(
+    title: &str,
+    max_lines: usize,
+    mut fits: impl FnMut(&str) -> bool,
+) -> Vec<String> {
+    let (head, overrides) = match title.split_once(" [") {
+        Some((head, rest)) if !fits(title) => (head, Some(format!("[{rest}"))),
+        _ => (title, None),
+    };
+    let mut lines = vec![String::new()];
+    let mut cut = false;
+    let words = head.split_whitespace().map(|w| (false, w)).chain(
+        overrides
+            .iter()
+            .flat_map(|o| o.split_whitespace().enumerate().map(|(i, w)| (i == 0, w))),
+    );
+    for (new_line, word) in words {
+        if new_line && !lines.last().expect("at least one line").is_empty() {
+            if lines.len() == max_lines.max(1) {
+                cut = true;
+                break;
+            }
+            lines.push(String::new());
+        }
+        let last = lines.last_mut().expect("at least one line");
+        let joined = if last.is_empty() {
+            word.to_string()
+        } else {
+            format!("{last} {word}")
+        };
+        if fits(&joined) {
+            *last = joined;
+            continue;
+        }
+        if !last.is_empty() {
+            if lines.len() == max_lines.max(1) {
+                cut = true;
+                break;
+            }
+            lines.push(String::new());
+        }
+        let last = lines.last_mut().expect("at least one line");
+        *last = word.to_string();
+        if !fits(word) {
+            cut = true;
+            break;
+        }
+    }
+    if cut {
+        let last = lines.last_mut().expect("at least one line");
+        while !last.is_empty() && !fits(&format!("{last}…")) {
+            last.pop();
+        }
+        last.push('…');
+    }
+    lines
 }
 
 /// Draws one row per strip (the first on top) with a coloured marker at each of its abscissae.
@@ -200,4 +292,41 @@ fn draw_state_legend<DB: DrawingBackend>(
         x += area.estimate_text_size(state.label(), &style)?.0 as i32 + 30;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Titles wrap at spaces onto at most the lines given, each within the width; what is
+    /// left over ends the last line in "…".
+    #[test]
+    fn titles_wrap_and_shorten() {
+        let fits = |t: &str| t.chars().count() <= 12;
+        assert_eq!(wrap_title("short", 3, fits), ["short"]);
+        assert_eq!(
+            wrap_title("aaaa bbbb cccc dddd", 3, fits),
+            ["aaaa bbbb", "cccc dddd"]
+        );
+        assert_eq!(
+            wrap_title("aaaa bbbb cccc dddd eeee ffff gggg", 2, fits),
+            ["aaaa bbbb", "cccc dddd…"]
+        );
+        assert_eq!(
+            wrap_title("x [limits.bound_scan=[-0.5,0.5]]", 3, fits),
+            ["x", "[limits.bou…"]
+        );
+        // The overrides start a line of their own.
+        assert_eq!(
+            wrap_title("aaaa bbbb cc [d=1, e=2]", 3, fits),
+            ["aaaa bbbb cc", "[d=1, e=2]"]
+        );
+        assert_eq!(wrap_title("aa [d=1]", 3, fits), ["aa [d=1]"]);
+        for lines in [
+            wrap_title("aaaa bbbb cccc dddd eeee ffff gggg", 2, fits),
+            wrap_title("x [limits.bound_scan=[-0.5,0.5]]", 3, fits),
+        ] {
+            assert!(lines.iter().all(|l| fits(l)), "{lines:?}");
+        }
+    }
 }

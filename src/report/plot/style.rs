@@ -16,8 +16,13 @@ const FONT: &str = "sans-serif";
 const FONT_BYTES: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");
 /// Size of every figure in pixels (PNG) and user units (SVG).
 pub(super) const SIZE: (u32, u32) = (1200, 800);
-/// Largest title size; long titles shrink to fit the width.
+/// Largest title size; a title too wide at this size shrinks, down to [`TITLE_MIN_SIZE`].
 pub(super) const TITLE_SIZE: f64 = 28.0;
+/// Smallest title size: a title still too wide at it is wrapped onto more lines, never drawn
+/// smaller (as the axis descriptions' size, it stays readable in a report).
+pub(super) const TITLE_MIN_SIZE: f64 = 22.0;
+/// Most lines of a wrapped title; what does not fit on them ends in "…".
+pub(super) const TITLE_MAX_LINES: usize = 3;
 /// Size of the axis descriptions.
 pub(super) const DESC_SIZE: f64 = 22.0;
 /// Size of the tick labels and the strip names.
