@@ -498,11 +498,17 @@ proptest! {
     }
 }
 
+/// Force coefficients (T̂, N̂) of one law at coefficients (û, v̂).
+type Forces<'a> = dyn FnMut(&[f64], &[f64]) -> Vec<f64> + 'a;
+
+/// A line in the unknowns: its name, (û₀, v̂₀) and direction (dû, dv̂) at H = 2.
+type Line = (&'static str, [f64; 5], [f64; 5], [f64; 5], [f64; 5]);
+
 /// Largest second difference |F(s+h) − 2F(s) + F(s−h)| / h² of the force coefficients
 /// F = (T̂, N̂) along the line x(s) = x₀ + s·d, over every s = i·h on [0, 0.2]: with the step
 /// as the spacing, every kink on the stretch lies within ±h of some s.
 fn largest_second_difference(
-    evaluate: &mut dyn FnMut(&[f64], &[f64]) -> Vec<f64>,
+    evaluate: &mut Forces<'_>,
     (u0, v0): (&[f64], &[f64]),
     (du, dv): (&[f64], &[f64]),
     h: f64,
@@ -534,7 +540,7 @@ fn largest_second_difference(
 fn event_law_forces_have_no_kinks_along_a_line() {
     let set = HarmonicSet::up_to(2);
     let l = law(1e5, 1e5, 0.5, 0.0);
-    let lines: [(&str, [f64; 5], [f64; 5], [f64; 5], [f64; 5]); 2] = [
+    let lines: [Line; 2] = [
         (
             "stick-slip",
             [0.0, 2e-4, 0.0, 0.0, 3e-5],

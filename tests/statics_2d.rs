@@ -15,7 +15,7 @@ use fricbound::model::{Formulation, Problem};
 mod common;
 use common::{
     assert_formulations_agree, compare_on_planar_path, excited_out_of_plane, planar, problem,
-    IN_PLANE, OUT_OF_PLANE, OUT_OF_PLANE_RUN, PLANAR, SPATIAL,
+    IN_PLANE, OUT_OF_PLANE, OUT_OF_PLANE_RUN, SPATIAL,
 };
 
 /// The damper's out-of-plane DOF (zD) in the 3D scene.

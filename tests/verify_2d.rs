@@ -17,7 +17,7 @@ use fricbound::contact::ContactState;
 use fricbound::model::{HarmonicLoad, Problem};
 
 mod common;
-use common::{planar, problem, IN_PLANE, PLANAR, SPATIAL};
+use common::{planar, problem, IN_PLANE, SPATIAL};
 
 /// The HBM point at `freq_hz` from the stuck linear guess: (harmonic set, coefficients,
 /// output amplitudes).
