@@ -17,7 +17,7 @@ use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use plotters::style::RGBColor;
 
-use super::CommandError;
+use super::context::CommandError;
 use crate::hbm::cost::formulation_name;
 use crate::report::files::write_atomic;
 use crate::report::plot::{self, figure_files, Curve};
