@@ -377,7 +377,7 @@ fn a_problem_too_large_for_the_machine_is_refused_before_anything_is_written() {
     assert_eq!(cost.force_blocks, 20_001);
     // At least the two AFT matrices of 32 768 × 20 001 values.
     assert!(cost.aft_bytes >= 2.0 * 32768.0 * 20001.0 * 8.0);
-    let Some(available) = fricbound::cli::available_memory() else {
+    let Some(available) = fricbound::hbm::cost::available_memory() else {
         eprintln!("no /proc/meminfo: the refusal is skipped by design, nothing to test");
         return;
     };
@@ -446,7 +446,7 @@ fn check_prints_the_cost_of_a_small_scene() {
         cost.contains("MiB") && cost.contains("(estimate: 3.5 factorisations of "),
         "{cost}"
     );
-    if fricbound::cli::available_memory().is_some() {
+    if fricbound::hbm::cost::available_memory().is_some() {
         assert!(stdout.contains("): fits"), "{stdout}");
     }
 }

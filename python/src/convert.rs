@@ -271,7 +271,7 @@ pub fn frf_dict<'py>(
     problem_names(&d, problem)?;
     d.set_item(
         "status",
-        fricbound::cli::status_text(run.incomplete_reason().as_deref()),
+        fricbound::report::files::status_text(run.incomplete_reason().as_deref()),
     )?;
     d.set_item("turning_points_hz", run.turning_points.clone())?;
     d.set_item("leaps_hz", run.leaps.clone())?;
@@ -524,7 +524,7 @@ pub fn limits_dict<'py>(
     let unfinished = a.unfinished();
     d.set_item(
         "status",
-        fricbound::cli::status_text(
+        fricbound::report::files::status_text(
             if unfinished.is_empty() {
                 None
             } else {
@@ -610,7 +610,7 @@ pub fn sweep_dict<'py>(
         .collect();
     d.set_item(
         "status",
-        fricbound::cli::status_text(
+        fricbound::report::files::status_text(
             if failed.is_empty() {
                 None
             } else {

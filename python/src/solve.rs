@@ -85,8 +85,8 @@ fn load(
 /// Refuses a problem that would not fit in memory (the CLI's check, `fricbound run`), with
 /// `MemoryError` naming the estimate and the fields to lower.
 fn check_memory(label: &str, problem: &Problem, parallel: usize) -> PyResult<()> {
-    fricbound::cli::check_memory(label, problem, parallel)
-        .map_err(|e| PyMemoryError::new_err(e.to_string()))
+    fricbound::hbm::cost::check_memory(problem, parallel)
+        .map_err(|e| PyMemoryError::new_err(format!("{label}: {e}")))
 }
 
 /// Validates a scene and describes it (sizes, formulation, cost estimate).

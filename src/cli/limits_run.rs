@@ -3,7 +3,7 @@
 
 use std::sync::Mutex;
 
-use super::{CommandError, RunContext, RunOutcome, RunReport};
+use super::context::{CommandError, RunContext, RunOutcome, RunReport};
 use crate::analysis::frf::FrfPoint;
 use crate::analysis::limits::{self, CaseCurve, LimitAnalysis, Regime};
 use crate::analysis::stability::{methods_text, stretches_text, unstable_stretches};
@@ -117,7 +117,7 @@ pub fn run_limits(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
         ctx,
         &analysis,
         elapsed,
-        &super::status_text(incomplete.as_deref()),
+        &crate::report::files::status_text(incomplete.as_deref()),
     )?;
     Ok(RunReport {
         dir: ctx.dir.clone(),

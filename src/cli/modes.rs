@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use crate::analysis::linear::LinearCase;
 use crate::analysis::modes::{self, case_name, EigenMethod, NaturalModes};
-use crate::cli::{create_dir, default_out_dir, CommandError};
+use crate::cli::context::{create_dir, default_out_dir, CommandError};
 use crate::model::reduce::{self, Reduction, ReductionSettings};
 use crate::model::Problem;
 use crate::report::files::write_atomic;

@@ -13,7 +13,8 @@
 use std::path::PathBuf;
 use std::sync::Mutex;
 
-use super::{limits_run, CommandError, RunContext, RunOutcome, RunReport};
+use super::context::{CommandError, RunContext, RunOutcome, RunReport};
+use super::limits_run;
 use crate::analysis::limits::LimitSettings;
 use crate::model::Problem;
 use crate::report::files;
@@ -66,13 +67,13 @@ fn write_point_analysis(
         return Ok(());
     };
     let dir = point_dir(ctx, spec, point.series, point.value);
-    super::create_dir(&dir)?;
+    super::context::create_dir(&dir)?;
     let label = format!(
         "{} ({})",
         ctx.label,
         point_label(spec, point.series, point.value)
     );
-    let (open, stuck) = super::linear_references(&label, problem, &dir)?;
+    let (open, stuck) = super::context::linear_references(&label, problem, &dir)?;
     let mut scene = scene.clone();
     scene.title = format!(
         "{}: {}",
@@ -100,7 +101,7 @@ fn write_point_analysis(
         &sub,
         analysis,
         f64::NAN,
-        &super::status_text(incomplete.as_deref()),
+        &crate::report::files::status_text(incomplete.as_deref()),
     )
 }
 
@@ -221,7 +222,7 @@ pub fn run_sweep(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
     let incomplete = sweep_incomplete(&spec, &points);
     let json = serde_json::json!({
         "info": ctx.info(),
-        "status": super::status_text(incomplete.as_deref()),
+        "status": crate::report::files::status_text(incomplete.as_deref()),
         "elapsed_s": elapsed,
         "parameter": spec.parameter,
         "unit": spec.unit,

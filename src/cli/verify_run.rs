@@ -21,7 +21,7 @@ use crate::analysis::verify::{self, PointVerification, VerifySettings};
 use crate::report::files::write_atomic;
 use crate::report::plot::{self, figure_files, palette, Curve};
 
-use super::{create_dir, default_out_dir, load_scene, CommandError};
+use super::context::{create_dir, default_out_dir, load_scene, CommandError};
 
 /// Relative first-harmonic difference from the HBM point (last integrated period, dt/2) below
 /// which a motion started on the HBM point counts as having stayed on it, settled or not (a

@@ -398,9 +398,168 @@ pub fn format_seconds(s: f64) -> String {
     }
 }
 
+/// Where the available memory was read, for messages.
+pub const MEMINFO: &str = "/proc/meminfo";
+
+/// The memory available to a new process (bytes): `MemAvailable` of `/proc/meminfo`, lowered
+/// to the room left under the cgroup's limit (`/sys/fs/cgroup/memory.max` minus
+/// `memory.current`) when the process runs in a limited cgroup (a container). `None` when
+/// `/proc/meminfo` cannot be read or has no `MemAvailable` line (not Linux): the caller then
+/// skips the refusal.
+pub fn available_memory() -> Option<u64> {
+    let meminfo = std::fs::read_to_string(MEMINFO).ok()?;
+    let available = parse_mem_available(&meminfo)?;
+    let read = |f: &str| -> Option<u64> {
+        std::fs::read_to_string(std::path::Path::new("/sys/fs/cgroup").join(f))
+            .ok()?
+            .trim()
+            .parse()
+            .ok()
+    };
+    let cgroup_room =
+        read("memory.max").map(|max| max.saturating_sub(read("memory.current").unwrap_or(0)));
+    Some(cgroup_room.map_or(available, |room| room.min(available)))
+}
+
+/// `MemAvailable` of a `/proc/meminfo` text, in bytes (the file gives kB).
+pub fn parse_mem_available(meminfo: &str) -> Option<u64> {
+    meminfo.lines().find_map(|line| {
+        let rest = line.strip_prefix("MemAvailable:")?;
+        let mut parts = rest.split_whitespace();
+        let value: u64 = parts.next()?.parse().ok()?;
+        match parts.next() {
+            Some("kB") | None => Some(value * 1024),
+            Some(_) => None,
+        }
+    })
+}
+
+/// A problem refused before anything proportional to it is allocated: its estimated memory
+/// exceeds what the machine has available ([`check_memory`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{reason}")]
+pub struct TooLarge {
+    /// The estimate, the memory available and the fields to lower ([`memory_refusal`]).
+    pub reason: String,
+}
+
+/// Refuses a problem whose estimated memory, one Newton iteration ([`estimate`]) times the
+/// solves that run at the same time, exceeds the memory available ([`available_memory`]);
+/// nothing is allocated in proportion to the problem before this check. When the available
+/// memory cannot be read the check is skipped.
+pub fn check_memory(problem: &Problem, parallel: usize) -> Result<(), TooLarge> {
+    let Some(available) = available_memory() else {
+        return Ok(());
+    };
+    let cost = estimate(problem);
+    match memory_refusal(problem, &cost, parallel, available as f64) {
+        Some(reason) => Err(TooLarge { reason }),
+        None => Ok(()),
+    }
+}
+
+/// Why a problem of estimate `cost`, solved `parallel` times at once, does not fit in
+/// `available` bytes; `None` when it fits. Names the fields to lower.
+pub fn memory_refusal(
+    problem: &Problem,
+    cost: &CostEstimate,
+    parallel: usize,
+    available: f64,
+) -> Option<String> {
+    let needed = cost.bytes() * parallel.max(1) as f64;
+    if needed <= available {
+        return None;
+    }
+    let max_h = problem.harmonics.iter().copied().max().unwrap_or(0);
+    Some(format!(
+        "refused: one Newton iteration is estimated to need {}{} ({} formulation: {} unknowns, \
+         factorised matrix of {} rows; AFT {} samples x {} coefficient blocks), more than the {} \
+         available ({MEMINFO}); lower harmonics.max (highest harmonic {max_h}, {} blocks), \
+         harmonics.samples ({}) or the model size ({} DOFs, {} contact points: coarser mesh, \
+         [reduction], fewer contact pairs){}{}",
+        format_bytes(needed),
+        if parallel > 1 {
+            format!(" for {parallel} curves solved at once")
+        } else {
+            String::new()
+        },
+        formulation_name(cost.formulation),
+        cost.unknowns,
+        cost.factored,
+        cost.samples,
+        cost.force_blocks,
+        format_bytes(available),
+        cost.blocks,
+        cost.samples,
+        cost.dofs,
+        cost.contacts,
+        if parallel > 1 {
+            ", or the curves solved at once (RAYON_NUM_THREADS)"
+        } else {
+            ""
+        },
+        if cost.formulation == Formulation::Condensed && problem.model.stiffness.is_sparse() {
+            ", or change analysis.formulation: `condensed` holds K, M and C of the whole model \
+             dense, `sparse` (or `auto`) keeps them sparse"
+        } else {
+            ""
+        },
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn reads_mem_available() {
+        let text = "MemTotal:       24585944 kB\nMemFree:         1000000 kB\n\
+                    MemAvailable:   20000000 kB\nBuffers:          100 kB\n";
+        assert_eq!(parse_mem_available(text), Some(20_000_000 * 1024));
+        assert_eq!(parse_mem_available("MemTotal: 1 kB\n"), None);
+        assert_eq!(parse_mem_available("MemAvailable: lots\n"), None);
+    }
+
+    /// The refusal compares the estimate (times the solves at once) with the memory given and
+    /// names the fields to lower.
+    #[test]
+    fn refuses_what_does_not_fit() {
+        let problem = crate::scene::parse(crate::scene::PAPER_DEFAULT_SCENE, "paper", &[])
+            .and_then(|s| s.validate("paper"))
+            .unwrap();
+        let cost = estimate(&problem);
+        assert!(memory_refusal(&problem, &cost, 1, 2.0 * cost.bytes()).is_none());
+        let why = memory_refusal(&problem, &cost, 1, 0.5 * cost.bytes()).unwrap();
+        for field in [
+            "harmonics.max",
+            "harmonics.samples",
+            "model size",
+            "dense formulation",
+        ] {
+            assert!(why.contains(field), "{field}: {why}");
+        }
+        // Four curves at once need four times the memory.
+        assert!(memory_refusal(&problem, &cost, 4, 2.0 * cost.bytes())
+            .unwrap()
+            .contains("RAYON_NUM_THREADS"));
+        assert!(!why.contains("analysis.formulation"), "{why}");
+    }
+
+    /// A sparse FE model asked to run `condensed` (which holds K, M and C dense: the 18 574-DOF
+    /// blade pair needs 54 GiB) is also told that another formulation keeps them sparse.
+    #[test]
+    fn a_condensed_fe_model_is_pointed_to_a_sparse_formulation() {
+        let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("meshes/blade-pair/blade-pair-2d.toml");
+        let overrides = [
+            "reduction=".to_string(),
+            "analysis.formulation=condensed".to_string(),
+        ];
+        let (_, problem) = crate::scene::load_problem(&scene, &overrides).unwrap();
+        let cost = estimate(&problem);
+        let why = memory_refusal(&problem, &cost, 1, 0.5 * cost.bytes()).unwrap();
+        assert!(why.contains("analysis.formulation"), "{why}");
+    }
     use crate::contact::harmonic::SampleBasis;
     use crate::hbm::operator::HbmOperator;
     use crate::numerics::ParametricResidual;

@@ -678,6 +678,14 @@ impl FrfObserver for FrfWriter {
     }
 }
 
+/// The status written into a run's JSON file: `complete`, or `incomplete: <reason>`.
+pub fn status_text(incomplete: Option<&str>) -> String {
+    match incomplete {
+        None => "complete".to_string(),
+        Some(reason) => format!("incomplete: {reason}"),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -3,7 +3,7 @@
 //! response envelope), the list [`FIGURES`] in the paper's order, and the [`FigureResult`] of
 //! running one.
 
-use crate::cli::RunReport;
+use crate::cli::context::RunReport;
 
 /// One figure of the study: the scene that computes it and its coarser `--quick` settings.
 #[derive(Debug)]

@@ -12,8 +12,8 @@ use super::numbers::{
 };
 use crate::analysis::limits::LimitAnalysis;
 use crate::analysis::linear::LinearCurve;
+use crate::cli::context::RunOutcome;
 use crate::cli::sweep_run::parameter_label;
-use crate::cli::RunOutcome;
 use crate::scene::SweepSpec;
 use crate::study::sweep::SweepPoint;
 

@@ -9,7 +9,8 @@ use super::figures::{FigureResult, FIGURES};
 use super::from_runs::key_numbers;
 use super::markdown::markdown;
 use super::stability::{stability_folders, stability_markdown, stability_study, StabilityStudy};
-use crate::cli::{create_dir, run, CommandError, RunOptions, RunOutcome};
+use crate::cli::context::{create_dir, CommandError, RunOptions, RunOutcome};
+use crate::cli::run;
 use crate::report::{files, owned};
 
 /// The files `paper` writes into its output folder itself (each figure's run writes its own

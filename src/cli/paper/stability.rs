@@ -16,7 +16,8 @@ use serde::Serialize;
 
 use super::figures::FIGURES;
 use crate::analysis::stability::{stretches_text, unstable_stretches};
-use crate::cli::{run, RunOptions, RunOutcome};
+use crate::cli::context::{RunOptions, RunOutcome};
+use crate::cli::run;
 
 /// One stability run: sub-folder, what it is, and its overrides of `fig13-3rd.toml`.
 struct StabilityJob {
