@@ -56,13 +56,14 @@ pub enum ContinuationError {
         /// Cause.
         reason: NewtonFailure,
     },
-    /// The step fell below the minimum. When Newton stagnates just above the tolerance, a
-    /// contact transition (stick-slip or lift-off) usually sits between two AFT time samples,
-    /// where the residual has a kink; the message says so and names the remedy.
+    /// The step fell below the minimum. With a sampled contact law, when Newton stagnates
+    /// just above the tolerance a contact transition (stick-slip or lift-off) usually sits
+    /// between two time samples, where the residual has a kink; the message names the remedy.
     #[error(
         "continuation stalled at {freq_hz:.4} Hz (step {step:.3e} below minimum): {reason}; \
-         if the residual stagnates just above tolerance, a contact transition falls between AFT \
-         time samples: more samples ([harmonics] samples) usually get past it"
+         with a sampled contact law (`jenkins-1d-sampled`, `jenkins-2d`) a residual stagnating \
+         just above tolerance means a contact transition falls between time samples: more \
+         samples ([harmonics] samples) usually get past it"
     )]
     Stalled {
         /// Frequency of the last converged point (Hz).
