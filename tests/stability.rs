@@ -68,7 +68,8 @@ fn the_branch_past_the_fold_is_unstable_and_the_linear_branch_stable() {
     );
     assert!(stable[..fold - 1].iter().all(|&s| s));
     // … and comes back over the saddle branch: a real positive exponent at every point of
-    // the first backward stretch (two points next to the fold left out, where it crosses 0).
+    // the first backward stretch (two points next to each fold left out, where it crosses 0:
+    // the stretch ends at the lower fold).
     let back_end = (fold + 1..freq.len())
         .find(|&i| freq[i] > freq[i - 1])
         .unwrap_or(freq.len());
@@ -78,7 +79,7 @@ fn the_branch_past_the_fold_is_unstable_and_the_linear_branch_stable() {
         freq[back_end - 1],
         freq[fold]
     );
-    for i in fold + 3..back_end {
+    for i in fold + 3..back_end - 2 {
         assert!(
             !stable[i] && floquet_re[i] > 0.0 && floquet_hz[i] == 0.0,
             "point {i} at {} Hz: Re = {}, f = {}",
