@@ -246,8 +246,8 @@ mod tests {
         text.parse().unwrap()
     }
 
-    /// Placeholders show the field's value (negated with `-`), braces doubled are literal,
-    /// and a placeholder naming no field, or negating text, is refused.
+    /// Placeholders show the field's value (negated with `-`), braces doubled are literal, a
+    /// placeholder naming no field reads "none", and negating text is refused.
     #[test]
     fn title_placeholders_show_the_scene_values() {
         let t = table(
@@ -265,8 +265,8 @@ mod tests {
         );
         assert_eq!(resolve("{{not}} a {{field}}").unwrap(), "{not} a {field}");
         assert_eq!(resolve("plain").unwrap(), "plain");
+        assert_eq!(resolve("{static_loads.1.value}").unwrap(), "none");
         for (bad, says) in [
-            ("{static_loads.1.value}", "no field `static_loads.1.value`"),
             ("{-static_loads.0.dof}", "not a number"),
             ("open {", "without `}`"),
             ("close }", "without `{`"),
