@@ -36,10 +36,7 @@ fn liftoff_fold() -> String {
 }
 
 /// The paper scene's two contacts on the sampled law.
-const SAMPLED: [&str; 2] = [
-    "contacts.0.law=\"jenkins-1d-sampled\"",
-    "contacts.1.law=\"jenkins-1d-sampled\"",
-];
+const SAMPLED: [&str; 2] = common::scenes::SAMPLED_PAPER;
 
 /// The FE scenes' two contact patches on the sampled law.
 const SAMPLED_PATCHES: [&str; 2] = [

@@ -14,10 +14,7 @@ pub const SPATIAL: &str = include_str!("../../meshes/paper-wedge-3d/fig13-3rd-3d
 /// marched on the samples, so the two scenes agree to round-off only on the same time
 /// resolution (the event-resolved `jenkins-1d` differs from both by the sampling error).
 pub fn planar(overrides: &[&str]) -> Problem {
-    let mut all = vec![
-        "contacts.0.law=\"jenkins-1d-sampled\"",
-        "contacts.1.law=\"jenkins-1d-sampled\"",
-    ];
+    let mut all = super::scenes::SAMPLED_PAPER.to_vec();
     all.extend_from_slice(overrides);
     super::scenes::problem(PLANAR, &all)
 }

@@ -5,6 +5,14 @@ use fricbound::model::Problem;
 use fricbound::scene;
 use std::path::Path;
 
+/// Overrides that put the paper scene's two contacts on the sampled law
+/// (`jenkins-1d-sampled`): for the tests of what its corners make (dead ends, leaps, jumps)
+/// and of its equivalence with the sampled 2D law.
+pub const SAMPLED_PAPER: [&str; 2] = [
+    "contacts.0.law=\"jenkins-1d-sampled\"",
+    "contacts.1.law=\"jenkins-1d-sampled\"",
+];
+
 /// A validated problem from scene text with `--set`-style overrides.
 pub fn problem(text: &str, overrides: &[&str]) -> Problem {
     let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();

@@ -149,6 +149,8 @@ impl AftWorkspace {
                 None => params.mu_kn * self.v[k].max(0.0),
             };
             let (t, kind) = match pieces.get(p).map(|q| q.phase) {
+                // The anchor fields serve the sampled law's Jacobian only; the event law's
+                // anchors live in its pieces, so these samples record the kind alone.
                 Some(Phase::Stick { w, .. }) => (
                     params.kt * (self.u[k] - w),
                     SampleKind::Stick {
