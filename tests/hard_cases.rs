@@ -16,7 +16,6 @@ use fricbound::analysis::linear::{self, LinearCase};
 use fricbound::analysis::peaks;
 use fricbound::contact::ContactState;
 use fricbound::model::Problem;
-use fricbound::numerics::PathEnd;
 use fricbound::scene::{self, paper_wedge_scene};
 
 fn problem(overrides: &[&str]) -> Problem {
@@ -209,25 +208,12 @@ fn frictionless_contacts_give_the_normal_spring_linear_system() {
 }
 
 /// 25 harmonics with 4096 samples per period: a big harmonic balance (6 DOFs × 51 blocks) must
-/// still follow the whole path, every branch included. Near 254.8 Hz the path turns back up at
-/// a fold onto a branch above those followed there; while it went no higher in frequency it
-/// was given up there (Newton just past it found a solution no branch of the run held, and the
-/// run ended incomplete); counted as progress while it enters ground it had not covered, it
-/// follows that branch, and the run is complete.
+/// still follow the whole path, every branch included (near 254.8 Hz the path turns back up at
+/// a fold onto a branch above those followed there).
 #[test]
 fn many_harmonics_follow_every_branch_to_the_end() {
     let p = problem(&["harmonics.max=25", "harmonics.samples=4096"]);
-    let run = solve_complete(&p, "H = 25");
-    assert_eq!(run.abandoned().count(), 0, "{:?}", run.jumps);
-}
-
-/// For each branch `run` abandoned inside the range, the run's judgement of it holds when
-/// checked again by Newton ([`common::abandoned::abandoned_branches_are_off_the_run`]): the
-/// branch goes on past the point given up, off the run, or Newton converged nowhere past it,
-/// so `incomplete` is right.
-fn abandoned_branches_go_on(p: &Problem, run: &FrfRun, label: &str) {
-    let abandoned = common::abandoned::abandoned_branches_are_off_the_run(p, run, label);
-    assert!(!abandoned.is_empty(), "{label}: {:?}", run.jumps);
+    solve_complete(&p, "H = 25");
 }
 
 /// A small initial gap on both contacts (1 µm): the pre-load closes it, and contacts graze
@@ -334,13 +320,6 @@ fn starts_on_resonances_and_ranges_across_the_damper_mode_cover_the_range() {
 /// intermediate ones) must cover the range with the checks of [`check_points`], and the band
 /// they form must exist over the whole grid with its upper edge above its lower one.
 fn limits_complete(path: &str, overrides: &[&str], label: &str) {
-    limits_cover(path, overrides, label, &[]);
-}
-
-/// As [`limits_complete`], except that the curves named in `abandoning` may end `incomplete`
-/// for branches abandoned inside the range only (every frequency reached, no stretch
-/// uncovered), each checked to go on past its point given up ([`abandoned_branches_go_on`]).
-fn limits_cover(path: &str, overrides: &[&str], label: &str, abandoning: &[&str]) {
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let file = format!("{}/{path}", env!("CARGO_MANIFEST_DIR"));
     let (p, settings) = scene::load(std::path::Path::new(&file), &overrides)
@@ -349,47 +328,10 @@ fn limits_cover(path: &str, overrides: &[&str], label: &str, abandoning: &[&str]
     let settings = settings.expect("a limit scene");
     let analysis = limits::analyse(&p, &settings, |_| {}).unwrap_or_else(|e| panic!("{e}"));
     assert!(
-        !abandoning.is_empty() || analysis.is_complete(),
+        analysis.is_complete(),
         "{label}: not every curve is complete: {:?}",
         analysis.unfinished()
     );
-    for curve in analysis.limits.iter().chain(&analysis.intermediate) {
-        let name = &curve.case.name;
-        if curve.status.is_complete() {
-            continue;
-        }
-        assert!(
-            abandoning.contains(&name.as_str()),
-            "{label}: curve `{name}` is not complete: {:?}",
-            curve.status.text()
-        );
-        let run = FrfRun {
-            points: curve.points.clone(),
-            turning_points: curve.turning_points.clone(),
-            rejected_steps: 0,
-            leaps: Vec::new(),
-            leap_points: Vec::new(),
-            leap_checks: Vec::new(),
-            jumps: curve.jumps.clone(),
-            end: PathEnd::EndFrequency,
-            elapsed_s: 0.0,
-        };
-        assert!(
-            run.abandoned().count() > 0 && run.jumps.iter().all(|j| j.uncovered_hz() == 0.0),
-            "{label}: curve `{name}` is incomplete otherwise than by abandoned branches: {}",
-            curve.status.text()
-        );
-        let highest = run
-            .points
-            .iter()
-            .map(|q| q.freq_hz)
-            .fold(f64::NEG_INFINITY, f64::max);
-        assert!(
-            highest >= p.analysis.continuation.freq_end_hz * (1.0 - 1e-9),
-            "{label}: curve `{name}` reached {highest} Hz"
-        );
-        abandoned_branches_go_on(&curve.case.apply(&p), &run, &format!("{label}, {name}"));
-    }
     for curve in analysis.limits.iter().chain(&analysis.intermediate) {
         let q = curve.case.apply(&p);
         check_points(&q, &curve.points, &format!("{label}, {}", curve.case.name));
@@ -420,8 +362,6 @@ fn limit_scene_at_a_low_preload_covers_the_range() {
 /// The 2D FE blade pair (Craig-Bampton, a patch of contact pairs per damper side) with a
 /// tenth of its pre-load (5 N instead of 50 N): pairs open and close along the patches, and a
 /// user sees both limit curves and the intermediate one reach 1100 Hz from 700 Hz, complete.
-/// (With the sampled law the m = +1 curve meets a dead end at 875.50 Hz, running down from a
-/// fold, past which Newton converges nowhere: `tests/frf_abandoned.rs`.)
 #[test]
 fn fe_blade_pair_limits_at_a_low_preload_reach_the_end() {
     limits_complete(

@@ -155,53 +155,11 @@ class FrfResult(ContinuationPath):
     :class:`ContinuationPath`, plus
 
     - ``status``: ``complete`` or ``incomplete: <reason>`` (as ``solution.json``);
-    - ``turning_points_hz``, ``leaps_hz``, ``leap_checks``, ``jumps``, ``rejected_steps``,
-      ``elapsed_s``; each leap check is a dict ``from_hz``, ``to_hz``, ``before_amplitude``
-      (m, the point before the leap), ``back_amplitude`` (m, where the path followed back from
-      the landing reached ``from_hz``; None when it did not), ``distance`` (relative, on all
-      Fourier coefficients, between the two), ``points`` (of the path back) and ``verdict``
-      (``covered`` within 1 %, ``abandoned`` beyond: the leap crossed onto another branch,
-      ``unjudged``: the path back did not reach ``from_hz``; the last two make ``status``
-      ``incomplete``) and ``past`` (None, or for a leap onto another branch the judgement of
-      the branch through the point before it, a dict with the fields of ``end_check`` in
-      ``solution.json``; its verdict is the leap's: ``covered`` where that branch goes on on
-      the run, or turns back at a fold whose other side lies below the run);
-      each jump is a dict ``from_hz``, ``to_hz``, ``first_point``, ``kind``
-      (``past-fold``, ``past-dead-end``, ``bridge``), ``abandoned`` (True when the branch
-      before it was abandoned inside the range: the response beyond its last point is
-      missing and ``status`` is ``incomplete``), ``before`` (``left-range``, ``abandoned``,
-      ``retrace``, ``outside-range``, ``bridge``) and, for a branch given up, ``given_up_hz``,
-      ``given_up_amplitude`` (m), ``given_up_rising``, ``given_up_fold_hz`` and
-      ``given_up_cause`` (``dead-end`` or ``no-progress``, as ``cause`` in ``solution.json``;
-      None otherwise), for a branch given up off every stretch followed (``before``
-      ``abandoned``) its judgement by Newton just past its last point once the run is over
-      (``end_check`` in ``solution.json``): ``given_up_verdict`` (``covered``: the landing
-      lies on a stretch of the run, or, where Newton converged nowhere past the point, the
-      branch turns back there at a fold whose other side lies on or below the run: nothing
-      is missing and ``abandoned`` is False; ``abandoned`` or ``unjudged``), ``given_up_check_hz``, ``given_up_check_amplitude`` (m,
-      where Newton landed) and ``given_up_check_distance`` (relative distance of the landing's
-      coefficients from the nearest stretch of the run; all None otherwise), and
-      ``fill_cut_hz``, ``fill_cut_amplitude`` (m), ``fill_cut_fold_hz`` where the branch
-      after the jump (a fill or a bridge) was left off every stretch followed before (at the
-      edge of its stretch after a fold of its own, given up before it, or out of points;
-      None otherwise), and its judgement by Newton just past it once the run is over:
-      ``cut_verdict`` (``covered``, ``abandoned`` or ``unjudged``; the last two make
-      ``status`` ``incomplete``), ``cut_check_hz``, ``cut_check_amplitude`` (m, where Newton
-      landed), ``cut_check_distance`` (relative distance of the landing's coefficients from
-      the stretch of the run the verdict rests on), ``cut_check_own_side`` (True when that
-      stretch is the cut branch's own side of its fold, which next to the fold lies within
-      the tolerance) and ``cut_check_resolved_distance`` (relative distance between the
-      landing and Newton's solution at its frequency from that stretch: at most 1e-6, the
-      same solution), and, when the landing is that own side (the stretch came back along
-      it), or when Newton converged nowhere past a dead end and the other side of a fold at
-      the dead end was found (the fold is the dead end), the judgement past that fold:
-      ``cut_check_beyond_fold_hz`` (the fold),
-      ``cut_check_beyond_fold_amplitude`` (m, where Newton landed past it; None when it
-      converged nowhere) and ``cut_check_beyond_fold_run_amplitude`` (m, the run's largest
-      amplitude there; a landing above it on no stretch makes the cut ``abandoned``); a
-      bridge cut at both of its sides has the same keys for its way up's
-      cut prefixed ``second_`` (``second_fill_cut_hz``, ``second_cut_verdict``, …; None
-      otherwise);
+    - ``turning_points_hz``, ``jumps``, ``rejected_steps``, ``elapsed_s``; each jump (where
+      the path turned back at a fold and left the range below the start, the run went on on
+      a branch found past the highest frequency reached) is a dict ``from_hz`` (the highest
+      frequency before it), ``to_hz`` (the lowest the branch after it reached, followed back
+      down) and ``first_point`` (index of that branch's first point);
     - ``csv``: the run's ``frf.csv`` exactly as the CLI writes it (:meth:`write_csv`).
     """
 

@@ -261,7 +261,7 @@ pub fn points_dict<'py>(py: Python<'py>, points: &[FrfPoint]) -> PyResult<Bound<
 
 /// An FRF run: its points ([`points_dict`]), the names ([`problem_names`]), how it ended
 /// (`status`: `complete` or `incomplete: <reason>`, as in `solution.json`), turning points,
-/// leaps and their judgement (`leap_checks`), jumps, cut steps, wall time, and `csv`: the run's `frf.csv` text as the CLI writes it.
+/// jumps, cut steps, wall time, and `csv`: the run's `frf.csv` text as the CLI writes it.
 pub fn frf_dict<'py>(
     py: Python<'py>,
     problem: &Problem,
@@ -274,115 +274,12 @@ pub fn frf_dict<'py>(
         fricbound::report::files::status_text(run.incomplete_reason().as_deref()),
     )?;
     d.set_item("turning_points_hz", run.turning_points.clone())?;
-    d.set_item("leaps_hz", run.leaps.clone())?;
-    // The judgement of each leap, as `leap_checks` in solution.json.
-    d.set_item("leap_checks", as_json(py, &run.leap_checks)?)?;
     let jumps = PyList::empty(py);
     for j in &run.jumps {
         let jd = PyDict::new(py);
         jd.set_item("from_hz", j.from_hz)?;
         jd.set_item("to_hz", j.to_hz)?;
         jd.set_item("first_point", j.first_point)?;
-        jd.set_item(
-            "kind",
-            match j.kind {
-                fricbound::analysis::frf::JumpKind::PastFold => "past-fold",
-                fricbound::analysis::frf::JumpKind::PastDeadEnd => "past-dead-end",
-                fricbound::analysis::frf::JumpKind::Bridge => "bridge",
-            },
-        )?;
-        // How the branch before ended (as `before.how` in solution.json), and where a branch
-        // given up was left: `abandoned` is true when the response beyond it is missing.
-        use fricbound::analysis::frf::BranchEnd;
-        jd.set_item("abandoned", j.abandons_branch())?;
-        let (how, given_up) = match &j.before {
-            BranchEnd::LeftRange => ("left-range", None),
-            BranchEnd::Abandoned(g) => ("abandoned", Some(g)),
-            BranchEnd::Retrace(g) => ("retrace", Some(g)),
-            BranchEnd::OutsideRange(g) => ("outside-range", Some(g)),
-            BranchEnd::Bridge => ("bridge", None),
-        };
-        jd.set_item("before", how)?;
-        jd.set_item("given_up_hz", given_up.map(|g| g.freq_hz))?;
-        jd.set_item("given_up_amplitude", given_up.map(|g| g.amplitude))?;
-        jd.set_item("given_up_rising", given_up.map(|g| g.amplitude_rising))?;
-        jd.set_item("given_up_fold_hz", given_up.and_then(|g| g.fold_hz))?;
-        jd.set_item(
-            "given_up_cause",
-            given_up.map(|g| json_name(&g.cause)).transpose()?,
-        )?;
-        // The judgement of an abandoned branch's last point (`end_check` in solution.json):
-        // its verdict and where Newton landed just past it.
-        let end = j.end_check.as_ref();
-        jd.set_item(
-            "given_up_verdict",
-            end.map(|c| json_name(&c.verdict)).transpose()?,
-        )?;
-        jd.set_item("given_up_check_hz", end.map(|c| c.landing.freq_hz))?;
-        jd.set_item(
-            "given_up_check_amplitude",
-            end.and_then(|c| c.landing.amplitude),
-        )?;
-        jd.set_item(
-            "given_up_check_distance",
-            end.and_then(|c| c.landing.distance),
-        )?;
-        // The first cut under its own keys, the second (a bridge cut on both sides) under
-        // the same keys prefixed `second_`.
-        let cuts = [
-            ("", j.fill_cut.as_ref(), j.cut_check.as_ref()),
-            (
-                "second_",
-                j.second_cut.as_ref(),
-                j.second_cut_check.as_ref(),
-            ),
-        ];
-        for (prefix, cut, check) in cuts {
-            jd.set_item(format!("{prefix}fill_cut_hz"), cut.map(|g| g.freq_hz))?;
-            jd.set_item(
-                format!("{prefix}fill_cut_amplitude"),
-                cut.map(|g| g.amplitude),
-            )?;
-            jd.set_item(
-                format!("{prefix}fill_cut_fold_hz"),
-                cut.and_then(|g| g.fold_hz),
-            )?;
-            jd.set_item(
-                format!("{prefix}cut_verdict"),
-                check.map(|c| json_name(&c.verdict)).transpose()?,
-            )?;
-            let landing = check.map(|c| &c.landing);
-            jd.set_item(format!("{prefix}cut_check_hz"), landing.map(|l| l.freq_hz))?;
-            jd.set_item(
-                format!("{prefix}cut_check_amplitude"),
-                landing.and_then(|l| l.amplitude),
-            )?;
-            jd.set_item(
-                format!("{prefix}cut_check_distance"),
-                landing.and_then(|l| l.distance),
-            )?;
-            jd.set_item(
-                format!("{prefix}cut_check_own_side"),
-                check.map(|c| c.own_side),
-            )?;
-            jd.set_item(
-                format!("{prefix}cut_check_resolved_distance"),
-                landing.and_then(|l| l.resolved_distance),
-            )?;
-            let fold = check.and_then(|c| c.beyond_fold.as_ref());
-            jd.set_item(
-                format!("{prefix}cut_check_beyond_fold_hz"),
-                fold.map(|f| f.fold_hz),
-            )?;
-            jd.set_item(
-                format!("{prefix}cut_check_beyond_fold_amplitude"),
-                fold.and_then(|f| f.landing.amplitude),
-            )?;
-            jd.set_item(
-                format!("{prefix}cut_check_beyond_fold_run_amplitude"),
-                fold.and_then(|f| f.run_amplitude),
-            )?;
-        }
         jumps.append(jd)?;
     }
     d.set_item("jumps", jumps)?;

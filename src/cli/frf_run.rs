@@ -5,9 +5,7 @@
 use indicatif::ProgressBar;
 
 use super::context::{CommandError, RunContext, RunOutcome, RunReport};
-use crate::analysis::frf::{
-    self, BranchEnd, CutCheck, FrfObserver, FrfPoint, GivenUp, Jump, JumpKind, LeapCheck,
-};
+use crate::analysis::frf::{self, FrfObserver, FrfPoint, Jump};
 use crate::analysis::peaks::{self, ExtremumKind};
 use crate::model::Problem;
 use crate::numerics::NewtonFailure;
@@ -69,116 +67,11 @@ impl FrfObserver for RunObserver<'_> {
         } else {
             String::new()
         };
-        let before = match (jump.before.words(), jump.abandons_branch()) {
-            (Some(words), true) => format!(
-                "\nABANDONED: the branch before it was {words}, and the run will be reported \
-                 incomplete unless Newton past that point, once the run is over, lands on a \
-                 stretch of the run (the jump's end_check)"
-            ),
-            (Some(words), false) => format!("\nthe branch before it was {words}"),
-            (None, _) => String::new(),
-        };
-        let before = jump.cuts().fold(before, |before, (g, _)| {
-            format!(
-                "{before}\nthe branch past it (a fill or bridge) was left {}: it may go on \
-                 beyond {:.4} Hz, not followed (the jump's fill_cut; judged by Newton past it \
-                 once the run is over)",
-                g.describe(),
-                g.freq_hz
-            )
-        });
-        let msg = match jump.kind {
-            JumpKind::PastFold => format!(
-                "the path turned back at a fold below {:.4} Hz and did not return: it goes on \
-                 on a branch found past it, from {:.4} Hz{uncovered}",
-                jump.from_hz, jump.to_hz
-            ),
-            JumpKind::PastDeadEnd => format!(
-                "the path could not be followed on below {:.4} Hz (only the way back was \
-                 found): it goes on on a branch found past it, from {:.4} Hz{uncovered}",
-                jump.from_hz, jump.to_hz
-            ),
-            JumpKind::Bridge => format!(
-                "a branch solved between the fold's two sides goes on from {:.4} Hz (the \
-                 previous branch reached {:.4} Hz){uncovered}",
-                jump.to_hz, jump.from_hz
-            ),
-        } + &before;
-        self.say(msg);
-    }
-    fn narrow_pass(&mut self, from_hz: f64, to_hz: f64) {
-        self.writer.narrow_pass(from_hz, to_hz);
-        if !self.quiet {
-            let msg = format!(
-                "the path stalled past {from_hz:.4} Hz and was followed on over a narrow window \
-                 around it up to {to_hz:.4} Hz"
-            );
-            self.say(msg);
-        }
-    }
-    fn cut_judged(&mut self, index: usize, jump: &Jump) {
-        self.writer.cut_judged(index, jump);
-        // Always said, as the jump was.
-        if let (BranchEnd::Abandoned(g), Some(check)) = (&jump.before, &jump.end_check) {
-            let msg = format!(
-                "{}the branch given up at {:.4} Hz before the jump at {:.4} Hz: {}{}",
-                if check.uncovered() { "ABANDONED: " } else { "" },
-                g.freq_hz,
-                jump.from_hz,
-                check.describe_past("the point given up"),
-                if check.uncovered() {
-                    "; the run will be reported incomplete"
-                } else {
-                    "; nothing is missing there"
-                }
-            );
-            self.say(msg);
-        }
-        let judged: Vec<(GivenUp, CutCheck)> = jump
-            .cuts()
-            .filter_map(|(g, check)| check.map(|c| (*g, *c)))
-            .collect();
-        for (g, check) in judged {
-            let msg = format!(
-                "{}the cut at {:.4} Hz of the branch past the jump at {:.4} Hz: {}{}",
-                if check.uncovered() {
-                    "NOT COVERED: "
-                } else {
-                    ""
-                },
-                g.freq_hz,
-                jump.from_hz,
-                check.describe(),
-                if check.uncovered() {
-                    "; the run will be reported incomplete"
-                } else {
-                    ""
-                }
-            );
-            self.say(msg);
-        }
-    }
-    fn leap_judged(&mut self, check: &LeapCheck) {
-        self.writer.leap_judged(check);
-        // An uncovered leap is always said, as an uncovered cut is.
-        if check.uncovered() {
-            self.say(format!(
-                "NOT COVERED: {}; the run will be reported incomplete",
-                check.describe()
-            ));
-        } else if !self.quiet {
-            self.say(check.describe());
-        }
-    }
-    fn leap(&mut self, from_hz: f64, to_hz: f64) {
-        self.writer.leap(from_hz, to_hz);
-        if !self.quiet {
-            let msg = format!(
-                "the path could not be followed past {from_hz:.4} Hz and resumed at \
-                 {to_hz:.4} Hz (no points in between)"
-            );
-            self.say(msg);
-        }
+        self.say(format!(
+            "the path turned back at a fold below {:.4} Hz and left the range: it goes on on a \
+             branch found past it, from {:.4} Hz{uncovered}",
+            jump.from_hz, jump.to_hz
+        ));
     }
 }
 

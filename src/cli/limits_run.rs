@@ -205,9 +205,6 @@ struct CurveJson<'a> {
     status: &'a limits::CurveStatus,
     peak: Option<&'a limits::Peak>,
     continuation_retries: usize,
-    /// Stalls passed over a narrow window around them: `[from_hz, to_hz]`, the last point
-    /// before the stall and the first outside the window (see `CaseCurve::narrow_passes`).
-    narrow_passes_hz: Vec<[f64; 2]>,
     /// Largest error estimates over the curve's points (when the scene asks for them).
     #[serde(skip_serializing_if = "Option::is_none")]
     accuracy: Option<files::AccuracySummary>,
@@ -227,7 +224,6 @@ fn curve_json(ctx: &RunContext<'_>, c: &CaseCurve, stability: bool) -> serde_jso
         status: &c.status,
         peak: c.peak.as_ref(),
         continuation_retries: c.retries,
-        narrow_passes_hz: c.narrow_passes.iter().map(|&(a, b)| [a, b]).collect(),
         accuracy: files::accuracy_summary(
             &info.outputs,
             ctx.problem.analysis.error_estimate.warn_threshold,
@@ -505,17 +501,13 @@ pub(super) fn summary(a: &LimitAnalysis, elapsed: f64) -> String {
         };
         let _ = writeln!(
             s,
-            "  {:<24} {peak}{}{}{}",
+            "  {:<24} {peak}{}{}",
             c.case.name,
             if c.retries > 0 {
                 format!(" ({} continuation retries)", c.retries)
             } else {
                 String::new()
             },
-            c.narrow_passes
-                .iter()
-                .map(|(a, b)| format!(" (stall passed over a narrow window, {a:.4} -> {b:.4} Hz)"))
-                .collect::<String>(),
             if c.status.is_complete() {
                 String::new()
             } else {

@@ -61,9 +61,10 @@ pub enum ContinuationError {
     /// between two time samples, where the residual has a kink; the message names the remedy.
     #[error(
         "continuation stalled at {freq_hz:.4} Hz (step {step:.3e} below minimum): {reason}; \
-         with a sampled contact law (`jenkins-1d-sampled`, `jenkins-2d`) a residual stagnating \
-         just above tolerance means a contact transition falls between time samples: more \
-         samples ([harmonics] samples) usually get past it"
+         with a sampled contact law (`jenkins-1d-sampled`, `jenkins-2d-sampled`) a residual \
+         stagnating just above tolerance means a contact transition falls between time \
+         samples: the event-resolved law (`jenkins-1d`, `jenkins-2d`) or more samples \
+         ([harmonics] samples) get past it"
     )]
     Stalled {
         /// Frequency of the last converged point (Hz).
@@ -120,13 +121,6 @@ pub trait Observer<S: ParametricResidual> {
     fn rejected(&mut self, _freq_hz: f64, _step: f64, _new_step: f64, _reason: &NewtonFailure) {}
     /// dω/ds changed sign between the previous and this point.
     fn turning_point(&mut self, _freq_hz: f64) {}
-    /// The path could not be followed from `from_hz` and was resumed at `to_hz` (Hz).
-    fn leap(&mut self, _from_hz: f64, _to_hz: f64) {}
-    /// The path stalled after `from_hz` and was taken on over a narrow window around it (the
-    /// response weighing more in the arc length, steps as for that window) up to `to_hz`, the
-    /// first point outside the window, from which it goes on with the range's scales and
-    /// steps (Hz).
-    fn narrow_pass(&mut self, _from_hz: f64, _to_hz: f64) {}
 }
 
 /// An observer that does nothing.
@@ -142,11 +136,6 @@ pub struct PathSummary {
     pub turning_points: Vec<f64>,
     /// Rejected steps.
     pub rejected_steps: usize,
-    /// Stretches of the path leapt over: (last point before, first point after), Hz.
-    pub leaps: Vec<(f64, f64)>,
-    /// The index in `points` of each leap's first point after (its landing; the point before
-    /// it is the one before), in the order of `leaps`.
-    pub leap_landings: Vec<usize>,
     /// Why the run stopped.
     pub end: PathEnd,
 }
@@ -161,16 +150,4 @@ pub enum PathEnd {
     LeftRangeBelow,
     /// The point budget was used up.
     MaxPoints,
-    /// The path wandered for `Continuation::stagnation_points` points without entering ground
-    /// it had not covered (a frequency and size of the unknowns no point had reached before:
-    /// back and forth through folds of the sampled contact law, or round a loop again): the
-    /// range above was not covered.
-    NoProgress,
-    /// The path met a spot it could not pass (the corrector failed at every step down to the
-    /// minimum, and neither the corner search nor a leap found a way on) where the only way on
-    /// found led back along the path already followed (a retrace, refused), or below the
-    /// highest frequency it had reached (it had turned back at a fold): the range above the
-    /// highest frequency was not covered. Anywhere else such a spot is a
-    /// [`ContinuationError::Stalled`].
-    DeadEnd,
 }

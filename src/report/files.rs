@@ -15,7 +15,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::analysis::error_estimate::EstimateMethod;
-use crate::analysis::frf::{FrfObserver, FrfPoint, Jump, LeapCheck};
+use crate::analysis::frf::{FrfObserver, FrfPoint, Jump};
 use crate::analysis::linear::LinearCurve;
 use crate::analysis::peaks::{ExtremumKind, PathExtremum};
 use crate::contact::ContactState;
@@ -292,14 +292,6 @@ struct SolutionFile<'a> {
     mean_point_ms: f64,
     turning_points_hz: &'a [f64],
     step_cuts: &'a [StepCut],
-    leaps_hz: &'a [(f64, f64)],
-    /// The judgement of each leap, in the order of `leaps_hz`; omitted when none.
-    #[serde(skip_serializing_if = "<[_]>::is_empty")]
-    leap_checks: &'a [LeapCheck],
-    /// Stalls passed over a narrow window around them (last point before the stall, first
-    /// point outside the window), Hz; omitted when none.
-    #[serde(skip_serializing_if = "<[_]>::is_empty")]
-    narrow_passes_hz: &'a [(f64, f64)],
     /// Jumps to another branch past a fold (highest frequency before, lowest of the new
     /// branch, its first point's index).
     jumps: &'a [Jump],
@@ -405,9 +397,6 @@ pub struct FrfWriter {
     points: Vec<FrfPoint>,
     turning_points: Vec<f64>,
     step_cuts: Vec<StepCut>,
-    leaps: Vec<(f64, f64)>,
-    leap_checks: Vec<LeapCheck>,
-    narrow_passes: Vec<(f64, f64)>,
     jumps: Vec<Jump>,
     /// Refined extrema, set by [`Self::write_peaks`].
     peaks: Option<Vec<PeakRecord>>,
@@ -460,9 +449,6 @@ impl FrfWriter {
             points: Vec::new(),
             turning_points: Vec::new(),
             step_cuts: Vec::new(),
-            leaps: Vec::new(),
-            leap_checks: Vec::new(),
-            narrow_passes: Vec::new(),
             jumps: Vec::new(),
             peaks: None,
             started: Instant::now(),
@@ -512,9 +498,6 @@ impl FrfWriter {
             },
             turning_points_hz: &self.turning_points,
             step_cuts: &self.step_cuts,
-            leaps_hz: &self.leaps,
-            leap_checks: &self.leap_checks,
-            narrow_passes_hz: &self.narrow_passes,
             jumps: &self.jumps,
             coefficients_file: (!inline).then(|| CoefficientsFile {
                 file: "coefficients.bin",
@@ -655,26 +638,8 @@ impl FrfObserver for FrfWriter {
         self.turning_points.push(freq_hz);
     }
 
-    fn leap(&mut self, from_hz: f64, to_hz: f64) {
-        self.leaps.push((from_hz, to_hz));
-    }
-
-    fn narrow_pass(&mut self, from_hz: f64, to_hz: f64) {
-        self.narrow_passes.push((from_hz, to_hz));
-    }
-
     fn jump(&mut self, jump: &Jump) {
         self.jumps.push(*jump);
-    }
-
-    fn cut_judged(&mut self, index: usize, jump: &Jump) {
-        if let Some(j) = self.jumps.get_mut(index) {
-            *j = *jump;
-        }
-    }
-
-    fn leap_judged(&mut self, check: &LeapCheck) {
-        self.leap_checks.push(*check);
     }
 }
 

@@ -523,8 +523,6 @@ fn measure_formulation(
         PathEnd::EndFrequency => "end frequency".to_string(),
         PathEnd::MaxPoints => format!("capped at {} points", budget.frf_points),
         PathEnd::LeftRangeBelow => "left the range below".to_string(),
-        PathEnd::NoProgress => "no progress".to_string(),
-        PathEnd::DeadEnd => "dead end".to_string(),
     };
     if probe.is_none() {
         *probe = run

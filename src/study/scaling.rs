@@ -325,11 +325,8 @@ pub struct SolveMeasure {
     /// Newton iterations (FRF runs).
     pub iterations: usize,
     /// Whether the FRF covered its window within `max_points` (`FrfRun::is_complete`: the end
-    /// reached, no stretch on no branch, no branch abandoned inside it).
+    /// reached, every stretch on some branch).
     pub complete: bool,
-    /// Whether the FRF reached the end of its window within `max_points` with every stretch on
-    /// some branch (`FrfRun::covers_range`), whatever became of the branches it gave up.
-    pub covered: bool,
     /// Wall time of the FRF (s; FRF runs).
     pub frf_s: f64,
     /// Wall time per continuation point (ms; FRF runs).
@@ -507,7 +504,6 @@ pub fn measure_solve(
         points: 0,
         iterations: 0,
         complete: false,
-        covered: false,
         frf_s: 0.0,
         per_point_ms: 0.0,
         frf_iteration_ms: 0.0,
@@ -523,7 +519,6 @@ pub fn measure_solve(
         m.frf_s = started.elapsed().as_secs_f64();
         m.points = points.len();
         m.complete = outcome.as_ref().is_ok_and(|run| run.is_complete());
-        m.covered = outcome.as_ref().is_ok_and(|run| run.covers_range());
         m.iterations = points.iter().map(|q| q.newton_iterations).sum();
         m.per_point_ms = 1e3 * m.frf_s / m.points.max(1) as f64;
         m.frf_iteration_ms = 1e3 * m.frf_s / m.iterations.max(1) as f64;

@@ -7,13 +7,11 @@
 //! | [`linear`] | linear references: the damped eigenvalues of a problem's structure |
 //! | [`envelope`] | the m = ±1 limit states at given frequencies, seeds of the response envelope |
 //! | [`points`] | solved points compared: coefficients to 1e-8 of their largest, contact states |
-//! | [`abandoned`] | the judgement of a branch an FRF run abandoned, checked again by fixed-frequency Newton |
 //! | [`blade_pair`] | the generated blade pairs of the FE tests: the reduced 2D one with 2 pairs per side, the coarse 2D or 3D one with fields added to its patches |
 //!
 //! Each test crate uses a part of it.
 #![allow(dead_code)]
 
-pub mod abandoned;
 pub mod blade_pair;
 pub mod envelope;
 pub mod linear;

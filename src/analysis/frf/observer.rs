@@ -3,7 +3,6 @@
 
 use std::collections::VecDeque;
 
-use super::checks::LeapCheck;
 use super::point::{full_point, with_stability};
 use super::status::{FrfPoint, Jump};
 use crate::analysis::error_estimate::PathPlace;
@@ -20,19 +19,9 @@ pub trait FrfObserver {
     fn step_cut(&mut self, _freq_hz: f64, _step: f64, _new_step: f64, _reason: &NewtonFailure) {}
     /// A turning point was passed (Hz).
     fn turning_point(&mut self, _freq_hz: f64) {}
-    /// The path could not be followed from `from_hz` and was resumed at `to_hz` (Hz).
-    fn leap(&mut self, _from_hz: f64, _to_hz: f64) {}
-    /// The path stalled after `from_hz` and was taken on over a narrow window around it up to
-    /// `to_hz` (Hz; see `Continuation::run`).
-    fn narrow_pass(&mut self, _from_hz: f64, _to_hz: f64) {}
     /// The path turned back at a fold and did not return; it goes on on another branch, whose
     /// points come next (see [`Jump`]).
     fn jump(&mut self, _jump: &Jump) {}
-    /// After the run, the cut of the `index`-th jump (in the order reported) was judged:
-    /// `jump` is that jump with its [`Jump::cut_check`] set.
-    fn cut_judged(&mut self, _index: usize, _jump: &Jump) {}
-    /// After the run, a leap was judged ([`judge_leaps`](super::judge::judge_leaps)).
-    fn leap_judged(&mut self, _check: &LeapCheck) {}
 }
 
 /// Observer that ignores everything.
@@ -62,10 +51,7 @@ pub(super) enum Held {
     Point(usize),
     StepCut(f64, f64, f64, NewtonFailure),
     TurningPoint(f64),
-    Leap(f64, f64),
-    NarrowPass(f64, f64),
-    /// Boxed: a jump is ten times the size of the other events.
-    Jump(Box<Jump>),
+    Jump(Jump),
 }
 
 impl<O: FrfObserver> Adapter<'_, '_, '_, O> {
@@ -121,8 +107,6 @@ impl<O: FrfObserver> Adapter<'_, '_, '_, O> {
                     self.observer.step_cut(freq_hz, step, new_step, &reason)
                 }
                 Held::TurningPoint(freq_hz) => self.observer.turning_point(freq_hz),
-                Held::Leap(from_hz, to_hz) => self.observer.leap(from_hz, to_hz),
-                Held::NarrowPass(from_hz, to_hz) => self.observer.narrow_pass(from_hz, to_hz),
                 Held::Jump(jump) => self.observer.jump(&jump),
             }
         }
@@ -166,11 +150,5 @@ impl<O: FrfObserver> Observer<HbmOperator<'_>> for Adapter<'_, '_, '_, O> {
     }
     fn turning_point(&mut self, freq_hz: f64) {
         self.report(Held::TurningPoint(freq_hz));
-    }
-    fn leap(&mut self, from_hz: f64, to_hz: f64) {
-        self.report(Held::Leap(from_hz, to_hz));
-    }
-    fn narrow_pass(&mut self, from_hz: f64, to_hz: f64) {
-        self.report(Held::NarrowPass(from_hz, to_hz));
     }
 }

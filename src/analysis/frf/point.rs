@@ -13,9 +13,7 @@ use crate::hbm::operator::HbmOperator;
 use crate::hbm::{HbmError, HbmSystem};
 use crate::model::{Problem, StabilityMethod};
 use crate::numerics::golden;
-use crate::numerics::{
-    Continuation, ContinuationSettings, NewtonFailure, ParametricResidual, PathPoint,
-};
+use crate::numerics::{Continuation, NewtonFailure, ParametricResidual, PathPoint};
 
 /// The largest |offset + q(τ)| over a period of the trigonometric polynomial q with
 /// coefficients `coef` on `set` (m): the time-domain peak of a DOF. The maximum is located on a
@@ -171,79 +169,6 @@ pub(super) fn with_stability(
     Ok(point)
 }
 
-/// How far back along the stretch into a dead end, relative to its frequency, the chord of
-/// [`judge_round_dead_end`](super::landing::judge_round_dead_end) reaches: the first point at least
-/// this far from the dead end in frequency (or the stretch's first point). On the 3D blade pair's m
-/// = −1 curve the stretch reaches its dead end at 869.0841 Hz in halving steps (the last ones 10⁻⁸
-/// Hz apart): the chord reaches back to 869.0123 Hz, and a quarter of it past the dead end lands on
-/// the other side of its fold at 869.0661 Hz; on the paper's system at −5 N and H = 3 a fill's dead
-/// end at 92.0992 Hz, reached the same way, turns back a few 10⁻⁵ Hz behind it
-/// (`tests/frf_abandoned.rs`).
-pub const ROUND_FOLD_CHORD: f64 = 5e-5;
-
-/// Steps past a dead end along the chord of
-/// [`judge_round_dead_end`](super::landing::judge_round_dead_end), in chord lengths, in the order
-/// tried.
-pub const ROUND_FOLD_STEPS: &[f64] = &[0.25, 1.0, 0.0625];
-
-/// The other side of a fold at the point `b`, reached from the point `a` before it on the
-/// same stretch: Newton with the frequency free (the corrector of `settings`) on the
-/// hyperplane normal to the chord from `a` to `b` in the unknowns alone, through `b` plus
-/// [`ROUND_FOLD_STEPS`] chord lengths along it; the first landing behind `b` in frequency (on
-/// the side of `a`) is returned. The unknowns are Fourier coefficients of displacements, all in
-/// metres, and the chord is taken in that metric (one scale for all of them, the largest
-/// coefficient of `b`), not in the run's arc-length scales, which grow along the run: the
-/// landing depends on the two points only ([`PointSolver::solve_round_fold`] finds it again).
-pub(super) fn land_round_fold(
-    system: &mut HbmOperator<'_>,
-    settings: ContinuationSettings,
-    a: &FrfPoint,
-    b: &FrfPoint,
-) -> Option<FrfPoint> {
-    let size = system
-        .restrict(&b.coefficients)
-        .iter()
-        .fold(0.0_f64, |m, v| m.max(v.abs()));
-    if !(size > 0.0 && size.is_finite()) {
-        return None;
-    }
-    let newton = Continuation::new(settings, vec![size; system.dim()]);
-    let scale = &newton.x_scale;
-    let scaled = |p: &FrfPoint, system: &HbmOperator<'_>| -> Vec<f64> {
-        system
-            .restrict(&p.coefficients)
-            .iter()
-            .zip(scale)
-            .map(|(v, s)| v / s)
-            .collect()
-    };
-    let (ya, yb) = (scaled(a, system), scaled(b, system));
-    let mut chord: Vec<f64> = yb.iter().zip(&ya).map(|(q, p)| q - p).collect();
-    let length = crate::numerics::linalg::norm(&chord);
-    if !(length > 0.0 && length.is_finite()) {
-        return None;
-    }
-    chord.iter_mut().for_each(|v| *v /= length);
-    // The frequency is free: the hyperplane's normal has no component on it.
-    chord.push(0.0);
-    let back = (a.freq_hz - b.freq_hz).signum();
-    for &steps in ROUND_FOLD_STEPS {
-        let mut predicted: Vec<f64> = yb
-            .iter()
-            .zip(&chord)
-            .map(|(y, c)| y + steps * length * c)
-            .collect();
-        predicted.push(b.freq_hz);
-        let Ok(point) = correct_on_hyperplane(system, &newton, &predicted, &chord) else {
-            continue;
-        };
-        if (point.freq_hz - b.freq_hz) * back > 0.0 {
-            return Some(point);
-        }
-    }
-    None
-}
-
 /// The point on the hyperplane through `predicted` normal to `normal` (both in the scaled
 /// space of `newton`: unknowns over its `x_scale`, then the frequency in Hz), by its corrector
 /// from `predicted`, with the operator left evaluated at it (its contact states those of the
@@ -277,25 +202,6 @@ fn correct_on_hyperplane(
         full_point(system, &path_point).map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
     point.freq_hz = y[n];
     Ok(point)
-}
-
-/// Newton's solution at ω = `omega` (rad/s) from the full coefficients `start`, on full
-/// coefficients; None when it does not converge.
-pub(super) fn newton_at(
-    system: &mut HbmOperator<'_>,
-    newton: &Continuation,
-    start: &[f64],
-    omega: f64,
-) -> Option<Vec<f64>> {
-    let guess = system.restrict(start);
-    let solved = newton.solve_fixed(system, &guess, omega).ok()?;
-    system.expand(&solved.x, omega).ok()
-}
-
-/// ‖a − reference‖ / ‖reference‖ over all coefficients.
-pub(super) fn relative_distance(a: &[f64], reference: &[f64]) -> f64 {
-    let squared: f64 = a.iter().zip(reference).map(|(u, v)| (u - v).powi(2)).sum();
-    squared.sqrt() / crate::numerics::linalg::norm(reference)
 }
 
 /// Solves single points of a problem at fixed frequencies (Newton from a given guess), reusing
@@ -335,13 +241,6 @@ impl<'p> PointSolver<'p> {
             .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
         point.freq_hz = freq_hz;
         Ok(point)
-    }
-
-    /// The other side of a fold at `b`, as the judgement of a dead end seeks it from the point
-    /// `a` before it on the stretch into it (see `judge_round_dead_end`): None where no landing
-    /// behind `b` converges.
-    pub fn solve_round_fold(&mut self, a: &FrfPoint, b: &FrfPoint) -> Option<FrfPoint> {
-        land_round_fold(&mut self.system, self.continuation.settings, a, b)
     }
 
     /// Solves the path point on the hyperplane through `a + t (b − a)` normal to the chord
@@ -482,8 +381,24 @@ pub fn amplitude_across_path(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::frf::fixtures::{line_point, run_with_jumps};
-    use crate::analysis::frf::status::{BranchEnd, Jump, JumpKind};
+    use crate::analysis::frf::status::Jump;
+    use crate::numerics::PathEnd;
+
+    /// A one-DOF point at `freq_hz` (Hz) with first- and third-harmonic cosines `c1`, `c3` (m).
+    fn line_point(freq_hz: f64, c1: f64, c3: f64) -> FrfPoint {
+        FrfPoint {
+            freq_hz,
+            amplitudes: vec![c1.abs()],
+            peaks: vec![0.0],
+            states: Vec::new(),
+            newton_iterations: 1,
+            residual: 0.0,
+            coefficients: vec![c1, 0.0, c3, 0.0],
+            accuracy: None,
+            pending_estimate: None,
+            stability: None,
+        }
+    }
 
     /// The reference path c₁ = 1 + (f − 100) (one DOF, harmonics 1 and 3) crosses the
     /// hyperplane through (100.5 Hz, c₁ = 1.3) normal to the direction (1 Hz, 1) at 100.4 Hz,
@@ -501,19 +416,18 @@ mod tests {
         // jump's segment from (101 Hz, 2) to (99 Hz, −5) crosses it.
         points.push(line_point(99.0, -5.0, 0.0));
         points.push(line_point(97.0, -5.0, 0.0));
-        let mut reference = run_with_jumps(vec![Jump {
-            from_hz: 101.0,
-            to_hz: 97.0,
-            first_point: 11,
-            kind: JumpKind::PastFold,
-            before: BranchEnd::LeftRange,
-            fill_cut: None,
-            cut_check: None,
-            second_cut: None,
-            second_cut_check: None,
-            end_check: None,
-        }]);
-        reference.points = points;
+        let mut reference = FrfRun {
+            points,
+            turning_points: Vec::new(),
+            rejected_steps: 0,
+            jumps: vec![Jump {
+                from_hz: 101.0,
+                to_hz: 97.0,
+                first_point: 11,
+            }],
+            end: PathEnd::EndFrequency,
+            elapsed_s: 0.0,
+        };
         let point = FrfPoint {
             coefficients: vec![1.3, 0.0],
             ..line_point(100.5, 1.3, 0.0)

@@ -1,17 +1,15 @@
-//! The FRF driver: the starting guess, the continuation over the range, jumps past folds the
-//! path does not come back from, and the judgements, reported to the observer as they come.
+//! The FRF driver: the starting guess, the continuation over the range, and the jump past a
+//! fold the path does not come back from, reported to the observer as they come.
 
 use std::collections::VecDeque;
 use std::f64::consts::PI;
 use std::thread::Scope;
 use std::time::Instant;
 
-use super::branches::{forward_leaps, jump_target, reversed_leaps, Branching};
-use super::cuts::{branch_end, bridge_cuts, fill_cut};
-use super::judge::{judge_cuts, judge_leaps};
+use super::branches::{jump_target, Branching};
 use super::observer::{Adapter, FrfObserver, Held};
 use super::scale::{adaptive_scale, arc_length_x_scale, output_amplitude_groups};
-use super::status::{BranchEnd, FrfError, FrfPoint, FrfRun, GivenUp, Jump, JumpKind};
+use super::status::{FrfError, FrfRun, Jump};
 use crate::analysis::error_estimate::EstimateProblems;
 use crate::analysis::estimate_pool::EstimatePool;
 use crate::analysis::linear;
@@ -21,24 +19,20 @@ use crate::model::Problem;
 use crate::numerics::path::NoObserver;
 use crate::numerics::{Continuation, ContinuationSettings, PathEnd};
 
-/// Point budget of the fill of a branch back toward the fold (see [`solve`]).
-const FILL_POINTS: usize = 500;
-
 /// Most jumps to another branch in one run (see [`solve`]).
 const MAX_JUMPS: usize = 8;
 
 /// Solves the nonlinear frequency response of a problem over its analysis range.
 ///
-/// The path is followed from the start frequency. A path that turns back at a fold and does not
-/// come back toward the end (it leaves the range below the start, or wanders without reaching
-/// a higher frequency) is not the whole answer: as in a stepped-sine test sweeping
-/// up, the response then jumps to another branch. The run solves a point just past the highest
-/// frequency reached (see [`jump_target`]) and
-/// follows the path on from it, up to [`MAX_JUMPS`] times. The new branch is first followed
-/// back down toward the highest frequency reached, to fill the gap (those points come first,
-/// in rising frequency). Each jump is reported ([`FrfRun::jumps`], [`FrfObserver::jump`]) with
-/// the frequencies its ends reached: the stretch between them was not computed on any branch
-/// (empty when the fill got back to the highest frequency).
+/// The path is followed from the start frequency to the end frequency. A path that turns back
+/// at a fold and leaves the range below the start is not the whole answer: as in a stepped-sine
+/// test sweeping up, the response then jumps to another branch. The run solves a point just
+/// past the highest frequency reached (see [`jump_target`]) and follows the path on from it, up
+/// to [`MAX_JUMPS`] times. The new branch is first followed back down toward the highest
+/// frequency reached, to fill the gap (those points come first, in rising frequency). Each jump
+/// is reported ([`FrfRun::jumps`], [`FrfObserver::jump`]) with the frequencies its ends
+/// reached: the stretch between them was not computed on any branch (empty when the fill got
+/// back to the highest frequency).
 ///
 /// The points' error estimates (when the scene asks for them) are formed on worker threads
 /// while the path goes on ([`crate::analysis::estimate_pool`]); the observer still receives
@@ -81,17 +75,12 @@ fn solve_in<'scope, 'p, O: FrfObserver>(
         points: Vec::new(),
         turning_points: Vec::new(),
         rejected_steps: 0,
-        leaps: Vec::new(),
-        leap_points: Vec::new(),
-        leap_checks: Vec::new(),
         jumps: Vec::new(),
         end: PathEnd::MaxPoints,
         elapsed_s: 0.0,
     };
     let mut start_hz = settings.freq_start_hz;
     loop {
-        let segment_start = adapter.points.len();
-        let segment_fold: Option<f64>;
         let segment = ContinuationSettings {
             freq_start_hz: start_hz,
             max_points: settings.max_points.saturating_sub(adapter.points.len()),
@@ -100,40 +89,18 @@ fn solve_in<'scope, 'p, O: FrfObserver>(
         let mut continuation = Continuation::new(segment, x_scale.clone())
             .with_adaptive_scale(adaptive.clone())
             .with_amplitude_steps(amplitude_groups.clone());
-        // Where this branch's points go in the report (one per point of its path).
-        let offset = adapter.points.len();
         let outcome = continuation.run(&mut system, &guess, &mut adapter);
         // The next branch starts with the scale this one grew to.
         x_scale.clone_from(&continuation.x_scale);
         if let Some(e) = adapter.failure.take() {
             return Err(FrfError::Setup(e));
         }
-        match outcome {
-            Ok(summary) => {
-                segment_fold = summary.turning_points.last().copied();
-                run.turning_points.extend(summary.turning_points);
-                run.rejected_steps += summary.rejected_steps;
-                run.leaps.extend(summary.leaps);
-                run.leap_points
-                    .extend(forward_leaps(&summary.leap_landings, 0, offset));
-                run.end = summary.end;
-            }
-            // A stall is not a fold: the path goes on past it, but could not be followed. (A
-            // spot past which only the way back was found ends the summary as
-            // `PathEnd::DeadEnd` and is jumped past below.)
-            Err(e) => return Err(e.into()),
-        }
-        let turned_back = matches!(
-            run.end,
-            PathEnd::LeftRangeBelow | PathEnd::NoProgress | PathEnd::DeadEnd
-        );
+        let summary = outcome?;
+        run.turning_points.extend(summary.turning_points);
+        run.rejected_steps += summary.rejected_steps;
+        run.end = summary.end;
         let budget = settings.max_points.saturating_sub(adapter.points.len());
-        let past_folds = run
-            .jumps
-            .iter()
-            .filter(|j| matches!(j.kind, JumpKind::PastFold | JumpKind::PastDeadEnd))
-            .count();
-        if !turned_back || past_folds >= MAX_JUMPS || budget < 2 {
+        if run.end != PathEnd::LeftRangeBelow || run.jumps.len() >= MAX_JUMPS || budget < 2 {
             break;
         }
         let highest = adapter
@@ -152,198 +119,48 @@ fn solve_in<'scope, 'p, O: FrfObserver>(
         else {
             break;
         };
+        // Fill the gap on the new branch, back down toward the highest frequency reached, and
+        // report those points first (in rising frequency) so that the path reads on from the
+        // jump. The fill's first point (at the jump target) is solved again by the branch's
+        // own run.
         let branching = Branching {
             settings,
             x_scale: &x_scale,
             adaptive: &adaptive,
             amplitude_groups: &amplitude_groups,
         };
-        // Fill the gap on the new branch, back down toward the highest frequency reached, and
-        // report those points first (in rising frequency) so that the path reads on from the
-        // jump. The fill's first point (at the jump target) is solved again by the branch's
-        // own run.
-        let budget = settings.max_points.saturating_sub(adapter.points.len());
-        let (mut fill, summary) = branching.follow(
+        let (mut fill, fill_summary) = branching.follow(
             &mut system,
             &x,
             freq_hz,
             highest,
-            (budget / 2).min(FILL_POINTS),
+            budget / 2,
             adapter.estimates,
         );
-        let cut = summary.as_ref().and_then(|summary| {
-            fill_cut(
-                &adapter.points,
-                &run.branch_starts(),
-                &fill,
-                true,
-                summary.end,
-                summary.turning_points.last().copied(),
-            )
-        });
-        // A stretch neither branch reached: solve branches inside it, between the highest
-        // point before the jump and the lowest point of the new branch.
-        let top = adapter
-            .points
-            .iter()
-            .rev()
-            .find(|p| p.freq_hz == highest)
-            .cloned();
-        let bottom = fill
-            .iter()
-            .min_by(|a, b| a.freq_hz.total_cmp(&b.freq_hz))
-            .cloned();
-        // The fill as followed, from the jump target: a branch given up at the point where
-        // the fill ends (its end frequency) lies on the fill's segment into the jump target.
-        let followed_fill = fill.clone();
+        if let Some(s) = &fill_summary {
+            for &f in &s.turning_points {
+                run.turning_points.push(f);
+                adapter.report(Held::TurningPoint(f));
+            }
+            run.rejected_steps += s.rejected_steps;
+        }
         fill.reverse();
         fill.pop();
-        let bridges = match (top, bottom) {
-            (Some(top), Some(bottom)) if bottom.freq_hz > highest => {
-                let budget = settings
-                    .max_points
-                    .saturating_sub(adapter.points.len() + fill.len())
-                    / 2;
-                branching.bridge(
-                    &mut system,
-                    &top,
-                    &bottom,
-                    budget,
-                    adapter.estimates,
-                    (&adapter.points, &run.branch_starts()),
-                )
-            }
-            _ => Vec::new(),
+        let lowest = fill.first().map_or(freq_hz, |p| p.freq_hz.min(freq_hz));
+        let jump = Jump {
+            from_hz: highest,
+            to_hz: lowest,
+            first_point: adapter.points.len(),
         };
-        // What the bridges and the fill met, in the order they are reported (bridges first);
-        // their turning points and leaps go to the observer too (`solution.json` lists them),
-        // its leaps in the order of `run.leaps`, which the leaps' judgements follow.
-        // The fill's leaps as placed in its report: followed down from the jump target and
-        // reported in reverse without that first point, which the next branch solves again
-        // and reports right after the fill.
-        let fill_leaps = summary.as_ref().map_or(Vec::new(), |s| {
-            reversed_leaps(&s.leap_landings, followed_fill.len())
-        });
-        let met = bridges
-            .iter()
-            .map(|b| {
-                (
-                    &b.turning_points,
-                    b.rejected_steps,
-                    &b.leaps,
-                    &b.leap_points,
-                    b.points.len(),
-                )
-            })
-            .chain(summary.as_ref().map(|s| {
-                (
-                    &s.turning_points,
-                    s.rejected_steps,
-                    &s.leaps,
-                    &fill_leaps,
-                    fill.len(),
-                )
-            }));
-        let mut offset = adapter.points.len();
-        for (turning_points, rejected_steps, leaps, places, length) in met {
-            for &freq_hz in turning_points {
-                run.turning_points.push(freq_hz);
-                adapter.report(Held::TurningPoint(freq_hz));
-            }
-            run.rejected_steps += rejected_steps;
-            for (&(from_hz, to_hz), place) in leaps.iter().zip(places) {
-                run.leaps.push((from_hz, to_hz));
-                run.leap_points
-                    .push(place.map(|(before, landing)| (offset + before, offset + landing)));
-                adapter.report(Held::Leap(from_hz, to_hz));
-            }
-            offset += length;
-        }
-        // How the branch before ended, now that the branches solved past it are known (a
-        // branch given up whose last point one of them passes through abandoned nothing).
-        let later: Vec<&[FrfPoint]> = bridges
-            .iter()
-            .map(|b| b.points.as_slice())
-            .chain([followed_fill.as_slice()])
-            .collect();
-        let branch_end = branch_end(
-            &adapter.points,
-            &run.branch_starts(),
-            segment_start,
-            segment_fold,
-            run.end,
-            &later,
-            settings.freq_start_hz,
-        );
-        let mut reached = highest;
-        let mut kind = if run.end == PathEnd::DeadEnd {
-            JumpKind::PastDeadEnd
-        } else {
-            JumpKind::PastFold
-        };
-        let mut before = branch_end;
-        // A bridge's cuts: its way down's, then its way up's.
-        let cuts: Vec<[Option<GivenUp>; 2]> = bridges
-            .iter()
-            .map(|b| b.cuts)
-            .chain([[cut, None]])
-            .collect();
-        let branches = bridges.into_iter().map(|b| b.points).chain([fill]);
-        for (branch, cuts) in branches.zip(cuts) {
-            let (cut, second_cut) = bridge_cuts(cuts);
-            let lowest = branch
-                .iter()
-                .map(|p| p.freq_hz)
-                .fold(f64::INFINITY, f64::min);
-            let jump = Jump {
-                from_hz: reached,
-                // A fill that solved nothing below the jump target starts there.
-                to_hz: if lowest.is_finite() { lowest } else { freq_hz },
-                first_point: adapter.points.len(),
-                kind,
-                before,
-                fill_cut: cut,
-                cut_check: None,
-                second_cut,
-                second_cut_check: None,
-                end_check: None,
-            };
-            adapter.report(Held::Jump(Box::new(jump)));
-            run.jumps.push(jump);
-            for mut p in branch {
-                reached = reached.max(p.freq_hz);
-                // Points followed on a branch have their estimate (across the path) already,
-                // or pending; the others (solved at a fixed frequency) take it at their
-                // frequency.
-                if p.accuracy.is_none() && p.pending_estimate.is_none() {
-                    let omega = 2.0 * PI * p.freq_hz;
-                    adapter.estimate(&mut p, omega, None);
-                }
-                adapter.push_point(p);
-            }
-            kind = JumpKind::Bridge;
-            before = BranchEnd::Bridge;
+        adapter.report(Held::Jump(jump));
+        run.jumps.push(jump);
+        for p in fill {
+            adapter.push_point(p);
         }
         start_hz = freq_hz;
         guess = x;
     }
     run.points = adapter.take_points();
-    // Every branch is known now: judge the cuts of the fills and bridges against all of them.
-    let newton = Continuation::new(settings, x_scale.clone());
-    judge_cuts(&mut system, &newton, &mut run, &mut *adapter.observer);
-    let branching = Branching {
-        settings,
-        x_scale: &x_scale,
-        adaptive: &adaptive,
-        amplitude_groups: &amplitude_groups,
-    };
-    judge_leaps(
-        &mut system,
-        &newton,
-        &branching,
-        &mut run,
-        &mut *adapter.observer,
-    );
     run.elapsed_s = started.elapsed().as_secs_f64();
     Ok(run)
 }

@@ -73,12 +73,6 @@ pub struct CaseCurve {
     pub peak: Option<Peak>,
     /// Continuation retries with other step settings after the first attempt (0: none).
     pub retries: usize,
-    /// Stalls of the kept attempt's path passed over a narrow window around them (the
-    /// response weighing more in the arc length, steps as for that window; see
-    /// `Continuation::run`): (last point before the stall, first point outside the window),
-    /// Hz, in path order. The path is one path through them: a case that passed a stall this
-    /// way is complete only if it covers the range.
-    pub narrow_passes: Vec<(f64, f64)>,
     /// How the case ended.
     pub status: CurveStatus,
 }
@@ -103,7 +97,6 @@ struct Collect {
     points: Vec<FrfPoint>,
     turning_points: Vec<f64>,
     jumps: Vec<Jump>,
-    narrow_passes: Vec<(f64, f64)>,
 }
 
 impl FrfObserver for Collect {
@@ -116,9 +109,6 @@ impl FrfObserver for Collect {
     fn jump(&mut self, jump: &Jump) {
         self.jumps.push(*jump);
     }
-    fn narrow_pass(&mut self, from_hz: f64, to_hz: f64) {
-        self.narrow_passes.push((from_hz, to_hz));
-    }
 }
 
 /// One attempt: its points, turning points and status (before the peak is sought).
@@ -126,7 +116,6 @@ struct Attempt {
     points: Vec<FrfPoint>,
     turning_points: Vec<f64>,
     jumps: Vec<Jump>,
-    narrow_passes: Vec<(f64, f64)>,
     status: CurveStatus,
 }
 
@@ -168,13 +157,11 @@ pub fn attempt_case(problem: &Problem, case: &LimitCase, window: Option<(f64, f6
                 points: run.points,
                 turning_points: run.turning_points,
                 jumps: run.jumps,
-                narrow_passes: collect.narrow_passes,
             },
             Err(source) => Attempt {
                 points: collect.points,
                 turning_points: collect.turning_points,
                 jumps: collect.jumps,
-                narrow_passes: collect.narrow_passes,
                 status: CurveStatus::Failed {
                     error: LimitError::Curve {
                         case: case.name.clone(),
@@ -227,7 +214,6 @@ pub fn attempt_case(problem: &Problem, case: &LimitCase, window: Option<(f64, f6
         jumps: attempt.jumps,
         peak,
         retries,
-        narrow_passes: attempt.narrow_passes,
         status,
     }
 }

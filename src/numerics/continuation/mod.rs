@@ -11,34 +11,22 @@
 //! A point converges when ‖R‖ ≤ tol_R·‖F_ex‖ and the scaled Newton step ≤ tol_y, or when
 //! ‖R‖ ≤ tol_R·‖F_ex‖ and the full Newton step no longer lowers it (the step is then round-off
 //! amplified by an ill-conditioned Jacobian near a lightly damped resonance). A failed
-//! corrector (iteration limit, divergence, singular Jacobian, failed AFT) is not a result: the
-//! step is cut and the reason reported to the observer; below the minimum step the run ends
-//! with [`ContinuationError::Stalled`]. Turning points (sign changes of dω/ds) are reported and
-//! traversed. Where the corrector fails at every step down to the minimum (a contact sample
-//! changing state: the residual is only piecewise smooth), the path is resumed past the spot
-//! by [`Continuation::corner`] (along the outgoing piece) or [`Continuation::leap`] (further
-//! ahead), never on the path already followed: a point found behind the incoming direction
-//! is kept only when a look-ahead step from it leaves that path (a sharp fold), since at a
-//! contact transition such a point can lead straight back onto the incoming branch, which the
-//! path would then retrace (and loop: back along the followed path and on again through the
-//! same corners). "On the path" means near the polyline through all the points followed so far
-//! and the same solution as the path's own at that frequency, by Newton: the other side of a
-//! sharp fold may run within a fraction of a per cent of the side followed, and a branch may
-//! come back onto a stretch followed long before. When neither is found, the path is taken on from its last point over a
-//! narrow window around the spot, with the arc-length scales of a range that narrow, and past
-//! the window with the range's again ([`Continuation::run`]). The spot is instead a *dead
-//! end*, where the run ends with [`PathEnd::DeadEnd`] for the caller to go on past the highest
-//! frequency reached (as after a path that wandered without progress), when it lies below that
-//! frequency (behind a fold), or when a way back along the followed path was refused and either
-//! no window is left to try or the frequency turned back and forth over the last points (the
-//! path bouncing between corners of the sampled law, see `frequency_reversals`). A window
-//! taken where a way back was refused holds its points back from the observer until the path
-//! leaves it; a point of it that lands back on the path already followed, or the window
-//! failing, drops them and ends the path at that dead end. A stall with no window left ends
-//! the run with [`ContinuationError::Stalled`]. The last point is solved at exactly the end
-//! frequency. A path runs down in
-//! frequency when the end frequency is below the start (e.g. to fill in, back toward a fold, a
-//! branch found past it).
+//! corrector (iteration limit, divergence, singular Jacobian, failed AFT), a correction
+//! further from the prediction than the step, or a tangent turned by more than 45° in one
+//! step (a jump to another branch) cuts the step in half and is reported to the observer;
+//! below the minimum step the run ends with [`ContinuationError::Stalled`]. An accepted step
+//! sets the next from Newton's iterations, the turn of the tangent and the change of the
+//! watched output amplitudes. Turning points (sign changes of dω/ds) are reported and
+//! followed. The last point is solved at exactly the end frequency. A path runs down in
+//! frequency when the end frequency is below the start (e.g. to fill in, back toward a fold,
+//! a branch found past it), and a path that turns back at a fold and runs half the range
+//! behind its start ends there ([`PathEnd::LeftRangeBelow`]).
+//!
+//! Nothing here walks around kinks: the event-resolved contact laws make the residual
+//! continuously differentiable, so Newton converges to the tolerance at every point of a
+//! smooth path and plain step control follows its folds. A sampled contact law
+//! (`jenkins-1d-sampled`, `jenkins-2d-sampled`) has kinks where a transition crosses a time
+//! sample; there a run may stall, and says so.
 //!
 //! On large problems (at least [`ContinuationSettings::chord_min_unknowns`] unknowns) the corrector takes
 //! chord iterations: the bordered Newton matrix factorised at one iterate is reused for the
@@ -58,19 +46,16 @@
 //!
 //! The files: [`settings`] (what a continuation is set up with), [`corrector`] (Newton on the
 //! hyperplane and at a fixed frequency), [`predictor`] (the tangent and the step length),
-//! [`events`] (range ends, turning back, no progress), [`recovery`] (corners, leaps and narrow
-//! windows past a spot the corrector cannot pass), [`step`] (accepting a point, and the
-//! observer's events, held back in a window) and [`run`] (the path, step by step).
+//! [`events`] (range ends and Newton's stagnation exit), [`step`] (accepting a point) and
+//! [`run`] (the path, step by step).
 
 mod corrector;
 mod events;
 #[cfg(test)]
 mod fixtures;
 mod predictor;
-mod recovery;
 mod run;
 mod settings;
 mod step;
 
-pub use events::SAME_SOLUTION_TOLERANCE;
 pub use settings::{AdaptiveScale, Continuation, ContinuationSettings, StagnationExit};

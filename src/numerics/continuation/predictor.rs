@@ -11,7 +11,7 @@ use crate::numerics::residual::ParametricResidual;
 /// [`Continuation::with_amplitude_steps`]): about 10 %.
 pub(super) const TARGET_LOG_AMPLITUDE_CHANGE: f64 = 0.1;
 
-/// Largest turn of the tangent in one step before the step is cut (unless it is a corner).
+/// Largest turn of the tangent in one step before the step is cut (a jump to another branch).
 pub(super) const MAX_TURN_DEGREES: f64 = 45.0;
 
 /// Turn of the tangent per step the step length aims at: a step that turned the tangent by
@@ -61,22 +61,6 @@ impl Continuation {
                 self.x_scale[i] = new;
             }
         }
-        let length = norm(tangent);
-        tangent.iter_mut().for_each(|v| *v /= length);
-        *self.last_factor.borrow_mut() = None;
-        *self.carried.borrow_mut() = None;
-    }
-
-    /// Multiplies the scale of every unknown (and the adaptive scale's climb) by `factor` and
-    /// carries the unit tangent over to the new scaled space as the same direction. Kept
-    /// factorisations are dropped: they were built in the old one.
-    pub(super) fn rescale(&mut self, factor: f64, tangent: &mut [f64]) {
-        let n = self.x_scale.len();
-        self.x_scale.iter_mut().for_each(|s| *s *= factor);
-        if let Some(adaptive) = &mut self.adaptive {
-            adaptive.climb *= factor;
-        }
-        tangent[..n].iter_mut().for_each(|v| *v /= factor);
         let length = norm(tangent);
         tangent.iter_mut().for_each(|v| *v /= length);
         *self.last_factor.borrow_mut() = None;

@@ -50,8 +50,6 @@ pub struct Continuation {
     pub(super) adaptive: Option<AdaptiveScale>,
     /// Groups of unknowns whose norm (an output's amplitude) the step length watches.
     pub(super) amplitudes: Vec<Vec<usize>>,
-    /// The narrow-window pass under way, if any (see [`Continuation::enter_narrow`]).
-    pub(super) narrow: Option<NarrowPass>,
     /// Newton gives up once its residual stagnates, if set (see
     /// [`Continuation::with_stagnation_exit`]).
     pub(super) stagnation: Option<StagnationExit>,
@@ -96,27 +94,6 @@ impl StagnationExit {
     }
 }
 
-/// A pass over a narrow window around a spot where the path stalled: the response's arc-length
-/// scale (and that of the adaptive scale's climb) is that of a range a fraction
-/// [`NARROW_WINDOW_FRACTIONS`](super::recovery::NARROW_WINDOW_FRACTIONS) of the path's own, so that
-/// the response weighs that much more against the frequency in the arc length; the step bounds stay
-/// the range's.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct NarrowPass {
-    /// Frequency of the last point before the stall this window starts from (Hz).
-    pub(super) from_hz: f64,
-    /// Frequency of the last point before the first stall of this pass (Hz): `from_hz` unless
-    /// the path stalled inside a narrower window first.
-    pub(super) stalled_hz: f64,
-    /// Half width of the window (Hz): the pass ends at the first point farther than this from
-    /// `from_hz`, either way.
-    pub(super) half_width_hz: f64,
-    /// Factor applied to the scales (the window's width over the range).
-    pub(super) factor: f64,
-    /// Index of `factor` in [`NARROW_WINDOW_FRACTIONS`](super::recovery::NARROW_WINDOW_FRACTIONS).
-    pub(super) attempt: usize,
-}
-
 /// Groups of unknowns whose arc-length scale grows with the response along the path.
 ///
 /// A scale fixed from a first estimate of the response (e.g. the stuck linear one) becomes far
@@ -145,7 +122,6 @@ impl Continuation {
             carried: std::cell::RefCell::new(None),
             adaptive: None,
             amplitudes: Vec::new(),
-            narrow: None,
             stagnation: None,
         }
     }
