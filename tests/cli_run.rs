@@ -164,12 +164,12 @@ fn set_overrides_change_the_solve() {
 #[test]
 fn failed_continuation_keeps_finished_points_and_exits_nonzero() {
     // One Newton iteration per step and a large minimum step: stuck points (a linear
-    // problem) converge in one iteration, so the path must stall at the first stick-slip
-    // transition, after some converged stuck points.
+    // problem) converge in one iteration, so the path over the full range, stuck at its
+    // start, must stall at the first stick-slip transition, after some converged stuck points.
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("stall");
     let o = run_scene(
-        &scene("zoom-2nd.toml"),
+        &scene("full-range.toml"),
         &out,
         &[
             "analysis.max_iterations=1",

@@ -22,11 +22,15 @@
 //! a branch found past it), and a path that turns back at a fold and runs half the range
 //! behind its start ends there ([`PathEnd::LeftRangeBelow`]).
 //!
-//! Nothing here walks around kinks: the event-resolved contact laws make the residual
-//! continuously differentiable, so Newton converges to the tolerance at every point of a
-//! smooth path and plain step control follows its folds. A sampled contact law
-//! (`jenkins-1d-sampled`, `jenkins-2d-sampled`) has kinks where a transition crosses a time
-//! sample; there a run may stall, and says so.
+//! The event-resolved contact laws make the residual continuously differentiable wherever a
+//! contact slips or lifts off, so Newton converges to the tolerance and plain step control
+//! follows the folds. One seam is left: where a contact goes from stuck all period to
+//! slipping, its periodic state changes from the one its initial state sets to the one its
+//! slip sets, and the path has a corner. Where the steps are cut to the minimum at such a
+//! corner, the path is taken on past it on a sphere about the last point
+//! ([`Continuation::turn_corner`]); only where that fails too does the run stall. A sampled
+//! contact law (`jenkins-1d-sampled`, `jenkins-2d-sampled`) has a kink wherever a transition
+//! crosses a time sample, and may stall there.
 //!
 //! On large problems (at least [`ContinuationSettings::chord_min_unknowns`] unknowns) the corrector takes
 //! chord iterations: the bordered Newton matrix factorised at one iterate is reused for the
@@ -46,9 +50,10 @@
 //!
 //! The files: [`settings`] (what a continuation is set up with), [`corrector`] (Newton on the
 //! hyperplane and at a fixed frequency), [`predictor`] (the tangent and the step length),
-//! [`events`] (range ends and Newton's stagnation exit), [`step`] (accepting a point) and
-//! [`run`] (the path, step by step).
+//! [`events`] (range ends and Newton's stagnation exit), [`corner`] (past a corner of the
+//! path), [`step`] (accepting a point) and [`run`] (the path, step by step).
 
+mod corner;
 mod corrector;
 mod events;
 #[cfg(test)]

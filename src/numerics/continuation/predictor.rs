@@ -67,6 +67,22 @@ impl Continuation {
         *self.carried.borrow_mut() = None;
     }
 
+    /// Multiplies the scale of every unknown (and the adaptive scale's climb) by `factor` and
+    /// carries the unit tangent over to the new scaled space as the same direction. Kept
+    /// factorisations are dropped: they were built in the old one.
+    pub(super) fn rescale(&mut self, factor: f64, tangent: &mut [f64]) {
+        let n = self.x_scale.len();
+        self.x_scale.iter_mut().for_each(|s| *s *= factor);
+        if let Some(adaptive) = &mut self.adaptive {
+            adaptive.climb *= factor;
+        }
+        tangent[..n].iter_mut().for_each(|v| *v /= factor);
+        let length = norm(tangent);
+        tangent.iter_mut().for_each(|v| *v /= length);
+        *self.last_factor.borrow_mut() = None;
+        *self.carried.borrow_mut() = None;
+    }
+
     /// Keeps the chord corrector's last factorisation for the tangent at its point.
     pub(super) fn keep_factor(&self, factor: Option<BorderedFactor>, tangent: &[f64]) {
         *self.last_factor.borrow_mut() = factor.map(|f| (tangent.to_vec(), f));
