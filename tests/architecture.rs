@@ -3,9 +3,9 @@
 //!
 //! The layers, lowest first, are listed in [`LAYERS`] (and in the guide's architecture
 //! chapter, docs/src/dev/architecture.md). An edge A → B is any path in A's code (not its
-//! comments or strings) that names an item of module B: `crate::…`, `super::…` and `self::…` paths and, in a module with children (a folder's
-//! `mod.rs`), paths through a child: the re-exports `pub use child::…` and calls such as
-//! `child::run(…)`, so a `mod.rs` that calls into a child which uses the `mod.rs` back is a
+//! comments or strings) that names an item of module B: `crate::…`, `super::…` and
+//! `self::…` paths and, in a module with children (a folder's `mod.rs`), paths through a
+//! child: the re-exports `pub use child::…` and calls such as `child::run(…)`, so a `mod.rs` that calls into a child which uses the `mod.rs` back is a
 //! loop. A path through a re-export is followed to the module that defines the item, so
 //! `crate::contact::ContactPoint` is an edge to `contact::point`. `mod` declarations are
 //! containment, not use, and are not edges. Inline `#[cfg(test)]` modules are tests: like the
