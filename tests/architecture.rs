@@ -1,14 +1,14 @@
 //! The module graph points one way: no import cycle between any two files of the workspace,
 //! and the layers of `src/` only use layers below them.
 //!
-//! The layers, lowest first, are listed in [`LAYERS`] (and in the guide's architecture
-//! chapter, docs/src/dev/architecture.md). An edge A → B is any path in A's code (not its
-//! comments or strings) that names an item of module B: `crate::…`, `super::…` and
-//! `self::…` paths and, in a module with children (a folder's `mod.rs`), paths through a
-//! child: the re-exports `pub use child::…` and calls such as `child::run(…)`, so a `mod.rs` that calls into a child which uses the `mod.rs` back is a
-//! loop. A path through a re-export is followed to the module that defines the item, so
-//! `crate::contact::ContactPoint` is an edge to `contact::point`. `mod` declarations are
-//! containment, not use, and are not edges. Inline `#[cfg(test)]` modules are tests: like the
+//! The layers, lowest first, are listed in [`LAYERS`] (and in the guide's architecture chapter,
+//! docs/src/dev/architecture.md). An edge A → B is any path in A's code (not its comments or
+//! strings) that names an item of module B: `crate::…`, `super::…` and `self::…` paths and, in a
+//! module with children (a folder's `mod.rs`), paths through a child: the re-exports `pub use
+//! child::…` and calls such as `child::run(…)`, so a `mod.rs` that calls into a child which uses
+//! the `mod.rs` back is a loop. A path through a re-export is followed to the module that defines
+//! the item, so `crate::contact::ContactPoint` is an edge to `contact::point`. `mod` declarations
+//! are containment, not use, and are not edges. Inline `#[cfg(test)]` modules are tests: like the
 //! files of `tests/`, they may build their fixtures with any layer, and are left out.
 //!
 //! No source file of the workspace is longer than [`MAX_LINES`] lines: a file that grows past
