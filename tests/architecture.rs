@@ -721,6 +721,9 @@ fn the_link_checker_sees_missing_files_and_headings() {
     let broken = doc_links::broken_links(&dir, &[index, page]);
     std::fs::remove_dir_all(&dir).unwrap();
     assert_eq!(broken.len(), 2, "{broken:?}");
-    assert!(broken[0].contains("page.md#title-2: no such heading"), "{broken:?}");
+    assert!(
+        broken[0].contains("page.md#title-2: no such heading"),
+        "{broken:?}"
+    );
     assert!(broken[1].contains("gone.md: no such file"), "{broken:?}");
 }

@@ -37,7 +37,11 @@ pub fn broken_links(root: &Path, files: &[PathBuf]) -> Vec<String> {
     for file in files {
         let text = std::fs::read_to_string(file).expect("documentation file is readable");
         let dir = file.parent().expect("a file has a folder");
-        let shown = file.strip_prefix(root).unwrap_or(file).display().to_string();
+        let shown = file
+            .strip_prefix(root)
+            .unwrap_or(file)
+            .display()
+            .to_string();
         for (line_no, line) in prose_lines(&text) {
             for target in link_targets(&line) {
                 let (path, anchor) = target.split_once('#').unwrap_or((target.as_str(), ""));
