@@ -1,14 +1,14 @@
 //! The module graph points one way: no import cycle between any two files of the workspace,
 //! and the layers of `src/` only use layers below them.
 //!
-//! The layers, lowest first, are listed in [`LAYERS`] (and in the README's layout table). An
-//! edge A → B is any path in A's code (not its comments or strings) that names an item of
-//! module B: `crate::…`, `super::…` and `self::…` paths and, in a module with children (a folder's
-//! `mod.rs`), paths through a child: the re-exports `pub use child::…` and calls such as
-//! `child::run(…)`, so a `mod.rs` that calls into a child which uses the `mod.rs` back is a
-//! loop. A path through a re-export is followed to the module that defines the item, so
-//! `crate::contact::ContactPoint` is an edge to `contact::point`. `mod` declarations are
-//! containment, not use, and are not edges. Inline `#[cfg(test)]` modules are tests: like the
+//! The layers, lowest first, are listed in [`LAYERS`] (and in the guide's architecture chapter,
+//! docs/src/dev/architecture.md). An edge A → B is any path in A's code (not its comments or
+//! strings) that names an item of module B: `crate::…`, `super::…` and `self::…` paths and, in a
+//! module with children (a folder's `mod.rs`), paths through a child: the re-exports `pub use
+//! child::…` and calls such as `child::run(…)`, so a `mod.rs` that calls into a child which uses
+//! the `mod.rs` back is a loop. A path through a re-export is followed to the module that defines
+//! the item, so `crate::contact::ContactPoint` is an edge to `contact::point`. `mod` declarations
+//! are containment, not use, and are not edges. Inline `#[cfg(test)]` modules are tests: like the
 //! files of `tests/`, they may build their fixtures with any layer, and are left out.
 //!
 //! No source file of the workspace is longer than [`MAX_LINES`] lines: a file that grows past
@@ -16,6 +16,13 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
+
+#[path = "support/rust_source.rs"]
+mod rust_source;
+use rust_source::{code_only, declared_for_tests, tokens, without_test_modules, Token};
+
+#[path = "support/doc_links.rs"]
+mod doc_links;
 
 /// Top-level modules of `src/`, lowest layer first. A module may use the ones before it.
 const LAYERS: &[&str] = &[
@@ -92,182 +99,6 @@ impl CrateModules {
     fn is_module(&self, path: &str) -> bool {
         self.files.contains_key(path)
     }
-}
-
-/// Source text without comments, string and character literals (replaced by spaces).
-fn code_only(text: &str) -> String {
-    let b = text.as_bytes();
-    let mut out = String::with_capacity(text.len());
-    let mut i = 0;
-    while i < b.len() {
-        let c = b[i];
-        if c == b'/' && b.get(i + 1) == Some(&b'/') {
-            while i < b.len() && b[i] != b'\n' {
-                i += 1;
-            }
-        } else if c == b'/' && b.get(i + 1) == Some(&b'*') {
-            let mut depth = 0;
-            while i < b.len() {
-                if b[i] == b'/' && b.get(i + 1) == Some(&b'*') {
-                    depth += 1;
-                    i += 2;
-                } else if b[i] == b'*' && b.get(i + 1) == Some(&b'/') {
-                    depth -= 1;
-                    i += 2;
-                    if depth == 0 {
-                        break;
-                    }
-                } else {
-                    i += 1;
-                }
-            }
-            out.push(' ');
-        } else if c == b'r' && matches!(b.get(i + 1), Some(b'"') | Some(b'#')) && {
-            let mut j = i + 1;
-            while b.get(j) == Some(&b'#') {
-                j += 1;
-            }
-            b.get(j) == Some(&b'"') && (i == 0 || !(b[i - 1].is_ascii_alphanumeric()))
-        } {
-            let mut j = i + 1;
-            let mut hashes = 0;
-            while b[j] == b'#' {
-                hashes += 1;
-                j += 1;
-            }
-            j += 1;
-            loop {
-                if j >= b.len() {
-                    break;
-                }
-                if b[j] == b'"' && (0..hashes).all(|k| b.get(j + 1 + k) == Some(&b'#')) {
-                    j += 1 + hashes;
-                    break;
-                }
-                j += 1;
-            }
-            i = j;
-            out.push_str("\"\"");
-        } else if c == b'"' {
-            i += 1;
-            while i < b.len() && b[i] != b'"' {
-                if b[i] == b'\\' {
-                    i += 1;
-                }
-                i += 1;
-            }
-            i += 1;
-            out.push_str("\"\"");
-        } else if c == b'\'' && (b.get(i + 1) == Some(&b'\\') || b.get(i + 2) == Some(&b'\'')) {
-            // A character literal ('a', '\n', '\''); a lifetime has no closing quote.
-            i += 1;
-            if b[i] == b'\\' {
-                i += 2;
-            }
-            while i < b.len() && b[i] != b'\'' {
-                i += 1;
-            }
-            i += 1;
-            out.push_str("' '");
-        } else {
-            // Copy one UTF-8 character.
-            let len = text[i..].chars().next().map_or(1, char::len_utf8);
-            out.push_str(&text[i..i + len]);
-            i += len;
-        }
-    }
-    out
-}
-
-/// Whether `text` declares the child module `name` as `#[cfg(test)] mod name;`.
-fn declared_for_tests(text: &str, name: &str) -> bool {
-    ["mod ", "pub mod ", "pub(crate) mod "].iter().any(|kw| {
-        let decl = format!("{kw}{name};");
-        text.match_indices(&decl)
-            .any(|(at, _)| text[..at].trim_end().ends_with("#[cfg(test)]"))
-    })
-}
-
-/// Code without its inline `#[cfg(test)] mod name { … }` blocks.
-fn without_test_modules(code: &str) -> String {
-    let mut out = code.to_string();
-    while let Some(start) = out.find("#[cfg(test)]") {
-        let rest = &out[start + "#[cfg(test)]".len()..];
-        let trimmed = rest.trim_start();
-        let is_mod = trimmed.starts_with("mod ") || trimmed.starts_with("pub mod ");
-        // `#[cfg(test)] mod name;` declares a test module in a file of its own (left out by
-        // `CrateModules::read`): blank the declaration only.
-        let semicolon = rest.find(';');
-        let brace = rest.find('{');
-        if is_mod && semicolon.is_some_and(|sc| brace.is_none_or(|b| sc < b)) {
-            let end = start + "#[cfg(test)]".len() + semicolon.expect("checked") + 1;
-            out.replace_range(start..end, " ");
-            continue;
-        }
-        let Some(open) = brace.filter(|_| is_mod) else {
-            // Not a module (a test-only item): blank the attribute only.
-            out.replace_range(start..start + "#[cfg(test)]".len(), " ");
-            continue;
-        };
-        let open = start + "#[cfg(test)]".len() + open;
-        let mut depth = 0usize;
-        let mut end = out.len();
-        for (k, c) in out[open..].char_indices() {
-            match c {
-                '{' => depth += 1,
-                '}' => {
-                    depth -= 1;
-                    if depth == 0 {
-                        end = open + k + 1;
-                        break;
-                    }
-                }
-                _ => {}
-            }
-        }
-        out.replace_range(start..end, " ");
-    }
-    out
-}
-
-#[derive(Debug, Clone, PartialEq)]
-enum Token {
-    Ident(String),
-    PathSep,
-    Open,
-    Close,
-    Comma,
-    Other(char),
-}
-
-fn tokens(code: &str) -> Vec<Token> {
-    let chars: Vec<char> = code.chars().collect();
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < chars.len() {
-        let c = chars[i];
-        if c.is_alphanumeric() || c == '_' {
-            let start = i;
-            while i < chars.len() && (chars[i].is_alphanumeric() || chars[i] == '_') {
-                i += 1;
-            }
-            out.push(Token::Ident(chars[start..i].iter().collect()));
-            continue;
-        }
-        match c {
-            ':' if chars.get(i + 1) == Some(&':') => {
-                out.push(Token::PathSep);
-                i += 1;
-            }
-            '{' => out.push(Token::Open),
-            '}' => out.push(Token::Close),
-            ',' => out.push(Token::Comma),
-            c if c.is_whitespace() => {}
-            c => out.push(Token::Other(c)),
-        }
-        i += 1;
-    }
-    out
 }
 
 /// Reads a path or use tree from `toks[*i]` (after a `::`), appending every full path.
@@ -860,4 +691,39 @@ fn the_checker_sees_a_mod_rs_calling_into_a_child_that_uses_it_back() {
             ],
         ])
     );
+}
+
+#[test]
+fn every_relative_link_and_anchor_of_the_documentation_resolves() {
+    let root = root();
+    let files = doc_links::documentation_files(&root);
+    assert!(files.len() > 10, "the guide's pages are found: {files:?}");
+    let broken = doc_links::broken_links(&root, &files);
+    assert!(broken.is_empty(), "broken links:\n{}", broken.join("\n"));
+}
+
+#[test]
+fn the_link_checker_sees_missing_files_and_headings() {
+    assert_eq!(
+        doc_links::anchor("2D friction law (`jenkins-2d`)".replace('`', "").as_str()),
+        "2d-friction-law-jenkins-2d"
+    );
+    assert_eq!(doc_links::anchor("The 5 % bound"), "the-5--bound");
+    assert_eq!(doc_links::anchor("See [Outputs](x.md)"), "see-outputs");
+    let dir = std::env::temp_dir().join(format!("fricbound-doc-links-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let page = dir.join("page.md");
+    std::fs::write(&page, "# Title\n\n## Title\n\n```\n[not](a-link.md)\n```\n").unwrap();
+    let index = dir.join("index.md");
+    let links = "[a](page.md#title-1) [b](page.md#title-2) [c](gone.md) `[d](gone.md)` \
+                 [e](https://example.org/x) [f](#here)\n\n# Here\n";
+    std::fs::write(&index, links).unwrap();
+    let broken = doc_links::broken_links(&dir, &[index, page]);
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(broken.len(), 2, "{broken:?}");
+    assert!(
+        broken[0].contains("page.md#title-2: no such heading"),
+        "{broken:?}"
+    );
+    assert!(broken[1].contains("gone.md: no such file"), "{broken:?}");
 }

@@ -707,7 +707,7 @@ fn check_accepts_the_shipped_scene_file() {
     assert!(out.stdout.contains("harmonics    [0, 1]"), "{}", out.stdout);
 }
 
-/// The minimal example of `docs/scene.md`, verbatim.
+/// The minimal example of `docs/src/scene.md`, verbatim.
 const DOC_EXAMPLE: &str = r#"title = "Single-DOF oscillator grounded through one Jenkins contact"
 
 [model]
@@ -774,11 +774,11 @@ fn doc_example_is_valid() {
 
 #[test]
 fn doc_example_matches_the_docs() {
-    let docs = concat!(env!("CARGO_MANIFEST_DIR"), "/docs/scene.md");
-    let text = std::fs::read_to_string(docs).expect("docs/scene.md");
+    let docs = concat!(env!("CARGO_MANIFEST_DIR"), "/docs/src/scene.md");
+    let text = std::fs::read_to_string(docs).expect("docs/src/scene.md");
     assert!(
         text.contains(DOC_EXAMPLE),
-        "the minimal example in docs/scene.md differs from DOC_EXAMPLE"
+        "the minimal example in docs/src/scene.md differs from DOC_EXAMPLE"
     );
 }
 

@@ -80,7 +80,6 @@ class ContinuationPath:
 
 class FrfResult(ContinuationPath):
     turning_points_hz: List[float]
-    leaps_hz: List[Tuple[float, float]]
     jumps: List[Dict[str, Any]]
     rejected_steps: int
     elapsed_s: float
