@@ -36,13 +36,14 @@ impl AftWorkspace {
         self.synthesize(v_coefficients, Signal::V);
         self.events
             .differentiate(&self.set, u_coefficients, v_coefficients);
-        for i in 0..4 {
+        // u′ and v′ on the grid; u″ and v″ only where the march asks for them.
+        for (coefficients, samples) in [0, 2].iter().zip(&mut self.events.derivative_samples) {
             super::synthesize_into(
                 &self.set,
                 self.inverse.as_ref(),
                 (&mut self.spectrum, &mut self.scratch_inv),
-                &self.events.derivative_coefficients[i],
-                &mut self.events.derivative_samples[i],
+                &self.events.derivative_coefficients[*coefficients],
+                samples,
             );
         }
         let constant_v = self
@@ -69,11 +70,17 @@ impl AftWorkspace {
             self.settings.periodicity_tolerance * self.settings.length_scale(scale, law.kt);
         let mut pieces = std::mem::take(&mut self.events.pieces);
         let mut intervals = std::mem::take(&mut self.events.closed_intervals);
+        let mut bounds = std::mem::take(&mut self.events.bounds);
         let orbit = {
-            let [du, ddu, dv, ddv] = &self.events.derivative_samples;
+            let [du, dv] = &self.events.derivative_samples;
+            let [_, ddu, _, ddv] = &self.events.derivative_coefficients;
+            bounds.fill(&params, &signals, [&self.u, du], [&self.v, dv]);
             let grid = Grid {
-                u: [&self.u, du, ddu],
-                v: [&self.v, dv, ddv],
+                u: [&self.u, du],
+                v: [&self.v, dv],
+                second: [ddu, ddv],
+                basis: &self.basis,
+                bounds: &bounds,
             };
             if params.constant_limit.is_none() && effects.liftoff {
                 closed_intervals(&signals, &grid, &mut intervals);
@@ -89,6 +96,7 @@ impl AftWorkspace {
         };
         self.events.pieces = pieces;
         self.events.closed_intervals = intervals;
+        self.events.bounds = bounds;
         let periods = orbit.map_err(|failure| match failure {
             MarchFailure::NotSettled { periods, drift } => AftError::NotSettled { periods, drift },
             MarchFailure::TooManyEvents => AftError::TooManyEvents,

@@ -7,8 +7,9 @@
 //! change of f′ across it, and every root is refined by Brent's method on direct evaluations
 //! of the trigonometric polynomials, to round-off of τ.
 
+use super::bounds::{Bounded, CellBounds, BLOCK};
 use super::roots::brent;
-use crate::contact::harmonic::Block;
+use crate::contact::harmonic::{Block, SampleBasis};
 use std::f64::consts::PI;
 
 /// u, v and their first two τ-derivatives at one instant (m, m/rad, m/rad²).
@@ -34,6 +35,8 @@ impl Signals<'_> {
     /// u, v and their derivatives at τ.
     pub fn at(&self, tau: f64) -> Kinematics {
         let mut k = Kinematics::default();
+        // The cosine and sine blocks of a harmonic are adjacent: one sin_cos serves both.
+        let mut last = (usize::MAX, 0.0, 0.0);
         for (j, block) in self.blocks.iter().enumerate() {
             let (cu, cv) = (self.u[j], self.v[j]);
             match *block {
@@ -41,9 +44,12 @@ impl Signals<'_> {
                     k.u[0] += cu;
                     k.v[0] += cv;
                 }
-                Block::Cos(h) | Block::Sin(h) => {
-                    let h = h as f64;
-                    let (s, c) = (h * tau).sin_cos();
+                Block::Cos(n) | Block::Sin(n) => {
+                    if last.0 != n {
+                        let (s, c) = (n as f64 * tau).sin_cos();
+                        last = (n, s, c);
+                    }
+                    let (h, s, c) = (n as f64, last.1, last.2);
                     // d/dτ cos hτ = −h sin hτ, d/dτ sin hτ = h cos hτ.
                     let (b0, b1, b2) = match *block {
                         Block::Cos(_) => (c, -h * s, -h * h * c),
@@ -61,12 +67,20 @@ impl Signals<'_> {
     }
 }
 
-/// The grid values of [`Kinematics`] over one period, N samples at τₖ = 2πk/N.
+/// The grid values of [`Kinematics`] over one period, N samples at τₖ = 2πk/N: u, u′, v, v′
+/// as samples, u″ and v″ from their coefficients at the few samples that need them (the end
+/// of a slip is the one exit whose rate uses them).
 pub struct Grid<'a> {
-    /// [u, u′, u″] samples.
-    pub u: [&'a [f64]; 3],
-    /// [v, v′, v″] samples.
-    pub v: [&'a [f64]; 3],
+    /// [u, u′] samples.
+    pub u: [&'a [f64]; 2],
+    /// [v, v′] samples.
+    pub v: [&'a [f64]; 2],
+    /// Coefficients of u″ and v″ on the force blocks.
+    pub second: [&'a [f64]; 2],
+    /// The synthesis matrix of the grid (basis values at the samples).
+    pub basis: &'a SampleBasis,
+    /// Bounds of the exit functions over blocks of cells, filled from these samples.
+    pub bounds: &'a CellBounds,
 }
 
 impl Grid<'_> {
@@ -74,11 +88,18 @@ impl Grid<'_> {
         self.u[0].len()
     }
 
-    fn at(&self, k: usize) -> Kinematics {
-        let k = k % self.len();
+    /// The kinematics at sample k (0 ≤ k < N); u″ and v″ only with `second` (zero otherwise).
+    fn at(&self, k: usize, second: bool) -> Kinematics {
+        let (ddu, ddv) = if second {
+            let row = self.basis.row(k);
+            let dot = |c: &[f64]| row.iter().zip(c).map(|(e, c)| e * c).sum::<f64>();
+            (dot(self.second[0]), dot(self.second[1]))
+        } else {
+            (0.0, 0.0)
+        };
         Kinematics {
-            u: [self.u[0][k], self.u[1][k], self.u[2][k]],
-            v: [self.v[0][k], self.v[1][k], self.v[2][k]],
+            u: [self.u[0][k], self.u[1][k], ddu],
+            v: [self.v[0][k], self.v[1][k], ddv],
         }
     }
 }
@@ -312,6 +333,16 @@ struct Marcher<'a> {
     cell: f64,
 }
 
+/// One cell (a, b] of the march for one exit function: τ (rad), f and f′ at both ends, the
+/// level below which f counts as zero at a, and whether the cell is the phase's first.
+#[derive(Clone, Copy)]
+struct Cell {
+    a: (f64, f64, f64),
+    b: (f64, f64, f64),
+    zero: f64,
+    first: bool,
+}
+
 impl Marcher<'_> {
     /// The phase at τ = 0: open without a friction limit there, else stuck with the slider
     /// at T(0) = m μN(0), or slipping at once when |m| = 1 and the trial force leaves the
@@ -420,6 +451,11 @@ impl Marcher<'_> {
     }
 
     /// The first event of `phase` in (t0, t_end], with its time.
+    ///
+    /// The exit functions and their rates at a cell's end are carried over as the next cell's
+    /// start values, and a cell is examined further only where an exit function ends above
+    /// zero or its rate falls from positive to negative (the two cases
+    /// [`Self::crossing`] looks at): most cells cost one evaluation of each exit function.
     fn next_event(&self, phase: Phase, t0: f64, t_end: f64) -> Option<(f64, Event)> {
         let (events, count) = self.exits(phase);
         let events = &events[..count];
@@ -430,22 +466,66 @@ impl Marcher<'_> {
             Phase::Stick { w, .. } => w,
             _ => 0.0,
         };
+        let n = self.grid.len();
+        // Only the end of a slip has a rate that needs u″ and v″.
+        let second = matches!(phase, Phase::Slip { .. });
         let mut a = t0;
         let mut ka = self.signals.at(t0);
+        let mut exits_a = [(0.0, 0.0); 3];
+        for (x, &event) in exits_a.iter_mut().zip(events) {
+            *x = self.exit(event, w, &ka);
+        }
         let mut first = true;
         let mut k = (t0 / self.cell).floor() as usize + 1;
+        let mut index = k % n;
         loop {
+            if !first {
+                // a is the grid point k − 1: pass over the rest of its block at once where
+                // no exit function can turn positive in it, as long as the block ends
+                // before t_end.
+                let i = if index == 0 { n - 1 } else { index - 1 };
+                let block = i / BLOCK;
+                let block_end = ((block + 1) * BLOCK).min(n);
+                let a_next = k - 1 + (block_end - i);
+                if (a_next as f64) * self.cell < t_end && self.block_quiet(phase, block) {
+                    let ia = block_end % n;
+                    a = a_next as f64 * self.cell;
+                    ka = self.grid.at(ia, second);
+                    for (x, &event) in exits_a.iter_mut().zip(events) {
+                        *x = self.exit(event, w, &ka);
+                    }
+                    k = a_next + 1;
+                    index = if ia + 1 == n { 0 } else { ia + 1 };
+                    continue;
+                }
+            }
             let grid_b = k as f64 * self.cell;
             let (b, kb) = if grid_b < t_end {
-                (grid_b, self.grid.at(k))
+                (grid_b, self.grid.at(index, second))
             } else {
                 (t_end, self.signals.at(t_end))
             };
+            let mut exits_b = [(0.0, 0.0); 3];
+            for (x, &event) in exits_b.iter_mut().zip(events) {
+                *x = self.exit(event, w, &kb);
+            }
             if b > a {
                 let mut best: Option<(f64, Event)> = None;
-                for &event in events {
-                    let root = self.crossing(event, w, (a, &ka), (b, &kb), first);
-                    if let Some(tau) = root {
+                for (i, &event) in events.iter().enumerate() {
+                    let ((fa, dfa), (fb, dfb)) = (exits_a[i], exits_b[i]);
+                    // The zero level is never negative: below both tests, no root (see
+                    // `crossing`).
+                    if fb <= 0.0 && !(dfa > 0.0 && dfb < 0.0) {
+                        continue;
+                    }
+                    let zero = self.zero_level(event, w, &ka);
+                    let cell = Cell {
+                        a: (a, fa, dfa),
+                        b: (b, fb, dfb),
+                        zero,
+                        first,
+                    };
+                    if let Some(tau) = self.crossing(event, w, cell) {
                         if best.is_none_or(|(t, _)| tau < t) {
                             best = Some((tau, event));
                         }
@@ -461,7 +541,33 @@ impl Marcher<'_> {
             }
             a = b;
             ka = kb;
+            exits_a = exits_b;
             k += 1;
+            index = if index + 1 == n { 0 } else { index + 1 };
+        }
+    }
+
+    /// Whether no exit function of `phase` can turn positive anywhere in block `block` of
+    /// the grid ([`CellBounds`]).
+    fn block_quiet(&self, phase: Phase, block: usize) -> bool {
+        let bound = |which| self.grid.bounds.of(block, which);
+        let stays_closed = self.law.constant_limit.is_some() || bound(Bounded::Opening) < 0.0;
+        match phase {
+            Phase::Stick { w, .. } => {
+                let ktw = self.law.kt * w;
+                bound(Bounded::SlipPositive) - ktw < 0.0
+                    && bound(Bounded::SlipNegative) + ktw < 0.0
+                    && stays_closed
+            }
+            Phase::Slip { sign } => {
+                let end = if sign > 0.0 {
+                    Bounded::StickPositive
+                } else {
+                    Bounded::StickNegative
+                };
+                bound(end) < 0.0 && stays_closed
+            }
+            Phase::Open => self.law.constant_limit.is_some() || bound(Bounded::Closing) < 0.0,
         }
     }
 
@@ -469,17 +575,13 @@ impl Marcher<'_> {
     /// sign change across the cell, or a graze (f′ falls from positive to negative inside the
     /// cell at a positive maximum of f). At a phase's first cell f(a) is zero by construction
     /// (the event that started it), and f is known to fall first.
-    fn crossing(
-        &self,
-        event: Event,
-        w: f64,
-        (a, ka): (f64, &Kinematics),
-        (b, kb): (f64, &Kinematics),
-        first: bool,
-    ) -> Option<f64> {
-        let (fa, dfa) = self.exit(event, w, ka);
-        let (fb, dfb) = self.exit(event, w, kb);
-        let zero = self.zero_level(event, w, ka);
+    fn crossing(&self, event: Event, w: f64, cell: Cell) -> Option<f64> {
+        let Cell {
+            a: (a, fa, dfa),
+            b: (b, fb, dfb),
+            zero,
+            first,
+        } = cell;
         let f = |t: f64| self.exit(event, w, &self.signals.at(t)).0;
         if fb > zero {
             if fa < -zero {
@@ -558,8 +660,20 @@ pub fn closed_intervals(signals: &Signals<'_>, grid: &Grid<'_>, out: &mut Vec<(f
             out.push((*start, tau));
         }
     };
-    for k in 0..n {
+    let mut k = 0;
+    while k < n {
+        if k % BLOCK == 0 {
+            // v keeps its sign over the whole block: no root, no short closing or opening.
+            let block = k / BLOCK;
+            let bounds = grid.bounds;
+            if bounds.of(block, Bounded::Opening) < 0.0 || bounds.of(block, Bounded::Closing) < 0.0
+            {
+                k = (k + BLOCK).min(n);
+                continue;
+            }
+        }
         let ((a, va, da), (b, vb, db)) = (at(k), at(k + 1));
+        k += 1;
         if (va > 0.0) != (vb > 0.0) {
             let tau = brent(v, a, b, va, vb);
             closed = vb > 0.0;

@@ -42,6 +42,7 @@
 //!   vanishes: at τₐ, kₜ u′ = s L′);
 //! * closing at τ_c: w = u(τ_c) with v(τ_c) = 0, dw = du(τ_c) − (u′/v′)(τ_c) dv(τ_c).
 
+pub mod bounds;
 pub mod march;
 mod roots;
 
@@ -122,12 +123,14 @@ pub struct ForceOutputs<'a> {
 pub struct EventSolver {
     /// Coefficients of u′, u″, v′, v″ on the force blocks.
     pub derivative_coefficients: [Vec<f64>; 4],
-    /// Grid samples of u′, u″, v′, v″.
-    pub derivative_samples: [Vec<f64>; 4],
+    /// Grid samples of u′ and v′.
+    pub derivative_samples: [Vec<f64>; 2],
     /// Phases of the last periodic orbit over [0, 2π].
     pub pieces: Vec<Piece>,
     /// Stretches of [0, 2π] where v > 0 (variable normal load with lift-off).
     pub closed_intervals: Vec<(f64, f64)>,
+    /// Bounds of the exit functions over blocks of grid cells (for the march to skip them).
+    pub bounds: bounds::CellBounds,
     stick: Moments,
     slip: Moments,
     closed: Moments,

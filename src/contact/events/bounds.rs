@@ -1,0 +1,119 @@
+//! Upper bounds of the exit functions over blocks of grid cells, so that the event march
+//! passes over a block where no event can happen with one comparison per exit function
+//! instead of one evaluation per cell.
+//!
+//! Each exit function of the march ([`super::march`]) is a fixed trigonometric polynomial
+//! shifted by a constant of the phase: kₜ(u − w) − L = (kₜu − L) − kₜw for a slip onset of
+//! sign +, −kₜ(u − w) − L = (−kₜu − L) + kₜw for one of sign −, L′ ∓ kₜu′ for the end of a
+//! slip of sign ±, and ∓v for opening and closing. Between two samples τₐ < τ_b a function f
+//! stays below the chord of its samples plus (τ_b − τₐ)²/8 · max|f″|, and max|f″| is bounded
+//! by the coefficients (Σ h² |ĉ_h| for the second derivative, Σ h³ |ĉ_h| for the third). A
+//! block whose bound is negative holds no root and no graze: the march skips it, and finds
+//! exactly what a cell-by-cell scan finds (which reports nothing in such cells).
+
+use super::march::{LawParams, Signals};
+use crate::contact::harmonic::Block;
+use std::f64::consts::PI;
+
+/// Cells per block.
+pub const BLOCK: usize = 16;
+
+/// Which bounded function (index into [`CellBounds::max`]'s entries).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Bounded {
+    /// kₜu − L (N): a slip onset of sign + once kₜw is subtracted.
+    SlipPositive = 0,
+    /// −kₜu − L (N): a slip onset of sign − once kₜw is added.
+    SlipNegative = 1,
+    /// L′ − kₜu′ (N/rad): the end of a slip of sign +.
+    StickPositive = 2,
+    /// L′ + kₜu′ (N/rad): the end of a slip of sign −.
+    StickNegative = 3,
+    /// −v (m): an opening.
+    Opening = 4,
+    /// v (m): a closing.
+    Closing = 5,
+}
+
+/// Per block of [`BLOCK`] cells, an upper bound of each [`Bounded`] function over the block:
+/// its largest sample on the block's cells (ends included) plus the curvature margin.
+#[derive(Debug, Clone, Default)]
+pub struct CellBounds {
+    /// One entry per block, indexed by [`Bounded`].
+    pub max: Vec<[f64; 6]>,
+}
+
+impl CellBounds {
+    /// The bound of `which` over block `block`.
+    #[inline]
+    pub fn of(&self, block: usize, which: Bounded) -> f64 {
+        self.max[block][which as usize]
+    }
+
+    /// Fills the bounds from the grid samples of u, u′ (`u`) and v, v′ (`v`), N each, and the
+    /// coefficients in `signals` (for the curvature margins).
+    pub fn fill(&mut self, law: &LawParams, signals: &Signals<'_>, u: [&[f64]; 2], v: [&[f64]; 2]) {
+        let n = u[0].len();
+        let cell = 2.0 * PI / n as f64;
+        let variable = law.constant_limit.is_none();
+        let mu_kn = if variable { law.mu_kn } else { 0.0 };
+        // Σ h^p |ĉ| of u and v, p = 2 and 3.
+        let (mut u2, mut u3, mut v2, mut v3) = (0.0, 0.0, 0.0, 0.0);
+        for (j, b) in signals.blocks.iter().enumerate() {
+            if let Block::Cos(h) | Block::Sin(h) = *b {
+                let h = h as f64;
+                let (cu, cv) = (signals.u[j].abs(), signals.v[j].abs());
+                u2 += h * h * cu;
+                u3 += h * h * h * cu;
+                v2 += h * h * cv;
+                v3 += h * h * h * cv;
+            }
+        }
+        let chord = cell * cell / 8.0;
+        let margin_force = chord * (law.kt * u2 + mu_kn * v2);
+        let margin_rate = chord * (law.kt * u3 + mu_kn * v3);
+        let margin_v = chord * v2;
+        let margins = [
+            margin_force,
+            margin_force,
+            margin_rate,
+            margin_rate,
+            margin_v,
+            margin_v,
+        ];
+        let blocks = n.div_ceil(BLOCK);
+        self.max.clear();
+        self.max.resize(blocks, [f64::NEG_INFINITY; 6]);
+        let (kt, constant) = (law.kt, law.constant_limit);
+        // The six functions at sample k (L unclamped, as in the exit functions).
+        let values = |k: usize| {
+            let (limit, rate) = match constant {
+                Some(l) => (l, 0.0),
+                None => (mu_kn * v[0][k], mu_kn * v[1][k]),
+            };
+            let (ktu, ktdu) = (kt * u[0][k], kt * u[1][k]);
+            [
+                ktu - limit,
+                -ktu - limit,
+                rate - ktdu,
+                rate + ktdu,
+                -v[0][k],
+                v[0][k],
+            ]
+        };
+        for (j, m) in self.max.iter_mut().enumerate() {
+            let last = ((j + 1) * BLOCK).min(n);
+            // The block's cells run from sample j·BLOCK to sample `last` (N wraps to 0).
+            let mut acc = values(last % n);
+            for k in j * BLOCK..last {
+                let x = values(k);
+                for (a, x) in acc.iter_mut().zip(x) {
+                    *a = if x > *a { x } else { *a };
+                }
+            }
+            for ((m, a), margin) in m.iter_mut().zip(acc).zip(margins) {
+                *m = a + margin;
+            }
+        }
+    }
+}
