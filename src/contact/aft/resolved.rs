@@ -58,13 +58,15 @@ impl AftWorkspace {
             u: u_coefficients,
             v: v_coefficients,
         };
-        let (umin, umax) = self
-            .u
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
-                (a.min(x), b.max(x))
-            });
-        let nmax = self.n.iter().fold(0.0_f64, |a, &x| a.max(x.abs()));
+        // Plain comparisons (the samples are finite): these loops vectorise.
+        let (mut umin, mut umax, mut nmax) = (f64::INFINITY, f64::NEG_INFINITY, 0.0_f64);
+        for &x in &self.u {
+            umin = if x < umin { x } else { umin };
+            umax = if x > umax { x } else { umax };
+        }
+        for &x in &self.n {
+            nmax = if x.abs() > nmax { x.abs() } else { nmax };
+        }
         let scale = (umax - umin) + law.mu * nmax / law.kt + f64::MIN_POSITIVE;
         let tolerance =
             self.settings.periodicity_tolerance * self.settings.length_scale(scale, law.kt);
@@ -91,7 +93,7 @@ impl AftWorkspace {
                 &grid,
                 self.settings.max_periods,
                 tolerance,
-                &mut pieces,
+                (&mut pieces, &mut self.events.previous_pieces),
             )
         };
         self.events.pieces = pieces;
@@ -142,35 +144,44 @@ impl AftWorkspace {
     }
 
     /// The tangential force samples T(τₖ) and sample kinds of the orbit in the event buffers
-    /// (the normal force samples are set by `normal_forces`).
+    /// (the normal force samples are set by `normal_forces`): sample k lies in the first
+    /// piece that ends after τₖ (the last piece takes the rest).
     fn sample_orbit(&mut self, params: &LawParams) {
         let ns = self.n_samples;
         let pieces = &self.events.pieces;
-        let mut p = 0;
-        for k in 0..ns {
-            let tau = 2.0 * PI * k as f64 / ns as f64;
-            while p + 1 < pieces.len() && pieces[p].end <= tau {
-                p += 1;
+        let tau = |k: usize| 2.0 * PI * k as f64 / ns as f64;
+        let mut k = 0;
+        for (p, piece) in pieces.iter().enumerate() {
+            let last = p + 1 == pieces.len();
+            while k < ns && (last || piece.end > tau(k)) {
+                let (t, kind) = match piece.phase {
+                    // The anchor fields serve the sampled law's Jacobian only; the event
+                    // law's anchors live in its pieces, so these samples record the kind alone.
+                    Phase::Stick { w, .. } => (
+                        params.kt * (self.u[k] - w),
+                        SampleKind::Stick {
+                            anchor: 0,
+                            sign: 0.0,
+                        },
+                    ),
+                    Phase::Slip { sign } => {
+                        let limit = match params.constant_limit {
+                            Some(l) => l,
+                            None => params.mu_kn * self.v[k].max(0.0),
+                        };
+                        (sign * limit, SampleKind::Slip { sign })
+                    }
+                    Phase::Open => (0.0, SampleKind::Open),
+                };
+                self.t[k] = t;
+                self.kinds[k] = kind;
+                k += 1;
             }
-            let limit = match params.constant_limit {
-                Some(l) => l,
-                None => params.mu_kn * self.v[k].max(0.0),
-            };
-            let (t, kind) = match pieces.get(p).map(|q| q.phase) {
-                // The anchor fields serve the sampled law's Jacobian only; the event law's
-                // anchors live in its pieces, so these samples record the kind alone.
-                Some(Phase::Stick { w, .. }) => (
-                    params.kt * (self.u[k] - w),
-                    SampleKind::Stick {
-                        anchor: 0,
-                        sign: 0.0,
-                    },
-                ),
-                Some(Phase::Slip { sign }) => (sign * limit, SampleKind::Slip { sign }),
-                Some(Phase::Open) | None => (0.0, SampleKind::Open),
-            };
-            self.t[k] = t;
-            self.kinds[k] = kind;
         }
+        // No pieces (never after a march): no force.
+        self.t[k..].iter_mut().for_each(|t| *t = 0.0);
+        self.kinds[k..]
+            .iter_mut()
+            .for_each(|kind| *kind = SampleKind::Open);
     }
 }

@@ -249,13 +249,19 @@ pub struct Orbit {
 /// the one-period map of the slider is piecewise constant wherever it resets. The march thus
 /// stops after two or three periods with an exactly periodic event sequence, or after the
 /// first with a contact stuck all period from its initial state.
+///
+/// A period need not be marched to its end: as soon as one of its events repeats an event of
+/// the period before, one period later to round-off of τ and into the same phase, the rest of
+/// it is the rest of that period shifted by 2π (the phase after an event is set by the event
+/// alone), and so is its end state, which the end-of-period test would then accept. That
+/// rest is copied instead of marched. `previous` is scratch for the period before.
 pub fn periodic_orbit(
     law: &LawParams,
     signals: &Signals<'_>,
     grid: &Grid<'_>,
     max_periods: usize,
     tolerance: f64,
-    pieces: &mut Vec<Piece>,
+    (pieces, previous): (&mut Vec<Piece>, &mut Vec<Piece>),
 ) -> Result<usize, MarchFailure> {
     let marcher = Marcher {
         law,
@@ -266,10 +272,12 @@ pub fn periodic_orbit(
     let mut state = marcher.initial_phase();
     let mut drift = f64::INFINITY;
     let max_events = 4 * grid.len() + 16;
+    previous.clear();
     for period in 1..=max_periods.max(2) {
         pieces.clear();
         let start = state;
         let (mut t, end) = (2.0 * PI * (period - 1) as f64, 2.0 * PI * period as f64);
+        let mut matched = false;
         loop {
             match marcher.next_event(state, t, end) {
                 None => {
@@ -288,41 +296,79 @@ pub fn periodic_orbit(
                     });
                     state = marcher.after(event, tau);
                     t = tau;
+                    if let Some(q) = repeated_piece(previous, tau - 2.0 * PI, state, tolerance) {
+                        pieces.push(Piece {
+                            start: tau,
+                            end: previous[q].end + 2.0 * PI,
+                            phase: state,
+                        });
+                        pieces.extend(previous[q + 1..].iter().map(|p| shifted(*p, 2.0 * PI)));
+                        matched = true;
+                        break;
+                    }
                 }
             }
             if pieces.len() > max_events {
                 return Err(MarchFailure::TooManyEvents);
             }
         }
-        let repeats = match (start, state) {
-            (Phase::Slip { sign: a }, Phase::Slip { sign: b }) => a == b,
-            (Phase::Open, Phase::Open) => true,
-            (Phase::Stick { w: a, .. }, Phase::Stick { w: b, .. }) => {
-                drift = (a - b).abs();
-                drift <= tolerance
-            }
-            _ => false,
-        };
+        let repeats = matched
+            || match (start, state) {
+                (Phase::Slip { sign: a }, Phase::Slip { sign: b }) => a == b,
+                (Phase::Open, Phase::Open) => true,
+                (Phase::Stick { w: a, .. }, Phase::Stick { w: b, .. }) => {
+                    drift = (a - b).abs();
+                    drift <= tolerance
+                }
+                _ => false,
+            };
         if repeats {
             let shift = 2.0 * PI * (period - 1) as f64;
             pieces.retain(|p| p.end > p.start);
             for p in pieces.iter_mut() {
-                p.start -= shift;
-                p.end -= shift;
-                if let Phase::Stick { anchor, .. } = &mut p.phase {
-                    match anchor {
-                        Anchor::SlipEnd { tau, .. } | Anchor::Closing { tau } => *tau -= shift,
-                        Anchor::Initial => {}
-                    }
-                }
+                *p = shifted(*p, -shift);
             }
             return Ok(period);
         }
+        std::mem::swap(pieces, previous);
     }
     Err(MarchFailure::NotSettled {
         periods: max_periods.max(2),
         drift,
     })
+}
+
+/// `piece` moved by `by` (rad) along the time line, its anchor with it.
+fn shifted(mut piece: Piece, by: f64) -> Piece {
+    piece.start += by;
+    piece.end += by;
+    if let Phase::Stick { anchor, .. } = &mut piece.phase {
+        match anchor {
+            Anchor::SlipEnd { tau, .. } | Anchor::Closing { tau } => *tau += by,
+            Anchor::Initial => {}
+        }
+    }
+    piece
+}
+
+/// The index of the piece of the previous period (`previous`, in order) that an event starts
+/// at `tau` (rad, on that period's time line) to round-off, in `phase` (a stick's slider
+/// within `tolerance`, m); the first piece, which no event of that period starts, never.
+fn repeated_piece(previous: &[Piece], tau: f64, phase: Phase, tolerance: f64) -> Option<usize> {
+    let eps = 1e-12 * tau.abs().max(1.0);
+    let first = previous.partition_point(|p| p.start < tau - eps).max(1);
+    previous
+        .iter()
+        .enumerate()
+        .skip(first)
+        .take_while(|(_, p)| p.start <= tau + eps)
+        .find(|(_, p)| match (p.phase, phase) {
+            (Phase::Slip { sign: a }, Phase::Slip { sign: b }) => a == b,
+            (Phase::Open, Phase::Open) => true,
+            (Phase::Stick { w: a, .. }, Phase::Stick { w: b, .. }) => (a - b).abs() <= tolerance,
+            _ => false,
+        })
+        .map(|(i, _)| i)
 }
 
 struct Marcher<'a> {

@@ -127,6 +127,8 @@ pub struct EventSolver {
     pub derivative_samples: [Vec<f64>; 2],
     /// Phases of the last periodic orbit over [0, 2π].
     pub pieces: Vec<Piece>,
+    /// Scratch for the march: the phases of the period before.
+    pub previous_pieces: Vec<Piece>,
     /// Stretches of [0, 2π] where v > 0 (variable normal load with lift-off).
     pub closed_intervals: Vec<(f64, f64)>,
     /// Bounds of the exit functions over blocks of grid cells (for the march to skip them).
