@@ -149,39 +149,48 @@ impl AftWorkspace {
     fn sample_orbit(&mut self, params: &LawParams) {
         let ns = self.n_samples;
         let pieces = &self.events.pieces;
-        let tau = |k: usize| 2.0 * PI * k as f64 / ns as f64;
+        let step = 2.0 * PI / ns as f64;
         let mut k = 0;
         for (p, piece) in pieces.iter().enumerate() {
-            let last = p + 1 == pieces.len();
-            while k < ns && (last || piece.end > tau(k)) {
-                let (t, kind) = match piece.phase {
-                    // The anchor fields serve the sampled law's Jacobian only; the event
-                    // law's anchors live in its pieces, so these samples record the kind alone.
-                    Phase::Stick { w, .. } => (
-                        params.kt * (self.u[k] - w),
-                        SampleKind::Stick {
-                            anchor: 0,
-                            sign: 0.0,
-                        },
-                    ),
-                    Phase::Slip { sign } => {
-                        let limit = match params.constant_limit {
-                            Some(l) => l,
-                            None => params.mu_kn * self.v[k].max(0.0),
-                        };
-                        (sign * limit, SampleKind::Slip { sign })
+            // Samples k..end: τₖ = k·step < piece.end.
+            let end = if p + 1 == pieces.len() {
+                ns
+            } else {
+                ((piece.end / step).ceil().max(0.0) as usize).clamp(k, ns)
+            };
+            let range = k..end;
+            let (t, kinds) = (&mut self.t[range.clone()], &mut self.kinds[range.clone()]);
+            match piece.phase {
+                // The anchor fields serve the sampled law's Jacobian only; the event law's
+                // anchors live in its pieces, so these samples record the kind alone.
+                Phase::Stick { w, .. } => {
+                    for (t, u) in t.iter_mut().zip(&self.u[range]) {
+                        *t = params.kt * (u - w);
                     }
-                    Phase::Open => (0.0, SampleKind::Open),
-                };
-                self.t[k] = t;
-                self.kinds[k] = kind;
-                k += 1;
+                    kinds.fill(SampleKind::Stick {
+                        anchor: 0,
+                        sign: 0.0,
+                    });
+                }
+                Phase::Slip { sign } => {
+                    for (t, v) in t.iter_mut().zip(&self.v[range]) {
+                        *t = sign
+                            * match params.constant_limit {
+                                Some(l) => l,
+                                None => params.mu_kn * v.max(0.0),
+                            };
+                    }
+                    kinds.fill(SampleKind::Slip { sign });
+                }
+                Phase::Open => {
+                    t.fill(0.0);
+                    kinds.fill(SampleKind::Open);
+                }
             }
+            k = end;
         }
         // No pieces (never after a march): no force.
-        self.t[k..].iter_mut().for_each(|t| *t = 0.0);
-        self.kinds[k..]
-            .iter_mut()
-            .for_each(|kind| *kind = SampleKind::Open);
+        self.t[k..].fill(0.0);
+        self.kinds[k..].fill(SampleKind::Open);
     }
 }

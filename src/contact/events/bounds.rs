@@ -5,11 +5,12 @@
 //! Each exit function of the march ([`super::march`]) is a fixed trigonometric polynomial
 //! shifted by a constant of the phase: kₜ(u − w) − L = (kₜu − L) − kₜw for a slip onset of
 //! sign +, −kₜ(u − w) − L = (−kₜu − L) + kₜw for one of sign −, L′ ∓ kₜu′ for the end of a
-//! slip of sign ±, and ∓v for opening and closing. Between two samples τₐ < τ_b a function f
-//! stays below the chord of its samples plus (τ_b − τₐ)²/8 · max|f″|, and max|f″| is bounded
-//! by the coefficients (Σ h² |ĉ_h| for the second derivative, Σ h³ |ĉ_h| for the third). A
-//! block whose bound is negative holds no root and no graze: the march skips it, and finds
-//! exactly what a cell-by-cell scan finds (which reports nothing in such cells).
+//! slip of sign ±, and ∓v for opening and closing. Over a block τₐ ≤ τ ≤ τ_b a function f
+//! stays below the chord of its end values plus (τ_b − τₐ)²/8 · max|f″|, and max|f″| is
+//! bounded by the coefficients (Σ h² |ĉ_h| for the second derivative, Σ h³ |ĉ_h| for the
+//! third). A block whose bound is negative holds no root and no graze: the march skips it,
+//! and finds exactly what a cell-by-cell scan finds (which reports nothing in such cells).
+//! The bounds cost two samples per block, not one per cell.
 
 use super::march::{LawParams, Signals};
 use crate::contact::harmonic::Block;
@@ -36,7 +37,7 @@ pub enum Bounded {
 }
 
 /// Per block of [`BLOCK`] cells, an upper bound of each [`Bounded`] function over the block:
-/// its largest sample on the block's cells (ends included) plus the curvature margin.
+/// the larger of its values at the block's ends plus the curvature margin.
 #[derive(Debug, Clone, Default)]
 pub struct CellBounds {
     /// One entry per block, indexed by [`Bounded`].
@@ -69,28 +70,17 @@ impl CellBounds {
                 v3 += h * h * h * cv;
             }
         }
-        let chord = cell * cell / 8.0;
-        let margin_force = chord * (law.kt * u2 + mu_kn * v2);
-        let margin_rate = chord * (law.kt * u3 + mu_kn * v3);
-        let margin_v = chord * v2;
-        let margins = [
-            margin_force,
-            margin_force,
-            margin_rate,
-            margin_rate,
-            margin_v,
-            margin_v,
-        ];
-        let blocks = n.div_ceil(BLOCK);
-        self.max.clear();
-        self.max.resize(blocks, [f64::NEG_INFINITY; 6]);
-        let (kt, constant) = (law.kt, law.constant_limit);
-        // The six functions at sample k (L unclamped, as in the exit functions).
+        // Curvature margins per unit of (block length)²/8.
+        let force = law.kt * u2 + mu_kn * v2;
+        let rate = law.kt * u3 + mu_kn * v3;
+        let curvature = [force, force, rate, rate, v2, v2];
+        let kt = law.kt;
+        // The six functions at sample k (L unclamped, as in the exit functions); with a
+        // constant load L = L₀ and L′ = 0 (`mu_kn` is 0 then).
+        let l0 = law.constant_limit.unwrap_or(0.0);
         let values = |k: usize| {
-            let (limit, rate) = match constant {
-                Some(l) => (l, 0.0),
-                None => (mu_kn * v[0][k], mu_kn * v[1][k]),
-            };
+            let k = if k == n { 0 } else { k };
+            let (limit, rate) = (l0 + mu_kn * v[0][k], mu_kn * v[1][k]);
             let (ktu, ktdu) = (kt * u[0][k], kt * u[1][k]);
             [
                 ktu - limit,
@@ -101,19 +91,20 @@ impl CellBounds {
                 v[0][k],
             ]
         };
+        let blocks = n.div_ceil(BLOCK);
+        self.max.clear();
+        self.max.resize(blocks, [0.0; 6]);
+        let mut start = values(0);
         for (j, m) in self.max.iter_mut().enumerate() {
-            let last = ((j + 1) * BLOCK).min(n);
-            // The block's cells run from sample j·BLOCK to sample `last` (N wraps to 0).
-            let mut acc = values(last % n);
-            for k in j * BLOCK..last {
-                let x = values(k);
-                for (a, x) in acc.iter_mut().zip(x) {
-                    *a = if x > *a { x } else { *a };
-                }
+            let (first, last) = (j * BLOCK, ((j + 1) * BLOCK).min(n));
+            let end = values(last);
+            let length = (last - first) as f64 * cell;
+            let chord = length * length / 8.0;
+            for (i, m) in m.iter_mut().enumerate() {
+                let larger = if end[i] > start[i] { end[i] } else { start[i] };
+                *m = larger + chord * curvature[i];
             }
-            for ((m, a), margin) in m.iter_mut().zip(acc).zip(margins) {
-                *m = a + margin;
-            }
+            start = end;
         }
     }
 }
