@@ -16,8 +16,12 @@ use super::march::{LawParams, Signals};
 use crate::contact::harmonic::Block;
 use std::f64::consts::PI;
 
-/// Cells per block.
-pub const BLOCK: usize = 16;
+/// Cells per block for N samples: N/32 between 4 and 16, so that a block spans at most
+/// π/16 rad (its curvature margin stays a small fraction of the functions) and costs few
+/// cells to scan where it holds an event.
+pub fn block_cells(n: usize) -> usize {
+    (n / 32).clamp(4, 16)
+}
 
 /// Which bounded function (index into [`CellBounds::max`]'s entries).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -36,10 +40,12 @@ pub enum Bounded {
     Closing = 5,
 }
 
-/// Per block of [`BLOCK`] cells, an upper bound of each [`Bounded`] function over the block:
-/// the larger of its values at the block's ends plus the curvature margin.
+/// Per block of [`Self::cells`] cells, an upper bound of each [`Bounded`] function over the
+/// block: the larger of its values at the block's ends plus the curvature margin.
 #[derive(Debug, Clone, Default)]
 pub struct CellBounds {
+    /// Cells per block ([`block_cells`]).
+    pub cells: usize,
     /// One entry per block, indexed by [`Bounded`].
     pub max: Vec<[f64; 6]>,
 }
@@ -91,12 +97,14 @@ impl CellBounds {
                 v[0][k],
             ]
         };
-        let blocks = n.div_ceil(BLOCK);
+        let cells = block_cells(n);
+        self.cells = cells;
+        let blocks = n.div_ceil(cells);
         self.max.clear();
         self.max.resize(blocks, [0.0; 6]);
         let mut start = values(0);
         for (j, m) in self.max.iter_mut().enumerate() {
-            let (first, last) = (j * BLOCK, ((j + 1) * BLOCK).min(n));
+            let (first, last) = (j * cells, ((j + 1) * cells).min(n));
             let end = values(last);
             let length = (last - first) as f64 * cell;
             let chord = length * length / 8.0;

@@ -7,7 +7,7 @@
 //! change of f′ across it, and every root is refined by Brent's method on direct evaluations
 //! of the trigonometric polynomials, to round-off of τ.
 
-use super::bounds::{Bounded, CellBounds, BLOCK};
+use super::bounds::{Bounded, CellBounds};
 use super::roots::brent;
 use crate::contact::harmonic::{Block, SampleBasis};
 use std::f64::consts::PI;
@@ -530,8 +530,9 @@ impl Marcher<'_> {
                 // no exit function can turn positive in it, as long as the block ends
                 // before t_end.
                 let i = if index == 0 { n - 1 } else { index - 1 };
-                let block = i / BLOCK;
-                let block_end = ((block + 1) * BLOCK).min(n);
+                let cells = self.grid.bounds.cells;
+                let block = i / cells;
+                let block_end = ((block + 1) * cells).min(n);
                 let a_next = k - 1 + (block_end - i);
                 if (a_next as f64) * self.cell < t_end && self.block_quiet(phase, block) {
                     let ia = block_end % n;
@@ -708,13 +709,13 @@ pub fn closed_intervals(signals: &Signals<'_>, grid: &Grid<'_>, out: &mut Vec<(f
     };
     let mut k = 0;
     while k < n {
-        if k % BLOCK == 0 {
+        let bounds = grid.bounds;
+        if k % bounds.cells == 0 {
             // v keeps its sign over the whole block: no root, no short closing or opening.
-            let block = k / BLOCK;
-            let bounds = grid.bounds;
+            let block = k / bounds.cells;
             if bounds.of(block, Bounded::Opening) < 0.0 || bounds.of(block, Bounded::Closing) < 0.0
             {
-                k = (k + BLOCK).min(n);
+                k = (k + bounds.cells).min(n);
                 continue;
             }
         }
