@@ -35,8 +35,10 @@ impl Signals<'_> {
     /// u, v and their derivatives at τ.
     pub fn at(&self, tau: f64) -> Kinematics {
         let mut k = Kinematics::default();
-        // The cosine and sine blocks of a harmonic are adjacent: one sin_cos serves both.
-        let mut last = (usize::MAX, 0.0, 0.0);
+        // sin hτ, cos hτ by the angle-addition recurrence from sin τ, cos τ (the blocks are
+        // in increasing harmonic order): one sin_cos per evaluation.
+        let (s1, c1) = tau.sin_cos();
+        let (mut harmonic, mut s, mut c) = (0usize, 0.0, 1.0);
         for (j, block) in self.blocks.iter().enumerate() {
             let (cu, cv) = (self.u[j], self.v[j]);
             match *block {
@@ -45,11 +47,11 @@ impl Signals<'_> {
                     k.v[0] += cv;
                 }
                 Block::Cos(n) | Block::Sin(n) => {
-                    if last.0 != n {
-                        let (s, c) = (n as f64 * tau).sin_cos();
-                        last = (n, s, c);
+                    while harmonic < n {
+                        (s, c) = (s * c1 + c * s1, c * c1 - s * s1);
+                        harmonic += 1;
                     }
-                    let (h, s, c) = (n as f64, last.1, last.2);
+                    let h = n as f64;
                     // d/dτ cos hτ = −h sin hτ, d/dτ sin hτ = h cos hτ.
                     let (b0, b1, b2) = match *block {
                         Block::Cos(_) => (c, -h * s, -h * h * c),
