@@ -3,6 +3,7 @@
 //! samples and contact state as the sampled march, so every caller reads either alike.
 
 use super::{AftError, AftWorkspace, MarchReport, SampleKind, Signal};
+use crate::contact::events::bounds::BoundLaw;
 use crate::contact::events::march::{
     closed_intervals, periodic_orbit, Anchor, Grid, LawParams, Phase, Signals,
 };
@@ -76,7 +77,13 @@ impl AftWorkspace {
         let orbit = {
             let [du, dv] = &self.events.derivative_samples;
             let [_, ddu, _, ddv] = &self.events.derivative_coefficients;
-            bounds.fill(&params, &signals, [&self.u, du], [&self.v, dv]);
+            let law = BoundLaw {
+                kt: params.kt,
+                mu_kn: params.mu_kn,
+                constant_limit: params.constant_limit,
+            };
+            let coefficients = (signals.blocks, signals.u, signals.v);
+            bounds.fill(law, coefficients, [&self.u, du], [&self.v, dv]);
             let grid = Grid {
                 u: [&self.u, du],
                 v: [&self.v, dv],

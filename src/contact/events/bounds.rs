@@ -12,7 +12,6 @@
 //! and finds exactly what a cell-by-cell scan finds (which reports nothing in such cells).
 //! The bounds cost two samples per block, not one per cell.
 
-use super::march::{LawParams, Signals};
 use crate::contact::harmonic::Block;
 use std::f64::consts::PI;
 
@@ -40,6 +39,17 @@ pub enum Bounded {
     Closing = 5,
 }
 
+/// What the bounds need of the Jenkins law (see [`super::march::LawParams`]).
+#[derive(Debug, Clone, Copy)]
+pub struct BoundLaw {
+    /// Tangential stiffness kₜ (N/m).
+    pub kt: f64,
+    /// μ kₙ (N/m).
+    pub mu_kn: f64,
+    /// The constant friction limit (N) under a constant normal load; `None` with a variable one.
+    pub constant_limit: Option<f64>,
+}
+
 /// Per block of [`Self::cells`] cells, an upper bound of each [`Bounded`] function over the
 /// block: the larger of its values at the block's ends plus the curvature margin.
 #[derive(Debug, Clone, Default)]
@@ -58,18 +68,24 @@ impl CellBounds {
     }
 
     /// Fills the bounds from the grid samples of u, u′ (`u`) and v, v′ (`v`), N each, and the
-    /// coefficients in `signals` (for the curvature margins).
-    pub fn fill(&mut self, law: &LawParams, signals: &Signals<'_>, u: [&[f64]; 2], v: [&[f64]; 2]) {
+    /// coefficients (blocks, û, v̂) of u and v (for the curvature margins).
+    pub fn fill(
+        &mut self,
+        law: BoundLaw,
+        (blocks, u_hat, v_hat): (&[Block], &[f64], &[f64]),
+        u: [&[f64]; 2],
+        v: [&[f64]; 2],
+    ) {
         let n = u[0].len();
         let cell = 2.0 * PI / n as f64;
         let variable = law.constant_limit.is_none();
         let mu_kn = if variable { law.mu_kn } else { 0.0 };
         // Σ h^p |ĉ| of u and v, p = 2 and 3.
         let (mut u2, mut u3, mut v2, mut v3) = (0.0, 0.0, 0.0, 0.0);
-        for (j, b) in signals.blocks.iter().enumerate() {
+        for (j, b) in blocks.iter().enumerate() {
             if let Block::Cos(h) | Block::Sin(h) = *b {
                 let h = h as f64;
-                let (cu, cv) = (signals.u[j].abs(), signals.v[j].abs());
+                let (cu, cv) = (u_hat[j].abs(), v_hat[j].abs());
                 u2 += h * h * cu;
                 u3 += h * h * h * cu;
                 v2 += h * h * cv;
