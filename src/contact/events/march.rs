@@ -5,7 +5,8 @@
 //! the first instant where one of them turns positive. They are bracketed on the sample grid
 //! (values and rates from the grid signals), grazes inside a cell are caught by the sign
 //! change of f′ across it, and every root is refined by Brent's method on direct evaluations
-//! of the trigonometric polynomials, to round-off of τ.
+//! of the trigonometric polynomials, to round-off of τ. Blocks of cells where bounds of the
+//! exit functions ([`super::bounds`]) rule out any root or graze are passed over whole.
 
 use super::bounds::{Bounded, CellBounds};
 use super::roots::brent;
