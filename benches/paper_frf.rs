@@ -2,7 +2,8 @@
 //! H = 5, analytic Jacobian; and H = 1 with forward differences as the baseline; without the
 //! error estimate of every point, then at H = 1 and 5 with it (its cost).
 //!
-//! `contact_law_residual`: one harmonic-balance residual with every contact on the
+//! `contact_law_residual`: one harmonic-balance residual, and one residual with its Jacobian
+//! (`_jacobian`), with every contact on the
 //! event-resolved law (`jenkins-1d`) against the sampled one (`jenkins-1d-sampled`) at 128,
 //! 512 and 2048 samples per period: on the paper case at its resonance peak (H = 1, 3) and on
 //! the reduced 2D blade pair with 49 contact pairs per side (contact_refine 8) at H = 3 and 5,
@@ -16,6 +17,7 @@ use fricbound::model::Problem;
 use fricbound::scene;
 use fricbound::scene::paper_wedge_scene;
 use fricbound::study::scaling::{self, ModelSize};
+use std::time::Duration;
 
 fn problem(overrides: &[&str]) -> fricbound::model::Problem {
     let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
@@ -63,10 +65,14 @@ fn with_law(problem: &Problem, resolution: TimeResolution, samples: usize) -> Pr
     p
 }
 
-/// Times one residual of `problem` at (x, ω) for both laws and three sample counts.
+/// Times one residual, and one residual with its Jacobian (∂R/∂x and ∂R/∂ω), of `problem` at
+/// (x, ω) for both laws and three sample counts.
 fn residual_group(c: &mut Criterion, name: &str, problem: &Problem, x: &[f64], omega: f64) {
     let mut group = c.benchmark_group(format!("contact_law_residual_{name}"));
-    group.sample_size(20);
+    group
+        .sample_size(20)
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(1));
     for samples in [128, 512, 2048] {
         for (law, resolution) in [
             ("events", TimeResolution::Events),
@@ -75,8 +81,17 @@ fn residual_group(c: &mut Criterion, name: &str, problem: &Problem, x: &[f64], o
             let p = with_law(problem, resolution, samples);
             let mut system = HbmSystem::new(&p).expect("operator");
             let mut r = vec![0.0; x.len()];
+            let mut dr = vec![0.0; x.len()];
+            let mut jac = system.new_jacobian();
             group.bench_function(format!("{law}_{samples}"), |b| {
                 b.iter(|| system.residual(x, omega, &mut r).expect("residual"))
+            });
+            group.bench_function(format!("{law}_{samples}_jacobian"), |b| {
+                b.iter(|| {
+                    system
+                        .residual_and_jacobian(x, omega, &mut r, &mut jac, &mut dr)
+                        .expect("residual and Jacobian")
+                })
             });
         }
     }

@@ -671,3 +671,77 @@ fn event_law_frictionless_contact_opens_and_closes() {
     );
     assert!(aft.t_hat.iter().all(|t| *t == 0.0));
 }
+
+/// The sampled law's error against the event law on one stick-slip-lift-off orbit (H = 3)
+/// at N = 64, 128, …, 8192 samples: (N, largest |sampled − event| over T̂ and N̂ relative to
+/// the largest N̂ coefficient), and the least-squares slope of ln(error) against ln(N).
+/// `tangential` (m) scales the tangential motion: u = ua cos τ + smaller harmonics against
+/// v = 2e-5 + 1e-4 sin τ + smaller harmonics (m), kₜ = kₙ = 1e5 N/m, μ = 0.5.
+fn sampled_law_convergence(tangential: f64) -> (Vec<(usize, f64)>, f64) {
+    let seed = [
+        0.3, -0.5, 0.2, 0.7, -0.1, 0.4, 0.6, -0.3, 0.5, -0.2, 0.1, 0.8, -0.4,
+    ];
+    let (mut u, mut v) = coefficients(&seed, 0.5 * tangential, 2e-5, 2e-5);
+    u[1] += tangential;
+    v[2] += 1e-4;
+    let (l, fx) = (law(1e5, 1e5, 0.5, 0.0), effects(false, true));
+    let set = HarmonicSet::up_to(3);
+    let mut events = AftWorkspace::new(&set, 256);
+    let report = events.evaluate_events(&l, fx, &u, &v, false).unwrap();
+    assert_eq!(report.state, ContactState::StickSlipLiftoff);
+    let scale = events.n_hat.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+    let table: Vec<(usize, f64)> = (6..=13)
+        .map(|p| {
+            let n = 1usize << p;
+            let mut sampled = AftWorkspace::new(&set, n);
+            let report = sampled.evaluate(&l, fx, &u, &v, false).unwrap();
+            assert_eq!(report.state, ContactState::StickSlipLiftoff, "N = {n}");
+            let error = events
+                .t_hat
+                .iter()
+                .chain(&events.n_hat)
+                .zip(sampled.t_hat.iter().chain(&sampled.n_hat))
+                .fold(0.0_f64, |e, (a, b)| e.max((a - b).abs()));
+            (n, error / scale)
+        })
+        .collect();
+    let points: Vec<(f64, f64)> = table
+        .iter()
+        .map(|&(n, e)| ((n as f64).ln(), e.ln()))
+        .collect();
+    let k = points.len() as f64;
+    let (mx, my) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / k, b + y / k));
+    let (sxy, sxx) = points.iter().fold((0.0, 0.0), |(a, b), (x, y)| {
+        (a + (x - mx) * (y - my), b + (x - mx) * (x - mx))
+    });
+    (table, sxy / sxx)
+}
+
+/// The sampled law converges to the event law at first order in 1/N where a stick follows a
+/// closing (the slider is set at the last open sample, up to one sample late), at second
+/// order where the contact slips at once on closing and every stick starts at the end of a
+/// slip (the late start then costs O(Δτ²)): least-squares slopes of its error against N
+/// (docs/accuracy.md, "Event-resolved against sampled contact law").
+#[test]
+fn sampled_law_error_against_the_event_law_falls_like_one_over_n() {
+    let mut slopes = Vec::new();
+    // kₜ|u′| ≈ 2 N/rad below μkₙ v′ ≈ 5 N/rad at closing: stuck on closing; then 20 N/rad.
+    for tangential in [2e-5, 2e-4] {
+        let (table, slope) = sampled_law_convergence(tangential);
+        for (n, e) in &table {
+            println!("u amplitude {tangential:.0e} m, N = {n:5}: relative error {e:.3e}");
+        }
+        println!("least-squares slope of ln(error) against ln(N): {slope:.3}");
+        slopes.push(slope);
+    }
+    assert!(
+        (-1.3..=-0.8).contains(&slopes[0]),
+        "stuck on closing: {slopes:?}"
+    );
+    assert!(
+        (-2.5..=-1.7).contains(&slopes[1]),
+        "slipping on closing: {slopes:?}"
+    );
+}

@@ -1,7 +1,8 @@
 //! Switched effects (constant normal load, no lift-off, uncoupled statics) and Jacobian
 //! strategies on the paper case.
 
-use fricbound::analysis::frf::{self, Silent};
+use fricbound::analysis::frf::{self, PointSolver, Silent};
+use fricbound::analysis::limits::{self, LimitCase};
 use fricbound::hbm::{check_jacobian, HbmSystem};
 use fricbound::model::Problem;
 
@@ -166,13 +167,21 @@ fn describing_function_peak() -> (f64, f64) {
 
 /// A 1-DOF Jenkins oscillator at H = 1 with a constant normal load: the refined resonance
 /// peak of the event-resolved law equals the describing function's to 1e-9; the sampled law
-/// at 256 samples is off by its sampling error (about 1e-4).
+/// at 256 samples is off by its sampling error (about 1e-4), at 8 192 samples by less than
+/// 1e-5.
 #[test]
 fn jenkins_oscillator_peak_equals_the_describing_function() {
     let (f_ref, a_ref) = describing_function_peak();
     let mut errors = Vec::new();
-    for law in ["jenkins-1d", "jenkins-1d-sampled"] {
-        let overrides = [format!("contacts.0.law=\"{law}\"")];
+    for (law, samples) in [
+        ("jenkins-1d", 256),
+        ("jenkins-1d-sampled", 256),
+        ("jenkins-1d-sampled", 8192),
+    ] {
+        let overrides = [
+            format!("contacts.0.law=\"{law}\""),
+            format!("harmonics.samples={samples}"),
+        ];
         let overrides: Vec<&str> = overrides.iter().map(|s| s.as_str()).collect();
         let problem = scenes::problem(JENKINS_OSCILLATOR, &overrides);
         let run = frf::solve(&problem, &mut Silent).unwrap();
@@ -183,8 +192,8 @@ fn jenkins_oscillator_peak_equals_the_describing_function() {
         assert!(peak.refined, "{law}");
         let error = (peak.amplitude - a_ref).abs() / a_ref;
         eprintln!(
-            "{law}: peak {:.12e} m at {:.9} Hz; describing function {a_ref:.12e} m at \
-             {f_ref:.9} Hz; relative error {error:.2e}",
+            "{law}, {samples} samples: peak {:.12e} m at {:.9} Hz; describing function \
+             {a_ref:.12e} m at {f_ref:.9} Hz; relative error {error:.2e}",
             peak.amplitude, peak.freq_hz
         );
         errors.push(error);
@@ -195,4 +204,63 @@ fn jenkins_oscillator_peak_equals_the_describing_function() {
         "the sampled law's error is its sampling error: {:.2e}",
         errors[1]
     );
+    assert!(
+        errors[2] < 1e-5,
+        "sampled law at 8192 samples: {:.2e}",
+        errors[2]
+    );
+}
+
+/// The paper scene (`fricbound run` defaults) around its 3rd resonance, 200-235 Hz, where the
+/// limit curves differ: on the event law, and on the sampled law at 8 192 samples.
+fn paper_on_both_laws() -> (Problem, Problem) {
+    let window = ["analysis.freq_start_hz=200.0", "analysis.freq_end_hz=235.0"];
+    let event = scenes::paper(&window);
+    let mut sampled: Vec<&str> = window.to_vec();
+    sampled.extend_from_slice(&scenes::SAMPLED_PAPER);
+    sampled.push("harmonics.samples=8192");
+    (event, scenes::paper(&sampled))
+}
+
+/// The paper case's FRF (m = 0) and its limit peaks (m = ±1) with the event law equal those
+/// of the sampled law at 8 192 samples, whose error is O(1/N): points of the event curve
+/// solved again at their frequencies with the sampled law, and the refined peaks.
+#[test]
+fn paper_case_event_law_equals_the_sampled_law_at_8192_samples() {
+    let (event, sampled) = paper_on_both_laws();
+    let run = frf::solve(&event, &mut Silent).unwrap();
+    assert!(run.is_complete(), "{:?}", run.incomplete_reason());
+    let mut solver = PointSolver::new(&sampled).unwrap();
+    let mut worst: f64 = 0.0;
+    for p in run.points.iter().step_by(run.points.len() / 12) {
+        let q = solver.solve(&p.coefficients, p.freq_hz).unwrap();
+        let rel = (q.amplitudes[0] - p.amplitudes[0]).abs() / p.amplitudes[0];
+        println!(
+            "{:.4} Hz: event {:.9e} m, sampled {:.9e} m, relative {rel:.2e}",
+            p.freq_hz, p.amplitudes[0], q.amplitudes[0]
+        );
+        worst = worst.max(rel);
+    }
+    let mut peak_worst: f64 = 0.0;
+    for m in [1.0, -1.0] {
+        let peaks: Vec<_> = [&event, &sampled]
+            .iter()
+            .map(|p| {
+                let curve = limits::solve_case(p, &LimitCase::uniform(p, m), None).unwrap();
+                curve.peak.unwrap()
+            })
+            .collect();
+        let (a, b) = (&peaks[0], &peaks[1]);
+        assert!(a.refined && b.refined, "m = {m}");
+        let rel = (a.amplitude - b.amplitude).abs() / a.amplitude;
+        let rel_f = (a.freq_hz - b.freq_hz).abs() / a.freq_hz;
+        println!(
+            "m = {m:+}: event peak {:.9e} m at {:.6} Hz, sampled {:.9e} m at {:.6} Hz, \
+             relative {rel:.2e} (frequency {rel_f:.2e})",
+            a.amplitude, a.freq_hz, b.amplitude, b.freq_hz
+        );
+        peak_worst = peak_worst.max(rel).max(rel_f);
+    }
+    assert!(worst < 1e-5, "FRF points: {worst:.2e}");
+    assert!(peak_worst < 1e-5, "limit peaks: {peak_worst:.2e}");
 }

@@ -3,6 +3,7 @@
 //! samples and contact state as the sampled march, so every caller reads either alike.
 
 use super::{AftError, AftWorkspace, MarchReport, SampleKind, Signal};
+use crate::contact::events::bounds::BoundLaw;
 use crate::contact::events::march::{
     closed_intervals, periodic_orbit, Anchor, Grid, LawParams, Phase, Signals,
 };
@@ -36,13 +37,14 @@ impl AftWorkspace {
         self.synthesize(v_coefficients, Signal::V);
         self.events
             .differentiate(&self.set, u_coefficients, v_coefficients);
-        for i in 0..4 {
+        // u′ and v′ on the grid; u″ and v″ only where the march asks for them.
+        for (coefficients, samples) in [0, 2].iter().zip(&mut self.events.derivative_samples) {
             super::synthesize_into(
                 &self.set,
                 self.inverse.as_ref(),
                 (&mut self.spectrum, &mut self.scratch_inv),
-                &self.events.derivative_coefficients[i],
-                &mut self.events.derivative_samples[i],
+                &self.events.derivative_coefficients[*coefficients],
+                samples,
             );
         }
         let constant_v = self
@@ -57,23 +59,37 @@ impl AftWorkspace {
             u: u_coefficients,
             v: v_coefficients,
         };
-        let (umin, umax) = self
-            .u
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
-                (a.min(x), b.max(x))
-            });
-        let nmax = self.n.iter().fold(0.0_f64, |a, &x| a.max(x.abs()));
+        // Plain comparisons (the samples are finite): these loops vectorise.
+        let (mut umin, mut umax, mut nmax) = (f64::INFINITY, f64::NEG_INFINITY, 0.0_f64);
+        for &x in &self.u {
+            umin = if x < umin { x } else { umin };
+            umax = if x > umax { x } else { umax };
+        }
+        for &x in &self.n {
+            nmax = if x.abs() > nmax { x.abs() } else { nmax };
+        }
         let scale = (umax - umin) + law.mu * nmax / law.kt + f64::MIN_POSITIVE;
         let tolerance =
             self.settings.periodicity_tolerance * self.settings.length_scale(scale, law.kt);
         let mut pieces = std::mem::take(&mut self.events.pieces);
         let mut intervals = std::mem::take(&mut self.events.closed_intervals);
+        let mut bounds = std::mem::take(&mut self.events.bounds);
         let orbit = {
-            let [du, ddu, dv, ddv] = &self.events.derivative_samples;
+            let [du, dv] = &self.events.derivative_samples;
+            let [_, ddu, _, ddv] = &self.events.derivative_coefficients;
+            let law = BoundLaw {
+                kt: params.kt,
+                mu_kn: params.mu_kn,
+                constant_limit: params.constant_limit,
+            };
+            let coefficients = (signals.blocks, signals.u, signals.v);
+            bounds.fill(law, coefficients, [&self.u, du], [&self.v, dv]);
             let grid = Grid {
-                u: [&self.u, du, ddu],
-                v: [&self.v, dv, ddv],
+                u: [&self.u, du],
+                v: [&self.v, dv],
+                second: [ddu, ddv],
+                basis: &self.basis,
+                bounds: &bounds,
             };
             if params.constant_limit.is_none() && effects.liftoff {
                 closed_intervals(&signals, &grid, &mut intervals);
@@ -84,11 +100,12 @@ impl AftWorkspace {
                 &grid,
                 self.settings.max_periods,
                 tolerance,
-                &mut pieces,
+                (&mut pieces, &mut self.events.previous_pieces),
             )
         };
         self.events.pieces = pieces;
         self.events.closed_intervals = intervals;
+        self.events.bounds = bounds;
         let periods = orbit.map_err(|failure| match failure {
             MarchFailure::NotSettled { periods, drift } => AftError::NotSettled { periods, drift },
             MarchFailure::TooManyEvents => AftError::TooManyEvents,
@@ -134,35 +151,53 @@ impl AftWorkspace {
     }
 
     /// The tangential force samples T(τₖ) and sample kinds of the orbit in the event buffers
-    /// (the normal force samples are set by `normal_forces`).
+    /// (the normal force samples are set by `normal_forces`): sample k lies in the first
+    /// piece that ends after τₖ (the last piece takes the rest).
     fn sample_orbit(&mut self, params: &LawParams) {
         let ns = self.n_samples;
         let pieces = &self.events.pieces;
-        let mut p = 0;
-        for k in 0..ns {
-            let tau = 2.0 * PI * k as f64 / ns as f64;
-            while p + 1 < pieces.len() && pieces[p].end <= tau {
-                p += 1;
-            }
-            let limit = match params.constant_limit {
-                Some(l) => l,
-                None => params.mu_kn * self.v[k].max(0.0),
+        let step = 2.0 * PI / ns as f64;
+        let mut k = 0;
+        for (p, piece) in pieces.iter().enumerate() {
+            // Samples k..end: τₖ = k·step < piece.end.
+            let end = if p + 1 == pieces.len() {
+                ns
+            } else {
+                ((piece.end / step).ceil().max(0.0) as usize).clamp(k, ns)
             };
-            let (t, kind) = match pieces.get(p).map(|q| q.phase) {
+            let range = k..end;
+            let (t, kinds) = (&mut self.t[range.clone()], &mut self.kinds[range.clone()]);
+            match piece.phase {
                 // The anchor fields serve the sampled law's Jacobian only; the event law's
                 // anchors live in its pieces, so these samples record the kind alone.
-                Some(Phase::Stick { w, .. }) => (
-                    params.kt * (self.u[k] - w),
-                    SampleKind::Stick {
+                Phase::Stick { w, .. } => {
+                    for (t, u) in t.iter_mut().zip(&self.u[range]) {
+                        *t = params.kt * (u - w);
+                    }
+                    kinds.fill(SampleKind::Stick {
                         anchor: 0,
                         sign: 0.0,
-                    },
-                ),
-                Some(Phase::Slip { sign }) => (sign * limit, SampleKind::Slip { sign }),
-                Some(Phase::Open) | None => (0.0, SampleKind::Open),
-            };
-            self.t[k] = t;
-            self.kinds[k] = kind;
+                    });
+                }
+                Phase::Slip { sign } => {
+                    for (t, v) in t.iter_mut().zip(&self.v[range]) {
+                        *t = sign
+                            * match params.constant_limit {
+                                Some(l) => l,
+                                None => params.mu_kn * v.max(0.0),
+                            };
+                    }
+                    kinds.fill(SampleKind::Slip { sign });
+                }
+                Phase::Open => {
+                    t.fill(0.0);
+                    kinds.fill(SampleKind::Open);
+                }
+            }
+            k = end;
         }
+        // No pieces (never after a march): no force.
+        self.t[k..].fill(0.0);
+        self.kinds[k..].fill(SampleKind::Open);
     }
 }

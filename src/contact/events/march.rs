@@ -5,10 +5,12 @@
 //! the first instant where one of them turns positive. They are bracketed on the sample grid
 //! (values and rates from the grid signals), grazes inside a cell are caught by the sign
 //! change of f′ across it, and every root is refined by Brent's method on direct evaluations
-//! of the trigonometric polynomials, to round-off of τ.
+//! of the trigonometric polynomials, to round-off of τ. Blocks of cells where bounds of the
+//! exit functions ([`super::bounds`]) rule out any root or graze are passed over whole.
 
+use super::bounds::{Bounded, CellBounds};
 use super::roots::brent;
-use crate::contact::harmonic::Block;
+use crate::contact::harmonic::{Block, SampleBasis};
 use std::f64::consts::PI;
 
 /// u, v and their first two τ-derivatives at one instant (m, m/rad, m/rad²).
@@ -34,6 +36,10 @@ impl Signals<'_> {
     /// u, v and their derivatives at τ.
     pub fn at(&self, tau: f64) -> Kinematics {
         let mut k = Kinematics::default();
+        // sin hτ, cos hτ by the angle-addition recurrence from sin τ, cos τ (the blocks are
+        // in increasing harmonic order): one sin_cos per evaluation.
+        let (s1, c1) = tau.sin_cos();
+        let (mut harmonic, mut s, mut c) = (0usize, 0.0, 1.0);
         for (j, block) in self.blocks.iter().enumerate() {
             let (cu, cv) = (self.u[j], self.v[j]);
             match *block {
@@ -41,9 +47,12 @@ impl Signals<'_> {
                     k.u[0] += cu;
                     k.v[0] += cv;
                 }
-                Block::Cos(h) | Block::Sin(h) => {
-                    let h = h as f64;
-                    let (s, c) = (h * tau).sin_cos();
+                Block::Cos(n) | Block::Sin(n) => {
+                    while harmonic < n {
+                        (s, c) = (s * c1 + c * s1, c * c1 - s * s1);
+                        harmonic += 1;
+                    }
+                    let h = n as f64;
                     // d/dτ cos hτ = −h sin hτ, d/dτ sin hτ = h cos hτ.
                     let (b0, b1, b2) = match *block {
                         Block::Cos(_) => (c, -h * s, -h * h * c),
@@ -61,12 +70,20 @@ impl Signals<'_> {
     }
 }
 
-/// The grid values of [`Kinematics`] over one period, N samples at τₖ = 2πk/N.
+/// The grid values of [`Kinematics`] over one period, N samples at τₖ = 2πk/N: u, u′, v, v′
+/// as samples, u″ and v″ from their coefficients at the few samples that need them (the end
+/// of a slip is the one exit whose rate uses them).
 pub struct Grid<'a> {
-    /// [u, u′, u″] samples.
-    pub u: [&'a [f64]; 3],
-    /// [v, v′, v″] samples.
-    pub v: [&'a [f64]; 3],
+    /// [u, u′] samples.
+    pub u: [&'a [f64]; 2],
+    /// [v, v′] samples.
+    pub v: [&'a [f64]; 2],
+    /// Coefficients of u″ and v″ on the force blocks.
+    pub second: [&'a [f64]; 2],
+    /// The synthesis matrix of the grid (basis values at the samples).
+    pub basis: &'a SampleBasis,
+    /// Bounds of the exit functions over blocks of cells, filled from these samples.
+    pub bounds: &'a CellBounds,
 }
 
 impl Grid<'_> {
@@ -74,11 +91,18 @@ impl Grid<'_> {
         self.u[0].len()
     }
 
-    fn at(&self, k: usize) -> Kinematics {
-        let k = k % self.len();
+    /// The kinematics at sample k (0 ≤ k < N); u″ and v″ only with `second` (zero otherwise).
+    fn at(&self, k: usize, second: bool) -> Kinematics {
+        let (ddu, ddv) = if second {
+            let row = self.basis.row(k);
+            let dot = |c: &[f64]| row.iter().zip(c).map(|(e, c)| e * c).sum::<f64>();
+            (dot(self.second[0]), dot(self.second[1]))
+        } else {
+            (0.0, 0.0)
+        };
         Kinematics {
-            u: [self.u[0][k], self.u[1][k], self.u[2][k]],
-            v: [self.v[0][k], self.v[1][k], self.v[2][k]],
+            u: [self.u[0][k], self.u[1][k], ddu],
+            v: [self.v[0][k], self.v[1][k], ddv],
         }
     }
 }
@@ -228,13 +252,19 @@ pub struct Orbit {
 /// the one-period map of the slider is piecewise constant wherever it resets. The march thus
 /// stops after two or three periods with an exactly periodic event sequence, or after the
 /// first with a contact stuck all period from its initial state.
+///
+/// A period need not be marched to its end: as soon as one of its events repeats an event of
+/// the period before, one period later to round-off of τ and into the same phase, the rest of
+/// it is the rest of that period shifted by 2π (the phase after an event is set by the event
+/// alone), and so is its end state, which the end-of-period test would then accept. That
+/// rest is copied instead of marched. `previous` is scratch for the period before.
 pub fn periodic_orbit(
     law: &LawParams,
     signals: &Signals<'_>,
     grid: &Grid<'_>,
     max_periods: usize,
     tolerance: f64,
-    pieces: &mut Vec<Piece>,
+    (pieces, previous): (&mut Vec<Piece>, &mut Vec<Piece>),
 ) -> Result<usize, MarchFailure> {
     let marcher = Marcher {
         law,
@@ -245,10 +275,12 @@ pub fn periodic_orbit(
     let mut state = marcher.initial_phase();
     let mut drift = f64::INFINITY;
     let max_events = 4 * grid.len() + 16;
+    previous.clear();
     for period in 1..=max_periods.max(2) {
         pieces.clear();
         let start = state;
         let (mut t, end) = (2.0 * PI * (period - 1) as f64, 2.0 * PI * period as f64);
+        let mut matched = false;
         loop {
             match marcher.next_event(state, t, end) {
                 None => {
@@ -267,41 +299,79 @@ pub fn periodic_orbit(
                     });
                     state = marcher.after(event, tau);
                     t = tau;
+                    if let Some(q) = repeated_piece(previous, tau - 2.0 * PI, state, tolerance) {
+                        pieces.push(Piece {
+                            start: tau,
+                            end: previous[q].end + 2.0 * PI,
+                            phase: state,
+                        });
+                        pieces.extend(previous[q + 1..].iter().map(|p| shifted(*p, 2.0 * PI)));
+                        matched = true;
+                        break;
+                    }
                 }
             }
             if pieces.len() > max_events {
                 return Err(MarchFailure::TooManyEvents);
             }
         }
-        let repeats = match (start, state) {
-            (Phase::Slip { sign: a }, Phase::Slip { sign: b }) => a == b,
-            (Phase::Open, Phase::Open) => true,
-            (Phase::Stick { w: a, .. }, Phase::Stick { w: b, .. }) => {
-                drift = (a - b).abs();
-                drift <= tolerance
-            }
-            _ => false,
-        };
+        let repeats = matched
+            || match (start, state) {
+                (Phase::Slip { sign: a }, Phase::Slip { sign: b }) => a == b,
+                (Phase::Open, Phase::Open) => true,
+                (Phase::Stick { w: a, .. }, Phase::Stick { w: b, .. }) => {
+                    drift = (a - b).abs();
+                    drift <= tolerance
+                }
+                _ => false,
+            };
         if repeats {
             let shift = 2.0 * PI * (period - 1) as f64;
             pieces.retain(|p| p.end > p.start);
             for p in pieces.iter_mut() {
-                p.start -= shift;
-                p.end -= shift;
-                if let Phase::Stick { anchor, .. } = &mut p.phase {
-                    match anchor {
-                        Anchor::SlipEnd { tau, .. } | Anchor::Closing { tau } => *tau -= shift,
-                        Anchor::Initial => {}
-                    }
-                }
+                *p = shifted(*p, -shift);
             }
             return Ok(period);
         }
+        std::mem::swap(pieces, previous);
     }
     Err(MarchFailure::NotSettled {
         periods: max_periods.max(2),
         drift,
     })
+}
+
+/// `piece` moved by `by` (rad) along the time line, its anchor with it.
+fn shifted(mut piece: Piece, by: f64) -> Piece {
+    piece.start += by;
+    piece.end += by;
+    if let Phase::Stick { anchor, .. } = &mut piece.phase {
+        match anchor {
+            Anchor::SlipEnd { tau, .. } | Anchor::Closing { tau } => *tau += by,
+            Anchor::Initial => {}
+        }
+    }
+    piece
+}
+
+/// The index of the piece of the previous period (`previous`, in order) that an event starts
+/// at `tau` (rad, on that period's time line) to round-off, in `phase` (a stick's slider
+/// within `tolerance`, m); the first piece, which no event of that period starts, never.
+fn repeated_piece(previous: &[Piece], tau: f64, phase: Phase, tolerance: f64) -> Option<usize> {
+    let eps = 1e-12 * tau.abs().max(1.0);
+    let first = previous.partition_point(|p| p.start < tau - eps).max(1);
+    previous
+        .iter()
+        .enumerate()
+        .skip(first)
+        .take_while(|(_, p)| p.start <= tau + eps)
+        .find(|(_, p)| match (p.phase, phase) {
+            (Phase::Slip { sign: a }, Phase::Slip { sign: b }) => a == b,
+            (Phase::Open, Phase::Open) => true,
+            (Phase::Stick { w: a, .. }, Phase::Stick { w: b, .. }) => (a - b).abs() <= tolerance,
+            _ => false,
+        })
+        .map(|(i, _)| i)
 }
 
 struct Marcher<'a> {
@@ -310,6 +380,16 @@ struct Marcher<'a> {
     grid: &'a Grid<'a>,
     /// Grid spacing (rad).
     cell: f64,
+}
+
+/// One cell (a, b] of the march for one exit function: τ (rad), f and f′ at both ends, the
+/// level below which f counts as zero at a, and whether the cell is the phase's first.
+#[derive(Clone, Copy)]
+struct Cell {
+    a: (f64, f64, f64),
+    b: (f64, f64, f64),
+    zero: f64,
+    first: bool,
 }
 
 impl Marcher<'_> {
@@ -420,6 +500,11 @@ impl Marcher<'_> {
     }
 
     /// The first event of `phase` in (t0, t_end], with its time.
+    ///
+    /// The exit functions and their rates at a cell's end are carried over as the next cell's
+    /// start values, and a cell is examined further only where an exit function ends above
+    /// zero or its rate falls from positive to negative (the two cases
+    /// [`Self::crossing`] looks at): most cells cost one evaluation of each exit function.
     fn next_event(&self, phase: Phase, t0: f64, t_end: f64) -> Option<(f64, Event)> {
         let (events, count) = self.exits(phase);
         let events = &events[..count];
@@ -430,22 +515,67 @@ impl Marcher<'_> {
             Phase::Stick { w, .. } => w,
             _ => 0.0,
         };
+        let n = self.grid.len();
+        // Only the end of a slip has a rate that needs u″ and v″.
+        let second = matches!(phase, Phase::Slip { .. });
         let mut a = t0;
         let mut ka = self.signals.at(t0);
+        let mut exits_a = [(0.0, 0.0); 3];
+        for (x, &event) in exits_a.iter_mut().zip(events) {
+            *x = self.exit(event, w, &ka);
+        }
         let mut first = true;
         let mut k = (t0 / self.cell).floor() as usize + 1;
+        let mut index = k % n;
         loop {
+            if !first {
+                // a is the grid point k − 1: pass over the rest of its block at once where
+                // no exit function can turn positive in it, as long as the block ends
+                // before t_end.
+                let i = if index == 0 { n - 1 } else { index - 1 };
+                let cells = self.grid.bounds.cells;
+                let block = i / cells;
+                let block_end = ((block + 1) * cells).min(n);
+                let a_next = k - 1 + (block_end - i);
+                if (a_next as f64) * self.cell < t_end && self.block_quiet(phase, block) {
+                    let ia = block_end % n;
+                    a = a_next as f64 * self.cell;
+                    ka = self.grid.at(ia, second);
+                    for (x, &event) in exits_a.iter_mut().zip(events) {
+                        *x = self.exit(event, w, &ka);
+                    }
+                    k = a_next + 1;
+                    index = if ia + 1 == n { 0 } else { ia + 1 };
+                    continue;
+                }
+            }
             let grid_b = k as f64 * self.cell;
             let (b, kb) = if grid_b < t_end {
-                (grid_b, self.grid.at(k))
+                (grid_b, self.grid.at(index, second))
             } else {
                 (t_end, self.signals.at(t_end))
             };
+            let mut exits_b = [(0.0, 0.0); 3];
+            for (x, &event) in exits_b.iter_mut().zip(events) {
+                *x = self.exit(event, w, &kb);
+            }
             if b > a {
                 let mut best: Option<(f64, Event)> = None;
-                for &event in events {
-                    let root = self.crossing(event, w, (a, &ka), (b, &kb), first);
-                    if let Some(tau) = root {
+                for (i, &event) in events.iter().enumerate() {
+                    let ((fa, dfa), (fb, dfb)) = (exits_a[i], exits_b[i]);
+                    // The zero level is never negative: below both tests, no root (see
+                    // `crossing`).
+                    if fb <= 0.0 && !(dfa > 0.0 && dfb < 0.0) {
+                        continue;
+                    }
+                    let zero = self.zero_level(event, w, &ka);
+                    let cell = Cell {
+                        a: (a, fa, dfa),
+                        b: (b, fb, dfb),
+                        zero,
+                        first,
+                    };
+                    if let Some(tau) = self.crossing(event, w, cell) {
                         if best.is_none_or(|(t, _)| tau < t) {
                             best = Some((tau, event));
                         }
@@ -461,7 +591,33 @@ impl Marcher<'_> {
             }
             a = b;
             ka = kb;
+            exits_a = exits_b;
             k += 1;
+            index = if index + 1 == n { 0 } else { index + 1 };
+        }
+    }
+
+    /// Whether no exit function of `phase` can turn positive anywhere in block `block` of
+    /// the grid ([`CellBounds`]).
+    fn block_quiet(&self, phase: Phase, block: usize) -> bool {
+        let bound = |which| self.grid.bounds.of(block, which);
+        let stays_closed = self.law.constant_limit.is_some() || bound(Bounded::Opening) < 0.0;
+        match phase {
+            Phase::Stick { w, .. } => {
+                let ktw = self.law.kt * w;
+                bound(Bounded::SlipPositive) - ktw < 0.0
+                    && bound(Bounded::SlipNegative) + ktw < 0.0
+                    && stays_closed
+            }
+            Phase::Slip { sign } => {
+                let end = if sign > 0.0 {
+                    Bounded::StickPositive
+                } else {
+                    Bounded::StickNegative
+                };
+                bound(end) < 0.0 && stays_closed
+            }
+            Phase::Open => self.law.constant_limit.is_some() || bound(Bounded::Closing) < 0.0,
         }
     }
 
@@ -469,17 +625,13 @@ impl Marcher<'_> {
     /// sign change across the cell, or a graze (f′ falls from positive to negative inside the
     /// cell at a positive maximum of f). At a phase's first cell f(a) is zero by construction
     /// (the event that started it), and f is known to fall first.
-    fn crossing(
-        &self,
-        event: Event,
-        w: f64,
-        (a, ka): (f64, &Kinematics),
-        (b, kb): (f64, &Kinematics),
-        first: bool,
-    ) -> Option<f64> {
-        let (fa, dfa) = self.exit(event, w, ka);
-        let (fb, dfb) = self.exit(event, w, kb);
-        let zero = self.zero_level(event, w, ka);
+    fn crossing(&self, event: Event, w: f64, cell: Cell) -> Option<f64> {
+        let Cell {
+            a: (a, fa, dfa),
+            b: (b, fb, dfb),
+            zero,
+            first,
+        } = cell;
         let f = |t: f64| self.exit(event, w, &self.signals.at(t)).0;
         if fb > zero {
             if fa < -zero {
@@ -558,8 +710,20 @@ pub fn closed_intervals(signals: &Signals<'_>, grid: &Grid<'_>, out: &mut Vec<(f
             out.push((*start, tau));
         }
     };
-    for k in 0..n {
+    let mut k = 0;
+    while k < n {
+        let bounds = grid.bounds;
+        if k % bounds.cells == 0 {
+            // v keeps its sign over the whole block: no root, no short closing or opening.
+            let block = k / bounds.cells;
+            if bounds.of(block, Bounded::Opening) < 0.0 || bounds.of(block, Bounded::Closing) < 0.0
+            {
+                k = (k + bounds.cells).min(n);
+                continue;
+            }
+        }
         let ((a, va, da), (b, vb, db)) = (at(k), at(k + 1));
+        k += 1;
         if (va > 0.0) != (vb > 0.0) {
             let tau = brent(v, a, b, va, vb);
             closed = vb > 0.0;

@@ -42,6 +42,7 @@
 //!   vanishes: at τₐ, kₜ u′ = s L′);
 //! * closing at τ_c: w = u(τ_c) with v(τ_c) = 0, dw = du(τ_c) − (u′/v′)(τ_c) dv(τ_c).
 
+pub mod bounds;
 pub mod march;
 mod roots;
 
@@ -92,14 +93,17 @@ impl Moments {
         }
     }
 
-    /// The moments of the unit weight over [t0, t1].
+    /// The moments of the unit weight over [t0, t1]; sin mt, cos mt by the angle-addition
+    /// recurrence from sin t, cos t.
     fn interval(&mut self, t0: f64, t1: f64) {
         self.c[0] = t1 - t0;
         self.s[0] = 0.0;
+        let ((a0, b0), (a1, b1)) = (t0.sin_cos(), t1.sin_cos());
+        let (mut s0, mut c0, mut s1, mut c1) = (0.0, 1.0, 0.0, 1.0);
         for m in 1..self.c.len() {
+            (s0, c0) = (s0 * b0 + c0 * a0, c0 * b0 - s0 * a0);
+            (s1, c1) = (s1 * b1 + c1 * a1, c1 * b1 - s1 * a1);
             let mf = m as f64;
-            let (s0, c0) = (mf * t0).sin_cos();
-            let (s1, c1) = (mf * t1).sin_cos();
             self.c[m] = (s1 - s0) / mf;
             self.s[m] = (c0 - c1) / mf;
         }
@@ -122,12 +126,16 @@ pub struct ForceOutputs<'a> {
 pub struct EventSolver {
     /// Coefficients of u′, u″, v′, v″ on the force blocks.
     pub derivative_coefficients: [Vec<f64>; 4],
-    /// Grid samples of u′, u″, v′, v″.
-    pub derivative_samples: [Vec<f64>; 4],
+    /// Grid samples of u′ and v′.
+    pub derivative_samples: [Vec<f64>; 2],
     /// Phases of the last periodic orbit over [0, 2π].
     pub pieces: Vec<Piece>,
+    /// Scratch for the march: the phases of the period before.
+    pub previous_pieces: Vec<Piece>,
     /// Stretches of [0, 2π] where v > 0 (variable normal load with lift-off).
     pub closed_intervals: Vec<(f64, f64)>,
+    /// Bounds of the exit functions over blocks of grid cells (for the march to skip them).
+    pub bounds: bounds::CellBounds,
     stick: Moments,
     slip: Moments,
     closed: Moments,
