@@ -25,6 +25,39 @@ fn jacobian_error(l: Jenkins2dLaw, effects: ContactEffects, x: [&[f64]; 3]) -> (
     jacobian_error_with_step(l, effects, x, 1e-7)
 }
 
+/// The 2D law's two time resolutions: the sampled march and the event-resolved law.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum March {
+    Sampled,
+    Events,
+}
+
+/// Evaluates a point with the chosen march.
+fn evaluate(
+    aft: &mut Aft2dWorkspace,
+    march: March,
+    l: &Jenkins2dLaw,
+    effects: ContactEffects,
+    x: [&[f64]; 3],
+    jacobian: bool,
+) -> Result<fricbound::contact::aft::MarchReport, fricbound::contact::aft::AftError> {
+    match march {
+        March::Sampled => aft.evaluate(l, effects, [x[0], x[1]], x[2], jacobian),
+        March::Events => aft.evaluate_events(l, effects, [x[0], x[1]], x[2], jacobian),
+    }
+}
+
+/// [`jacobian_error_with_step`] with either march.
+fn jacobian_error_of(
+    march: March,
+    l: Jenkins2dLaw,
+    effects: ContactEffects,
+    x: [&[f64]; 3],
+    relative_step: f64,
+) -> (f64, ContactState) {
+    jacobian_error_general(march, l, effects, x, relative_step)
+}
+
 /// [`jacobian_error`] with difference steps of `relative_step` times the largest displacement
 /// coefficient.
 fn jacobian_error_with_step(
@@ -33,11 +66,20 @@ fn jacobian_error_with_step(
     x: [&[f64]; 3],
     relative_step: f64,
 ) -> (f64, ContactState) {
-    let set = HarmonicSet::up_to(3);
+    jacobian_error_general(March::Sampled, l, effects, x, relative_step)
+}
+
+fn jacobian_error_general(
+    march: March,
+    l: Jenkins2dLaw,
+    effects: ContactEffects,
+    x: [&[f64]; 3],
+    relative_step: f64,
+) -> (f64, ContactState) {
+    let set = HarmonicSet::up_to((x[0].len() - 1) / 2);
     let nb = set.n_blocks();
     let mut aft = Aft2dWorkspace::new(&set, SAMPLES);
-    let state = aft
-        .evaluate(&l, effects, [x[0], x[1]], x[2], true)
+    let state = evaluate(&mut aft, march, &l, effects, x, true)
         .expect("march settles")
         .state;
     let forces = |aft: &Aft2dWorkspace| -> Vec<f64> {
@@ -79,7 +121,7 @@ fn jacobian_error_with_step(
         let mut shifted = |sign: f64| {
             let mut p = [x[0].to_vec(), x[1].to_vec(), x[2].to_vec()];
             p[which][i] += sign * h;
-            aft.evaluate(&l, effects, [&p[0], &p[1]], &p[2], false)
+            evaluate(&mut aft, march, &l, effects, [&p[0], &p[1], &p[2]], false)
                 .expect("march settles");
             forces(&aft)
         };
@@ -298,4 +340,94 @@ fn grazing_inside_the_stick_circle_keeps_the_history_derivative() {
     let (err, state) = jacobian_error(law(mu, [0.0, 0.0]), effects(true), [&x[0], &x[1], &x[2]]);
     assert_eq!(state, ContactState::Stuck);
     assert!(err < 1e-6, "relative error {err:.3e}");
+}
+
+mod events {
+    //! The event-resolved 2D law (`jenkins-2d`) against the 1D event law, the sampled 2D law,
+    //! closed forms and central differences.
+
+    use super::*;
+    use fricbound::contact::aft::AftWorkspace;
+    use fricbound::contact::JenkinsLaw;
+
+    fn c(set: &HarmonicSet, e: &[(usize, f64)]) -> Vec<f64> {
+        let mut x = vec![0.0; set.n_blocks()];
+        for &(j, v) in e {
+            x[j] = v;
+        }
+        x
+    }
+
+    #[test]
+    fn straight_motion_equals_the_1d_event_law() {
+        let set = HarmonicSet::up_to(3);
+        let nb = set.n_blocks();
+        let mut plane = Aft2dWorkspace::new(&set, 64);
+        let mut line = AftWorkspace::new(&set, 64);
+        let zero = vec![0.0; nb];
+        let cases = [
+            (
+                c(&set, &[(0, 1e-6), (1, 8e-5), (2, 2e-5), (3, 1e-5)]),
+                c(&set, &[(0, 1e-4), (1, 3e-5), (4, 1e-5)]),
+            ),
+            (
+                c(&set, &[(1, 5e-5), (2, -3e-5)]),
+                c(&set, &[(0, 2e-5), (1, 4e-5), (2, 1e-5)]),
+            ),
+            (c(&set, &[(1, 1e-6), (5, 2e-7)]), c(&set, &[(0, 1e-4)])),
+        ];
+        let (kt, kn, mu) = (1e5, 2e5, 0.3);
+        let mut worst = (0.0_f64, 0.0_f64);
+        for constant in [false, true] {
+            for (u, v) in &cases {
+                for m in [-1.0, -0.4, 0.0, 0.7, 1.0] {
+                    let law1 = JenkinsLaw {
+                        kt,
+                        kn,
+                        mu,
+                        initial_state: m,
+                    };
+                    let law2 = Jenkins2dLaw {
+                        kt,
+                        kn,
+                        mu,
+                        initial_state: [m, 0.0],
+                    };
+                    let r1 = line
+                        .evaluate_events(&law1, effects(constant), u, v, true)
+                        .unwrap();
+                    let r2 = plane
+                        .evaluate_events(&law2, effects(constant), [u, &zero], v, true)
+                        .unwrap();
+                    assert_eq!(r1.state, r2.state, "state at m = {m}");
+                    let scale = line.t_hat.iter().fold(1.0_f64, |a, x| a.max(x.abs()));
+                    for j in 0..nb {
+                        let e = (plane.t_hat[0][j] - line.t_hat[j])
+                            .abs()
+                            .max(plane.t_hat[1][j].abs())
+                            .max((plane.n_hat[j] - line.n_hat[j]).abs());
+                        worst.0 = worst.0.max(e / scale);
+                        for i in 0..nb {
+                            let d = (plane.dt_dx[j * 3 * nb + i] - line.dt_du[j * nb + i])
+                                .abs()
+                                .max(
+                                    (plane.dt_dx[j * 3 * nb + 2 * nb + i] - line.dt_dv[j * nb + i])
+                                        .abs(),
+                                )
+                                .max((plane.dn_dv[j * nb + i] - line.dn_dv[j * nb + i]).abs())
+                                .max(plane.dt_dx[(nb + j) * 3 * nb + i].abs())
+                                .max(plane.dt_dx[(nb + j) * 3 * nb + 2 * nb + i].abs());
+                            worst.1 = worst.1.max(d / kn);
+                        }
+                    }
+                }
+            }
+        }
+        println!(
+            "largest force difference {:.2e} (relative), Jacobian {:.2e} (of kₙ)",
+            worst.0, worst.1
+        );
+        assert!(worst.0 < 1e-12, "{worst:?}");
+        assert!(worst.1 < 1e-12, "{worst:?}");
+    }
 }

@@ -17,6 +17,7 @@ pub mod aft;
 pub mod aft2d;
 pub mod describing_function;
 pub mod events;
+pub mod events2d;
 pub mod harmonic;
 pub mod point;
 

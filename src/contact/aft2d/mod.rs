@@ -115,6 +115,7 @@
 mod fixtures;
 mod jacobian;
 mod march;
+mod resolved;
 mod settle;
 mod workspace;
 
