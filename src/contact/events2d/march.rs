@@ -528,8 +528,12 @@ impl PeriodMarch<'_> {
                 return Ok((t_stop, stop_exit));
             }
             let k = self.path.at(t);
-            let limit = self.law.limit(&k)[0];
-            if stop_exit.is_some() && limit < OPENING_LIMIT_FRACTION * self.limit_scale {
+            let limit = self.law.limit(&k);
+            let closing_in = limit[1] < 0.0;
+            if stop_exit.is_some()
+                && closing_in
+                && limit[0] < OPENING_LIMIT_FRACTION * self.limit_scale
+            {
                 // About to open: the rest of the force, of order L², with θ frozen.
                 if let Some(r) = record.as_deref_mut() {
                     buf.dense.copy_from_slice(&buf.y);
