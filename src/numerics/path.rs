@@ -61,7 +61,7 @@ pub enum ContinuationError {
     /// between two time samples, where the residual has a kink; the message names the remedy.
     #[error(
         "continuation stalled at {freq_hz:.4} Hz (step {step:.3e} below minimum): {reason}; \
-         with a sampled contact law (`jenkins-1d-sampled`, `jenkins-2d`) a residual stagnating \
+         with a sampled contact law (`jenkins-1d-sampled`, `jenkins-2d-sampled`) a residual stagnating \
          just above tolerance means a contact transition falls between time samples: more \
          samples ([harmonics] samples) usually get past it"
     )]

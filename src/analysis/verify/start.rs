@@ -9,6 +9,7 @@ use super::contact::{return_map, slider_dims, slider_offsets, tangential_pair, T
 use super::newmark::mat_vec_add;
 use super::settings::VerifyError;
 use crate::contact::aft2d::Aft2dWorkspace;
+use crate::contact::TimeResolution;
 use crate::contact::harmonic::HarmonicSet;
 use crate::contact::ContactPoint;
 use crate::model::Problem;
@@ -83,10 +84,14 @@ pub fn hbm_state(
                 v[j0] -= p.gap;
             }
             let ws = aft2d.get_or_insert_with(|| Aft2dWorkspace::new(set, samples));
-            ws.evaluate(&law, problem.effects.contact, [&u1, &u2], &v, false)
-                .map_err(|e| VerifyError::Unsupported {
+            let effects = problem.effects.contact;
+            match p.resolution {
+                TimeResolution::Events => ws.evaluate_events(&law, effects, [&u1, &u2], &v, false),
+                TimeResolution::Samples => ws.evaluate(&law, effects, [&u1, &u2], &v, false),
+            }
+            .map_err(|e| VerifyError::Unsupported {
                     reason: format!(
-                        "the 2D march of contact `{}` on the harmonic-balance point: {e}",
+                        "the 2D law of contact `{}` on the harmonic-balance point: {e}",
                         p.name
                     ),
                 })?;
