@@ -815,4 +815,64 @@ mod events {
             prop_assert!(err < 1e-5, "relative error {}", err);
         }
     }
+
+    /// Cost of one point's evaluation with each law (forces alone and with the Jacobian), in
+    /// the stuck, partial-slip, rotating-slip and lift-off regimes at H = 3 and 128 samples:
+    /// `cargo test --release --test aft_jenkins_2d cost -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn cost_per_evaluation() {
+        let set = HarmonicSet::up_to(3);
+        let l = law(0.3, [0.2, -0.3]);
+        let cases = [
+            ("stuck", false, coefficients(&[0.3; 21], 1e-6, 1e-3, 1e-5)),
+            ("partial slip", false, {
+                let mut x = coefficients(&[0.2; 21], 1e-5, 1e-4, 1e-5);
+                x[0][1] += 4e-5;
+                x[1][2] += 1e-5;
+                x
+            }),
+            ("rotating slip", true, {
+                let mut x = coefficients(&[0.1; 21], 1e-5, 1e-4, 0.0);
+                x[0][1] += 5e-4;
+                x[1][2] += 3e-4;
+                x
+            }),
+            ("lift-off", false, {
+                let mut x = coefficients(&[0.1; 21], 1e-5, 2e-5, 2e-5);
+                x[0][1] += 2e-4;
+                x[1][2] += 1e-4;
+                x[2][2] += 1e-4;
+                x
+            }),
+        ];
+        for (what, constant, x) in &cases {
+            for jacobian in [false, true] {
+                let mut times = [0.0; 2];
+                let mut states = [ContactState::Open; 2];
+                for (k, march) in [March::Sampled, March::Events].into_iter().enumerate() {
+                    let mut aft = Aft2dWorkspace::new(&set, 128);
+                    let reps = 200;
+                    let started = std::time::Instant::now();
+                    for _ in 0..reps {
+                        let r = evaluate(
+                            &mut aft,
+                            march,
+                            &l,
+                            effects(*constant),
+                            [&x[0], &x[1], &x[2]],
+                            jacobian,
+                        )
+                        .unwrap();
+                        states[k] = r.state;
+                    }
+                    times[k] = started.elapsed().as_secs_f64() / reps as f64;
+                }
+                println!(
+                    "{what} (jacobian {jacobian}): sampled {:.1} µs ({:?}), events {:.1} µs ({:?}), ratio {:.2}",
+                    1e6 * times[0], states[0], 1e6 * times[1], states[1], times[1] / times[0]
+                );
+            }
+        }
+    }
 }

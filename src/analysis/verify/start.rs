@@ -9,7 +9,6 @@ use super::contact::{return_map, slider_dims, slider_offsets, tangential_pair, T
 use super::newmark::mat_vec_add;
 use super::settings::VerifyError;
 use crate::contact::aft2d::Aft2dWorkspace;
-use crate::contact::TimeResolution;
 use crate::contact::harmonic::HarmonicSet;
 use crate::contact::ContactPoint;
 use crate::model::Problem;
@@ -70,7 +69,10 @@ pub fn hbm_state(
     let mut aft2d: Option<Aft2dWorkspace> = None;
     for p in &problem.contacts {
         if let Some(law) = p.law_2d() {
-            // The AFT's 2D march on the point's own coefficients (u₁, u₂, v per block).
+            // The sampled 2D march on the point's own coefficients (u₁, u₂, v per block),
+            // whatever the point's time resolution: its slider start is that of a law applied
+            // at discrete instants, as the time integration applies it, and the 1D points'
+            // starts below are sampled alike.
             let row_coefficients = |row: &[(usize, f64)]| -> Vec<f64> {
                 (0..nb)
                     .map(|j| row.iter().map(|&(i, a)| a * x[j * n + i]).sum())
@@ -84,14 +86,10 @@ pub fn hbm_state(
                 v[j0] -= p.gap;
             }
             let ws = aft2d.get_or_insert_with(|| Aft2dWorkspace::new(set, samples));
-            let effects = problem.effects.contact;
-            match p.resolution {
-                TimeResolution::Events => ws.evaluate_events(&law, effects, [&u1, &u2], &v, false),
-                TimeResolution::Samples => ws.evaluate(&law, effects, [&u1, &u2], &v, false),
-            }
-            .map_err(|e| VerifyError::Unsupported {
+            ws.evaluate(&law, problem.effects.contact, [&u1, &u2], &v, false)
+                .map_err(|e| VerifyError::Unsupported {
                     reason: format!(
-                        "the 2D law of contact `{}` on the harmonic-balance point: {e}",
+                        "the 2D march of contact `{}` on the harmonic-balance point: {e}",
                         p.name
                     ),
                 })?;
