@@ -6,7 +6,9 @@
 //! VTU output; the FRF over 840-900 Hz is one complete path through both folds, and over
 //! 845-900 Hz its leap past the lower fold is judged abandoned; and the m = +1 limit curve
 //! crosses its former stall at 852.78 Hz, on a narrow window and, over a wide one, by the
-//! continuation's narrow-window pass.
+//! continuation's narrow-window pass. The tests of the path's corners, leaps and stalls were
+//! measured on the sampled laws and run on them (`SAMPLED`); the formulations' agreement and
+//! the short run with VTU output run the scene's own event-resolved `jenkins-2d`.
 
 mod support;
 
@@ -19,6 +21,21 @@ use fricbound::model::{Formulation, Problem};
 use fricbound::scene;
 
 const SCENE: &str = "meshes/blade-pair/blade-pair-3d.toml";
+
+/// Overrides that put the 3D scenes on the sampled laws (`jenkins-2d-sampled` patches, the
+/// axial springs on `jenkins-1d-sampled`), as they were when the tests of the sampled law's
+/// corners, leaps and stalls below were measured.
+const SAMPLED: [&str; 4] = [
+    "contact_patches.0.law=\"jenkins-2d-sampled\"",
+    "contact_patches.1.law=\"jenkins-2d-sampled\"",
+    "contacts.0.law=\"jenkins-1d-sampled\"",
+    "contacts.1.law=\"jenkins-1d-sampled\"",
+];
+
+/// `overrides` after [`SAMPLED`].
+fn sampled(overrides: &[&'static str]) -> Vec<&'static str> {
+    SAMPLED.iter().chain(overrides).copied().collect()
+}
 
 /// Fixed frequencies below the first bending pair (Hz), each solved by Newton from the stuck
 /// linear response; at these the patch points are stuck, open or in stick-slip with lift-off.
@@ -158,12 +175,12 @@ fn the_3d_frf_crosses_contact_transitions_on_the_bending_flank() {
     let frf = narrow_frf(
         "flank",
         "right-7",
-        &[
+        &sampled(&[
             "analysis.freq_start_hz=885.4",
             "analysis.freq_end_hz=885.7",
             "analysis.linear_points=3",
             "accuracy.estimate=false",
-        ],
+        ]),
     );
     let freqs = &frf.freqs;
     assert!(
@@ -188,13 +205,13 @@ fn the_3d_frf_crosses_the_transition_at_886_685_hz_without_turning_back() {
     let frf = narrow_frf(
         "886",
         "left-25",
-        &[
+        &sampled(&[
             "analysis.freq_start_hz=886.6",
             "analysis.freq_end_hz=886.75",
             "analysis.max_step=0.02",
             "analysis.linear_points=3",
             "accuracy.estimate=false",
-        ],
+        ]),
     );
     let freqs = &frf.freqs;
     println!("{} points: {freqs:?}", freqs.len());
@@ -228,12 +245,12 @@ fn the_3d_frf_over_the_bending_pair_is_one_complete_path_through_both_folds() {
     let run = support::run_scene(
         SCENE,
         &out,
-        &[
+        &sampled(&[
             "analysis.freq_start_hz=840",
             "analysis.freq_end_hz=900",
             "analysis.linear_points=3",
             "accuracy.estimate=false",
-        ],
+        ]),
     );
     assert!(run.status.success(), "{}", support::text(&run.stderr));
     let solution = support::json(&out.join("solution.json"));
@@ -310,11 +327,11 @@ fn the_3d_frf_over_the_bending_pair_is_one_complete_path_through_both_folds() {
 /// the other.
 #[test]
 fn a_leap_past_the_lower_fold_is_judged_abandoned_and_the_run_incomplete() {
-    let problem = problem(&[
+    let problem = problem(&sampled(&[
         "analysis.freq_start_hz=845",
         "analysis.freq_end_hz=900",
         "accuracy.estimate=false",
-    ]);
+    ]));
     let run =
         fricbound::analysis::frf::solve(&problem, &mut fricbound::analysis::frf::Silent).unwrap();
     println!("leaps {:?}, checks {:?}", run.leaps, run.leap_checks);
@@ -437,7 +454,7 @@ fn m_plus_1_case(
         format!("analysis.freq_end_hz={end}"),
         "accuracy.estimate=false".to_string(),
     ];
-    o.extend(extra.iter().map(|s| s.to_string()));
+    o.extend(SAMPLED.iter().chain(extra).map(|s| s.to_string()));
     let problem = scene::load_problem(Path::new(LIMITS_SCENE), &o).unwrap().1;
     let case = fricbound::analysis::limits::case::two_point_cases(&problem)
         .into_iter()

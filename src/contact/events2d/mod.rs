@@ -30,14 +30,15 @@
 //!
 //! * at a slip onset τₛ: S(τₛ) = kₜ e⊥·(du − dw)/L (the onset time's terms, kₜ(u′·e⊥)/L from
 //!   the stick and from the ODE, cancel);
-//! * at a slip end τₐ: dw = du − (dL e + L e⊥ S)/kₜ (the τₐ term is e λ′-free: it is e times the
-//!   slip rate, zero there);
+//! * at a slip end τₐ: dw = du − (dL e + L e⊥ S)/kₜ (the τₐ term is e times the slip rate,
+//!   zero there);
 //! * at closing τ_c: dw = du(τ_c) − u′(τ_c) dv(τ_c)/v′(τ_c) (T = 0 there, as in 1D).
 //!
 //! The period map's derivative A = ∂w_end/∂w_start and B = ∂w_end/∂(û, v̂) are the slider's
 //! sensitivities at the period's end; the periodic state and its derivative
 //! dw_start = (I − A)⁻¹ B dx are in [`crate::contact::aft2d`]'s `resolved` file.
 
+mod crossing;
 pub mod dopri;
 pub mod march;
 
