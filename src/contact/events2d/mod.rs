@@ -72,8 +72,9 @@ impl Path2<'_> {
     /// u₁, u₂, v and their derivatives at τ.
     pub fn at(&self, tau: f64) -> Kinematics2 {
         let mut k = Kinematics2::default();
+        let table = Harmonics::at(self.blocks, tau);
         for (j, block) in self.blocks.iter().enumerate() {
-            let (b0, b1, b2) = basis_derivatives(*block, tau);
+            let (b0, b1, b2) = table.derivatives(*block, tau);
             let [u0, u1] = &mut k.u;
             for (out, coef) in [
                 (u0, self.u[0][j]),
@@ -90,10 +91,59 @@ impl Path2<'_> {
 
     /// The basis b_i(τ) and its rate b_i′(τ) over the blocks.
     pub fn basis(&self, tau: f64, b: &mut [f64], db: &mut [f64]) {
+        let table = Harmonics::at(self.blocks, tau);
         for ((block, x), dx) in self.blocks.iter().zip(b).zip(db) {
-            let (b0, b1, _) = basis_derivatives(*block, tau);
+            let (b0, b1, _) = table.derivatives(*block, tau);
             *x = b0;
             *dx = b1;
+        }
+    }
+}
+
+/// Highest harmonic whose sine and cosine [`Harmonics`] tabulates by recurrence.
+const TABLE_HARMONICS: usize = 32;
+
+/// cos hτ and sin hτ for h = 0..=H at one τ, from one `sin_cos` and the angle-addition
+/// recurrence (rounding grows like h·ε), or none when H exceeds [`TABLE_HARMONICS`].
+struct Harmonics {
+    cos: [f64; TABLE_HARMONICS + 1],
+    sin: [f64; TABLE_HARMONICS + 1],
+    len: usize,
+}
+
+impl Harmonics {
+    fn at(blocks: &[Block], tau: f64) -> Self {
+        let top = blocks.iter().map(|b| b.harmonic()).max().unwrap_or(0);
+        let mut t = Self {
+            cos: [0.0; TABLE_HARMONICS + 1],
+            sin: [0.0; TABLE_HARMONICS + 1],
+            len: 0,
+        };
+        if top > TABLE_HARMONICS {
+            return t;
+        }
+        let (s1, c1) = tau.sin_cos();
+        t.cos[0] = 1.0;
+        for h in 1..=top {
+            t.cos[h] = t.cos[h - 1] * c1 - t.sin[h - 1] * s1;
+            t.sin[h] = t.sin[h - 1] * c1 + t.cos[h - 1] * s1;
+        }
+        t.len = top + 1;
+        t
+    }
+
+    /// b(τ), b′(τ), b″(τ) of one basis function.
+    fn derivatives(&self, block: Block, tau: f64) -> (f64, f64, f64) {
+        let h = block.harmonic();
+        if h >= self.len {
+            return basis_derivatives(block, tau);
+        }
+        let hf = h as f64;
+        let (s, c) = (self.sin[h], self.cos[h]);
+        match block {
+            Block::Constant => (1.0, 0.0, 0.0),
+            Block::Cos(_) => (c, -hf * s, -hf * hf * c),
+            Block::Sin(_) => (s, hf * c, -hf * hf * s),
         }
     }
 }
