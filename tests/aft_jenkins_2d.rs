@@ -546,7 +546,14 @@ mod events {
             mu,
             initial_state: m,
         };
-        let cases: Vec<(&str, ContactEffects, [f64; 2], [Vec<f64>; 3], ContactState)> = vec![
+        type Case = (
+            &'static str,
+            ContactEffects,
+            [f64; 2],
+            [Vec<f64>; 3],
+            ContactState,
+        );
+        let cases: Vec<Case> = vec![
             (
                 "stuck",
                 variable,
@@ -698,31 +705,30 @@ mod events {
                     initial_state: m,
                 };
                 // (A constant N cannot keep both m = e and m = −e stuck.)
-                for constant in [false] {
-                    let mut events = Aft2dWorkspace::new(&set, 128);
-                    let report = events
-                        .evaluate_events(&l, effects(constant), [&x[0], &x[1]], &x[2], true)
-                        .unwrap();
-                    let mut sampled = Aft2dWorkspace::new(&set, 128);
-                    let sampled_report = sampled
-                        .evaluate(&l, effects(constant), [&x[0], &x[1]], &x[2], false)
-                        .unwrap();
-                    let limit0 = mu * events.n[0];
-                    let t0 = [events.t[0][0], events.t[1][0]];
-                    let error = (t0[0] - limit0 * m[0]).hypot(t0[1] - limit0 * m[1]) / limit0;
-                    let difference = (0..2)
-                        .flat_map(|a| (0..set.n_blocks()).map(move |j| (a, j)))
-                        .fold(0.0_f64, |e, (a, j)| {
-                            e.max((events.t_hat[a][j] - sampled.t_hat[a][j]).abs() / limit0)
-                        });
-                    let (r1, r2) = (report.state, sampled_report.state);
-                    // The sampled law's state: the sampled path may touch the circle apart.
-                    assert_eq!(r1, ContactState::Stuck, "m = {m:?}");
-                    assert_eq!(r2, ContactState::Stuck, "m = {m:?}");
-                    assert!(error < 1e-12, "m = {m:?}: T(0) off by {error:.2e}");
-                    // Stuck all period, both laws give T = kₜ(u − w₀) exactly.
-                    assert!(difference < 1e-12, "m = {m:?}: {difference:.2e}");
-                }
+                let constant = false;
+                let mut events = Aft2dWorkspace::new(&set, 128);
+                let report = events
+                    .evaluate_events(&l, effects(constant), [&x[0], &x[1]], &x[2], true)
+                    .unwrap();
+                let mut sampled = Aft2dWorkspace::new(&set, 128);
+                let sampled_report = sampled
+                    .evaluate(&l, effects(constant), [&x[0], &x[1]], &x[2], false)
+                    .unwrap();
+                let limit0 = mu * events.n[0];
+                let t0 = [events.t[0][0], events.t[1][0]];
+                let error = (t0[0] - limit0 * m[0]).hypot(t0[1] - limit0 * m[1]) / limit0;
+                let difference = (0..2)
+                    .flat_map(|a| (0..set.n_blocks()).map(move |j| (a, j)))
+                    .fold(0.0_f64, |e, (a, j)| {
+                        e.max((events.t_hat[a][j] - sampled.t_hat[a][j]).abs() / limit0)
+                    });
+                let (r1, r2) = (report.state, sampled_report.state);
+                // The sampled law's state: the sampled path may touch the circle apart.
+                assert_eq!(r1, ContactState::Stuck, "m = {m:?}");
+                assert_eq!(r2, ContactState::Stuck, "m = {m:?}");
+                assert!(error < 1e-12, "m = {m:?}: T(0) off by {error:.2e}");
+                // Stuck all period, both laws give T = kₜ(u − w₀) exactly.
+                assert!(difference < 1e-12, "m = {m:?}: {difference:.2e}");
             }
         }
     }
