@@ -32,23 +32,12 @@ use super::settle::{newton_step, pseudo_inverse, FIXED_POINT_CONDITION};
 use super::workspace::{Aft2dWorkspace, SampleKind};
 use crate::contact::aft::{AftError, MarchReport};
 use crate::contact::events::roots::brent;
-use crate::contact::events::{normalisation, MarchFailure, Moments};
-use crate::contact::events2d::march::{Buffers, PeriodEnd, PeriodMarch, Record};
-use crate::contact::events2d::{Columns, Law2, Path2};
+use crate::contact::events::{normalisation, MarchFailure};
+use crate::contact::events2d::march::{PeriodEnd, PeriodMarch};
+use crate::contact::events2d::{Columns, EventScratch, Law2, Path2};
 use crate::contact::point::Jenkins2dLaw;
 use crate::contact::{ContactEffects, ContactState, NormalLoad};
 use std::f64::consts::PI;
-
-/// Buffers of the event-resolved 2D law, kept in the workspace.
-#[derive(Debug, Clone, Default)]
-pub(super) struct EventScratch {
-    buffers: Buffers,
-    record: Record,
-    start_derivative: Vec<f64>,
-    gram: Moments,
-    piece: Moments,
-    closed: Vec<(f64, f64)>,
-}
 
 /// Where the final period's start comes from.
 enum Start {
