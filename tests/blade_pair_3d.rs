@@ -3,8 +3,10 @@
 //! carry the `jenkins-2d` law; fixed-frequency solves near the first bending pair, where
 //! contacts stick, slip and lift off, give the same solutions in the schur (`auto`) and dense
 //! formulations; `fricbound run` of a narrow window completes with its result files and
-//! VTU output; the FRF over 840-900 Hz and over 845-900 Hz is one complete path through both
-//! folds; and the m = +1 limit curve crosses its former stall at 852.78 Hz.
+//! VTU output; the FRF over 840-900 Hz and over 845-900 Hz is complete through both folds on
+//! the event-resolved `jenkins-2d`; and the m = +1 limit curve crosses its former stall at
+//! 852.78 Hz. The tests of the path at single contact transitions were measured on the sampled
+//! laws and run on them (`SAMPLED`).
 
 mod support;
 
@@ -17,6 +19,21 @@ use fricbound::model::{Formulation, Problem};
 use fricbound::scene;
 
 const SCENE: &str = "meshes/blade-pair/blade-pair-3d.toml";
+
+/// Overrides that put the 3D scenes on the sampled laws (`jenkins-2d-sampled` patches, the
+/// axial springs on `jenkins-1d-sampled`), as they were when the tests of the sampled law's
+/// corners, leaps and stalls below were measured.
+const SAMPLED: [&str; 4] = [
+    "contact_patches.0.law=\"jenkins-2d-sampled\"",
+    "contact_patches.1.law=\"jenkins-2d-sampled\"",
+    "contacts.0.law=\"jenkins-1d-sampled\"",
+    "contacts.1.law=\"jenkins-1d-sampled\"",
+];
+
+/// `overrides` after [`SAMPLED`].
+fn sampled(overrides: &[&'static str]) -> Vec<&'static str> {
+    SAMPLED.iter().chain(overrides).copied().collect()
+}
 
 /// Fixed frequencies below the first bending pair (Hz), each solved by Newton from the stuck
 /// linear response; at these the patch points are stuck, open or in stick-slip with lift-off.
@@ -156,12 +173,12 @@ fn the_3d_frf_crosses_contact_transitions_on_the_bending_flank() {
     let frf = narrow_frf(
         "flank",
         "right-7",
-        &[
+        &sampled(&[
             "analysis.freq_start_hz=885.4",
             "analysis.freq_end_hz=885.7",
             "analysis.linear_points=3",
             "accuracy.estimate=false",
-        ],
+        ]),
     );
     let freqs = &frf.freqs;
     assert!(
@@ -186,13 +203,13 @@ fn the_3d_frf_crosses_the_transition_at_886_685_hz_without_turning_back() {
     let frf = narrow_frf(
         "886",
         "left-25",
-        &[
+        &sampled(&[
             "analysis.freq_start_hz=886.6",
             "analysis.freq_end_hz=886.75",
             "analysis.max_step=0.02",
             "analysis.linear_points=3",
             "accuracy.estimate=false",
-        ],
+        ]),
     );
     let freqs = &frf.freqs;
     println!("{} points: {freqs:?}", freqs.len());
@@ -208,13 +225,13 @@ fn the_3d_frf_crosses_the_transition_at_886_685_hz_without_turning_back() {
 /// The FRF across the first bending pair, 840-900 Hz (the scene's window): up the lower
 /// branch past the contact transitions at 886.685 Hz, round the fold at 886.85 Hz, down the
 /// middle branch, round the sharp fold at 874.57 Hz and up the upper branch over the resonance
-/// peak and down its flank to 900 Hz. On the sampled 2D law the path leaves the fold region
-/// below the start at some of its corners; the run then jumps past the highest frequency
-/// reached and fills back down, and every stretch lies on a branch: `complete` (exit 0), with
-/// both folds among the turning points and the resonance (measured: 5.24e-5 m at 874.73 Hz)
-/// far above the lower branch (6.6e-6 m at its fold).
+/// peak and down its flank to 900 Hz, on the scene's event-resolved `jenkins-2d`: `complete`
+/// (exit 0), every stretch on a branch, with both folds among the turning points and the
+/// resonance (measured on the sampled law: 5.24e-5 m at 874.73 Hz) far above the lower branch.
+/// (On the sampled 2D law the path leaves the fold region at its corners and jumps past it
+/// onto the lower branch's continuation, missing the resonance.)
 #[test]
-fn the_3d_frf_over_the_bending_pair_is_one_complete_path_through_both_folds() {
+fn the_3d_frf_over_the_bending_pair_is_complete_through_both_folds() {
     let out = std::env::temp_dir().join(format!("fricbound-blade-3d-frf-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     let run = support::run_scene(
@@ -277,17 +294,16 @@ fn the_3d_frf_over_the_bending_pair_is_one_complete_path_through_both_folds() {
 
 /// Over 845-900 Hz (another window, so other arc-length scales than 840-900 Hz) the path
 /// comes up the lower branch past the lower branch's fold region at 886.85 Hz, where the
-/// sampled law's corners once made the continuation leap onto the upper branch's flank and
-/// leave out the middle and upper branches and the resonance peak. The run is complete, every
-/// stretch on a branch (jumps past the fold region fill back to it), with its peak at
-/// 874.5-876 Hz.
+/// sampled law's corners made the continuation leave the middle and upper branches and the
+/// resonance peak out. On the event-resolved `jenkins-2d` the run is complete, every stretch on
+/// a branch, with its peak at 874.5-876 Hz.
 #[test]
-fn the_window_from_845_hz_is_one_complete_path_through_both_folds() {
+fn the_window_from_845_hz_is_complete_through_both_folds() {
     let problem = problem(&[
         "analysis.freq_start_hz=845",
         "analysis.freq_end_hz=900",
         "accuracy.estimate=false",
-    ]);
+    ]));
     let run =
         fricbound::analysis::frf::solve(&problem, &mut fricbound::analysis::frf::Silent).unwrap();
     println!(
@@ -355,7 +371,7 @@ fn m_plus_1_case(
         format!("analysis.freq_end_hz={end}"),
         "accuracy.estimate=false".to_string(),
     ];
-    o.extend(extra.iter().map(|s| s.to_string()));
+    o.extend(SAMPLED.iter().chain(extra).map(|s| s.to_string()));
     let problem = scene::load_problem(Path::new(LIMITS_SCENE), &o).unwrap().1;
     let case = fricbound::analysis::limits::case::two_point_cases(&problem)
         .into_iter()

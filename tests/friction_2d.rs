@@ -85,7 +85,9 @@ fn formulations_agree_and_jacobians_match_central_differences_with_out_of_plane_
         ("schur", out_of_plane(Formulation::Schur)),
     ];
     let mut rotating = 0;
-    for p in run.points.iter().step_by(run.points.len() / 8) {
+    // Every twelfth point of the path (eight missed a third rotating one on the
+    // event-resolved law's path).
+    for p in run.points.iter().step_by(run.points.len() / 12) {
         let f = p.freq_hz;
         let omega = 2.0 * std::f64::consts::PI * f;
         let z = p
@@ -99,9 +101,11 @@ fn formulations_agree_and_jacobians_match_central_differences_with_out_of_plane_
         }
         // Same solutions from the same guess.
         assert_formulations_agree(&mut reference, &variants, &p.coefficients, f);
-        // Analytic Jacobians against central differences of the residual.
+        // Analytic Jacobians against central differences of the residual, steps of 10⁻⁶: the
+        // event-resolved 2D law's slip integration leaves noise of about 10⁻¹² of the forces,
+        // which steps of 10⁻⁷ amplify to 2e-6 (measured at 160.096 Hz).
         let mut s = HbmSystem::new(&dense).unwrap();
-        let check = check_jacobian(&mut s, &p.coefficients, omega, 1e-7).unwrap();
+        let check = check_jacobian(&mut s, &p.coefficients, omega, 1e-6).unwrap();
         assert!(
             check.relative() < 1e-6,
             "dense at {f:.3} Hz: {:.3e}",
@@ -109,7 +113,7 @@ fn formulations_agree_and_jacobians_match_central_differences_with_out_of_plane_
         );
         let mut s = HbmSystem::new(&variants[0].1).unwrap();
         assert_eq!(s.storage(), Storage::Sparse);
-        let check = check_jacobian(&mut s, &p.coefficients, omega, 1e-7).unwrap();
+        let check = check_jacobian(&mut s, &p.coefficients, omega, 1e-6).unwrap();
         assert!(
             check.relative() < 1e-6,
             "sparse at {f:.3} Hz: {:.3e}",
@@ -117,7 +121,7 @@ fn formulations_agree_and_jacobians_match_central_differences_with_out_of_plane_
         );
         let mut c = HbmOperator::new(&variants[1].1).unwrap();
         let xc = c.restrict(&p.coefficients);
-        let check = check_operator_jacobian(&mut c, &xc, omega, 1e-7).unwrap();
+        let check = check_operator_jacobian(&mut c, &xc, omega, 1e-6).unwrap();
         assert!(
             check.relative() < 1e-6,
             "condensed at {f:.3} Hz: {:.3e}",
@@ -129,7 +133,7 @@ fn formulations_agree_and_jacobians_match_central_differences_with_out_of_plane_
         // analytic ones.
         let mut s = HbmSystem::new(&variants[2].1).unwrap();
         assert_eq!(s.storage(), Storage::Schur);
-        let check = check_jacobian(&mut s, &p.coefficients, omega, 1e-7).unwrap();
+        let check = check_jacobian(&mut s, &p.coefficients, omega, 1e-6).unwrap();
         assert!(
             check.relative() < 1e-6,
             "schur at {f:.3} Hz: {:.3e}",

@@ -267,6 +267,7 @@ fn contact_laws(problem: &crate::model::Problem) -> String {
         FrictionLaw::Jenkins1d,
         FrictionLaw::Jenkins1dSampled,
         FrictionLaw::Jenkins2d,
+        FrictionLaw::Jenkins2dSampled,
     ]
     .into_iter()
     .filter_map(|law| {
@@ -280,7 +281,13 @@ fn contact_laws(problem: &crate::model::Problem) -> String {
                 FrictionLaw::Jenkins1d => {
                     "transitions located in continuous time, the samples bracket them"
                 }
-                _ => "marched on the samples",
+                FrictionLaw::Jenkins2d => {
+                    "transitions located in continuous time, slip direction integrated, the \
+                     samples bracket them"
+                }
+                FrictionLaw::Jenkins1dSampled | FrictionLaw::Jenkins2dSampled => {
+                    "marched on the samples"
+                }
             };
             format!("{} × {count} ({how})", law.name())
         })

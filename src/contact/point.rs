@@ -110,8 +110,8 @@ pub struct ContactPoint {
     /// The second tangent direction of a point with the 2D Jenkins law (`jenkins-2d`), None
     /// for the paper's 1D law (`jenkins-1d`, the default).
     pub second_tangent: Option<SecondTangent>,
-    /// How a 1D point's law is resolved in time (events for `jenkins-1d`, samples for
-    /// `jenkins-1d-sampled`); a 2D point is always marched on the samples.
+    /// How the point's law is resolved in time (events for `jenkins-1d` and `jenkins-2d`,
+    /// samples for `jenkins-1d-sampled` and `jenkins-2d-sampled`).
     pub resolution: TimeResolution,
 }
 
@@ -128,23 +128,31 @@ pub enum FrictionLaw {
     /// [`crate::contact::aft`]), for comparison with the paper and with codes that sample.
     #[serde(rename = "jenkins-1d-sampled")]
     Jenkins1dSampled,
-    /// The isotropic Jenkins element in the tangent plane, radial return onto the friction
-    /// circle ([`crate::contact::aft2d`]).
+    /// The isotropic Jenkins element in the tangent plane, its transitions located in
+    /// continuous time and its slip direction integrated as an ODE
+    /// ([`crate::contact::events2d`]): a C¹ residual.
     #[serde(rename = "jenkins-2d")]
     Jenkins2d,
+    /// The same element sampled on `harmonics.samples` instants per period, radial return
+    /// onto the friction circle at each ([`crate::contact::aft2d`]'s march).
+    #[serde(rename = "jenkins-2d-sampled")]
+    Jenkins2dSampled,
 }
 
 impl FrictionLaw {
-    /// Whether the law acts in the tangent plane (`jenkins-2d`, 3 DOFs per point).
+    /// Whether the law acts in the tangent plane (`jenkins-2d`, `jenkins-2d-sampled`; 3 DOFs
+    /// per point).
     pub fn is_2d(self) -> bool {
-        self == FrictionLaw::Jenkins2d
+        matches!(self, FrictionLaw::Jenkins2d | FrictionLaw::Jenkins2dSampled)
     }
 
-    /// How a 1D point with this law resolves its transitions in time.
+    /// How a point with this law resolves its transitions in time.
     pub fn time_resolution(self) -> TimeResolution {
         match self {
-            FrictionLaw::Jenkins1dSampled => TimeResolution::Samples,
-            _ => TimeResolution::Events,
+            FrictionLaw::Jenkins1dSampled | FrictionLaw::Jenkins2dSampled => {
+                TimeResolution::Samples
+            }
+            FrictionLaw::Jenkins1d | FrictionLaw::Jenkins2d => TimeResolution::Events,
         }
     }
 
@@ -154,18 +162,20 @@ impl FrictionLaw {
             FrictionLaw::Jenkins1d => "jenkins-1d",
             FrictionLaw::Jenkins1dSampled => "jenkins-1d-sampled",
             FrictionLaw::Jenkins2d => "jenkins-2d",
+            FrictionLaw::Jenkins2dSampled => "jenkins-2d-sampled",
         }
     }
 }
 
-/// How the 1D Jenkins law of a point is resolved in time.
+/// How the Jenkins law of a point (1D or 2D) is resolved in time.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum TimeResolution {
-    /// Transitions located in continuous time, forces integrated exactly between them
-    /// (`jenkins-1d`).
+    /// Transitions located in continuous time, forces integrated between them (`jenkins-1d`,
+    /// `jenkins-2d`).
     #[default]
     Events,
-    /// The law marched on the sample grid (`jenkins-1d-sampled`, the paper's AFT).
+    /// The law marched on the sample grid (`jenkins-1d-sampled`, `jenkins-2d-sampled`; the
+    /// paper's AFT).
     Samples,
 }
 
@@ -184,7 +194,8 @@ impl ContactPoint {
     /// The point's tangential friction law.
     pub fn friction_law(&self) -> FrictionLaw {
         match (&self.second_tangent, self.resolution) {
-            (Some(_), _) => FrictionLaw::Jenkins2d,
+            (Some(_), TimeResolution::Events) => FrictionLaw::Jenkins2d,
+            (Some(_), TimeResolution::Samples) => FrictionLaw::Jenkins2dSampled,
             (None, TimeResolution::Events) => FrictionLaw::Jenkins1d,
             (None, TimeResolution::Samples) => FrictionLaw::Jenkins1dSampled,
         }

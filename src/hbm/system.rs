@@ -352,8 +352,8 @@ impl<'p> HbmSystem<'p> {
 
     /// Marches contact `c` from the coefficients û, û₂, v̂ in the system's buffers (filled by
     /// [`Self::contact_coefficients`], v̂ including the gap) with the march its law needs: the
-    /// 2D workspace for a `jenkins-2d` point, the 1D one otherwise (event-resolved for
-    /// `jenkins-1d`, sampled for `jenkins-1d-sampled`). The forces (and, with
+    /// 2D workspace for a 2D point, the 1D one otherwise; event-resolved for `jenkins-1d` and
+    /// `jenkins-2d`, sampled for `jenkins-1d-sampled` and `jenkins-2d-sampled`. The forces (and, with
     /// `jacobian`, their derivatives) stay in that workspace. The one place that chooses
     /// between the two marches.
     fn march_contact(&mut self, c: usize, jacobian: bool) -> Result<ContactState, HbmError> {
@@ -361,13 +361,17 @@ impl<'p> HbmSystem<'p> {
         let contact = &self.problem.contacts[c];
         let effects = self.problem.effects.contact;
         let report = match (self.law_2d(c), self.aft2d.as_mut()) {
-            (Some(law), Some(aft2d)) => aft2d.evaluate(
-                &law,
-                effects,
-                [&self.u_coef, &self.u2_coef],
-                &self.v_coef,
-                jacobian,
-            ),
+            (Some(law), Some(aft2d)) => {
+                let u = [self.u_coef.as_slice(), self.u2_coef.as_slice()];
+                match contact.resolution {
+                    TimeResolution::Events => {
+                        aft2d.evaluate_events(&law, effects, u, &self.v_coef, jacobian)
+                    }
+                    TimeResolution::Samples => {
+                        aft2d.evaluate(&law, effects, u, &self.v_coef, jacobian)
+                    }
+                }
+            }
             _ => match contact.resolution {
                 TimeResolution::Events => {
                     self.aft

@@ -10,13 +10,11 @@ pub const PLANAR: &str = include_str!("../../meshes/paper-wedge/fig13-3rd.toml")
 /// Its 3D version with 2D friction and the out-of-plane motion constrained.
 pub const SPATIAL: &str = include_str!("../../meshes/paper-wedge-3d/fig13-3rd-3d.toml");
 
-/// The planar scene with overrides, its 1D contacts on the sampled law: `jenkins-2d` is
-/// marched on the samples, so the two scenes agree to round-off only on the same time
-/// resolution (the event-resolved `jenkins-1d` differs from both by the sampling error).
+/// The planar scene with overrides, its 1D contacts on the event-resolved law like the 3D
+/// scene's `jenkins-2d` ones: the two scenes agree to round-off only on the same time
+/// resolution (a sampled law differs from the event-resolved ones by its sampling error).
 pub fn planar(overrides: &[&str]) -> Problem {
-    let mut all = super::scenes::SAMPLED_PAPER.to_vec();
-    all.extend_from_slice(overrides);
-    super::scenes::problem(PLANAR, &all)
+    super::scenes::problem(PLANAR, overrides)
 }
 
 /// In-plane DOFs of the 3D scene, in the order of the planar scene's DOFs.

@@ -69,7 +69,10 @@ pub fn hbm_state(
     let mut aft2d: Option<Aft2dWorkspace> = None;
     for p in &problem.contacts {
         if let Some(law) = p.law_2d() {
-            // The AFT's 2D march on the point's own coefficients (u₁, u₂, v per block).
+            // The sampled 2D march on the point's own coefficients (u₁, u₂, v per block),
+            // whatever the point's time resolution: its slider start is that of a law applied
+            // at discrete instants, as the time integration applies it, and the 1D points'
+            // starts below are sampled alike.
             let row_coefficients = |row: &[(usize, f64)]| -> Vec<f64> {
                 (0..nb)
                     .map(|j| row.iter().map(|&(i, a)| a * x[j * n + i]).sum())

@@ -1,4 +1,5 @@
-//! AFT of the two-dimensional Jenkins element: friction in the tangent plane of a 3D contact.
+//! The two-dimensional Jenkins element: friction in the tangent plane of a 3D contact, sampled
+//! (this module's march, `jenkins-2d-sampled`) or event-resolved ([`resolved`], `jenkins-2d`).
 //!
 //! A contact point of a 3D model moves in its tangent plane along a path u(τ) ∈ ℝ² (two
 //! tangential relative displacements u₁, u₂ along an orthonormal tangent basis t₁, t₂) and along
@@ -109,12 +110,15 @@
 //!
 //! The files: [`workspace`] (the workspace and its evaluation), [`march`] (one period of the
 //! march), [`settle`] (the march to the periodic steady state, with Newton restarts) and
-//! [`jacobian`] (the analytic Jacobian through it).
+//! [`jacobian`] (the analytic Jacobian through it) for the sampled law (`jenkins-2d-sampled`);
+//! [`resolved`] for the event-resolved law (`jenkins-2d`, [`crate::contact::events2d`]),
+//! whose periodic state is found by Newton on the continuous period map.
 
 #[cfg(test)]
 mod fixtures;
 mod jacobian;
 mod march;
+mod resolved;
 mod settle;
 mod workspace;
 

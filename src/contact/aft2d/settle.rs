@@ -344,7 +344,7 @@ struct NewtonTrial {
 /// Newton step (I − A)⁻¹ (Φ(w) − w) of the fixed-point equation, shortened to `max_length`
 /// (the point's motion scale, beyond which no slider start is reachable); None when I − A
 /// is exactly singular (no slip over the period) or the step is not finite.
-fn newton_step(mismatch: [f64; 2], a: [f64; 4], max_length: f64) -> Option<[f64; 2]> {
+pub(super) fn newton_step(mismatch: [f64; 2], a: [f64; 4], max_length: f64) -> Option<[f64; 2]> {
     let m = [1.0 - a[0], -a[1], -a[2], 1.0 - a[3]];
     let det = m[0] * m[3] - m[1] * m[2];
     if det == 0.0 || !det.is_finite() {

@@ -83,6 +83,8 @@ pub struct Aft2dWorkspace {
     /// Whether periods restart from Newton updates of the fixed point (always, except in the
     /// tests that compare with the plain march).
     pub(super) newton_restarts: bool,
+    /// Buffers of the event-resolved law ([`Self::evaluate_events`]).
+    pub(super) events: crate::contact::events2d::EventScratch,
 }
 
 impl Aft2dWorkspace {
@@ -123,6 +125,7 @@ impl Aft2dWorkspace {
                 ..MarchSettings::default()
             },
             newton_restarts: true,
+            events: Default::default(),
         }
     }
 
@@ -156,6 +159,28 @@ impl Aft2dWorkspace {
         jacobian: bool,
     ) -> Result<MarchReport, AftError> {
         let nb = self.set.n_blocks();
+        self.sample_motion(law, effects, u_coefficients, v_coefficients)?;
+        let (report, origin) = self.march(law)?;
+        for a in 0..2 {
+            analyze(&self.basis, &self.t[a], &mut self.t_hat[a]);
+        }
+        analyze(&self.basis, &self.n, &mut self.n_hat);
+        if jacobian {
+            self.accumulate_jacobian(law, effects, origin);
+        }
+        debug_assert_eq!(self.t_hat[0].len(), nb);
+        Ok(report)
+    }
+
+    /// Samples u₁, u₂, v and N on the grid from their coefficients (the normal force with
+    /// its law and effects, and whether the normal spring is active at each sample).
+    pub(super) fn sample_motion(
+        &mut self,
+        law: &Jenkins2dLaw,
+        effects: ContactEffects,
+        u_coefficients: [&[f64]; 2],
+        v_coefficients: &[f64],
+    ) -> Result<(), AftError> {
         for (signal, coefficients) in self.u.iter_mut().zip(u_coefficients) {
             synthesize(&self.basis, coefficients, signal);
         }
@@ -183,16 +208,7 @@ impl Aft2dWorkspace {
             self.n[k] = force;
             self.normal_active[k] = active;
         }
-        let (report, origin) = self.march(law)?;
-        for a in 0..2 {
-            analyze(&self.basis, &self.t[a], &mut self.t_hat[a]);
-        }
-        analyze(&self.basis, &self.n, &mut self.n_hat);
-        if jacobian {
-            self.accumulate_jacobian(law, effects, origin);
-        }
-        debug_assert_eq!(self.t_hat[0].len(), nb);
-        Ok(report)
+        Ok(())
     }
 
     /// The march's report for a final period `outcome` reached at period `period`.

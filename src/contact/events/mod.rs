@@ -44,7 +44,7 @@
 
 pub mod bounds;
 pub mod march;
-mod roots;
+pub(crate) mod roots;
 
 use crate::contact::harmonic::{product_integral, Block, HarmonicSet};
 use crate::contact::{ContactEffects, JenkinsLaw, NormalLoad};
@@ -55,20 +55,20 @@ pub use march::MarchFailure;
 
 /// Moments ∫ cos mτ and ∫ sin mτ (m = 0..=2H) of a weight over one period.
 #[derive(Debug, Clone, Default)]
-struct Moments {
+pub(crate) struct Moments {
     c: Vec<f64>,
     s: Vec<f64>,
 }
 
 impl Moments {
-    fn reset(&mut self, len: usize) {
+    pub(crate) fn reset(&mut self, len: usize) {
         self.c.clear();
         self.c.resize(len, 0.0);
         self.s.clear();
         self.s.resize(len, 0.0);
     }
 
-    fn add(&mut self, weight: f64, piece: &Moments) {
+    pub(crate) fn add(&mut self, weight: f64, piece: &Moments) {
         for (a, b) in self.c.iter_mut().zip(&piece.c) {
             *a += weight * b;
         }
@@ -78,14 +78,14 @@ impl Moments {
     }
 
     /// ∫ weight · b_j b_i over the period.
-    fn gram(&self, bj: Block, bi: Block) -> f64 {
+    pub(crate) fn gram(&self, bj: Block, bi: Block) -> f64 {
         let c = |m: i64| self.c[m.unsigned_abs() as usize];
         let s = |m: i64| m.signum() as f64 * self.s[m.unsigned_abs() as usize];
         product_integral(c, s, bj, bi)
     }
 
     /// ∫ weight · b_j over the period.
-    fn single(&self, b: Block) -> f64 {
+    pub(crate) fn single(&self, b: Block) -> f64 {
         match b {
             Block::Constant => self.c[0],
             Block::Cos(h) => self.c[h],
@@ -95,7 +95,7 @@ impl Moments {
 
     /// The moments of the unit weight over [t0, t1]; sin mt, cos mt by the angle-addition
     /// recurrence from sin t, cos t.
-    fn interval(&mut self, t0: f64, t1: f64) {
+    pub(crate) fn interval(&mut self, t0: f64, t1: f64) {
         self.c[0] = t1 - t0;
         self.s[0] = 0.0;
         let ((a0, b0), (a1, b1)) = (t0.sin_cos(), t1.sin_cos());
@@ -326,7 +326,7 @@ impl EventSolver {
 }
 
 /// c_j in coefficient_j = c_j ∫₀^{2π} f b_j dτ: 1/(2π) for the constant, 1/π otherwise.
-fn normalisation(b: Block) -> f64 {
+pub(crate) fn normalisation(b: Block) -> f64 {
     match b {
         Block::Constant => 0.5 / PI,
         _ => 1.0 / PI,

@@ -1,0 +1,252 @@
+//! The event-resolved 2D Jenkins law: the isotropic Jenkins element in the tangent plane with
+//! its stick, slip, opening and closing located in continuous time.
+//!
+//! # The law
+//!
+//! u(τ) ∈ ℝ² (the tangential relative displacement along t₁, t₂) and v(τ) are trigonometric
+//! polynomials of the unknowns; L = μN is the friction limit (N = kₙ v while closed, or the
+//! constant kₙ v̂₀). The slider w ∈ ℝ² carries the spring force T = kₜ (u − w), |T| ≤ L.
+//!
+//! | phase | force | ends when | next |
+//! |---|---|---|---|
+//! | stick, slider w | T = kₜ (u − w) | \|kₜ(u − w)\| − L rises through 0 | slip, θ = angle of T |
+//! | slip, angle θ | T = L e(θ), e = (cos θ, sin θ) | L′ − kₜ u′·e rises through 0 (the slip rate λ = (kₜ u′·e − L′)/kₜ reaches 0) | stick, w = u − L e/kₜ |
+//! | stick or slip | | v falls through 0 | open |
+//! | open | T = 0 | v rises through 0 | stick, w = u (or slip at once when kₜ\|u′\| > L′) |
+//!
+//! In slip the e⊥ component of T′ = kₜ(u′ − λ e) gives the angle's ODE
+//! θ′ = kₜ (u′·e⊥)/L, e⊥ = (−sin θ, cos θ), integrated by Dormand–Prince 5(4) ([`dopri`]) to
+//! [`ODE_TOLERANCE`] with steps no longer than a cell of the bracketing grid (the samples);
+//! its dense output locates the slip's end (Brent on the exit function) and carries the
+//! Gauss–Legendre quadrature of the force harmonics over each step. Stick pieces are
+//! integrated in closed form (T is kₜ u minus a constant), as by the 1D law
+//! ([`crate::contact::events`]).
+//!
+//! # Sensitivities
+//!
+//! With respect to the parameters p = (w_start, û₁, û₂, v̂) the slip angle's sensitivity
+//! S = ∂θ/∂p obeys S′ = −kₜ (u′·e)/L · S + ∂θ′/∂p, integrated with θ in the same steps. The
+//! transition-time terms cancel, as in 1D, since T is continuous at every transition:
+//!
+//! * at a slip onset τₛ: S(τₛ) = kₜ e⊥·(du − dw)/L (the onset time's terms, kₜ(u′·e⊥)/L from
+//!   the stick and from the ODE, cancel);
+//! * at a slip end τₐ: dw = du − (dL e + L e⊥ S)/kₜ (the τₐ term is e times the slip rate,
+//!   zero there);
+//! * at closing τ_c: dw = du(τ_c) − u′(τ_c) dv(τ_c)/v′(τ_c) (T = 0 there, as in 1D).
+//!
+//! The period map's derivative A = ∂w_end/∂w_start and B = ∂w_end/∂(û, v̂) are the slider's
+//! sensitivities at the period's end; the periodic state and its derivative
+//! dw_start = (I − A)⁻¹ B dx are in [`crate::contact::aft2d`]'s `resolved` file.
+
+mod crossing;
+pub mod dopri;
+pub mod march;
+
+use crate::contact::events::Moments;
+use crate::contact::harmonic::Block;
+use march::{Buffers, Record};
+
+/// Absolute tolerance (rad) of one step of the slip angle's integration: far below what a
+/// harmonic-balance Newton resolves (forces to ~10⁻¹¹ of μN).
+pub const ODE_TOLERANCE: f64 = 1e-11;
+
+/// u₁, u₂, v and their first two τ-derivatives at one instant (m, m/rad, m/rad²).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Kinematics2 {
+    /// [u, u′, u″] along t₁ and t₂.
+    pub u: [[f64; 3]; 2],
+    /// [v, v′, v″] (gap included).
+    pub v: [f64; 3],
+}
+
+/// Coefficients of u₁, u₂ and v on the force blocks, evaluated at any τ by direct summation.
+#[derive(Clone, Copy)]
+pub struct Path2<'a> {
+    /// Blocks of the coefficients.
+    pub blocks: &'a [Block],
+    /// û₁, û₂ (m).
+    pub u: [&'a [f64]; 2],
+    /// v̂ including the gap (m).
+    pub v: &'a [f64],
+}
+
+impl Path2<'_> {
+    /// u₁, u₂, v and their derivatives at τ.
+    pub fn at(&self, tau: f64) -> Kinematics2 {
+        let mut k = Kinematics2::default();
+        let table = Harmonics::at(self.blocks, tau);
+        for (j, block) in self.blocks.iter().enumerate() {
+            let (b0, b1, b2) = table.derivatives(*block, tau);
+            let [u0, u1] = &mut k.u;
+            for (out, coef) in [
+                (u0, self.u[0][j]),
+                (u1, self.u[1][j]),
+                (&mut k.v, self.v[j]),
+            ] {
+                out[0] += coef * b0;
+                out[1] += coef * b1;
+                out[2] += coef * b2;
+            }
+        }
+        k
+    }
+
+    /// The basis b_i(τ) and its rate b_i′(τ) over the blocks.
+    pub fn basis(&self, tau: f64, b: &mut [f64], db: &mut [f64]) {
+        let table = Harmonics::at(self.blocks, tau);
+        for ((block, x), dx) in self.blocks.iter().zip(b).zip(db) {
+            let (b0, b1, _) = table.derivatives(*block, tau);
+            *x = b0;
+            *dx = b1;
+        }
+    }
+}
+
+/// Highest harmonic whose sine and cosine [`Harmonics`] tabulates by recurrence.
+const TABLE_HARMONICS: usize = 32;
+
+/// cos hτ and sin hτ for h = 0..=H at one τ, from one `sin_cos` and the angle-addition
+/// recurrence (rounding grows like h·ε), or none when H exceeds [`TABLE_HARMONICS`].
+struct Harmonics {
+    cos: [f64; TABLE_HARMONICS + 1],
+    sin: [f64; TABLE_HARMONICS + 1],
+    len: usize,
+}
+
+impl Harmonics {
+    fn at(blocks: &[Block], tau: f64) -> Self {
+        let top = blocks.iter().map(|b| b.harmonic()).max().unwrap_or(0);
+        let mut t = Self {
+            cos: [0.0; TABLE_HARMONICS + 1],
+            sin: [0.0; TABLE_HARMONICS + 1],
+            len: 0,
+        };
+        if top > TABLE_HARMONICS {
+            return t;
+        }
+        let (s1, c1) = tau.sin_cos();
+        t.cos[0] = 1.0;
+        for h in 1..=top {
+            t.cos[h] = t.cos[h - 1] * c1 - t.sin[h - 1] * s1;
+            t.sin[h] = t.sin[h - 1] * c1 + t.cos[h - 1] * s1;
+        }
+        t.len = top + 1;
+        t
+    }
+
+    /// b(τ), b′(τ), b″(τ) of one basis function.
+    fn derivatives(&self, block: Block, tau: f64) -> (f64, f64, f64) {
+        let h = block.harmonic();
+        if h >= self.len {
+            return basis_derivatives(block, tau);
+        }
+        let hf = h as f64;
+        let (s, c) = (self.sin[h], self.cos[h]);
+        match block {
+            Block::Constant => (1.0, 0.0, 0.0),
+            Block::Cos(_) => (c, -hf * s, -hf * hf * c),
+            Block::Sin(_) => (s, hf * c, -hf * hf * s),
+        }
+    }
+}
+
+/// b(τ), b′(τ), b″(τ) of one basis function.
+fn basis_derivatives(block: Block, tau: f64) -> (f64, f64, f64) {
+    match block {
+        Block::Constant => (1.0, 0.0, 0.0),
+        Block::Cos(h) => {
+            let h = h as f64;
+            let (s, c) = (h * tau).sin_cos();
+            (c, -h * s, -h * h * c)
+        }
+        Block::Sin(h) => {
+            let h = h as f64;
+            let (s, c) = (h * tau).sin_cos();
+            (s, h * c, -h * h * s)
+        }
+    }
+}
+
+/// The 2D law's parameters as the march needs them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Law2 {
+    /// Tangential stiffness kₜ (N/m).
+    pub kt: f64,
+    /// μ kₙ (N/m).
+    pub mu_kn: f64,
+    /// The constant friction limit μ max(kₙ v̂₀, 0) (N) with a constant normal load; `None`
+    /// with a variable one (L = μ kₙ v while closed).
+    pub constant_limit: Option<f64>,
+}
+
+impl Law2 {
+    /// Friction limit L and its first two τ-derivatives, unclamped (smooth through v = 0).
+    pub fn limit(&self, k: &Kinematics2) -> [f64; 3] {
+        match self.constant_limit {
+            Some(l) => [l, 0.0, 0.0],
+            None => [
+                self.mu_kn * k.v[0],
+                self.mu_kn * k.v[1],
+                self.mu_kn * k.v[2],
+            ],
+        }
+    }
+}
+
+/// The parameter columns of the sensitivities: w_start (2), then û₁, û₂, v̂ (n_blocks each)
+/// when `count` > 2 (a march that only needs the period map's derivative A carries 2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Columns {
+    /// Columns carried: 2 or 2 + 3 n_blocks.
+    pub count: usize,
+    /// Blocks per signal.
+    pub nb: usize,
+    /// The constant block of v̂ (the constant normal load's column), if any.
+    pub constant: Option<usize>,
+}
+
+impl Columns {
+    /// Whether the coefficient columns are carried.
+    pub fn full(&self) -> bool {
+        self.count > 2
+    }
+
+    /// Adds `scale`·du_a(τ) (the basis `b` in the û_a columns).
+    pub fn add_du(&self, a: usize, scale: f64, b: &[f64], out: &mut [f64]) {
+        if self.full() {
+            let o = 2 + a * self.nb;
+            for (x, bi) in out[o..o + self.nb].iter_mut().zip(b) {
+                *x += scale * bi;
+            }
+        }
+    }
+
+    /// Adds `scale`·dv(τ) (the basis `b` in the v̂ columns, or the constant column alone
+    /// under a constant normal load when `constant_load`).
+    pub fn add_dv(&self, scale: f64, b: &[f64], constant_load: bool, out: &mut [f64]) {
+        if !self.full() {
+            return;
+        }
+        let o = 2 + 2 * self.nb;
+        if constant_load {
+            if let Some(c) = self.constant {
+                out[o + c] += scale;
+            }
+        } else {
+            for (x, bi) in out[o..o + self.nb].iter_mut().zip(b) {
+                *x += scale * bi;
+            }
+        }
+    }
+}
+
+/// Buffers of the event-resolved 2D law kept between evaluations (in the 2D workspace).
+#[derive(Debug, Clone, Default)]
+pub struct EventScratch {
+    pub(crate) buffers: Buffers,
+    pub(crate) record: Record,
+    pub(crate) start_derivative: Vec<f64>,
+    pub(crate) gram: Moments,
+    pub(crate) piece: Moments,
+    pub(crate) closed: Vec<(f64, f64)>,
+}
