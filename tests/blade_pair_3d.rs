@@ -303,7 +303,7 @@ fn the_window_from_845_hz_is_complete_through_both_folds() {
         "analysis.freq_start_hz=845",
         "analysis.freq_end_hz=900",
         "accuracy.estimate=false",
-    ]));
+    ]);
     let run =
         fricbound::analysis::frf::solve(&problem, &mut fricbound::analysis::frf::Silent).unwrap();
     println!(
