@@ -84,7 +84,7 @@ pub struct Aft2dWorkspace {
     /// tests that compare with the plain march).
     pub(super) newton_restarts: bool,
     /// Buffers of the event-resolved law ([`Self::evaluate_events`]).
-    pub(super) events: crate::contact::events2d::EventScratch,
+    pub(super) events: crate::contact::events2d::march::EventScratch,
 }
 
 impl Aft2dWorkspace {

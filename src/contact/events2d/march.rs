@@ -4,7 +4,7 @@
 use super::crossing::crossing;
 use super::dopri::Dopri;
 use super::{Columns, Kinematics2, Law2, Path2, ODE_TOLERANCE};
-use crate::contact::events::MarchFailure;
+use crate::contact::events::{MarchFailure, Moments};
 use std::f64::consts::PI;
 
 /// Gauss–Legendre nodes and weights on [−1, 1] (8 points: exact for degree 15; a step of
@@ -744,4 +744,15 @@ fn sample_range(cell: f64, a: f64, b: f64, n: usize) -> (usize, usize) {
 fn mark(flags: &mut [bool], cell: f64, a: f64, b: f64) {
     let (lo, hi) = sample_range(cell, a, b, flags.len());
     flags[lo..hi].iter_mut().for_each(|x| *x = true);
+}
+
+/// Buffers of the event-resolved 2D law kept between evaluations (in the 2D workspace).
+#[derive(Debug, Clone, Default)]
+pub struct EventScratch {
+    pub(crate) buffers: Buffers,
+    pub(crate) record: Record,
+    pub(crate) start_derivative: Vec<f64>,
+    pub(crate) gram: Moments,
+    pub(crate) piece: Moments,
+    pub(crate) closed: Vec<(f64, f64)>,
 }

@@ -42,9 +42,7 @@ mod crossing;
 pub mod dopri;
 pub mod march;
 
-use crate::contact::events::Moments;
 use crate::contact::harmonic::Block;
-use march::{Buffers, Record};
 
 /// Absolute tolerance (rad) of one step of the slip angle's integration: far below what a
 /// harmonic-balance Newton resolves (forces to ~10⁻¹¹ of μN).
@@ -238,15 +236,4 @@ impl Columns {
             }
         }
     }
-}
-
-/// Buffers of the event-resolved 2D law kept between evaluations (in the 2D workspace).
-#[derive(Debug, Clone, Default)]
-pub struct EventScratch {
-    pub(crate) buffers: Buffers,
-    pub(crate) record: Record,
-    pub(crate) start_derivative: Vec<f64>,
-    pub(crate) gram: Moments,
-    pub(crate) piece: Moments,
-    pub(crate) closed: Vec<(f64, f64)>,
 }
