@@ -96,7 +96,8 @@ impl Continuation {
                 let landing = self.scaled(&point);
                 let chord: Vec<f64> = landing.iter().zip(y).map(|(a, b)| a - b).collect();
                 let length = norm(&chord);
-                if !(length > 0.0)
+                if length.is_nan()
+                    || length <= 0.0
                     || length > self.settings.max_step
                     || distance_to_polyline(&landing, &recent) <= ON_PATH_FRACTION * length
                 {
