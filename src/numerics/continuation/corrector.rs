@@ -27,6 +27,84 @@ const CHORD_CONTRACTION: f64 = 0.5;
 /// Continuation points a factorisation may be carried over to (see [`Continuation::correct`]).
 const CARRY_POINTS: usize = 8;
 
+/// Smallest fraction of a Newton step the backtracking line search tries.
+const MIN_STEP_FRACTION: f64 = 1e-3;
+
+/// An operator error as a Newton failure.
+fn evaluation(e: impl std::fmt::Display) -> NewtonFailure {
+    NewtonFailure::Evaluation(e.to_string())
+}
+
+/// The work of one Newton solve: with chord steps, [`CHORD_STEPS_PER_ITERATION`] of them and
+/// each factorisation count as one iteration.
+struct Effort {
+    chord: bool,
+    factorisations: usize,
+    chord_steps: usize,
+}
+
+impl Effort {
+    fn new(chord: bool) -> Self {
+        Effort {
+            chord,
+            factorisations: 0,
+            chord_steps: 0,
+        }
+    }
+
+    /// Steps allowed for an iteration limit of `iterations`.
+    fn step_limit(&self, iterations: usize) -> usize {
+        iterations
+            * if self.chord {
+                CHORD_STEPS_PER_ITERATION
+            } else {
+                1
+            }
+    }
+
+    /// The iterations reported after `steps` steps.
+    fn iterations(&self, steps: usize) -> usize {
+        if self.chord {
+            (self.factorisations + self.chord_steps / CHORD_STEPS_PER_ITERATION).max(1)
+        } else {
+            steps
+        }
+    }
+}
+
+/// The residual at (x, ω), left in `r`, relative to the residual scale.
+fn relative_residual<S: ParametricResidual>(
+    system: &mut S,
+    (x, omega): (&[f64], f64),
+    r: &mut [f64],
+) -> Result<f64, NewtonFailure> {
+    system.residual(x, omega, r).map_err(evaluation)?;
+    Ok(norm(r) / system.residual_scale())
+}
+
+/// Backtracking line search on the residual norm: the trial residual at α = 1, ½, ¼, … until it
+/// falls below `rel` or α drops below [`MIN_STEP_FRACTION`] (or at α = 1 only when `single`).
+/// `place(α, x)` writes the trial unknowns for α into x and returns the trial ω. Returns α, the
+/// trial's relative residual (left in `r`) and whether it fell below `rel`.
+fn line_search<S: ParametricResidual>(
+    system: &mut S,
+    rel: f64,
+    single: bool,
+    (trial, r): (&mut [f64], &mut [f64]),
+    mut place: impl FnMut(f64, &mut [f64]) -> f64,
+) -> Result<(f64, f64, bool), NewtonFailure> {
+    let mut alpha = 1.0;
+    loop {
+        let omega = place(alpha, trial);
+        let rel_trial = relative_residual(system, (trial, omega), r)?;
+        let improved = rel_trial < rel;
+        if improved || single || alpha < MIN_STEP_FRACTION {
+            return Ok((alpha, rel_trial, improved));
+        }
+        alpha *= 0.5;
+    }
+}
+
 impl Continuation {
     /// The residual tolerance at the iterate (x, ω), relative to the residual scale: the
     /// settings' `residual_tolerance`, raised to [`ROUND_OFF_FACTOR`] times the operator's
@@ -65,11 +143,10 @@ impl Continuation {
         r_current: bool,
         previous: f64,
     ) -> Result<f64, NewtonFailure> {
-        let eval_err = |e: S::Error| NewtonFailure::Evaluation(e.to_string());
         let scale = system.residual_scale();
         if factor.is_some() {
             if !r_current {
-                system.residual(x, omega, r).map_err(eval_err)?;
+                system.residual(x, omega, r).map_err(evaluation)?;
             }
             let rel = norm(r) / scale;
             if rel <= CHORD_CONTRACTION * previous || rel <= self.settings.residual_tolerance {
@@ -79,7 +156,7 @@ impl Continuation {
         }
         system
             .residual_and_jacobian(x, omega, r, jac, dr)
-            .map_err(eval_err)?;
+            .map_err(evaluation)?;
         Ok(norm(r) / scale)
     }
 
@@ -91,110 +168,88 @@ impl Continuation {
         omega: f64,
     ) -> Result<PathPoint, NewtonFailure> {
         let n = system.dim();
-        let scale = system.residual_scale();
         let mut x = x0.to_vec();
         let mut r = vec![0.0; n];
         let mut dr = vec![0.0; n];
         let mut jac = system.new_jacobian();
         let mut trial = vec![0.0; n];
-        let mut rt = vec![0.0; n];
-        let eval_err = |e: S::Error| NewtonFailure::Evaluation(e.to_string());
         // Chord steps on large problems, as in the corrector: the factorisation is kept while
         // each step cuts the residual by CHORD_CONTRACTION.
-        let chord = n >= self.settings.chord_min_unknowns;
-        let max_iter = self.settings.max_iterations.max(1)
-            * 3
-            * if chord { CHORD_STEPS_PER_ITERATION } else { 1 };
+        let mut effort = Effort::new(n >= self.settings.chord_min_unknowns);
+        let max_iter = effort.step_limit(self.settings.max_iterations.max(1) * 3);
         let mut factor: Option<BorderedFactor> = None;
-        let (mut factorisations, mut chord_steps) = (0usize, 0usize);
         // Whether r holds the residual at x (the accepted trial of the previous step).
         let mut r_current = false;
         let mut rel = f64::INFINITY;
         let mut history = Vec::new();
         for it in 1..=max_iter {
-            let previous = rel;
             rel = self.chord_evaluate(
                 system,
                 (&x, omega),
                 (&mut r, &mut jac, &mut dr),
                 &mut factor,
                 r_current,
-                previous,
+                rel,
             )?;
             let tolerance = self.tolerance_at(system, (&x, omega), rel);
             let at_tolerance = rel <= tolerance;
             history.push(rel);
-            if !at_tolerance && self.stagnates(&history, chord) {
+            if !at_tolerance && self.stagnates(&history, effort.chord) {
                 return Err(NewtonFailure::MaxIterations {
                     iterations: it,
                     residual: rel,
                 });
             }
-            let neg: Vec<f64> = r.iter().map(|v| -v).collect();
-            let dx = match &factor {
-                Some(f) => {
-                    chord_steps += 1;
-                    let mut rhs = neg;
-                    rhs.push(0.0);
-                    let mut d = f.solve_chord(&rhs)?;
-                    d.truncate(n);
-                    d
-                }
-                None if chord => {
-                    // J bordered by a unit row: its factorisation solves J alone.
-                    factorisations += 1;
-                    let mut row = vec![0.0; n + 1];
-                    row[n] = 1.0;
-                    let f = jac.factor_bordered(&vec![1.0; n], &vec![0.0; n], &row)?;
-                    let mut rhs = neg;
-                    rhs.push(0.0);
-                    let mut d = f.solve(&rhs)?;
-                    d.truncate(n);
-                    factor = Some(f);
-                    d
-                }
-                None => jac.solve(&neg)?,
+            let mut rhs: Vec<f64> = r.iter().map(|v| -v).collect();
+            let dx = if effort.chord {
+                rhs.push(0.0);
+                let mut d = match &factor {
+                    Some(f) => {
+                        effort.chord_steps += 1;
+                        f.solve_chord(&rhs)?
+                    }
+                    None => {
+                        // J bordered by a unit row: its factorisation solves J alone.
+                        effort.factorisations += 1;
+                        let mut row = vec![0.0; n + 1];
+                        row[n] = 1.0;
+                        let f = jac.factor_bordered(&vec![1.0; n], &vec![0.0; n], &row)?;
+                        let d = f.solve(&rhs)?;
+                        factor = Some(f);
+                        d
+                    }
+                };
+                d.truncate(n);
+                d
+            } else {
+                jac.solve(&rhs)?
             };
             let step_norm = scaled_norm(&dx, &self.x_scale);
-            let mut alpha = 1.0;
-            let improved = loop {
-                for i in 0..n {
-                    trial[i] = x[i] + alpha * dx[i];
-                }
-                system.residual(&trial, omega, &mut rt).map_err(eval_err)?;
-                let rel_t = norm(&rt) / scale;
-                let improved = rel_t < rel;
-                if improved || alpha < 1e-3 || at_tolerance {
-                    if improved || !at_tolerance {
-                        rel = rel_t;
+            // At tolerance only the full step is tried: one that does not lower the residual
+            // only moves through round-off, and the current point is kept (as in `correct`).
+            let (alpha, rel_trial, improved) =
+                line_search(system, rel, at_tolerance, (&mut trial, &mut r), |a, t| {
+                    for i in 0..n {
+                        t[i] = x[i] + a * dx[i];
                     }
-                    break improved;
-                }
-                alpha *= 0.5;
-            };
-            // At tolerance, a step that does not lower the residual only moves through
-            // round-off: keep the current point (see `correct`).
+                    omega
+                })?;
             let stalled_at_tolerance = at_tolerance && !improved;
             if !stalled_at_tolerance {
+                rel = rel_trial;
                 x.copy_from_slice(&trial);
-                r.copy_from_slice(&rt);
             }
             r_current = true;
-            let it = if chord {
-                (factorisations + chord_steps / CHORD_STEPS_PER_ITERATION).max(1)
-            } else {
-                it
-            };
             if stalled_at_tolerance || self.converged(rel, alpha * step_norm, tolerance) {
                 // Leave the operator evaluated at the returned point.
                 system
                     .residual_and_jacobian(&x, omega, &mut r, &mut jac, &mut dr)
-                    .map_err(eval_err)?;
+                    .map_err(evaluation)?;
                 return Ok(PathPoint {
                     omega,
                     x,
-                    iterations: it,
-                    residual: norm(&r) / scale,
+                    iterations: effort.iterations(it),
+                    residual: norm(&r) / system.residual_scale(),
                     step: 0.0,
                 });
             }
@@ -203,6 +258,75 @@ impl Continuation {
             iterations: max_iter,
             residual: rel,
         })
+    }
+
+    /// The factorisation carried from an earlier point of the path (at most [`CARRY_POINTS`]
+    /// back), bordered with this tangent: when the contact states have not moved much, the
+    /// point converges on it without a new factorisation.
+    fn carried_factor(&self, tangent: &[f64]) -> Option<BorderedFactor> {
+        let mut carried = self.carried.borrow_mut();
+        let (f, age) = carried.as_mut()?;
+        if *age < CARRY_POINTS {
+            *age += 1;
+            f.rebordered(tangent)
+        } else {
+            *carried = None;
+            None
+        }
+    }
+
+    /// The corrector's Newton direction for `rhs`: a chord step on the kept factorisation
+    /// `factor` (with Broyden's updates), else, with chord steps, a new factorisation of the
+    /// bordered Jacobian, kept for the next steps and carried to later points, or without
+    /// them a bordered solve.
+    fn corrector_direction(
+        &self,
+        (jac, dr): (&mut AssembledJacobian, &[f64]),
+        tangent: &[f64],
+        rhs: &[f64],
+        (factor, broyden, effort): (
+            &mut Option<BorderedFactor>,
+            &mut BroydenUpdates,
+            &mut Effort,
+        ),
+    ) -> Result<Vec<f64>, NewtonFailure> {
+        if let Some(f) = factor {
+            effort.chord_steps += 1;
+            return Ok(broyden.direction(f.solve_chord(rhs)?));
+        }
+        let col: Vec<f64> = dr.iter().map(|v| v * OMEGA_SCALE).collect();
+        effort.factorisations += 1;
+        if !effort.chord {
+            return Ok(jac.solve_bordered(&self.x_scale, &col, tangent, rhs)?);
+        }
+        let f = jac.factor_bordered(&self.x_scale, &col, tangent)?;
+        let d = f.solve(rhs)?;
+        broyden.restart(&d);
+        *self.carried.borrow_mut() = f.rebordered(tangent).map(|c| (c, 0));
+        *factor = Some(f);
+        Ok(d)
+    }
+
+    /// Whether Newton gives up at iteration `it`, from the relative residuals `history` of its
+    /// steps: the residual grew 10⁴ times above the first one (diverged), or it stagnates above
+    /// `tolerance` (see [`Continuation::stagnates`]).
+    fn diverged_or_stagnated(
+        &self,
+        history: &[f64],
+        tolerance: f64,
+        (it, chord): (usize, bool),
+    ) -> Result<(), NewtonFailure> {
+        let (first, rel) = (history[0], history[history.len() - 1]);
+        if rel > 1e4 * first.max(self.settings.residual_tolerance) {
+            return Err(NewtonFailure::Diverged { residual: rel });
+        }
+        if rel > tolerance && self.stagnates(history, chord) {
+            return Err(NewtonFailure::MaxIterations {
+                iterations: it,
+                residual: rel,
+            });
+        }
+        Ok(())
     }
 
     /// Corrector: Newton on R = 0 and tᵀ(y − y_p) = 0 in scaled space (y = (x / x_scale,
@@ -215,158 +339,91 @@ impl Continuation {
         tangent: &[f64],
     ) -> Result<(Vec<f64>, usize, f64), NewtonFailure> {
         let n = system.dim();
-        let scale = system.residual_scale();
         let mut y = predicted.to_vec();
         let mut r = vec![0.0; n];
         let mut dr = vec![0.0; n];
         let mut jac = system.new_jacobian();
-        let mut col = vec![0.0; n];
         let mut x = vec![0.0; n];
         let mut trial = vec![0.0; n];
-        let mut first = f64::NAN;
         let mut rel = f64::INFINITY;
         let mut history = Vec::new();
         // Chord iterations on large problems: the factorised bordered matrix is reused while
         // the residual keeps falling fast enough (see the module docs).
-        let chord = n >= self.settings.chord_min_unknowns;
+        let mut effort = Effort::new(n >= self.settings.chord_min_unknowns);
         *self.last_factor.borrow_mut() = None;
-        let mut factor: Option<BorderedFactor> = None;
-        // A factorisation made at an earlier point of the path (at most CARRY_POINTS back),
-        // bordered with this tangent, serves for the first chord steps: when the contact
-        // states have not moved much, the point converges without a new factorisation.
-        let mut from_carried = false;
+        let mut factor = effort.chord.then(|| self.carried_factor(tangent)).flatten();
+        let mut from_carried = factor.is_some();
         // Whether r holds the residual at the current iterate y (the accepted trial of the
         // previous step), so that a chord step need not evaluate it again.
         let mut r_current = false;
         let mut broyden = BroydenUpdates::default();
-        if chord {
-            let mut carried = self.carried.borrow_mut();
-            if let Some((f, age)) = carried.as_mut() {
-                if *age < CARRY_POINTS {
-                    *age += 1;
-                    factor = f.rebordered(tangent);
-                    from_carried = factor.is_some();
-                    broyden.clear();
-                } else {
-                    *carried = None;
-                }
-            }
-        }
-        let (mut factorisations, mut chord_steps) = (0usize, 0usize);
-        let effort = |f: usize, c: usize| (f + c / CHORD_STEPS_PER_ITERATION).max(1);
-        let limit = if chord {
-            CHORD_STEPS_PER_ITERATION * self.settings.max_iterations
-        } else {
-            self.settings.max_iterations
-        };
+        let limit = effort.step_limit(self.settings.max_iterations);
         for it in 1..=limit {
             for i in 0..n {
                 x[i] = y[i] * self.x_scale[i];
             }
             let omega = y[n] * OMEGA_SCALE;
-            let previous = rel;
             rel = self.chord_evaluate(
                 system,
                 (&x, omega),
                 (&mut r, &mut jac, &mut dr),
                 &mut factor,
                 r_current,
-                previous,
+                rel,
             )?;
             let tolerance = self.tolerance_at(system, (&x, omega), rel);
-            if first.is_nan() {
-                first = rel;
-            } else if rel > 1e4 * first.max(self.settings.residual_tolerance) {
-                return Err(NewtonFailure::Diverged { residual: rel });
-            }
             history.push(rel);
-            if rel > tolerance && self.stagnates(&history, chord) {
-                return Err(NewtonFailure::MaxIterations {
-                    iterations: it,
-                    residual: rel,
-                });
-            }
+            self.diverged_or_stagnated(&history, tolerance, (it, effort.chord))?;
             let mut rhs: Vec<f64> = r.iter().map(|v| -v).collect();
             rhs.push(
                 -(0..=n)
                     .map(|j| tangent[j] * (y[j] - predicted[j]))
                     .sum::<f64>(),
             );
-            let mut dy = match (&factor, chord) {
-                (Some(f), _) => {
-                    chord_steps += 1;
-                    let p = f.solve_chord(&rhs)?;
-                    broyden.direction(p)
-                }
-                (None, _) => {
-                    for i in 0..n {
-                        col[i] = dr[i] * OMEGA_SCALE;
-                    }
-                    factorisations += 1;
-                    if chord {
-                        let f = jac.factor_bordered(&self.x_scale, &col, tangent)?;
-                        let d = f.solve(&rhs)?;
-                        broyden.restart(&d);
-                        *self.carried.borrow_mut() = f.rebordered(tangent).map(|c| (c, 0));
-                        from_carried = false;
-                        factor = Some(f);
-                        d
-                    } else {
-                        jac.solve_bordered(&self.x_scale, &col, tangent, &rhs)?
-                    }
-                }
-            };
-            let it = if chord {
-                effort(factorisations, chord_steps)
-            } else {
-                it
-            };
-            if rel <= tolerance {
-                // At tolerance, a Newton step that does not lower the residual only moves
-                // through round-off (amplified by the Jacobian's condition number near a
-                // lightly damped resonance): the point is converged.
-                for j in 0..n {
-                    trial[j] = (y[j] + dy[j]) * self.x_scale[j];
-                }
-                system
-                    .residual(&trial, (y[n] + dy[n]) * OMEGA_SCALE, &mut r)
-                    .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
-                if norm(&r) / scale >= rel {
-                    self.keep_factor(factor.take(), tangent);
-                    return Ok((y, it, rel));
-                }
-                r_current = true;
-            } else {
-                // Backtracking: halve the step while it does not reduce the residual (the
-                // contact law is only piecewise smooth, and full steps can cycle between
-                // contact states). The arc-length equation is linear, so every fraction of
-                // the step keeps it.
-                let mut alpha = 1.0;
-                loop {
+            if factor.is_none() {
+                from_carried = false;
+            }
+            let mut dy = self.corrector_direction(
+                (&mut jac, &dr),
+                tangent,
+                &rhs,
+                (&mut factor, &mut broyden, &mut effort),
+            )?;
+            let it = effort.iterations(it);
+            // At tolerance only the full step is tried: one that does not lower the residual
+            // only moves through round-off (amplified by the Jacobian's condition number near a
+            // lightly damped resonance), and the point is converged. Elsewhere the step is
+            // halved while it does not lower the residual, except on a factorisation carried
+            // from an earlier point, which is not worth backtracking on: stay, and factorise
+            // afresh at this iterate. The arc-length equation is linear, so every fraction of
+            // the step keeps it.
+            let at_tolerance = rel <= tolerance;
+            let (mut alpha, _, improved) = line_search(
+                system,
+                rel,
+                at_tolerance || from_carried,
+                (&mut trial, &mut r),
+                |a, t| {
                     for j in 0..n {
-                        trial[j] = (y[j] + alpha * dy[j]) * self.x_scale[j];
+                        t[j] = (y[j] + a * dy[j]) * self.x_scale[j];
                     }
-                    system
-                        .residual(&trial, (y[n] + alpha * dy[n]) * OMEGA_SCALE, &mut r)
-                        .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
-                    if norm(&r) / scale < rel || alpha < 1e-3 {
-                        break;
-                    }
-                    if from_carried {
-                        // A factorisation carried from an earlier point that does not lower
-                        // the residual with a full step is not worth backtracking on: stay,
-                        // and factorise afresh at this iterate.
-                        alpha = 0.0;
-                        factor = None;
-                        from_carried = false;
-                        break;
-                    }
-                    alpha *= 0.5;
-                }
-                // r now holds the residual at the accepted iterate (not after a rejected
-                // carried step, which leaves the iterate where it was).
-                r_current = alpha > 0.0;
-                dy.iter_mut().for_each(|v| *v *= alpha);
+                    (y[n] + a * dy[n]) * OMEGA_SCALE
+                },
+            )?;
+            if at_tolerance && !improved {
+                self.keep_factor(factor.take(), tangent);
+                return Ok((y, it, rel));
+            }
+            if from_carried && !improved {
+                alpha = 0.0;
+                factor = None;
+                from_carried = false;
+            }
+            // r holds the residual at the accepted iterate (not after a rejected carried
+            // step, which leaves the iterate where it was).
+            r_current = alpha > 0.0;
+            dy.iter_mut().for_each(|v| *v *= alpha);
+            if !at_tolerance {
                 broyden.stepped(alpha);
             }
             for j in 0..=n {
@@ -382,10 +439,7 @@ impl Continuation {
                 for i in 0..n {
                     x[i] = y[i] * self.x_scale[i];
                 }
-                system
-                    .residual(&x, y[n] * OMEGA_SCALE, &mut r)
-                    .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
-                let rel_new = norm(&r) / scale;
+                let rel_new = relative_residual(system, (&x, y[n] * OMEGA_SCALE), &mut r)?;
                 r_current = true;
                 if rel_new <= tolerance {
                     self.keep_factor(factor.take(), tangent);
