@@ -493,3 +493,64 @@ fn a_wider_set_beyond_the_step_budget_is_not_stepped_on() {
     let json = json(&auto.join("solution.json"));
     assert_eq!(json["accuracy"]["unsolved_points"].as_u64(), Some(flagged));
 }
+
+/// The scene files a user meets: every `.toml` scene shipped under `meshes/` and `tests/data/`,
+/// and every complete scene (one with a `[model]` or `[mesh]` table) in a `toml` block of
+/// README.md or the guide (`docs/src`), written to a temporary file.
+fn shipped_and_shown_scenes(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut scenes = Vec::new();
+    let mut folders = vec![root.join("meshes"), root.join("tests/data")];
+    while let Some(folder) = folders.pop() {
+        for entry in std::fs::read_dir(&folder).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                folders.push(path);
+            } else if path.extension().is_some_and(|e| e == "toml") {
+                scenes.push(path);
+            }
+        }
+    }
+    let mut pages = vec![root.join("README.md")];
+    for entry in std::fs::read_dir(root.join("docs/src")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "md") {
+            pages.push(path);
+        }
+    }
+    for page in pages {
+        let text = std::fs::read_to_string(&page).unwrap();
+        for (i, block) in text.split("```toml\n").skip(1).enumerate() {
+            let block = block.split("```").next().unwrap();
+            if block.contains("[model]") || block.contains("[mesh]") {
+                let stem = page.file_stem().unwrap().to_string_lossy();
+                let file = dir.join(format!("{stem}-{i}.toml"));
+                std::fs::write(&file, block).unwrap();
+                scenes.push(file);
+            }
+        }
+    }
+    scenes.sort();
+    scenes
+}
+
+/// Every scene a user meets passes `fricbound check` (exit 0): the shipped scenes and the
+/// complete scenes shown in README.md and the guide.
+#[test]
+fn every_shipped_or_shown_scene_passes_check() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenes = shipped_and_shown_scenes(dir.path());
+    assert!(
+        scenes.iter().any(|s| s.starts_with(dir.path())),
+        "no complete scene found in the guide"
+    );
+    assert!(scenes.len() > 20, "{scenes:?}");
+    let failed: Vec<String> = scenes
+        .iter()
+        .filter_map(|scene| {
+            let o = support::fricbound(&["check", &scene.display().to_string()]);
+            (!o.status.success()).then(|| format!("{}: {}", scene.display(), text(&o.stderr)))
+        })
+        .collect();
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
+}

@@ -10,7 +10,7 @@
 //!   failed) and the exit codes, [`RunOptions`], [`RunReport`], [`RunOutcome`], the
 //!   [`RunContext`] each kind of run works in, [`load_scene`], [`scene_hash`],
 //!   [`default_out_dir`], [`figure_title`], [`run_summary`];
-//! - [`check`] (`fricbound check`): validates a scene and describes it;
+//! - [`check`](mod@check) (`fricbound check`): validates a scene and describes it;
 //! - [`mesh`] (`fricbound mesh`): generates the blade-pair mesh;
 //! - [`modes`] (`fricbound modes`, `fricbound reduce`): natural frequencies of the full and
 //!   reduced models, the reduced model written out;

@@ -47,7 +47,7 @@ pub struct VerifyOptions {
     pub scene: Option<PathBuf>,
     /// Excitation frequencies (Hz).
     pub freqs: Vec<f64>,
-    /// Output folder (default: out/<scene>/verify).
+    /// Output folder (default: `out/<scene>/verify`).
     pub out: Option<PathBuf>,
     /// Scene overrides.
     pub overrides: Vec<String>,

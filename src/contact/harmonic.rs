@@ -12,7 +12,7 @@
 //! `j·n .. (j+1)·n`, so the linear part D(ω) is block-diagonal (2×2 blocks per harmonic).
 //!
 //! Time samples are τ_k = 2πk/N, k = 0..N−1; N must exceed twice the highest harmonic
-//! (Nyquist). [`SampleBasis`] holds the dense sample matrix E (E[k][j] = basis function j at τ_k)
+//! (Nyquist). [`SampleBasis`] holds the dense sample matrix E (E\[k\]\[j\] = basis function j at τ_k)
 //! and the projection P (Fourier coefficients = P·samples), used by the analytic AFT Jacobian;
 //! the forces themselves go through real FFTs (see [`crate::contact::aft`]).
 
@@ -172,9 +172,9 @@ pub struct SampleBasis {
     pub n_samples: usize,
     /// Number of coefficient blocks.
     pub n_blocks: usize,
-    /// E, row-major N × n_blocks: E[k][j] = basis_j(τ_k).
+    /// E, row-major N × n_blocks: E\[k\]\[j\] = basis_j(τ_k).
     pub synthesis: Vec<f64>,
-    /// P, row-major n_blocks × N: coefficient_j = Σ_k P[j][k] f(τ_k) (exact for the set's harmonics).
+    /// P, row-major n_blocks × N: coefficient_j = Σ_k P\[j\]\[k\] f(τ_k) (exact for the set's harmonics).
     pub projection: Vec<f64>,
 }
 

@@ -3,8 +3,8 @@
 //! A [`ContactPoint`] couples the structure through two scalar relative displacements built
 //! from the DOFs by sparse linear rows:
 //!
-//! * tangential u = Σ aₜ[i] q[i]            (m)
-//! * normal     v = Σ aₙ[i] q[i] − gap      (m; v > 0 is penetration, i.e. compression)
+//! * tangential u = Σ aₜ\[i\] q\[i\]            (m)
+//! * normal     v = Σ aₙ\[i\] q\[i\] − gap      (m; v > 0 is penetration, i.e. compression)
 //!
 //! For a damper pressed against a body, aₜ and aₙ are the local frame vectors t, n applied to
 //! the relative displacement r = (damper point) − (body point). The contact forces are
@@ -211,7 +211,7 @@ impl ContactPoint {
         })
     }
 
-    /// The tangential rows: [aₜ] for a 1D point, [aₜ₁, aₜ₂] for a 2D point.
+    /// The tangential rows: \[aₜ\] for a 1D point, \[aₜ₁, aₜ₂\] for a 2D point.
     pub fn tangential_rows(&self) -> impl Iterator<Item = &[(usize, f64)]> {
         std::iter::once(self.tangential.as_slice())
             .chain(self.second_tangent.as_ref().map(|s| s.row.as_slice()))

@@ -326,7 +326,7 @@ fn lame(material: &Material) -> (f64, f64) {
 }
 
 /// Adds `factor · Bᵀ D B` of an isotropic 3D solid node block by node block:
-/// K_ab[i][j] = λ g_a[i] g_b[j] + μ g_a[j] g_b[i] + μ δ_ij g_a·g_b with g = ∇N. Equal to the
+/// K_ab\[i\]\[j\] = λ g_a\[i\] g_b\[j\] + μ g_a\[j\] g_b\[i\] + μ δ_ij g_a·g_b with g = ∇N. Equal to the
 /// B-matrix product for isotropic D (a unit test checks), with about a quarter of the work.
 fn add_isotropic_solid(k: &mut [f64], dx: &[[f64; 8]; 3], lambda: f64, mu: f64, factor: f64) {
     const N: usize = 24;

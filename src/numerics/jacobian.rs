@@ -63,7 +63,7 @@ pub trait ImplicitFactor: Send + Sync {
     fn solve(&self, b: &[f64], single: bool) -> Vec<f64>;
 }
 
-/// A factorised bordered matrix [[s·J, col], [row]], kept for several solves (the chord
+/// A factorised bordered matrix `[[s·J, col], [row]]`, kept for several solves (the chord
 /// iterations of the corrector on large problems, see [`crate::numerics::continuation`]).
 pub struct BorderedFactor {
     kind: FactorKind,
@@ -73,7 +73,7 @@ enum FactorKind {
     /// LU of the whole (n + 1) × (n + 1) matrix.
     Dense(faer::linalg::solvers::PartialPivLu<f64>),
     /// A factorisation of s·J with the border eliminated by blocks: a = (sJ)⁻¹ f,
-    /// z = (g − r·a)/d, y = a − b z with b = (sJ)⁻¹ col and d = row[n] − r·b.
+    /// z = (g − r·a)/d, y = a − b z with b = (sJ)⁻¹ col and d = row\[n\] − r·b.
     Eliminated {
         lu: Arc<InnerFactor>,
         b_col: Vec<f64>,
@@ -451,7 +451,7 @@ impl AssembledJacobian {
         }
     }
 
-    /// Solves the bordered system [[s·J, col], [row]] y = rhs, with `col` of length n and
+    /// Solves the bordered system `[[s·J, col], [row]] y = rhs`, with `col` of length n and
     /// `row`, `rhs` of length n + 1.
     pub fn solve_bordered(
         &mut self,
@@ -468,7 +468,7 @@ impl AssembledJacobian {
         }
     }
 
-    /// Factorises the bordered matrix [[s·J, col], [row]] for several solves
+    /// Factorises the bordered matrix `[[s·J, col], [row]]` for several solves
     /// ([`BorderedFactor::solve`], without the refinement steps of [`Self::solve_bordered`]).
     pub fn factor_bordered(
         &mut self,

@@ -82,7 +82,7 @@ impl<'p> ErrorEstimator<'p> {
     /// `step` is that across-path step on the same set (its unknowns, then δω), `contraction`
     /// its contraction: where it lowers the residual the solve starts from the stepped point
     /// (in the hyperplane, since the step is), as [`Self::converged_truncation`] does. The
-    /// Newton iterations are the continuation's corrector ([`Continuation::correct`]) with the
+    /// Newton iterations are the continuation's corrector ([`Continuation::correct`](crate::numerics::continuation::Continuation::correct)) with the
     /// hyperplane as its arc-length row, with three times the path's `max_iterations` as its
     /// limit, as the fixed-frequency solve, the iterations beyond the path's own only while
     /// the residual keeps falling ([`extended_newton`]). Three times the limit without that
@@ -274,7 +274,7 @@ impl<'p> ErrorEstimator<'p> {
 }
 
 impl<'p> ErrorEstimator<'p> {
-    /// The bordered Newton steps (δx, δω) of [[J, ∂R/∂ω], [row]] (δx, δω) = (r, 0) for each
+    /// The bordered Newton steps (δx, δω) of `[[J, ∂R/∂ω], [row]]` (δx, δω) = (r, 0) for each
     /// residual r of `rhs`, with one factorisation (the Jacobian last evaluated by the
     /// truncation operator, `dr` its ∂R/∂ω).
     /// The last right-hand side takes 1 in the border row instead of 0: its solution is the

@@ -138,7 +138,7 @@
 //! [`report`] (what an estimate says of a point), [`problems`] (the refined problems and
 //! operators), [`rules`] (how far an estimate goes: budget, tail test, widen gate, linear
 //! range), [`estimator`] (the estimate of a point), [`converged`] (the extension solved to
-//! convergence) and [`warnings`] (the run's accuracy warnings).
+//! convergence) and [`warnings`](mod@warnings) (the run's accuracy warnings).
 
 mod converged;
 mod estimator;

@@ -322,7 +322,7 @@ pub fn amplitude_on_path(points: &[FrfPoint], freq_hz: f64) -> Option<f64> {
 /// and the frequency there (Hz): the reference's counterpart of the point at the same place
 /// along the path, against which a bordered error estimate (see
 /// [`crate::analysis::error_estimate`]) is compared. `normal` is the hyperplane as
-/// [`PointAccuracy::path_normal`] holds it (a covector on `point`'s full coefficients on
+/// [`PointAccuracy::path_normal`](crate::analysis::error_estimate::PointAccuracy::path_normal) holds it (a covector on `point`'s full coefficients on
 /// `set`, then on ω in rad/s); the reference's coefficients on `reference_set` enter on the
 /// blocks of `set` (the hyperplane does not see the others). Each segment of the reference
 /// within a branch (not across a jump) whose ends lie on either side is a crossing,

@@ -94,7 +94,7 @@ pub(super) fn adaptive_scale(
 
 /// For each output DOF, the indices of its first-harmonic cosine and sine among the operator's
 /// unknowns (outputs the operator does not carry are left out), for the step length to follow
-/// the output amplitudes ([`Continuation::with_amplitude_steps`]).
+/// the output amplitudes ([`Continuation::with_amplitude_steps`](crate::numerics::continuation::Continuation::with_amplitude_steps)).
 pub(super) fn output_amplitude_groups(
     problem: &Problem,
     set: &HarmonicSet,

@@ -78,7 +78,7 @@ pub struct CaseCurve {
 }
 
 impl CaseCurve {
-    /// "curve `<name>` incomplete: <reason>" or "curve `<name>` failed: <cause>" when the case
+    /// `curve <name> incomplete: <reason>` or `curve <name> failed: <cause>` when the case
     /// did not cover the range; `None` when it did.
     pub fn unfinished_reason(&self) -> Option<String> {
         (!self.status.is_complete())

@@ -51,7 +51,7 @@
 //!
 //! The files: [`settings`] (what a verification takes and its errors), [`contact`] (the contact
 //! forces in time, by return mapping), [`newmark`] (the integrator), [`start`] (the starting
-//! state from a harmonic-balance point or the statics) and [`integrate`] (to the steady state).
+//! state from a harmonic-balance point or the statics) and [`integrate`](mod@integrate) (to the steady state).
 
 mod contact;
 mod integrate;

@@ -46,7 +46,7 @@ pub struct StudyArgs {
     /// Short setting lists and budgets (seconds on the paper case).
     #[arg(long)]
     pub quick: bool,
-    /// Output folder (default: out/<scene name>-accuracy or -jacobian).
+    /// Output folder (default: `out/<scene name>-accuracy` or `-jacobian`).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Override a scene field by its dotted path (accuracy: applied to every setting;

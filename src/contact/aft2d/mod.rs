@@ -36,7 +36,7 @@
 //! march ends when a period started at w ends within the periodicity tolerance of w, as the 1D
 //! one does; Newton steps then polish the fixed point to round-off, and its forces are the
 //! steady-state forces. The tolerance is relative to the point's own motion scale or, when
-//! larger, to the problem's force scale over kₜ ([`MarchSettings::length_scale`]), so that a
+//! larger, to the problem's force scale over kₜ ([`MarchSettings::length_scale`](crate::contact::aft::MarchSettings::length_scale)), so that a
 //! barely loaded point is not held to a drift below round-off of the problem.
 //!
 //! Degenerate fixed points. A point whose slip runs (nearly) along one direction contracts

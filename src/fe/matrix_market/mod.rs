@@ -7,7 +7,7 @@
 //! upper one; both are accepted, a file mixing both is rejected because its off-diagonal terms
 //! would be counted twice). A `general` file stores every entry and must be symmetric within a
 //! relative tolerance (`|a_ij − a_ji| ≤ tol · max|a|`). Units are the model's: K in N/m, M in kg
-//! (SI). The result is a faer [`SparseMatrix`] in full symmetric storage.
+//! (SI). The result is a faer [`SparseMatrix`](faer::sparse::SparseColMat) in full symmetric storage.
 //!
 //! Parsing and the symmetric expansion are done by `sprs::io::read_matrix_market_from_bufread`.
 //! sprs panics on an index outside the declared size, loops forever on a file that ends before

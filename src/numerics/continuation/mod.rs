@@ -14,13 +14,13 @@
 //! corrector (iteration limit, divergence, singular Jacobian, failed AFT), a correction
 //! further from the prediction than the step, or a tangent turned by more than 45° in one
 //! step (a jump to another branch) cuts the step in half and is reported to the observer;
-//! below the minimum step the run ends with [`ContinuationError::Stalled`]. An accepted step
+//! below the minimum step the run ends with [`ContinuationError::Stalled`](crate::numerics::path::ContinuationError::Stalled). An accepted step
 //! sets the next from Newton's iterations, the turn of the tangent and the change of the
 //! watched output amplitudes. Turning points (sign changes of dω/ds) are reported and
 //! followed. The last point is solved at exactly the end frequency. A path runs down in
 //! frequency when the end frequency is below the start (e.g. to fill in, back toward a fold,
 //! a branch found past it), and a path that turns back at a fold and runs half the range
-//! behind its start ends there ([`PathEnd::LeftRangeBelow`]).
+//! behind its start ends there ([`PathEnd::LeftRangeBelow`](crate::numerics::path::PathEnd::LeftRangeBelow)).
 //!
 //! The event-resolved contact laws make the residual continuously differentiable wherever a
 //! contact slips or lifts off, so Newton converges to the tolerance and plain step control

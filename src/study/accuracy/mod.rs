@@ -20,7 +20,7 @@
 //! case at the most refined setting). The `[limits]` and `[sweep]` tables are removed: a curve
 //! is the FRF of the scene with every contact's initial state set from the case.
 //!
-//! The files: [`settings`] (the settings changed and the curves studied), [`compare`] (errors
+//! The files: [`settings`](mod@settings) (the settings changed and the curves studied), [`compare`] (errors
 //! against the reference and the Pareto front) and [`run`] (running the settings).
 
 mod compare;

@@ -18,9 +18,9 @@
 //!
 //! The two-point method (paper §3.3, Eqs. 14-15) solves only the corners m = ±1 on every
 //! side; the paper leaves the general search open (§3.3, §5). Here each bound is a box-
-//! constrained optimisation ([`minimise_in_box`]: projected quasi-Newton) of A(m), where every
+//! constrained optimisation ([`minimise_in_box`](crate::numerics::box_minimize::minimise_in_box): projected quasi-Newton) of A(m), where every
 //! evaluation is a Newton solve of the harmonic balance at the frequency with that m, and the
-//! gradient dA/dm comes from the implicit-function theorem ([`amplitude_sensitivity`]: one
+//! gradient dA/dm comes from the implicit-function theorem ([`amplitude_sensitivity`](crate::analysis::limits::sensitivity::amplitude_sensitivity): one
 //! extra solve with the Jacobian per acting group). Contacts that slip or separate somewhere in
 //! the period forget their m (their gradient is exactly 0), so their m is not moved: the
 //! search runs, in effect, over the sides or points that stick at the current iterate.
@@ -28,9 +28,9 @@
 //! A contact's m acts only within the range where the contact, started at T(0) = mμN(0), stays
 //! stuck: beyond it the contact slips in the first periods of the march and then sticks with
 //! its slider set by that slip, the same state as the march started at the range's edge
-//! (T(0)/μN(0) of the steady state, [`AmplitudeSensitivity::effective`]). Such a state is
+//! (T(0)/μN(0) of the steady state, [`AmplitudeSensitivity::effective`](crate::analysis::limits::sensitivity::AmplitudeSensitivity::effective)). Such a state is
 //! re-solved at that edge m, where the gradient is the one-sided derivative into the range, and
-//! the optimiser takes the edge as the bound of that m ([`minimise_in_box`] moves to the point
+//! the optimiser takes the edge as the bound of that m ([`minimise_in_box`](crate::numerics::box_minimize::minimise_in_box) moves to the point
 //! an evaluation stands for). The limit curves m = ±1 are such states: the two-point method
 //! takes the two ends of the stuck side's range.
 //!
