@@ -554,3 +554,115 @@ fn every_shipped_or_shown_scene_passes_check() {
         .collect();
     assert!(failed.is_empty(), "{}", failed.join("\n"));
 }
+
+/// Commands of README.md and the guide that this test does not run, with the reason.
+const COMMANDS_NOT_RUN: &[(&str, &str)] = &[
+    ("cargo test", "the test suite itself"),
+    (
+        "paper --quick",
+        "tests/paper.rs runs it and checks what it writes",
+    ),
+    (
+        "paper",
+        "the full study takes minutes; tests/paper.rs runs `paper --quick`",
+    ),
+    ("bench scaling", "the scaling study takes minutes"),
+];
+
+/// A shell command line split into words ('…' and "…" quote, no other shell syntax).
+fn shell_words(line: &str) -> Vec<String> {
+    let (mut words, mut word, mut quote, mut started) = (Vec::new(), String::new(), None, false);
+    for c in line.chars() {
+        match (quote, c) {
+            (Some(q), c) if c == q => quote = None,
+            (Some(_), c) => word.push(c),
+            (None, '\'' | '"') => {
+                quote = Some(c);
+                started = true;
+            }
+            (None, c) if c.is_whitespace() => {
+                if started || !word.is_empty() {
+                    words.push(std::mem::take(&mut word));
+                }
+                started = false;
+            }
+            (None, c) => word.push(c),
+        }
+    }
+    if started || !word.is_empty() {
+        words.push(word);
+    }
+    words
+}
+
+/// The fricbound commands in the `sh` blocks of README.md and the guide: the arguments after
+/// `fricbound` or `cargo run --release --`, and the exit code the text gives (3 where its
+/// comment says "exits 3", else 0). Lines with placeholders (`scene.toml`, `SCENE`, `DIR`,
+/// `[--…]`, `F=V`) are templates, not commands.
+fn documented_commands() -> Vec<(String, Vec<String>, i32)> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut pages = vec![root.join("README.md")];
+    let mut guide: Vec<_> = std::fs::read_dir(root.join("docs/src"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "md"))
+        .collect();
+    guide.sort();
+    pages.extend(guide);
+    let mut commands = Vec::new();
+    for page in pages {
+        let text = std::fs::read_to_string(&page).unwrap();
+        for block in text.split("```sh\n").skip(1) {
+            for line in block.split("```").next().unwrap().lines() {
+                let (command, comment) = line.split_once(" #").unwrap_or((line, ""));
+                let args = match command.trim() {
+                    c if c.starts_with("fricbound ") => &c["fricbound ".len()..],
+                    c if c.starts_with("cargo run --release -- ") => {
+                        &c["cargo run --release -- ".len()..]
+                    }
+                    c if c.starts_with("cargo ") => c,
+                    _ => continue,
+                };
+                let template = ["scene.toml", "SCENE", "DIR", "[--", "F=V"];
+                if template.iter().any(|t| args.contains(t)) {
+                    continue;
+                }
+                let code = if comment.contains("exits 3") { 3 } else { 0 };
+                commands.push((args.to_string(), shell_words(args), code));
+            }
+        }
+    }
+    commands
+}
+
+/// Every command of README.md and the guide's `sh` blocks exits as the text says (0, or 3
+/// where it says why), run from a fresh folder that sees the repository's `meshes/`; the few
+/// left out are named in [`COMMANDS_NOT_RUN`] with the reason.
+#[test]
+fn every_documented_command_exits_as_documented() {
+    let dir = tempfile::tempdir().unwrap();
+    let meshes = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("meshes");
+    std::os::unix::fs::symlink(meshes, dir.path().join("meshes")).unwrap();
+    let commands = documented_commands();
+    assert!(commands.len() > 15, "{commands:?}");
+    let mut failed = Vec::new();
+    let mut ran = std::collections::BTreeSet::new();
+    for (line, args, code) in commands {
+        let skipped = COMMANDS_NOT_RUN
+            .iter()
+            .any(|(prefix, _)| line == *prefix || line.starts_with(&format!("{prefix} ")));
+        if skipped || !ran.insert(line.clone()) {
+            continue;
+        }
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = support::fricbound_in(dir.path(), &args);
+        if o.status.code() != Some(code) {
+            failed.push(format!(
+                "`{line}` exited {:?}, the text says {code}: {}",
+                o.status.code(),
+                text(&o.stderr).lines().last().unwrap_or("")
+            ));
+        }
+    }
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
+}
