@@ -26,7 +26,7 @@ from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
-from . import _native
+from . import _args, _native
 from ._native import SolveError
 from ._results import (
     AccuracyStudy,
@@ -207,8 +207,9 @@ def reduce(
     Parameters
     ----------
     K, M : scipy.sparse matrix or array_like, (n, n)
-        Stiffness (N/m) and mass (kg), symmetric with both triangles stored. ``K`` with the
-        boundary DOFs held must be positive definite.
+        Stiffness (N/m) and mass (kg), real (a complex dtype raises ``TypeError``), symmetric
+        with both triangles stored. ``K`` with the boundary DOFs held must be positive
+        definite.
     boundary : sequence of int
         DOF indices kept physical (contacts, loads, outputs), in the order of the reduced
         coordinates.
@@ -237,6 +238,8 @@ def _csc_arrays(name: str, a: Any, n: int):
     except ImportError as e:  # pragma: no cover - depends on the environment
         raise ImportError("reduce() needs scipy: pip install scipy") from e
     m = sp.csc_matrix(a)
+    if m.dtype.kind == "c":  # refused before; kept here so no imaginary part is ever dropped
+        raise TypeError(f"reduce: {name}: complex matrix given (dtype {m.dtype}); {_args._REAL_ONLY}")
     if m.shape != (n, n):
         raise ValueError(f"reduce: {name}: shape {m.shape}, expected ({n}, {n})")
     m.sum_duplicates()

@@ -9,7 +9,7 @@ from typing import Any, Iterable, Mapping, Optional, Sequence
 
 import numpy as np
 
-from . import _native
+from . import _args, _native
 
 #: Largest model ``Scene.from_matrices`` accepts as scipy.sparse matrices (they are written
 #: inline, dense, into the scene); reduce larger models first (:func:`fricbound.reduce`).
@@ -139,15 +139,20 @@ class Scene:
 
         Raises ``ValueError`` naming the field (``model.mass``, ``contacts[0].mu``, ...) of a
         bad value, as a scene file's errors do, once :meth:`check` or a solve validates it;
-        the schema (field names and types) is checked here.
+        the schema (field names and types) is checked here. A complex
+        matrix (numpy complex dtype, dense or sparse) raises ``TypeError`` naming ``M``, ``C``
+        or ``K``: the matrices must be real.
         """
         n = len(dofs)
+        arguments = {"mass": "M", "stiffness": "K", "damping": "C"}
 
         def matrix(name: str, a: Any) -> list:
+            arg = arguments[name]
+            a = _args.real_matrix("from_matrices", arg, a)
             if hasattr(a, "toarray"):  # scipy.sparse
                 if a.shape[0] > MAX_INLINE_DOFS:
                     raise ValueError(
-                        f"from_matrices: model.{name}: a sparse matrix of {a.shape[0]} DOFs is too "
+                        f"from_matrices: {arg}: model.{name}: a sparse matrix of {a.shape[0]} DOFs is too "
                         f"large to write inline (at most {MAX_INLINE_DOFS}): reduce it first with "
                         "fricbound.reduce, or export it as Matrix Market files for a scene's "
                         "[model.matrix_market]"
@@ -156,13 +161,13 @@ class Scene:
             arr = np.asarray(a, dtype=float)
             if arr.ndim != 2 or arr.shape != (n, n):
                 raise ValueError(
-                    f"from_matrices: model.{name}: shape {arr.shape}, expected ({n}, {n}) for "
+                    f"from_matrices: {arg}: model.{name}: shape {arr.shape}, expected ({n}, {n}) for "
                     f"{n} DOFs"
                 )
             bad = np.argwhere(~np.isfinite(arr))
             if len(bad):
                 i, j = bad[0]
-                raise ValueError(f"from_matrices: model.{name}[{i}][{j}] is {arr[i, j]}")
+                raise ValueError(f"from_matrices: {arg}: model.{name}[{i}][{j}] is {arr[i, j]}")
             return arr.tolist()
 
         model: dict = {
