@@ -172,8 +172,8 @@ def verify(
     freqs = _args.numbers_list("verify", "freqs_hz", freqs_hz)
     steps = _args.optional_integer("verify", "steps_per_period", steps_per_period, 8)
     periods = _args.optional_integer("verify", "max_periods", max_periods, 1)
-    cases = _native.verify(*s._args(), freqs, steps, periods)
-    return VerifyResult(cases, s.check()["outputs"])
+    result = _native.verify(*s._args(), freqs, steps, periods)
+    return VerifyResult(result["cases"], s.check()["outputs"], result["status"])
 
 
 def accuracy_study(scene: "Scene | str", quick: bool = False, progress: Progress = None) -> AccuracyStudy:

@@ -135,6 +135,9 @@ class VerifyResult:
     STAY_TOLERANCE: float
     cases: List[Dict[str, Any]]
     outputs: List[str]
+    status: str
+    @property
+    def complete(self) -> bool: ...
     def to_pandas(self) -> Any: ...
 
 class AccuracyStudy:

@@ -287,15 +287,18 @@ class VerifyResult(_Result):
     ``dt_change``, ``periods``, ``settled``, ``nonharmonic_energy``, ``hill_stable`` and
     ``floquet_re`` (None where Hill's method does not apply), ``stays`` (the motion stays within
     ``STAY_TOLERANCE`` = 1e-3 of the HBM amplitude, as ``fricbound verify`` reports), and
-    ``last_period`` (outputs × steps, m)."""
+    ``last_period`` (outputs × steps, m). ``status`` is what ``fricbound verify`` reports:
+    ``complete``, or ``incomplete: <freq> Hz did not settle, ...`` when a time integration did
+    not reach a periodic state within ``max_periods`` (the CLI's exit code 3); a motion that
+    settled away from the HBM point (``stays`` False) is a result, not incomplete."""
 
     STAY_TOLERANCE = 1e-3
 
-    def __init__(self, cases: List[Dict[str, Any]], outputs: List[str]):
+    def __init__(self, cases: List[Dict[str, Any]], outputs: List[str], status: str):
         for c in cases:
             c["stays"] = bool(c["hbm_difference"] < self.STAY_TOLERANCE)
             c["last_period"] = np.array(c["last_period"])
-        super().__init__({"cases": cases, "outputs": outputs, "status": "complete"})
+        super().__init__({"cases": cases, "outputs": outputs, "status": status})
 
     def to_pandas(self):
         """One row per frequency: ``freq_hz``, ``<dof>_hbm_amp`` and ``<dof>_time_amp`` per

@@ -486,7 +486,7 @@ pub fn verify<'py>(
     freqs_hz: Vec<f64>,
     steps_per_period: Option<usize>,
     max_periods: Option<usize>,
-) -> PyResult<Bound<'py, pyo3::types::PyList>> {
+) -> PyResult<Bound<'py, PyDict>> {
     use fricbound::analysis::frf::PointSolver;
     use fricbound::analysis::{linear, stability, verify};
     if let Some(f) = freqs_hz.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
@@ -534,10 +534,18 @@ pub fn verify<'py>(
             })
             .collect::<Vec<Result<_, String>>>()
     })?;
+    let cases = cases
+        .into_iter()
+        .map(|case| case.map_err(|e| SolveError::new_err(format!("{label}: verify: {e}"))))
+        .collect::<PyResult<Vec<_>>>()?;
+    // The status `fricbound verify` reports (its exit code 3 when incomplete).
+    let incomplete = verify::incomplete_reason(
+        cases
+            .iter()
+            .map(|(freq, _, _, v)| (verify::case_name(*freq, None), Some(v))),
+    );
     let out = pyo3::types::PyList::empty(py);
-    for case in cases {
-        let (freq, hbm, hill, v) =
-            case.map_err(|e| SolveError::new_err(format!("{label}: verify: {e}")))?;
+    for (freq, hbm, hill, v) in cases {
         let d = PyDict::new(py);
         d.set_item("freq_hz", freq)?;
         d.set_item("hbm_amplitudes", hbm)?;
@@ -554,7 +562,13 @@ pub fn verify<'py>(
         d.set_item("last_period", v.fine.last_period.clone())?;
         out.append(d)?;
     }
-    Ok(out)
+    let result = PyDict::new(py);
+    result.set_item("cases", out)?;
+    result.set_item(
+        "status",
+        fricbound::report::files::status_text(incomplete.as_deref()),
+    )?;
+    Ok(result)
 }
 
 /// The linear reference of the scene with its contacts `"open"` (removed) or `"stuck"`

@@ -240,8 +240,31 @@ def test_verify_by_time_integration():
     assert c["hbm_difference"] < 1e-3 and c["dt_change"] < 1e-3
     assert c["last_period"].shape == (1, c["steps_per_period"])
     assert list(v.to_pandas().columns[:3]) == ["freq_hz", "y2_hbm_amp", "y2_time_amp"]
+    assert v.status == "complete" and v.complete
     with pytest.raises(ValueError, match="freqs_hz"):
         fricbound.verify(Scene.paper(), [-5.0])
+
+
+def test_verify_status_is_the_cli_status(cli_binary, tmp_path):
+    """A time integration that does not settle within its period budget makes the verify
+    incomplete, with the reason `fricbound verify` gives (its exit code 3); one that settles
+    is complete (exit code 0)."""
+    for freqs, periods, code in (([120.0, 140.0], 2, 3), ([120.0], None, 0)):
+        cli = [str(cli_binary), "verify", "--quiet", "--freqs", ",".join(str(f) for f in freqs),
+               "--out", str(tmp_path / f"v{code}")]
+        if periods is not None:
+            cli += ["--max-periods", str(periods)]
+        done = subprocess.run(cli, capture_output=True, text=True)
+        assert done.returncode == code, done.stderr
+        v = fricbound.verify(Scene.paper(), freqs, max_periods=periods)
+        if code == 0:
+            assert v.status == "complete" and v.complete
+        else:
+            cli_status = [line for line in done.stderr.splitlines() if line.startswith("incomplete: ")]
+            assert [v.status] == cli_status
+            assert v.status == "incomplete: 120 Hz did not settle, 140 Hz did not settle"
+            assert not v.complete
+            assert not any(c["settled"] for c in v.cases)
 
 
 def test_linear_references_equal_the_cli_files(cli_binary, tmp_path):
