@@ -13,6 +13,7 @@ use fricbound::analysis::frf::{self, FrfObserver, FrfPoint};
 use fricbound::analysis::limits::{analyse, LimitSettings};
 use fricbound::analysis::linear::LinearCase;
 use fricbound::analysis::modes::natural_modes;
+use fricbound::analysis::peaks::path_extrema;
 use fricbound::model::Problem;
 use fricbound::numerics::interrupt;
 use fricbound::scene::{self, Scene, SceneError};
@@ -282,10 +283,15 @@ pub fn run<'py>(
     check_memory(label, &problem, 1)?;
     let result = in_background(py, progress.as_ref(), |tx| {
         let mut events = PointEvents { tx, count: 0 };
-        frf::solve(&problem, &mut events)
+        // The refined resonances and anti-resonances within each branch, as `fricbound run`
+        // writes them to peaks.csv.
+        frf::solve(&problem, &mut events).map(|run| {
+            let extrema = path_extrema(&problem, &run.points, &run.branch_starts());
+            (run, extrema)
+        })
     })?;
-    let run = result.map_err(|e| SolveError::new_err(format!("{label}: {e}")))?;
-    convert::frf_dict(py, &problem, &run)
+    let (run, extrema) = result.map_err(|e| SolveError::new_err(format!("{label}: {e}")))?;
+    convert::frf_dict(py, &problem, &run, &extrema)
 }
 
 /// The paper's two-point limit analysis (the scene's `[limits]` table, or the defaults).

@@ -50,6 +50,37 @@ def test_paper_case_equals_the_cli_frf_csv(cli_binary, tmp_path):
     # The error estimate is on by default: one column pair per output, finite and small.
     assert result.trunc_err.shape == (len(result), 1)
     assert np.all(np.isfinite(result.sampling_err))
+    # The largest displacement over the period is frf.csv's <dof>_peak column.
+    np.testing.assert_allclose(result.max_displacement[:, 0], rows["y2_peak"], rtol=1e-9)
+
+
+def test_refined_peaks_equal_the_cli_peaks_csv(cli_binary, tmp_path):
+    """`FrfResult.peaks` holds the refined resonances and anti-resonances the CLI writes to
+    peaks.csv: the same text byte for byte, and columns of the same names and values."""
+    out = tmp_path / "cli"
+    subprocess.run([str(cli_binary), "run", "--quiet", "--out", str(out)], check=True)
+    cli_peaks = (out / "peaks.csv").read_text()
+    result = fricbound.run(Scene.paper())
+    assert result.peaks_csv == cli_peaks
+    rows = list(csv.DictReader(io.StringIO(cli_peaks)))
+    assert list(result.peaks) == cli_peaks.splitlines()[0].split(",")
+    assert len(rows) == len(result.peaks["freq_hz"]) >= 3
+    assert list(result.peaks["kind"]) == [r["kind"] for r in rows]
+    assert list(result.peaks["dof"]) == [r["dof"] for r in rows]
+    np.testing.assert_allclose(result.peaks["freq_hz"], [float(r["freq_hz"]) for r in rows], rtol=1e-9)
+    np.testing.assert_allclose(result.peaks["amplitude"], [float(r["amplitude"]) for r in rows], rtol=1e-9)
+    assert list(result.peaks["refined"]) == [r["refined"] == "true" for r in rows]
+    assert list(result.peaks["path_index"]) == [int(r["path_index"]) for r in rows]
+    assert list(result.peaks["left_state"]) == [r["left_state"] for r in rows]
+    # A refined resonance is at least as high as the path point it was refined from, and it
+    # is not the per-point largest displacement (the renamed array).
+    res = result.resonances("y2")
+    assert len(res["freq_hz"]) >= 1 and res["refined"].all()
+    assert np.all(res["amplitude"] >= res["path_amplitude"] * (1 - 1e-12))
+    assert isinstance(result.peaks, dict) and result.max_displacement.shape == (len(result), 1)
+    assert list(result.peaks_to_pandas().columns) == list(result.peaks)
+    again = pickle.loads(pickle.dumps(result))
+    assert again.peaks_csv == result.peaks_csv
 
 
 def _paper_matrices_scene(path):
