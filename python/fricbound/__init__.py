@@ -45,6 +45,10 @@ from ._scene import MAX_INLINE_DOFS, Scene
 
 __version__ = _native.__version__
 
+# The extension defines SolveError in `_native`, which is not importable under that name:
+# naming its module `fricbound` lets it pickle (a Dask task's error comes back as itself).
+SolveError.__module__ = "fricbound"
+
 __all__ = [
     "Scene",
     "accuracy_study",

@@ -120,6 +120,12 @@ def test_function_arguments_name_themselves():
         fricbound.sweep(scene, 3, [0.3])
     with pytest.raises(TypeError, match=r"accuracy_study: quick: expected a bool, got str"):
         fricbound.accuracy_study(scene, quick="yes")
+    with pytest.raises(ValueError, match=r'map_values: client: expected a dask.distributed.Client, "serial" or None'):
+        fricbound.dask.sweep(scene, "contacts.0.mu", [0.3], client="local")
+    with pytest.raises(TypeError, match=r"map_values: client: expected a dask.distributed.Client"):
+        fricbound.dask.sweep(scene, "contacts.0.mu", [0.3], client=3)
+    with pytest.raises(TypeError, match=r"map_values: values: expected a sequence of numbers, got float"):
+        fricbound.dask.sweep(scene, "contacts.0.mu", 0.3, client="serial")
 
 
 def test_reduce_arguments_name_themselves():
