@@ -18,26 +18,6 @@ use fricbound::scene::SweepSpec;
 use fricbound::study::accuracy::{CurveStudy, SettingErrors, SettingResult, StudyPlan};
 use fricbound::study::sweep::SweepPoint;
 
-/// The name `solution.json` gives a unit enum variant (serde's kebab-case rename), so the dicts
-/// carry the same strings as the files without a second table of names to keep in step.
-fn json_name<T: serde::Serialize>(value: &T) -> PyResult<String> {
-    match serde_json::to_value(value) {
-        Ok(serde_json::Value::String(name)) => Ok(name),
-        Ok(other) => Err(PyRuntimeError::new_err(format!(
-            "expected a unit variant's name, serialised as {other}"
-        ))),
-        Err(e) => Err(PyRuntimeError::new_err(e.to_string())),
-    }
-}
-
-/// A serialisable value as `solution.json` writes it (serde_json), read back by Python's
-/// `json` module: the same keys, names and nulls as the file, with no field-by-field copy to
-/// keep in step.
-fn as_json<'py, T: serde::Serialize>(py: Python<'py>, value: &T) -> PyResult<Bound<'py, PyAny>> {
-    let text = serde_json::to_string(value).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
-    py.import("json")?.call_method1("loads", (text,))
-}
-
 /// The response envelope (`[limits] envelope`): per grid frequency and output DOF the smallest
 /// and largest amplitude over the initial states (m; NaN where no state was solved), the m of
 /// each group attaining them, and the check of the two limit curves against it.
