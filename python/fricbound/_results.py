@@ -323,7 +323,9 @@ class VerifyResult(_Result):
     ``last_period`` (outputs × steps, m). ``status`` is what ``fricbound verify`` reports:
     ``complete``, or ``incomplete: <freq> Hz did not settle, ...`` when a time integration did
     not reach a periodic state within ``max_periods`` (the CLI's exit code 3); a motion that
-    settled away from the HBM point (``stays`` False) is a result, not incomplete."""
+    settled away from the HBM point (``stays`` False) is a result, not incomplete. A frequency
+    whose harmonic balance does not converge raises :class:`fricbound.SolveError` instead
+    (the CLI reports it as ``<freq> Hz failed``)."""
 
     STAY_TOLERANCE = 1e-3
 
