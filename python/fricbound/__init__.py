@@ -15,9 +15,10 @@ Main entry points (units SI, frequencies in Hz):
 - :mod:`fricbound.dask`: independent solves mapped over a Dask cluster.
 
 Errors: bad input raises ``ValueError`` naming the file, the field (dotted path) and the
-reason; a failed solve raises :class:`SolveError`; a problem too large for the machine
-``MemoryError``. Solves release the GIL; Ctrl-C stops them (``KeyboardInterrupt``) within
-about one continuation step.
+reason; an argument of the wrong type ``TypeError`` naming the function and the argument (a
+complex matrix among them: fricbound's matrices are real); a failed solve raises
+:class:`SolveError`; a problem too large for the machine ``MemoryError``. Solves release the
+GIL; Ctrl-C stops them (``KeyboardInterrupt``) within about one continuation step.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
-from . import _native
+from . import _args, _native
 from ._native import SolveError
 from ._results import (
     AccuracyStudy,
@@ -43,6 +44,10 @@ from ._results import (
 from ._scene import MAX_INLINE_DOFS, Scene
 
 __version__ = _native.__version__
+
+# The extension defines SolveError in `_native`, which is not importable under that name:
+# naming its module `fricbound` lets it pickle (a Dask task's error comes back as itself).
+SolveError.__module__ = "fricbound"
 
 __all__ = [
     "Scene",
@@ -72,9 +77,12 @@ __all__ = [
 Progress = Optional[Callable[[dict], Any]]
 
 
-def _scene(scene: "Scene | str") -> Scene:
+def _scene(where: str, scene: "Scene | str") -> Scene:
+    """The ``scene`` argument of ``where``: a :class:`Scene`, or a path or TOML text read by
+    :meth:`Scene.from_toml`."""
     if isinstance(scene, Scene):
         return scene
+    _args.path_or_text(where, "scene", scene)
     return Scene.from_toml(scene)
 
 
@@ -91,7 +99,8 @@ def run(scene: "Scene | str", progress: Progress = None) -> FrfResult:
     ``status = "incomplete: <reason>"`` (``complete`` is False). Raises ``ValueError`` on a bad
     scene, :class:`SolveError` when the solve fails.
     """
-    return FrfResult(_native.run(*_scene(scene)._args(), progress))
+    s = _scene("run", scene)
+    return FrfResult(_native.run(*s._args(), _args.callback("run", "progress", progress)))
 
 
 def limits(scene: "Scene | str", progress: Progress = None) -> LimitsResult:
@@ -102,7 +111,8 @@ def limits(scene: "Scene | str", progress: Progress = None) -> LimitsResult:
     Curves are solved in parallel (rayon). ``progress`` is called with ``{"kind": "curve",
     "name": ..., "status": ...}`` as each curve ends.
     """
-    return LimitsResult(_native.limits(*_scene(scene)._args(), progress))
+    s = _scene("limits", scene)
+    return LimitsResult(_native.limits(*s._args(), _args.callback("limits", "progress", progress)))
 
 
 def sweep(
@@ -125,17 +135,25 @@ def sweep(
     table is run. Values are solved in parallel (rayon). ``progress`` is called with
     ``{"kind": "sweep", "value": ..., "failures": count}`` as each value finishes.
     """
-    s = _scene(scene)
+    s = _scene("sweep", scene)
+    progress = _args.callback("sweep", "progress", progress)
     if field is not None or values is not None:
         if field is None or values is None:
             raise ValueError("sweep: give both field and values (or neither, to run the scene's [sweep])")
+        field = _args.text("sweep", "field", field)
         s = s.copy().set(
             "sweep",
             {
-                "parameter": parameter or field,
-                "unit": unit,
-                "values": [float(v) for v in values],
-                "targets": [{"field": field, "scale": float(scale), "offset": float(offset)}],
+                "parameter": _args.text("sweep", "parameter", parameter) if parameter is not None else field,
+                "unit": _args.text("sweep", "unit", unit),
+                "values": _args.numbers_list("sweep", "values", values),
+                "targets": [
+                    {
+                        "field": field,
+                        "scale": _args.number("sweep", "scale", scale),
+                        "offset": _args.number("sweep", "offset", offset),
+                    }
+                ],
             },
         )
     return SweepResult(_native.sweep(*s._args(), progress))
@@ -154,9 +172,12 @@ def verify(
     dt/2 until periodic. A stable point's motion stays at the HBM amplitude
     (``hbm_difference`` < 1e-3); an unstable one drifts away. Dense models up to 2000 DOFs.
     """
-    s = _scene(scene)
-    cases = _native.verify(*s._args(), [float(f) for f in freqs_hz], steps_per_period, max_periods)
-    return VerifyResult(cases, s.check()["outputs"])
+    s = _scene("verify", scene)
+    freqs = _args.numbers_list("verify", "freqs_hz", freqs_hz)
+    steps = _args.optional_integer("verify", "steps_per_period", steps_per_period, 8)
+    periods = _args.optional_integer("verify", "max_periods", max_periods, 1)
+    result = _native.verify(*s._args(), freqs, steps, periods)
+    return VerifyResult(result["cases"], s.check()["outputs"], result["status"])
 
 
 def accuracy_study(scene: "Scene | str", quick: bool = False, progress: Progress = None) -> AccuracyStudy:
@@ -174,7 +195,11 @@ def accuracy_study(scene: "Scene | str", quick: bool = False, progress: Progress
     :class:`SolveError` when a curve's reference does not solve (no error can be measured
     then); a setting that fails is a row with its ``setting_status``.
     """
-    return AccuracyStudy(_native.accuracy_study(*_scene(scene)._args(), bool(quick), progress))
+    s = _scene("accuracy_study", scene)
+    if not isinstance(quick, (bool, np.bool_)):
+        raise TypeError(f"accuracy_study: quick: expected a bool, got {_args.type_name(quick)}")
+    progress = _args.callback("accuracy_study", "progress", progress)
+    return AccuracyStudy(_native.accuracy_study(*s._args(), bool(quick), progress))
 
 
 def linear(scene: "Scene | str", case: str = "open", points: Optional[int] = None) -> LinearResult:
@@ -182,8 +207,10 @@ def linear(scene: "Scene | str", case: str = "open", points: Optional[int] = Non
     (replaced by their kt, kn springs): first-harmonic amplitude of each output on ``points``
     uniformly spaced frequencies of the analysis range (default ``analysis.linear_points``),
     as the CLI's ``linear_open.csv`` and ``linear_stuck.csv``."""
-    s = _scene(scene)
-    return LinearResult(_native.linear(*s._args(), str(case), points))
+    s = _scene("linear", scene)
+    case = _args.text("linear", "case", case)
+    points = _args.optional_integer("linear", "points", points, 2)
+    return LinearResult(_native.linear(*s._args(), case, points))
 
 
 def modes(scene: "Scene | str", count: int = 10, case: str = "stuck") -> ModesResult:
@@ -191,7 +218,10 @@ def modes(scene: "Scene | str", count: int = 10, case: str = "stuck") -> ModesRe
     structure with its contacts ``"open"`` (removed) or ``"stuck"`` (replaced by their kt, kn
     springs), as ``fricbound modes`` (dense below a few thousand DOFs, shift-invert Lanczos
     above)."""
-    return ModesResult(_native.modes(*_scene(scene)._args(), int(count), str(case)))
+    s = _scene("modes", scene)
+    count = _args.integer("modes", "count", count, 1)
+    case = _args.text("modes", "case", case)
+    return ModesResult(_native.modes(*s._args(), count, case))
 
 
 def reduce(
@@ -207,8 +237,9 @@ def reduce(
     Parameters
     ----------
     K, M : scipy.sparse matrix or array_like, (n, n)
-        Stiffness (N/m) and mass (kg), symmetric with both triangles stored. ``K`` with the
-        boundary DOFs held must be positive definite.
+        Stiffness (N/m) and mass (kg), real (a complex dtype raises ``TypeError``), symmetric
+        with both triangles stored. ``K`` with the boundary DOFs held must be positive
+        definite.
     boundary : sequence of int
         DOF indices kept physical (contacts, loads, outputs), in the order of the reduced
         coordinates.
@@ -217,15 +248,21 @@ def reduce(
     recover : sequence of int, optional
         DOFs whose recovery rows are returned (default: none).
     """
-    n = K.shape[0]
+    K = _args.real_matrix("reduce", "K", K)
+    M = _args.real_matrix("reduce", "M", M)
+    if len(np.shape(K)) != 2 or np.shape(K)[0] != np.shape(K)[1]:
+        raise ValueError(f"reduce: K: expected a square matrix, got shape {np.shape(K)}")
+    n = np.shape(K)[0]
+    k_csc = _csc_arrays("K", K, n)
+    m_csc = _csc_arrays("M", M, n)
     return ReducedModel(
         _native.reduce(
             n,
-            *_csc_arrays("K", K, n),
-            *_csc_arrays("M", M, n),
-            [int(b) for b in boundary],
-            int(modes),
-            [int(r) for r in (recover or [])],
+            *k_csc,
+            *m_csc,
+            _args.indices("reduce", "boundary", boundary),
+            _args.integer("reduce", "modes", modes, 0),
+            _args.indices("reduce", "recover", recover if recover is not None else []),
         )
     )
 
@@ -237,6 +274,8 @@ def _csc_arrays(name: str, a: Any, n: int):
     except ImportError as e:  # pragma: no cover - depends on the environment
         raise ImportError("reduce() needs scipy: pip install scipy") from e
     m = sp.csc_matrix(a)
+    if m.dtype.kind == "c":  # refused before; kept here so no imaginary part is ever dropped
+        raise TypeError(f"reduce: {name}: complex matrix given (dtype {m.dtype}); {_args._REAL_ONLY}")
     if m.shape != (n, n):
         raise ValueError(f"reduce: {name}: shape {m.shape}, expected ({n}, {n})")
     m.sum_duplicates()

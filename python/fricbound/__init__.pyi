@@ -54,7 +54,7 @@ class Scene:
 class ContinuationPath:
     freq_hz: _F
     amplitudes: _F
-    peaks: _F
+    max_displacement: _F
     states: npt.NDArray[np.str_]
     coefficients: _F
     newton_iterations: npt.NDArray[np.int64]
@@ -84,7 +84,12 @@ class FrfResult(ContinuationPath):
     rejected_steps: int
     elapsed_s: float
     csv: str
+    peaks: Dict[str, Any]
+    peaks_csv: str
     def write_csv(self, path: str) -> None: ...
+    def write_peaks_csv(self, path: str) -> None: ...
+    def resonances(self, dof: str) -> Dict[str, Any]: ...
+    def peaks_to_pandas(self) -> Any: ...
 
 class Curve(ContinuationPath):
     name: str
@@ -135,6 +140,9 @@ class VerifyResult:
     STAY_TOLERANCE: float
     cases: List[Dict[str, Any]]
     outputs: List[str]
+    status: str
+    @property
+    def complete(self) -> bool: ...
     def to_pandas(self) -> Any: ...
 
 class AccuracyStudy:

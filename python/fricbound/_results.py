@@ -42,7 +42,9 @@ class ContinuationPath(_Result):
 
     - ``freq_hz`` (n,): excitation frequency (Hz);
     - ``amplitudes`` (n, outputs): first-harmonic amplitude √(c₁² + s₁²) (m);
-    - ``peaks`` (n, outputs): time-domain peak |q(τ)| over the period, static part included (m);
+    - ``max_displacement`` (n, outputs): the largest displacement over the period, max |q(τ)|,
+      static part included (m): the ``<dof>_peak`` column of ``frf.csv`` (called ``peaks``
+      until this release; the refined resonance peaks are :attr:`FrfResult.peaks`);
     - ``states`` (n, contacts) str: ``stuck``, ``stick-slip``, ``stick-slip-liftoff``, ``open``;
     - ``coefficients`` (n, DOFs × blocks): Fourier coefficients (m), harmonic-major: the value
       of DOF ``d`` in block ``b`` (``blocks``: ``0``, ``c1``, ``s1``, ...) is column
@@ -102,7 +104,7 @@ class ContinuationPath(_Result):
 
     def to_pandas(self):
         """A DataFrame with the columns of the CLI's ``frf.csv``: ``freq_hz``,
-        ``<dof>_amp``, ``<dof>_peak`` per output, ``<contact>_state`` per contact,
+        ``<dof>_amp``, ``<dof>_peak`` (:attr:`max_displacement`) per output, ``<contact>_state`` per contact,
         ``newton_iters``, then ``<dof>_trunc_err``, ``<dof>_sampling_err``,
         ``estimate_harmonic``, ``estimate_method`` and ``stable``,
         ``floquet_re``, ``floquet_freq_hz``, ``stability_method``, ``stability_reliable``
@@ -111,7 +113,7 @@ class ContinuationPath(_Result):
         cols: Dict[str, Any] = {"freq_hz": self.freq_hz}
         for k, name in enumerate(self.outputs):
             cols[f"{name}_amp"] = self.amplitudes[:, k]
-            cols[f"{name}_peak"] = self.peaks[:, k]
+            cols[f"{name}_peak"] = self.max_displacement[:, k]
         for k, name in enumerate(self.contacts):
             cols[f"{name}_state"] = self.states[:, k] if len(self) else []
         cols["newton_iters"] = self.newton_iterations
@@ -133,7 +135,7 @@ class ContinuationPath(_Result):
 _PATH_KEYS = (
     "freq_hz",
     "amplitudes",
-    "peaks",
+    "max_displacement",
     "coefficients",
     "states",
     "newton_iterations",
@@ -160,16 +162,47 @@ class FrfResult(ContinuationPath):
       a branch found past the highest frequency reached) is a dict ``from_hz`` (the highest
       frequency before it), ``to_hz`` (the lowest the branch after it reached, followed back
       down) and ``first_point`` (index of that branch's first point);
-    - ``csv``: the run's ``frf.csv`` exactly as the CLI writes it (:meth:`write_csv`).
+    - ``csv``: the run's ``frf.csv`` exactly as the CLI writes it (:meth:`write_csv`);
+    - ``peaks``: the refined resonances and anti-resonances of every output, as the CLI's
+      ``peaks.csv`` (one entry per extremum, ordered by output, then along the path): a dict
+      of columns named as that file's, ``dof``, ``kind`` (``resonance`` or
+      ``anti-resonance``), ``freq_hz`` (Hz) and ``amplitude`` (m) of the refined extremum,
+      ``refined`` (False where the refinement failed or the extremum is a branch's first or
+      last point: the values are then the path point's), ``at_branch_end`` (a resonance
+      standing out only toward a break between branches), ``path_index``, ``path_freq_hz``,
+      ``path_amplitude`` (the path point it was refined from), ``<contact>_state`` per
+      contact; :meth:`peaks_to_pandas` gives it as a DataFrame, :meth:`resonances` the
+      resonances of one output; ``peaks_csv``: that file's text (:meth:`write_peaks_csv`).
     """
 
     def __init__(self, d: Dict[str, Any]):
+        d = dict(d)
+        peaks = dict(d.get("peaks", {}))
+        for key in ["dof", "kind"] + [f"{c}_state" for c in d.get("contacts", [])]:
+            if key in peaks:
+                peaks[key] = np.array(peaks[key], dtype=str)
+        d["peaks"] = peaks
         super().__init__(d, d)
 
     def write_csv(self, path: str) -> None:
         """Writes ``frf.csv`` (the CLI's columns and number format) to ``path``."""
         with open(path, "w", encoding="utf-8") as f:
             f.write(self.csv)
+
+    def write_peaks_csv(self, path: str) -> None:
+        """Writes ``peaks.csv`` (the CLI's columns and number format) to ``path``."""
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(self.peaks_csv)
+
+    def resonances(self, dof: str) -> "Dict[str, np.ndarray]":
+        """The refined resonances (``kind == "resonance"``) of output ``dof``: the columns of
+        :attr:`peaks` cut to their rows."""
+        rows = (self.peaks["kind"] == "resonance") & (self.peaks["dof"] == dof)
+        return {k: np.asarray(v)[rows] for k, v in self.peaks.items()}
+
+    def peaks_to_pandas(self):
+        """:attr:`peaks` as a DataFrame, the columns of the CLI's ``peaks.csv``."""
+        return _pandas().DataFrame(self.peaks)
 
     def __repr__(self) -> str:
         return f"FrfResult({len(self)} points, {self.status})"
@@ -287,15 +320,20 @@ class VerifyResult(_Result):
     ``dt_change``, ``periods``, ``settled``, ``nonharmonic_energy``, ``hill_stable`` and
     ``floquet_re`` (None where Hill's method does not apply), ``stays`` (the motion stays within
     ``STAY_TOLERANCE`` = 1e-3 of the HBM amplitude, as ``fricbound verify`` reports), and
-    ``last_period`` (outputs × steps, m)."""
+    ``last_period`` (outputs × steps, m). ``status`` is what ``fricbound verify`` reports:
+    ``complete``, or ``incomplete: <freq> Hz did not settle, ...`` when a time integration did
+    not reach a periodic state within ``max_periods`` (the CLI's exit code 3); a motion that
+    settled away from the HBM point (``stays`` False) is a result, not incomplete. A frequency
+    whose harmonic balance does not converge raises :class:`fricbound.SolveError` instead
+    (the CLI reports it as ``<freq> Hz failed``)."""
 
     STAY_TOLERANCE = 1e-3
 
-    def __init__(self, cases: List[Dict[str, Any]], outputs: List[str]):
+    def __init__(self, cases: List[Dict[str, Any]], outputs: List[str], status: str):
         for c in cases:
             c["stays"] = bool(c["hbm_difference"] < self.STAY_TOLERANCE)
             c["last_period"] = np.array(c["last_period"])
-        super().__init__({"cases": cases, "outputs": outputs, "status": "complete"})
+        super().__init__({"cases": cases, "outputs": outputs, "status": status})
 
     def to_pandas(self):
         """One row per frequency: ``freq_hz``, ``<dof>_hbm_amp`` and ``<dof>_time_amp`` per

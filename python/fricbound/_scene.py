@@ -9,7 +9,7 @@ from typing import Any, Iterable, Mapping, Optional, Sequence
 
 import numpy as np
 
-from . import _native
+from . import _args, _native
 
 #: Largest model ``Scene.from_matrices`` accepts as scipy.sparse matrices (they are written
 #: inline, dense, into the scene); reduce larger models first (:func:`fricbound.reduce`).
@@ -27,6 +27,8 @@ def _toml_literal(value: Any) -> str:
         return "true" if value else "false"
     if isinstance(value, (int, np.integer)):
         return str(int(value))
+    if isinstance(value, (complex, np.complexfloating)):
+        raise TypeError(f"complex value given ({value}); fricbound needs real numbers")
     if isinstance(value, (float, np.floating)):
         v = float(value)
         if math.isnan(v):
@@ -71,6 +73,7 @@ class Scene:
         Raises ``ValueError`` naming the line and field of a parse error, ``OSError`` when the
         file cannot be read.
         """
+        _args.path_or_text("Scene.from_toml", "path_or_text", path_or_text)
         if isinstance(path_or_text, os.PathLike) or (
             "\n" not in path_or_text and "=" not in path_or_text
         ):
@@ -139,15 +142,25 @@ class Scene:
 
         Raises ``ValueError`` naming the field (``model.mass``, ``contacts[0].mu``, ...) of a
         bad value, as a scene file's errors do, once :meth:`check` or a solve validates it;
-        the schema (field names and types) is checked here.
+        the schema (field names and types) is checked here, and a NaN or infinite number in
+        any argument (``contacts[0].mu: must be a finite number, got nan``). A complex
+        matrix (numpy complex dtype, dense or sparse) raises ``TypeError`` naming ``M``, ``C``
+        or ``K``: the matrices must be real.
         """
+        where = "from_matrices"
+        if isinstance(dofs, (str, bytes)) or not hasattr(dofs, "__iter__"):
+            raise TypeError(f"{where}: dofs: expected a list of DOF names, got {_args.type_name(dofs)}")
+        dofs = [_args.text(where, f"dofs[{i}]", d) for i, d in enumerate(dofs)]
         n = len(dofs)
+        arguments = {"mass": "M", "stiffness": "K", "damping": "C"}
 
         def matrix(name: str, a: Any) -> list:
+            arg = arguments[name]
+            a = _args.real_matrix(where, arg, a)
             if hasattr(a, "toarray"):  # scipy.sparse
                 if a.shape[0] > MAX_INLINE_DOFS:
                     raise ValueError(
-                        f"from_matrices: model.{name}: a sparse matrix of {a.shape[0]} DOFs is too "
+                        f"from_matrices: {arg}: model.{name}: a sparse matrix of {a.shape[0]} DOFs is too "
                         f"large to write inline (at most {MAX_INLINE_DOFS}): reduce it first with "
                         "fricbound.reduce, or export it as Matrix Market files for a scene's "
                         "[model.matrix_market]"
@@ -156,13 +169,13 @@ class Scene:
             arr = np.asarray(a, dtype=float)
             if arr.ndim != 2 or arr.shape != (n, n):
                 raise ValueError(
-                    f"from_matrices: model.{name}: shape {arr.shape}, expected ({n}, {n}) for "
+                    f"from_matrices: {arg}: model.{name}: shape {arr.shape}, expected ({n}, {n}) for "
                     f"{n} DOFs"
                 )
             bad = np.argwhere(~np.isfinite(arr))
             if len(bad):
                 i, j = bad[0]
-                raise ValueError(f"from_matrices: model.{name}[{i}][{j}] is {arr[i, j]}")
+                raise ValueError(f"from_matrices: {arg}: model.{name}[{i}][{j}] is {arr[i, j]}")
             return arr.tolist()
 
         model: dict = {
@@ -172,6 +185,23 @@ class Scene:
         }
         if C is not None:
             model["damping"] = matrix("damping", C)
+        contacts = _args.table_list(where, "contacts", contacts)
+        loads = _args.table_list(where, "loads", loads)
+        if isinstance(freq_range_hz, (str, bytes)) or len(np.shape(freq_range_hz)) != 1 or len(freq_range_hz) != 2:
+            raise TypeError(f"{where}: freq_range_hz: expected (start, end) in Hz, got {freq_range_hz!r}")
+        f_start, f_end = (_args.number(where, f"freq_range_hz[{i}]", f) for i, f in enumerate(freq_range_hz))
+        if outputs is not None:
+            if isinstance(outputs, (str, bytes)) or not hasattr(outputs, "__iter__"):
+                raise TypeError(f"{where}: outputs: expected a list of DOF names, got {_args.type_name(outputs)}")
+            outputs = [_args.text(where, f"outputs[{i}]", o) for i, o in enumerate(outputs)]
+        harmonics = _args.integer(where, "harmonics", harmonics, 1)
+        samples = _args.integer(where, "samples", samples, 1)
+        title = _args.text(where, "title", title)
+        for key, table in (("analysis", analysis), ("effects", effects), ("limits", limits), ("accuracy", accuracy)):
+            if table is not None:
+                if not isinstance(table, Mapping):
+                    raise TypeError(f"{where}: {key}: expected a dict, got {_args.type_name(table)}")
+                _args.scene_values(where, key, table)
         static, harmonic = [], []
         for load in loads:
             (static if "value" in load else harmonic).append(dict(load))
@@ -181,10 +211,10 @@ class Scene:
             "contacts": [dict(c) for c in contacts],
             "static_loads": static,
             "harmonic_loads": harmonic,
-            "harmonics": {"max": int(harmonics), "samples": int(samples)},
+            "harmonics": {"max": harmonics, "samples": samples},
             "analysis": {
-                "freq_start_hz": float(freq_range_hz[0]),
-                "freq_end_hz": float(freq_range_hz[1]),
+                "freq_start_hz": f_start,
+                "freq_end_hz": f_end,
                 **dict(analysis or {}),
             },
             "output": {"dofs": list(outputs) if outputs is not None else list(model["dofs"])},
@@ -208,7 +238,12 @@ class Scene:
         Raises ``ValueError`` naming the override and the reason (unknown field, wrong type);
         the scene is then unchanged.
         """
-        assignment = f"{field}={_toml_literal(value)}"
+        _args.text("Scene.set", "field", field)
+        try:
+            literal = _toml_literal(value)
+        except TypeError as e:
+            raise TypeError(f"Scene.set: {field}: {e}") from None
+        assignment = f"{field}={literal}"
         _native.parse_scene(self._text, self._label, self._overrides + [assignment])
         self._overrides.append(assignment)
         return self

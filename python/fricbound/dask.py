@@ -23,10 +23,12 @@ Matrix Market files, relative to the scene file's absolute path) readable at the
 from __future__ import annotations
 
 import os
+import pickle
 from typing import Any, Callable, Dict, List, Optional, Sequence
 
 import numpy as np
 
+from . import _args
 from . import limits as _limits
 from . import run as _run
 from . import sweep as _sweep
@@ -90,13 +92,42 @@ def limits_row(scene: Scene, field: str, value: float) -> Dict[str, Any]:
     return row
 
 
-def _single_threaded(task: Callable[..., Dict[str, Any]], *args: Any) -> Dict[str, Any]:
-    """Runs a task on a worker. Each worker process runs one case at a time on one core: the
-    library's rayon pool (used by limit analyses and sweeps) is kept to the worker's threads
-    unless ``RAYON_NUM_THREADS`` is already set (it must be set before the first solve of the
+def _single_threaded(task: Callable[..., Dict[str, Any]], *args: Any) -> "tuple[bool, Any]":
+    """Runs a task on a worker: ``(True, row)``, or ``(False, exception)`` when the task
+    raised. The exception is returned, not raised, so that the worker logs nothing and every
+    task ends normally; :func:`map_values` raises it once all tasks are in and the cluster it
+    started is closed. Each worker process runs one case at a time on one core: the library's
+    rayon pool (used by limit analyses and sweeps) is kept to the worker's threads unless
+    ``RAYON_NUM_THREADS`` is already set (it must be set before the first solve of the
     process)."""
     os.environ.setdefault("RAYON_NUM_THREADS", "1")
-    return task(*args)
+    try:
+        return True, task(*args)
+    except Exception as e:  # noqa: BLE001 - every error goes back to the caller
+        try:
+            pickle.loads(pickle.dumps(e))
+        except Exception:  # noqa: BLE001 - an exception that cannot travel is sent as text
+            e = RuntimeError(f"{type(e).__name__}: {e}")
+        return False, e
+
+
+def _gather(client: Any, task: Callable[..., Dict[str, Any]], scene: Scene, field: str, values: List[float]):
+    """Sends one task per value to ``client`` and waits for all of them (each returns its row
+    or its exception, see :func:`_single_threaded`). If the wait is interrupted (Ctrl-C), the
+    tasks not started are cancelled before the exception goes on."""
+    futures = client.map(
+        _single_threaded,
+        [task] * len(values),
+        [scene] * len(values),
+        [field] * len(values),
+        values,
+        pure=False,
+    )
+    try:
+        return client.gather(futures)
+    except BaseException:
+        client.cancel(futures)
+        raise
 
 
 def map_values(
@@ -108,43 +139,47 @@ def map_values(
 ):
     """Maps ``task(scene, field, value)`` over ``values`` on a Dask cluster and gathers the rows
     into a DataFrame in the order of ``values``. ``client``: a ``dask.distributed.Client``;
-    None starts a ``LocalCluster`` (one single-threaded worker process per core) for the
-    call. ``client="serial"`` runs the same tasks in this process, one after the other (the
-    reference the distributed result equals)."""
+    None starts a ``LocalCluster`` (one single-threaded worker process per core, no dashboard)
+    for the call and closes it once every task has ended. ``client="serial"`` runs the same
+    tasks in this process, one after the other (the reference the distributed result equals).
+
+    A task that fails does not stop the others: once all have ended (and the cluster started
+    here is closed), the first failure in the order of ``values`` is raised with its own type
+    (``ValueError``, :class:`fricbound.SolveError`, ...)."""
     import pandas as pd
 
-    if isinstance(scene, str):
+    if isinstance(scene, (str, os.PathLike)):
         scene = Scene.from_toml(scene)
-    values = [float(v) for v in values]
+    elif not isinstance(scene, Scene):
+        raise TypeError(f"map_values: scene: expected a Scene, a path or TOML text, got {type(scene).__name__}")
+    field = _args.text("map_values", "field", field)
+    values = _args.numbers_list("map_values", "values", values)
     if values:
         # A bad field is reported here, naming the override, before any task is sent.
         scene.copy().set(field, values[0])
-    if isinstance(client, str) and client == "serial":
-        rows = [task(scene, field, v) for v in values]
-        return pd.DataFrame(rows)
-    own = None
+    if isinstance(client, str):
+        if client != "serial":
+            raise ValueError(f'map_values: client: expected a dask.distributed.Client, "serial" or None, got {client!r}')
+        return pd.DataFrame([task(scene, field, v) for v in values])
     if client is None:
         from dask.distributed import Client, LocalCluster
 
         workers = os.cpu_count() or 1
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True)
-        own = (cluster, Client(cluster))
-        client = own[1]
-    try:
-        futures = client.map(
-            _single_threaded,
-            [task] * len(values),
-            [scene] * len(values),
-            [field] * len(values),
-            values,
-            pure=False,
+        # Closed in this order on the way out (client, then cluster), after every task ended.
+        with LocalCluster(
+            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster, Client(cluster) as own:
+            outcomes = _gather(own, task, scene, field, values)
+    elif callable(getattr(client, "map", None)) and callable(getattr(client, "gather", None)):
+        outcomes = _gather(client, task, scene, field, values)
+    else:
+        raise TypeError(
+            f'map_values: client: expected a dask.distributed.Client, "serial" or None, got {type(client).__name__}'
         )
-        rows: List[Dict[str, Any]] = client.gather(futures)
-    finally:
-        if own is not None:
-            own[1].close()
-            own[0].close()
-    return pd.DataFrame(rows)
+    for ok, outcome in outcomes:
+        if not ok:
+            raise outcome
+    return pd.DataFrame([row for _, row in outcomes])
 
 
 def sweep(scene: Scene, field: str, values: Sequence[float], client: Any = None):
@@ -168,5 +203,5 @@ def limits_sweep(
     ``output="limits"``: the whole analysis, summarised (:func:`limits_row`). See
     :func:`map_values` for ``client``."""
     if output not in ("peaks", "limits"):
-        raise ValueError(f'limits_sweep: output must be "peaks" or "limits", not {output!r}')
+        raise ValueError(f'limits_sweep: output: must be "peaks" or "limits", got {output!r}')
     return map_values(peaks_row if output == "peaks" else limits_row, scene, field, values, client)

@@ -11,31 +11,12 @@ use fricbound::analysis::frf::{FrfPoint, FrfRun};
 use fricbound::analysis::limits::envelope::{Envelope, EnvelopeBound};
 use fricbound::analysis::limits::{CaseCurve, LimitAnalysis, Peak, Regime};
 use fricbound::analysis::modes::{EigenMethod, NaturalModes};
+use fricbound::analysis::peaks::PathExtremum;
 use fricbound::model::Problem;
 use fricbound::report::files;
 use fricbound::scene::SweepSpec;
 use fricbound::study::accuracy::{CurveStudy, SettingErrors, SettingResult, StudyPlan};
 use fricbound::study::sweep::SweepPoint;
-
-/// The name `solution.json` gives a unit enum variant (serde's kebab-case rename), so the dicts
-/// carry the same strings as the files without a second table of names to keep in step.
-fn json_name<T: serde::Serialize>(value: &T) -> PyResult<String> {
-    match serde_json::to_value(value) {
-        Ok(serde_json::Value::String(name)) => Ok(name),
-        Ok(other) => Err(PyRuntimeError::new_err(format!(
-            "expected a unit variant's name, serialised as {other}"
-        ))),
-        Err(e) => Err(PyRuntimeError::new_err(e.to_string())),
-    }
-}
-
-/// A serialisable value as `solution.json` writes it (serde_json), read back by Python's
-/// `json` module: the same keys, names and nulls as the file, with no field-by-field copy to
-/// keep in step.
-fn as_json<'py, T: serde::Serialize>(py: Python<'py>, value: &T) -> PyResult<Bound<'py, PyAny>> {
-    let text = serde_json::to_string(value).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
-    py.import("json")?.call_method1("loads", (text,))
-}
 
 /// The response envelope (`[limits] envelope`): per grid frequency and output DOF the smallest
 /// and largest amplitude over the initial states (m; NaN where no state was solved), the m of
@@ -149,7 +130,8 @@ pub fn problem_names(d: &Bound<'_, PyDict>, problem: &Problem) -> PyResult<()> {
     Ok(())
 }
 
-/// The per-point arrays of a path: `freq_hz` (n), `amplitudes` and `peaks` (n × outputs),
+/// The per-point arrays of a path: `freq_hz` (n), `amplitudes` and `max_displacement` (the
+/// time-domain peak |q(τ)| over the period, the `<dof>_peak` column of `frf.csv`; n × outputs),
 /// `states` (n lists of contact-state labels), `newton_iterations`, `residual`,
 /// `coefficients` (n × DOFs·blocks, harmonic-major), `trunc_err` and `sampling_err`
 /// (n × outputs, NaN where not estimated), `estimate_harmonic` (n) and `estimate_method` (n
@@ -172,7 +154,10 @@ pub fn points_dict<'py>(py: Python<'py>, points: &[FrfPoint]) -> PyResult<Bound<
         "amplitudes",
         array2(py, n, outputs, per_output(&|p| &p.amplitudes))?,
     )?;
-    d.set_item("peaks", array2(py, n, outputs, per_output(&|p| &p.peaks))?)?;
+    d.set_item(
+        "max_displacement",
+        array2(py, n, outputs, per_output(&|p| &p.peaks))?,
+    )?;
     d.set_item(
         "coefficients",
         array2(py, n, coefs, per_output(&|p| &p.coefficients))?,
@@ -261,14 +246,25 @@ pub fn points_dict<'py>(py: Python<'py>, points: &[FrfPoint]) -> PyResult<Bound<
 
 /// An FRF run: its points ([`points_dict`]), the names ([`problem_names`]), how it ended
 /// (`status`: `complete` or `incomplete: <reason>`, as in `solution.json`), turning points,
-/// jumps, cut steps, wall time, and `csv`: the run's `frf.csv` text as the CLI writes it.
+/// jumps, cut steps, wall time, `csv`: the run's `frf.csv` text as the CLI writes it, and
+/// the refined resonances and anti-resonances ([`peaks_dict`], `peaks_csv`: the CLI's
+/// `peaks.csv`).
 pub fn frf_dict<'py>(
     py: Python<'py>,
     problem: &Problem,
     run: &FrfRun,
+    extrema: &[PathExtremum],
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = points_dict(py, &run.points)?;
     problem_names(&d, problem)?;
+    let outputs: Vec<String> = problem
+        .outputs
+        .iter()
+        .map(|&i| problem.model.dof_names[i].clone())
+        .collect();
+    let contacts: Vec<String> = problem.contacts.iter().map(|c| c.name.clone()).collect();
+    d.set_item("peaks", peaks_dict(py, &outputs, &contacts, extrema)?)?;
+    d.set_item("peaks_csv", files::peaks_csv(&outputs, &contacts, extrema))?;
     d.set_item(
         "status",
         fricbound::report::files::status_text(run.incomplete_reason().as_deref()),
@@ -290,6 +286,53 @@ pub fn frf_dict<'py>(
         csv.push_str(&files::frf_row(p));
     }
     d.set_item("csv", csv)?;
+    Ok(d)
+}
+
+/// The refined resonances and anti-resonances of an FRF run as columns named as `peaks.csv`
+/// ([`files::peaks_header`]): `dof`, `kind`, `freq_hz`, `amplitude`, `refined`,
+/// `at_branch_end`, `path_index`, `path_freq_hz`, `path_amplitude`, `<contact>_state`.
+fn peaks_dict<'py>(
+    py: Python<'py>,
+    outputs: &[String],
+    contacts: &[String],
+    extrema: &[PathExtremum],
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let floats =
+        |f: &dyn Fn(&PathExtremum) -> f64| PyArray1::from_vec(py, extrema.iter().map(f).collect());
+    let flags =
+        |f: &dyn Fn(&PathExtremum) -> bool| PyArray1::from_vec(py, extrema.iter().map(f).collect());
+    d.set_item(
+        "dof",
+        extrema
+            .iter()
+            .map(|e| outputs.get(e.output).cloned().unwrap_or_default())
+            .collect::<Vec<_>>(),
+    )?;
+    d.set_item(
+        "kind",
+        extrema.iter().map(|e| e.kind.label()).collect::<Vec<_>>(),
+    )?;
+    d.set_item("freq_hz", floats(&|e| e.peak.freq_hz))?;
+    d.set_item("amplitude", floats(&|e| e.peak.amplitude))?;
+    d.set_item("refined", flags(&|e| e.peak.refined))?;
+    d.set_item("at_branch_end", flags(&|e| e.at_branch_end))?;
+    d.set_item(
+        "path_index",
+        PyArray1::from_vec(py, extrema.iter().map(|e| e.path_index as i64).collect()),
+    )?;
+    d.set_item("path_freq_hz", floats(&|e| e.path_freq_hz))?;
+    d.set_item("path_amplitude", floats(&|e| e.path_amplitude))?;
+    for (k, c) in contacts.iter().enumerate() {
+        d.set_item(
+            format!("{c}_state"),
+            extrema
+                .iter()
+                .map(|e| e.peak.states.get(k).map_or("", |s| s.label()))
+                .collect::<Vec<_>>(),
+        )?;
+    }
     Ok(d)
 }
 

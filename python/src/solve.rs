@@ -13,6 +13,7 @@ use fricbound::analysis::frf::{self, FrfObserver, FrfPoint};
 use fricbound::analysis::limits::{analyse, LimitSettings};
 use fricbound::analysis::linear::LinearCase;
 use fricbound::analysis::modes::natural_modes;
+use fricbound::analysis::peaks::path_extrema;
 use fricbound::model::Problem;
 use fricbound::numerics::interrupt;
 use fricbound::scene::{self, Scene, SceneError};
@@ -282,10 +283,15 @@ pub fn run<'py>(
     check_memory(label, &problem, 1)?;
     let result = in_background(py, progress.as_ref(), |tx| {
         let mut events = PointEvents { tx, count: 0 };
-        frf::solve(&problem, &mut events)
+        // The refined resonances and anti-resonances within each branch, as `fricbound run`
+        // writes them to peaks.csv.
+        frf::solve(&problem, &mut events).map(|run| {
+            let extrema = path_extrema(&problem, &run.points, &run.branch_starts());
+            (run, extrema)
+        })
     })?;
-    let run = result.map_err(|e| SolveError::new_err(format!("{label}: {e}")))?;
-    convert::frf_dict(py, &problem, &run)
+    let (run, extrema) = result.map_err(|e| SolveError::new_err(format!("{label}: {e}")))?;
+    convert::frf_dict(py, &problem, &run, &extrema)
 }
 
 /// The paper's two-point limit analysis (the scene's `[limits]` table, or the defaults).
@@ -486,7 +492,7 @@ pub fn verify<'py>(
     freqs_hz: Vec<f64>,
     steps_per_period: Option<usize>,
     max_periods: Option<usize>,
-) -> PyResult<Bound<'py, pyo3::types::PyList>> {
+) -> PyResult<Bound<'py, PyDict>> {
     use fricbound::analysis::frf::PointSolver;
     use fricbound::analysis::{linear, stability, verify};
     if let Some(f) = freqs_hz.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
@@ -534,10 +540,18 @@ pub fn verify<'py>(
             })
             .collect::<Vec<Result<_, String>>>()
     })?;
+    let cases = cases
+        .into_iter()
+        .map(|case| case.map_err(|e| SolveError::new_err(format!("{label}: verify: {e}"))))
+        .collect::<PyResult<Vec<_>>>()?;
+    // The status `fricbound verify` reports (its exit code 3 when incomplete).
+    let incomplete = verify::incomplete_reason(
+        cases
+            .iter()
+            .map(|(freq, _, _, v)| (verify::case_name(*freq, None), Some(v))),
+    );
     let out = pyo3::types::PyList::empty(py);
-    for case in cases {
-        let (freq, hbm, hill, v) =
-            case.map_err(|e| SolveError::new_err(format!("{label}: verify: {e}")))?;
+    for (freq, hbm, hill, v) in cases {
         let d = PyDict::new(py);
         d.set_item("freq_hz", freq)?;
         d.set_item("hbm_amplitudes", hbm)?;
@@ -554,7 +568,13 @@ pub fn verify<'py>(
         d.set_item("last_period", v.fine.last_period.clone())?;
         out.append(d)?;
     }
-    Ok(out)
+    let result = PyDict::new(py);
+    result.set_item("cases", out)?;
+    result.set_item(
+        "status",
+        fricbound::report::files::status_text(incomplete.as_deref()),
+    )?;
+    Ok(result)
 }
 
 /// The linear reference of the scene with its contacts `"open"` (removed) or `"stuck"`

@@ -188,3 +188,30 @@ def test_limits_sweep_of_whole_analyses_matches_limits():
         fricbound.dask.limits_sweep(scene, "contacts.0.mu", [0.5], client="serial", output="bands")
     with pytest.raises(ValueError, match="contacts.0.friction"):
         fricbound.dask.sweep(scene, "contacts.0.friction", [0.5], client="serial")
+
+
+@pytest.mark.parametrize("values", [[0.3, 0.5], [0.3, -1.0]])
+def test_dask_sweep_on_its_own_cluster_shuts_down_without_output(capfd, values):
+    """`fricbound.dask.sweep` without a client starts a LocalCluster for the call and closes
+    it: nothing is written to stderr (the workers' included), also when a task fails (μ < 0)
+    while another still solves; the failure is raised with its own type and message once
+    every task has ended."""
+    pytest.importorskip("dask.distributed")
+    scene = Scene.from_toml(PAPER / "zoom-2nd.toml")
+    capfd.readouterr()
+    if values[1] < 0:
+        with pytest.raises(ValueError, match=r"contacts\[0\]\.mu"):
+            fricbound.dask.sweep(scene, "contacts.0.mu", values)
+    else:
+        df = fricbound.dask.sweep(scene, "contacts.0.mu", values)
+        assert list(df["status"]) == ["complete", "complete"]
+    captured = capfd.readouterr()
+    assert captured.err == ""
+
+
+def test_solve_error_pickles_as_itself():
+    """A SolveError raised on a Dask worker comes back as a SolveError."""
+    import pickle
+
+    e = pickle.loads(pickle.dumps(fricbound.SolveError("scene: no solution")))
+    assert type(e) is fricbound.SolveError and str(e) == "scene: no solution"

@@ -50,6 +50,37 @@ def test_paper_case_equals_the_cli_frf_csv(cli_binary, tmp_path):
     # The error estimate is on by default: one column pair per output, finite and small.
     assert result.trunc_err.shape == (len(result), 1)
     assert np.all(np.isfinite(result.sampling_err))
+    # The largest displacement over the period is frf.csv's <dof>_peak column.
+    np.testing.assert_allclose(result.max_displacement[:, 0], rows["y2_peak"], rtol=1e-9)
+
+
+def test_refined_peaks_equal_the_cli_peaks_csv(cli_binary, tmp_path):
+    """`FrfResult.peaks` holds the refined resonances and anti-resonances the CLI writes to
+    peaks.csv: the same text byte for byte, and columns of the same names and values."""
+    out = tmp_path / "cli"
+    subprocess.run([str(cli_binary), "run", "--quiet", "--out", str(out)], check=True)
+    cli_peaks = (out / "peaks.csv").read_text()
+    result = fricbound.run(Scene.paper())
+    assert result.peaks_csv == cli_peaks
+    rows = list(csv.DictReader(io.StringIO(cli_peaks)))
+    assert list(result.peaks) == cli_peaks.splitlines()[0].split(",")
+    assert len(rows) == len(result.peaks["freq_hz"]) >= 3
+    assert list(result.peaks["kind"]) == [r["kind"] for r in rows]
+    assert list(result.peaks["dof"]) == [r["dof"] for r in rows]
+    np.testing.assert_allclose(result.peaks["freq_hz"], [float(r["freq_hz"]) for r in rows], rtol=1e-9)
+    np.testing.assert_allclose(result.peaks["amplitude"], [float(r["amplitude"]) for r in rows], rtol=1e-9)
+    assert list(result.peaks["refined"]) == [r["refined"] == "true" for r in rows]
+    assert list(result.peaks["path_index"]) == [int(r["path_index"]) for r in rows]
+    assert list(result.peaks["left_state"]) == [r["left_state"] for r in rows]
+    # A refined resonance is at least as high as the path point it was refined from, and it
+    # is not the per-point largest displacement (the renamed array).
+    res = result.resonances("y2")
+    assert len(res["freq_hz"]) >= 1 and res["refined"].all()
+    assert np.all(res["amplitude"] >= res["path_amplitude"] * (1 - 1e-12))
+    assert isinstance(result.peaks, dict) and result.max_displacement.shape == (len(result), 1)
+    assert list(result.peaks_to_pandas().columns) == list(result.peaks)
+    again = pickle.loads(pickle.dumps(result))
+    assert again.peaks_csv == result.peaks_csv
 
 
 def _paper_matrices_scene(path):
@@ -240,8 +271,31 @@ def test_verify_by_time_integration():
     assert c["hbm_difference"] < 1e-3 and c["dt_change"] < 1e-3
     assert c["last_period"].shape == (1, c["steps_per_period"])
     assert list(v.to_pandas().columns[:3]) == ["freq_hz", "y2_hbm_amp", "y2_time_amp"]
+    assert v.status == "complete" and v.complete
     with pytest.raises(ValueError, match="freqs_hz"):
         fricbound.verify(Scene.paper(), [-5.0])
+
+
+def test_verify_status_is_the_cli_status(cli_binary, tmp_path):
+    """A time integration that does not settle within its period budget makes the verify
+    incomplete, with the reason `fricbound verify` gives (its exit code 3); one that settles
+    is complete (exit code 0)."""
+    for freqs, periods, code in (([120.0, 140.0], 2, 3), ([120.0], None, 0)):
+        cli = [str(cli_binary), "verify", "--quiet", "--freqs", ",".join(str(f) for f in freqs),
+               "--out", str(tmp_path / f"v{code}")]
+        if periods is not None:
+            cli += ["--max-periods", str(periods)]
+        done = subprocess.run(cli, capture_output=True, text=True)
+        assert done.returncode == code, done.stderr
+        v = fricbound.verify(Scene.paper(), freqs, max_periods=periods)
+        if code == 0:
+            assert v.status == "complete" and v.complete
+        else:
+            cli_status = [line for line in done.stderr.splitlines() if line.startswith("incomplete: ")]
+            assert [v.status] == cli_status
+            assert v.status == "incomplete: 120 Hz did not settle, 140 Hz did not settle"
+            assert not v.complete
+            assert not any(c["settled"] for c in v.cases)
 
 
 def test_linear_references_equal_the_cli_files(cli_binary, tmp_path):

@@ -534,7 +534,6 @@ pub fn run(options: &VerifyOptions) -> Result<VerifyReport, CommandError> {
     text.push_str(
         "freq_hz  m     rel_diff   dt_change  periods settled hill_stable stays agrees monodromy_re hill=monodromy\n",
     );
-    let mut problems = Vec::new();
     for c in &cases {
         csv.push_str(&format!(
             "{},{},{}",
@@ -621,15 +620,6 @@ pub fn run(options: &VerifyOptions) -> Result<VerifyReport, CommandError> {
                 c.error.clone().unwrap_or_default()
             )),
         }
-        let case_name = match c.initial_state {
-            Some(m) => format!("{} Hz (m = {m})", c.freq_hz),
-            None => format!("{} Hz", c.freq_hz),
-        };
-        if c.error.is_some() {
-            problems.push(format!("{case_name} failed"));
-        } else if v.is_some_and(|v| !v.fine.settled) {
-            problems.push(format!("{case_name} did not settle"));
-        }
     }
     write_atomic(&dir.join("verify.csv"), csv.as_bytes())?;
     let json = serde_json::to_string_pretty(&cases).unwrap_or_default();
@@ -637,7 +627,12 @@ pub fn run(options: &VerifyOptions) -> Result<VerifyReport, CommandError> {
     text.push_str(&format!("written to {}\n", dir.display()));
     Ok(VerifyReport {
         text,
-        incomplete: (!problems.is_empty()).then(|| problems.join(", ")),
+        incomplete: verify::incomplete_reason(cases.iter().map(|c| {
+            (
+                verify::case_name(c.freq_hz, c.initial_state),
+                c.verification.as_ref(),
+            )
+        })),
         cases,
     })
 }

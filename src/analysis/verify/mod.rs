@@ -67,3 +67,31 @@ pub(crate) use newmark::Newmark;
 pub use newmark::{MAX_MONODROMY_STEPS, MIN_MONODROMY_STEPS};
 pub use settings::{VerifyError, VerifySettings, MAX_VERIFY_DOFS};
 pub use start::{hbm_state, static_state};
+
+/// How a verified case is named in a status: `<freq> Hz`, or `<freq> Hz (m = <m>)` for a case
+/// started with every contact's initial tangential state set to m.
+pub fn case_name(freq_hz: f64, initial_state: Option<f64>) -> String {
+    match initial_state {
+        Some(m) => format!("{freq_hz} Hz (m = {m})"),
+        None => format!("{freq_hz} Hz"),
+    }
+}
+
+/// Why a set of verified cases is incomplete, as `fricbound verify` reports it (exit code 3):
+/// each case (named by [`case_name`]) that failed (no verification) or whose time integration
+/// did not settle within its period budget, in order, joined by `, `; None when every case
+/// settled. A case that settled away from the HBM point (`hbm_difference` above the stay
+/// tolerance) is a result, not an incomplete run.
+pub fn incomplete_reason<'a>(
+    cases: impl IntoIterator<Item = (String, Option<&'a PointVerification>)>,
+) -> Option<String> {
+    let problems: Vec<String> = cases
+        .into_iter()
+        .filter_map(|(name, v)| match v {
+            None => Some(format!("{name} failed")),
+            Some(v) if !v.fine.settled => Some(format!("{name} did not settle")),
+            Some(_) => None,
+        })
+        .collect();
+    (!problems.is_empty()).then(|| problems.join(", "))
+}
