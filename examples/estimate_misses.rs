@@ -1,6 +1,6 @@
 //! Why the truncation estimate misses the criterion (within a factor 3 of the true
 //! error where that exceeds 1e-3) at a few points of the small generated blade pair (the scene
-//! and comparison of `tests/error_estimate_fe.rs`: 928-936 Hz, 128 samples, H = 1 and H = 3
+//! and comparison of `tests/it/error_estimate_fe.rs`: 928-936 Hz, 128 samples, H = 1 and H = 3
 //! against an H = 11 reference path checked against H = 9).
 //!
 //! For every compared point whose contacts' regimes equal the reference point's and whose

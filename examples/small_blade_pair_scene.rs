@@ -1,4 +1,4 @@
-//! Writes the small generated blade pair of `tests/error_estimate_fe.rs` (2 contact pairs per
+//! Writes the small generated blade pair of `tests/it/error_estimate_fe.rs` (2 contact pairs per
 //! side, 8 interior Craig-Bampton modes; [`common::SmallBladePair`]) into a folder, so that
 //! `fricbound run` can be pointed at it: its mesh `blade-pair-2d-r1-p2.msh` and its scene
 //! `blade-pair.toml`.

@@ -1,5 +1,5 @@
 //! The contact states of the small generated blade pair (2 contact pairs per side, 8 interior
-//! modes, the scene of `tests/error_estimate_fe.rs`) along the upper branch of its resonance
+//! modes, the scene of `tests/it/error_estimate_fe.rs`) along the upper branch of its resonance
 //! near 933.5 Hz, at several harmonic counts and sample counts: why the H = 5 and H = 7 paths
 //! differ there (docs/accuracy.md, "The upper branch of the small blade pair").
 //!

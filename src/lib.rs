@@ -6,7 +6,7 @@
 //!
 //! Data flows scene → problem → harmonic-balance operator → numerics → analyses → reports.
 //! Each layer is a folder and uses only the layers listed before it here (checked by
-//! `tests/architecture.rs`):
+//! `tests/it/architecture.rs`):
 //!
 //! 1. [`numerics`]: linear solves, Newton, pseudo-arc-length continuation ([`numerics::ParametricResidual`]);
 //! 2. [`contact`]: the Jenkins law at a contact point, harmonic sets, the AFT;

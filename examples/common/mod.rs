@@ -1,6 +1,6 @@
-//! Set-ups shared by the examples (`mod common;`): examples cannot use `tests/common`, and
+//! Set-ups shared by the examples (`mod common;`): examples cannot use `tests/it/common`, and
 //! `estimate_misses` and `upper_branch_states` study the same scene (the one of
-//! `tests/error_estimate_fe.rs`). Cargo does not build this folder as an example of its own: it
+//! `tests/it/error_estimate_fe.rs`). Cargo does not build this folder as an example of its own: it
 //! has no `main.rs`.
 //!
 //! | item | what |

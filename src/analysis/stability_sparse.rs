@@ -74,7 +74,7 @@
 //!
 //! # Checks and cost
 //!
-//! `tests/stability_sparse.rs`: on a 12-mass linear chain the 12 exponent pairs are the damped
+//! `tests/it/stability_sparse.rs`: on a 12-mass linear chain the 12 exponent pairs are the damped
 //! eigenvalues of M, C, K to 10⁻⁹ at 8, 17.3 and 30 Hz; on the paper system (H = 3) the leading
 //! exponent, its frequency and the verdict are the dense path's at 13 points of 150-235 Hz,
 //! stuck and stick-slip (to 10⁻⁶ relative; the printed digits agree); above the dense limit (90

@@ -40,7 +40,7 @@
 //! a band of its own). Against the true error across the path the converged across-path
 //! estimate is within 0.91-1.05 of it on the paper case (H = 1, 3; 208 points above 10⁻³) and
 //! 0.78-1.82 on the small blade pair (H = 1, 3; 129 points), formed at every point by the
-//! tests (`tests/error_estimate.rs`, `tests/error_estimate_fe.rs`).
+//! tests (`tests/it/error_estimate.rs`, `tests/it/error_estimate_fe.rs`).
 //!
 //! # Points that already solve the extension
 //!

@@ -86,7 +86,7 @@ pub struct PathPlace<'a> {
 /// The threshold is set from measurements: on the paper case's steep flank below its 2nd
 /// resonance (H = 1, `zoom-2nd.toml`) the slide reaches 21 steps while the fixed-frequency
 /// estimate still tracks the error at a fixed frequency (within the criteria, see
-/// `tests/error_estimate.rs`), so the switch sits above that.
+/// `tests/it/error_estimate.rs`), so the switch sits above that.
 pub struct PathSwitch;
 
 impl PathSwitch {

@@ -37,7 +37,7 @@ use crate::numerics::ParametricResidual;
 /// the larger 2D blade pair at H = 1, the small one at H = 3) against at least 12.2 per
 /// iteration (146 per solve) and 13.8 for the two steps (the larger 2D blade pair at H = 3,
 /// the 3D one at H = 1, the 2D one at H = 11 with H = 23 at 17.9 and H = 47 at 144.7, the
-/// paper case at H = 15 with H = 63 at 14.5: `tests/cli_run.rs` compares that run with
+/// paper case at H = 15 with H = 63 at 14.5: `tests/it/cli_run.rs` compares that run with
 /// `"solve"`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolveBudget {
@@ -209,7 +209,7 @@ impl TailTest {
 /// 37.3 × 8 × 10⁻⁶ = 3 × 10⁻⁴ < 10⁻³/3: it neither warns after widening nor sizes a true error
 /// above 10⁻³ within a factor 3, so the gate changes no outcome of the criteria on what was
 /// measured. A gate at 2.5 % of the threshold did: on the small blade pair
-/// (`tests/error_estimate_fe.rs`) it kept 4 points at H = 1 next to the fold (933.45 Hz) whose
+/// (`tests/it/error_estimate_fe.rs`) it kept 4 points at H = 1 next to the fold (933.45 Hz) whose
 /// 2H + 1 estimates of 1.7-2.3 × 10⁻⁴ are 5-7× below their true errors of 1.1-1.3 × 10⁻³.
 pub struct WidenGate;
 

@@ -28,7 +28,7 @@
 //! I − A most often means a transient slip followed by a state the map barely moves, which
 //! plain periods settle with the derivative of their own history, and restarting such points
 //! by Newton early was measured to break the harmonic-balance Newton on
-//! `tests/friction_2d.rs`'s out-of-plane case at 160.1 Hz)
+//! `tests/it/friction_2d.rs`'s out-of-plane case at 160.1 Hz)
 //! from a safeguarded Newton update of the fixed-point equation Φ(w) = w: the step
 //! (I − A)⁻¹(Φ(w) − w) is tried whole, then halved, until the period started there ends with a
 //! smaller mismatch |Φ(w) − w| (a backtracking line search); when no fraction down to 1/32
@@ -92,7 +92,7 @@
 //! Where the plain re-march of a stuck state does not settle in the budget (it creeps) but the
 //! Newton restarts did, their stuck state is kept, with the slider held in the directions
 //! where I − A is singular: a valid periodic state, though not necessarily the plain
-//! transient's (measured needed at `tests/friction_2d.rs`'s out-of-plane case at 160.1 Hz and
+//! transient's (measured needed at `tests/it/friction_2d.rs`'s out-of-plane case at 160.1 Hz and
 //! at the 3D blade pair's `left-17` at 852.78 Hz, whose plain marches creep). In
 //! between: a slight slip at a few samples per turning point is a genuine slip and takes the
 //! fixed-point derivative, resolved by Newton where I − A is ill-conditioned, and the

@@ -5,7 +5,7 @@
 
 use fricbound::study::accuracy::{self, StudyCurve};
 
-mod common;
+use crate::common;
 use common::blade_pair::reduced_blade_pair_2d;
 
 #[test]

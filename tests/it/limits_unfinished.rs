@@ -3,7 +3,7 @@
 //! limit curves were solved (NaN elsewhere), and `fricbound run` writes and draws what there is,
 //! lists every curve's status in `limits.json` and ends `incomplete: …` with exit code 3.
 
-mod support;
+use crate::support;
 
 use fricbound::analysis::limits::{self, CurveStatus, LimitAnalysis, LimitSettings, Regime};
 use fricbound::cli::EXIT_INCOMPLETE;

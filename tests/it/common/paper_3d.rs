@@ -6,9 +6,15 @@ use fricbound::analysis::frf::{self, FrfPoint, PointSolver, Silent};
 use fricbound::model::{Formulation, HarmonicLoad, Problem};
 
 /// The planar paper scene (Fig. 13, 3rd resonance).
-pub const PLANAR: &str = include_str!("../../meshes/paper-wedge/fig13-3rd.toml");
+pub const PLANAR: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/meshes/paper-wedge/fig13-3rd.toml"
+));
 /// Its 3D version with 2D friction and the out-of-plane motion constrained.
-pub const SPATIAL: &str = include_str!("../../meshes/paper-wedge-3d/fig13-3rd-3d.toml");
+pub const SPATIAL: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/meshes/paper-wedge-3d/fig13-3rd-3d.toml"
+));
 
 /// The planar scene with overrides, its 1D contacts on the event-resolved law like the 3D
 /// scene's `jenkins-2d` ones: the two scenes agree to round-off only on the same time

@@ -2,7 +2,7 @@
 //! meshes, rigid-body modes, mass totals, cantilever deflection and frequencies against beam
 //! theory, clamping and bad input.
 
-mod fe_support;
+use crate::fe_support;
 
 use fe_support::{box_mesh, hz, lowest_eigenvalues, solve, Family};
 use fricbound::fe::assembly::{assemble, AssemblyError, FeModel, GroupMaterial};

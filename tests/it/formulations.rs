@@ -11,7 +11,7 @@ use fricbound::model::{Formulation, HarmonicLoad, JacobianStrategy, Problem};
 use fricbound::numerics::derivatives::check_operator_jacobian;
 use fricbound::numerics::jacobian::Storage;
 
-mod common;
+use crate::common;
 use common::points::assert_same_point;
 use common::scenes::{paper, problem};
 

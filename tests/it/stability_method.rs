@@ -10,7 +10,7 @@
 //! to keep the file fast; its exponents there are within 10 % of those at 1 280 steps on these
 //! points (README).
 
-mod support;
+use crate::support;
 
 use std::path::Path;
 

@@ -15,7 +15,7 @@ use fricbound::analysis::verify::{self, VerifySettings};
 use fricbound::model::matrix::StructuralMatrix;
 use fricbound::model::Problem;
 
-mod common;
+use crate::common;
 use common::linear::damped_eigenvalues;
 use common::scenes::{load, paper};
 

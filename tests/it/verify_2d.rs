@@ -16,7 +16,7 @@ use fricbound::contact::harmonic::HarmonicSet;
 use fricbound::contact::ContactState;
 use fricbound::model::{HarmonicLoad, Problem};
 
-mod common;
+use crate::common;
 use common::{planar, problem, IN_PLANE, SPATIAL};
 
 /// The HBM point at `freq_hz` from the stuck linear guess: (harmonic set, coefficients,

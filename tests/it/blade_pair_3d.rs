@@ -8,7 +8,7 @@
 //! 852.78 Hz. The tests of the path at single contact transitions were measured on the sampled
 //! laws and run on them (`SAMPLED`).
 
-mod support;
+use crate::support;
 
 use std::path::Path;
 

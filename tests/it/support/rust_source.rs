@@ -1,4 +1,4 @@
-//! Lexical helpers of `tests/architecture.rs`: Rust source without comments and literals,
+//! Lexical helpers of `tests/it/architecture.rs`: Rust source without comments and literals,
 //! without its test modules, and as a stream of path tokens.
 
 /// Source text without comments, string and character literals (replaced by spaces).

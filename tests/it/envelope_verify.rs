@@ -51,7 +51,7 @@ fn settled_states_from_random_initial_sliders_lie_inside_the_envelope() {
 }
 
 /// The README's table: more frequencies and states (about a minute in release; run with
-/// `cargo test --release --test envelope_verify -- --ignored --nocapture`). A state that does
+/// `cargo test --release --test it -- envelope_verify:: --ignored --nocapture`). A state that does
 /// not settle within the period budget is reported and not judged; every settled one must lie
 /// inside the envelope.
 #[test]

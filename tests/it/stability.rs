@@ -5,7 +5,7 @@
 //! suit are refused naming the field. The linear check (exponents = damped eigenvalues) is a
 //! unit test of `analysis::stability`.
 
-mod support;
+use crate::support;
 
 use std::path::Path;
 

@@ -11,7 +11,7 @@
 //! truncation estimate cannot size is computed, not listed: those the estimate reports as not
 //! sizeable, and those where a contact's regime differs from the reference point's.
 
-mod common;
+use crate::common;
 
 use fricbound::analysis::error_estimate::{ErrorEstimator, EstimateMethod, EstimateProblems};
 use fricbound::analysis::frf::{self, Silent};

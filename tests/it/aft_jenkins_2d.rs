@@ -828,7 +828,7 @@ mod events {
 
     /// Cost of one point's evaluation with each law (forces alone and with the Jacobian), in
     /// the stuck, partial-slip, rotating-slip and lift-off regimes at H = 3 and 128 samples:
-    /// `cargo test --release --test aft_jenkins_2d cost -- --ignored --nocapture`.
+    /// `cargo test --release --test it -- aft_jenkins_2d::events::cost --ignored --nocapture`.
     #[test]
     #[ignore]
     fn cost_per_evaluation() {

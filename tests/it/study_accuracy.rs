@@ -2,7 +2,7 @@
 //! (a narrowed range, so that the whole study takes seconds): files, rows and the ordering of
 //! the errors along the harmonic ladder.
 
-mod support;
+use crate::support;
 
 use support::{csv, fricbound, scene, text};
 

@@ -14,7 +14,7 @@ use fricbound::numerics::derivatives::check_operator_jacobian;
 use fricbound::numerics::jacobian::Storage;
 use fricbound::scene;
 
-mod common;
+use crate::common;
 use common::blade_pair::coarse_blade_pair;
 use common::{
     assert_formulations_agree, compare_on_planar_path, excited_out_of_plane, planar, problem,
@@ -232,7 +232,7 @@ fn inconsistent_2d_frames_and_states_are_refused() {
         "contacts[0].law",
         "needs a 3D point",
     );
-    // The envelope searches the disc of a 2D side's m (tests/envelope_2d.rs).
+    // The envelope searches the disc of a 2D side's m (tests/it/envelope_2d.rs).
     let with_envelope = problem(&format!("{SPATIAL}\nenvelope = \"sides\"\n"), &[]);
     assert_eq!(with_envelope.contacts.len(), 2);
     // A given t₂ opposite to the default gives the same solution up to the sign of z.

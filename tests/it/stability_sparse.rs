@@ -18,7 +18,7 @@ use fricbound::model::Problem;
 use fricbound::scene;
 use fricbound::study::jacobian::chain_scene;
 
-mod common;
+use crate::common;
 use common::linear::damped_eigenvalues;
 use common::scenes::{paper, problem};
 

@@ -2,7 +2,7 @@
 //! refined resonances and anti-resonances of an FRF run (`peaks.csv`, `peaks` in
 //! `solution.json`) against a linear FRF computed here from the scene's matrices.
 
-mod support;
+use crate::support;
 
 use support::{csv, json, run_scene, scene, text};
 
@@ -75,7 +75,7 @@ fn run_writes_all_results() {
     }
     let json = json(&out.join("solution.json"));
     assert_eq!(json["status"], "complete");
-    // H = 1 is about 10 % off near this resonance (tests/error_estimate.rs): solution.json
+    // H = 1 is about 10 % off near this resonance (tests/it/error_estimate.rs): solution.json
     // has it, and a run that is not quiet says so on stderr (a quiet one writes nothing there).
     let largest = json["accuracy"]["max_trunc_err"][0].as_f64().unwrap();
     assert!(largest > 0.05, "{largest}");
@@ -198,7 +198,10 @@ fn failed_continuation_keeps_finished_points_and_exits_nonzero() {
 /// direction: its normal load is the constant kn·1e-4 = 10 N. With μ = 0 it transmits nothing
 /// (the structure alone); with μ = 100 (slip force 1000 N, far above kt times any amplitude
 /// reached) it stays stuck and adds kt = 10⁵ N/m to x1. Either way the response is linear.
-const TWO_DOF: &str = include_str!("data/two-dof-grounded.toml");
+const TWO_DOF: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/tests/data/two-dof-grounded.toml"
+));
 
 /// First-harmonic amplitudes |X1|, |X2| of (K − ω²M + iωC) X = (1, 0) for the two-DOF scene
 /// with `k11` on x1's diagonal, at `f` Hz (Cramer's rule on the 2 × 2 complex system).
@@ -560,11 +563,11 @@ const COMMANDS_NOT_RUN: &[(&str, &str)] = &[
     ("cargo test", "the test suite itself"),
     (
         "paper --quick",
-        "tests/paper.rs runs it and checks what it writes",
+        "tests/it/paper.rs runs it and checks what it writes",
     ),
     (
         "paper",
-        "the full study takes minutes; tests/paper.rs runs `paper --quick`",
+        "the full study takes minutes; tests/it/paper.rs runs `paper --quick`",
     ),
     ("bench scaling", "the scaling study takes minutes"),
 ];

@@ -17,7 +17,7 @@ use fricbound::contact::ContactState;
 use fricbound::model::{HarmonicLoad, Problem};
 use fricbound::scene;
 
-mod common;
+use crate::common;
 use common::blade_pair::coarse_blade_pair;
 use common::envelope::{as_seeds, limit_states, LimitState};
 use common::{planar, problem, PLANAR, SPATIAL};

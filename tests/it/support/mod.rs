@@ -1,5 +1,5 @@
-//! Shared helpers of the tests that run the `fricbound` binary (`tests/cli_run.rs`,
-//! `tests/outputs.rs`): running it, naming the paper scenes, reading what it wrote.
+//! Shared helpers of the tests that run the `fricbound` binary (`tests/it/cli_run.rs`,
+//! `tests/it/outputs.rs`): running it, naming the paper scenes, reading what it wrote.
 // Not every test file uses every helper.
 #![allow(dead_code)]
 

@@ -3,7 +3,7 @@
 //! to ground, the reduced blade pair with 2 pairs per side): files, one row per case and
 //! formulation, Jacobians that match differences, and `auto`'s choice marked.
 
-mod support;
+use crate::support;
 
 use support::{csv, fricbound, scene, text};
 

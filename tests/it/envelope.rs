@@ -3,8 +3,8 @@
 //! amplitudes in every contact regime, and the optimised envelope against a dense scan of
 //! m per side on the paper case (`meshes/paper-wedge/fig13-3rd.toml`).
 
-mod common;
-mod support;
+use crate::common;
+use crate::support;
 
 use common::envelope::limit_seeds;
 use common::scenes::load;

@@ -12,7 +12,7 @@ use fricbound::hbm::statics::{static_point_2d, static_solve, StaticSystem};
 use fricbound::hbm::{check_jacobian, HbmSystem};
 use fricbound::model::{Formulation, Problem};
 
-mod common;
+use crate::common;
 use common::{
     assert_formulations_agree, compare_on_planar_path, excited_out_of_plane, planar, problem,
     IN_PLANE, OUT_OF_PLANE, OUT_OF_PLANE_RUN, SPATIAL,

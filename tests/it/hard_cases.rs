@@ -7,9 +7,6 @@
 //! linear response with all contacts stuck (closed form, `analysis::linear`), whatever the
 //! frame angles, gap, harmonics or pre-load.
 
-mod common;
-mod support;
-
 use fricbound::analysis::frf::{self, FrfPoint, FrfRun, Silent};
 use fricbound::analysis::limits;
 use fricbound::analysis::linear::{self, LinearCase};

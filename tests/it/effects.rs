@@ -6,7 +6,7 @@ use fricbound::analysis::limits::{self, LimitCase};
 use fricbound::hbm::{check_jacobian, HbmSystem};
 use fricbound::model::Problem;
 
-mod common;
+use crate::common;
 use common::scenes;
 
 fn paper(overrides: &[&str]) -> Problem {

@@ -5,7 +5,7 @@
 //! anything is written; `fricbound check` prints that estimate without listing thousands of
 //! harmonics.
 
-mod support;
+use crate::support;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -197,7 +197,7 @@ fn a_failed_run_leaves_no_results_of_an_earlier_run() {
     assert_all_owned(&out);
     std::fs::write(out.join("notes.txt"), "mine").unwrap();
 
-    // The stall of tests/cli_run.rs: fails after some converged points.
+    // The stall of tests/it/cli_run.rs: fails after some converged points.
     let o = run_scene(
         &scene("zoom-2nd.toml"),
         &out,

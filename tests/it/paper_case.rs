@@ -7,7 +7,7 @@ use fricbound::contact::ContactState;
 use fricbound::hbm::{check_jacobian, HbmSystem};
 use fricbound::model::Problem;
 
-mod common;
+use crate::common;
 use common::scenes::paper;
 
 /// The paper structure with the damper also grounded (so that it is not a free body when

@@ -1,4 +1,4 @@
-//! Helpers shared by the test crates (`mod common;`), one job per file:
+//! Helpers shared by the test modules (`use crate::common;`), one job per file:
 //!
 //! | module | what |
 //! |---|---|
@@ -9,7 +9,7 @@
 //! | [`points`] | solved points compared: coefficients to 1e-8 of their largest, contact states |
 //! | [`blade_pair`] | the generated blade pairs of the FE tests: the reduced 2D one with 2 pairs per side, the coarse 2D or 3D one with fields added to its patches |
 //!
-//! Each test crate uses a part of it.
+//! Each test module uses a part of it.
 #![allow(dead_code)]
 
 pub mod blade_pair;
