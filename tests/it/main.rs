@@ -4,7 +4,8 @@
 //! stays a binary of its own: its stop request is process-wide and would stop the runs of
 //! the tests here. Helpers shared by several modules: [`support`] (running the binary,
 //! reading what it wrote), [`common`] (scenes, references and comparisons) and
-//! [`fe_support`] (FE test meshes).
+//! [`fe_support`] (FE test meshes). Proptest keeps the failing cases it found, which every run
+//! tries first, in `tests/proptest-regressions/<module>.txt`.
 
 mod common;
 mod fe_support;
