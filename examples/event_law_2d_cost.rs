@@ -22,12 +22,13 @@ fn coefficients(h: usize, ua: f64, v0: f64, va: f64) -> [Vec<f64>; 3] {
         2.0 * seed - 1.0
     };
     x[2][0] = v0;
-    for j in 0..nb {
+    let [u1, u2, v] = &mut x;
+    for (j, ((p, q), r)) in u1.iter_mut().zip(u2.iter_mut()).zip(v).enumerate() {
         let decay = 1.0 / (1 + j.saturating_sub(1) / 2) as f64;
-        x[0][j] = ua * next() * decay;
-        x[1][j] = ua * next() * decay;
+        *p = ua * next() * decay;
+        *q = ua * next() * decay;
         if j > 0 {
-            x[2][j] = va * next() * decay;
+            *r = va * next() * decay;
         }
     }
     x
