@@ -152,10 +152,15 @@ impl Aft2dWorkspace {
         } else {
             u0
         };
+        s.buffers.resize(&march.columns);
         initial_derivative(law, march, limit0 > 0.0, &mut s.start_derivative);
-        // The first period carries the period map's columns alone: the coefficients' columns
-        // of its end are needed only where the Newton settles, without a step, at a stuck
-        // period (the first period is then marched again with them).
+        s.buffers.dw.copy_from_slice(&s.start_derivative);
+        let first = march.run(&mut s.buffers, self.initial_slider, None)?;
+        if !(first.slipped || first.opened) {
+            let start = Start::History(x_part(&s.start_derivative, march));
+            return Ok((start, self.initial_slider, 1));
+        }
+        let after_first = x_part(&s.buffers.dw, march);
         let small = PeriodMarch {
             columns: Columns {
                 count: 2,
@@ -164,13 +169,6 @@ impl Aft2dWorkspace {
             ..*march
         };
         s.buffers.resize(&small.columns);
-        s.buffers.dw.copy_from_slice(&[1.0, 0.0, 0.0, 1.0]);
-        let first = small.run(&mut s.buffers, self.initial_slider, None)?;
-        if !(first.slipped || first.opened) {
-            s.buffers.resize(&march.columns);
-            let start = Start::History(x_part(&s.start_derivative, march));
-            return Ok((start, self.initial_slider, 1));
-        }
         let settled = self.newton(&small, s, first.w)?;
         s.buffers.resize(&march.columns);
         match settled {
@@ -179,11 +177,7 @@ impl Aft2dWorkspace {
                 w,
                 periods,
                 used_newton: false,
-            } => {
-                s.buffers.dw.copy_from_slice(&s.start_derivative);
-                march.run(&mut s.buffers, self.initial_slider, None)?;
-                Ok((Start::History(x_part(&s.buffers.dw, march)), w, periods))
-            }
+            } => Ok((Start::History(after_first), w, periods)),
             Settled::Stuck { .. } => self.plain(march, s),
         }
     }

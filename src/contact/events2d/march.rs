@@ -22,15 +22,6 @@ const GL_W: [f64; 4] = [
     0.101_228_536_290_376_3,
 ];
 
-/// The 4-point rule (exact for degree 7), for steps short against the integrand's
-/// variation (h ω ≤ [`SHORT_STEP`]: relative error below 10⁻¹⁴ there).
-const GL4_X: [f64; 2] = [0.339_981_043_584_856_3, 0.861_136_311_594_052_6];
-const GL4_W: [f64; 2] = [0.652_145_154_862_546_1, 0.347_854_845_137_453_9];
-
-/// Largest h ω (step times the integrand's highest angular rate) integrated by the 4-point
-/// rule.
-const SHORT_STEP: f64 = 0.25;
-
 /// Below this fraction of the point's largest friction limit a slip that is about to open
 /// ends: the angle's ODE stiffens like 1/L there, and the force left to integrate is of the
 /// order of this fraction squared.
@@ -528,7 +519,6 @@ impl PeriodMarch<'_> {
         dopri.start(&mut rhs, t0, y);
         let mut t = t0;
         let mut first = true;
-        let mut k = self.path.at(t0);
         if buf.h_guess <= 0.0 {
             buf.h_guess = 0.1 * cell;
         }
@@ -537,6 +527,7 @@ impl PeriodMarch<'_> {
             if remaining <= h_min {
                 return Ok((t_stop, stop_exit));
             }
+            let k = self.path.at(t);
             let limit = self.law.limit(&k);
             let closing_in = limit[1] < 0.0;
             if stop_exit.is_some()
@@ -606,7 +597,6 @@ impl PeriodMarch<'_> {
             }
             buf.y.copy_from_slice(&buf.dopri.y_new);
             t = t1;
-            k = kb;
             if t >= t_stop {
                 return Ok((t_stop, stop_exit));
             }
@@ -651,15 +641,7 @@ impl PeriodMarch<'_> {
     fn quadrature(&self, buf: &mut Buffers, r: &mut Record, a: f64, b: f64) {
         if b > a {
             let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
-            // The integrand's rate: the harmonics of b_j and L, and the angle's mean rate.
-            let turn = (buf.dopri.dense(0, b) - buf.dopri.dense(0, a)).abs();
-            let omega = 2.0 * self.path.top_harmonic() as f64 + 2.0 * turn / (b - a);
-            let (xs, ws): (&[f64], &[f64]) = if (b - a) * omega <= SHORT_STEP {
-                (&GL4_X, &GL4_W)
-            } else {
-                (&GL_X, &GL_W)
-            };
-            for (x, &wq) in xs.iter().zip(ws) {
+            for (x, wq) in GL_X.iter().zip(GL_W) {
                 for tau in [mid - half * x, mid + half * x] {
                     let Buffers { dopri, dense, .. } = buf;
                     dopri.dense_all(tau, dense);

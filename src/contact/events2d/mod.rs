@@ -69,11 +69,6 @@ pub struct Path2<'a> {
 }
 
 impl Path2<'_> {
-    /// The highest harmonic of the blocks.
-    pub fn top_harmonic(&self) -> usize {
-        self.blocks.iter().map(|b| b.harmonic()).max().unwrap_or(0)
-    }
-
     /// u₁, u₂, v and their derivatives at τ.
     pub fn at(&self, tau: f64) -> Kinematics2 {
         let mut k = Kinematics2::default();
