@@ -21,7 +21,7 @@ pub(super) fn crossing(
             return Some(brent(value, a, b, fa, fb));
         }
         if first || fa <= zero {
-            return Some(rising_root(&value, a, b, fb));
+            return Some(rising_root(&value, a, b, fb, dfa));
         }
         return Some(a);
     }
@@ -32,14 +32,19 @@ pub(super) fn crossing(
             if fa < -zero {
                 return Some(brent(value, a, peak, fa, f_peak));
             }
-            return Some(rising_root(&value, a, peak, f_peak));
+            return Some(rising_root(&value, a, peak, f_peak, dfa));
         }
     }
     None
 }
 
-/// The first rise of f through zero in (a, b] where f(a) ≈ 0 and f(b) > 0.
-fn rising_root(f: &impl Fn(f64) -> f64, a: f64, b: f64, fb: f64) -> f64 {
+/// The first rise of f through zero in (a, b] where f(a) ≈ 0 (rate `dfa`) and f(b) > 0.
+///
+/// Where f falls at a (dfa < 0) but is already positive at the first subdivision, the dip
+/// below zero is shorter than a subdivision (a trial force that barely lags the friction
+/// limit at a closing, say): it is found by halving towards a, rather than taking a itself
+/// as the root (which would end the phase where it starts, and the next phase there too).
+fn rising_root(f: &impl Fn(f64) -> f64, a: f64, b: f64, fb: f64, dfa: f64) -> f64 {
     const SUBDIVISIONS: usize = 16;
     let mut negative: Option<(f64, f64)> = None;
     for i in 1..=SUBDIVISIONS {
@@ -50,7 +55,7 @@ fn rising_root(f: &impl Fn(f64) -> f64, a: f64, b: f64, fb: f64) -> f64 {
         };
         let ft = if i == SUBDIVISIONS { fb } else { f(t) };
         if ft > 0.0 {
-            return match negative {
+            return match negative.or_else(|| dip(f, a, t, dfa)) {
                 Some((tn, fneg)) => brent(f, tn, t, fneg, ft),
                 None => a,
             };
@@ -60,4 +65,24 @@ fn rising_root(f: &impl Fn(f64) -> f64, a: f64, b: f64, fb: f64) -> f64 {
         }
     }
     b
+}
+
+/// A point of (a, t) where f < 0, found by halving t − a, when f falls at a (dfa < 0).
+fn dip(f: &impl Fn(f64) -> f64, a: f64, t: f64, dfa: f64) -> Option<(f64, f64)> {
+    if dfa >= 0.0 {
+        return None;
+    }
+    let mut step = t - a;
+    for _ in 0..60 {
+        step *= 0.5;
+        let tk = a + step;
+        if tk <= a {
+            break;
+        }
+        let fk = f(tk);
+        if fk < 0.0 {
+            return Some((tk, fk));
+        }
+    }
+    None
 }
