@@ -194,6 +194,36 @@ fn jacobian_error(
     (max_err / max_entry, state)
 }
 
+/// Inputs that guarantee slip: u(0) − u(π) = 2(c₁ + c₃) ≥ 2(5e-4 − 1e-4 − 0.5e-4) = 7e-4, so
+/// kₜ times the tangential travel (70) exceeds the width of the Coulomb band,
+/// 2μN ≤ 2 · 1e5 · (1e-4 + 3e-5 · 11/3) = 42.
+fn stick_slip_inputs(seed: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let (mut u, v) = coefficients(seed, 1e-4, 1e-4, 3e-5);
+    u[1] += 5e-4;
+    (u, v)
+}
+
+/// Slip, and a normal oscillation larger than the mean plus all other harmonics (by
+/// `normal_extra` on the second harmonic's cosine): with 1e-4 the contact separates for part
+/// of the period whatever the random coefficients.
+fn liftoff_inputs(seed: &[f64], normal_extra: f64) -> (Vec<f64>, Vec<f64>) {
+    let (mut u, mut v) = coefficients(seed, 1e-4, 2e-5, 2e-5);
+    u[1] += 2e-4;
+    v[2] += normal_extra;
+    (u, v)
+}
+
+/// Mean normal gap `touch` times the normal amplitude: the contact just touches or just
+/// separates once per period.
+fn grazing_inputs(seed: &[f64], touch: f64) -> (Vec<f64>, Vec<f64>) {
+    let mut u: Vec<f64> = seed.iter().take(7).map(|x| 1e-5 * x).collect();
+    let mut v = vec![0.0; 7];
+    v[1] = 3e-5;
+    v[0] = 3e-5 * touch;
+    u[1] += 1e-4;
+    (u, v)
+}
+
 /// Random coefficients for harmonics 0..3: u with amplitude `ua`, v with mean `v0` and
 /// oscillation amplitude `va`.
 fn coefficients(seed: &[f64], ua: f64, v0: f64, va: f64) -> (Vec<f64>, Vec<f64>) {
@@ -243,11 +273,7 @@ proptest! {
 
     #[test]
     fn jacobian_stick_slip((s, m, mu) in regime_strategy(), constant in any::<bool>()) {
-        let (mut u, v) = coefficients(&s, 1e-4, 1e-4, 3e-5);
-        // Guarantee slip: u(0) − u(π) = 2(c₁ + c₃) ≥ 2(5e-4 − 1e-4 − 0.5e-4) = 7e-4, so kₜ
-        // times the tangential travel (70) exceeds the width of the Coulomb band, 2μN ≤
-        // 2 · 1e5 · (1e-4 + 3e-5 · 11/3) = 42.
-        u[1] += 5e-4;
+        let (u, v) = stick_slip_inputs(&s);
         let (err, state) = jacobian_error(law(1e5, 1e5, mu, m), effects(constant, true), &u, &v);
         prop_assert_eq!(state, ContactState::StickSlip);
         prop_assert!(err < 1e-6, "relative error {}", err);
@@ -255,11 +281,7 @@ proptest! {
 
     #[test]
     fn jacobian_stick_slip_liftoff((s, m, mu) in regime_strategy()) {
-        let (mut u, mut v) = coefficients(&s, 1e-4, 2e-5, 2e-5);
-        u[1] += 2e-4;
-        // Normal oscillation larger than the mean plus all other harmonics: the contact
-        // separates for part of the period whatever the random coefficients.
-        v[2] += 1e-4;
+        let (u, v) = liftoff_inputs(&s, 1e-4);
         let (err, state) = jacobian_error(law(1e5, 1e5, mu, m), effects(false, true), &u, &v);
         prop_assert_eq!(state, ContactState::StickSlipLiftoff);
         prop_assert!(err < 1e-6, "relative error {}", err);
@@ -289,21 +311,14 @@ proptest! {
             .map(|k| (touch + (std::f64::consts::TAU * k as f64 / GRAZING_SAMPLES as f64).cos()).abs())
             .fold(f64::INFINITY, f64::min);
         prop_assume!(closest > 1e-5);
-        let mut u = vec![0.0; 7];
-        let mut v = vec![0.0; 7];
-        v[1] = 3e-5;
-        v[0] = 3e-5 * touch;
-        for j in 0..7 { u[j] = 1e-5 * s[j]; }
-        u[1] += 1e-4;
+        let (u, v) = grazing_inputs(&s, touch);
         let (err, _) = jacobian_error(law(1e5, 1e5, mu, m), effects(false, true), &u, &v);
         prop_assert!(err < 1e-6, "relative error {}", err);
     }
 
     #[test]
     fn jacobian_without_liftoff((s, m, mu) in regime_strategy()) {
-        let (mut u, mut v) = coefficients(&s, 1e-4, 2e-5, 2e-5);
-        u[1] += 2e-4;
-        v[2] += 4e-5;
+        let (u, v) = liftoff_inputs(&s, 4e-5);
         let (err, _) = jacobian_error(law(1e5, 1e5, mu, m), effects(false, false), &u, &v);
         prop_assert!(err < 1e-6, "relative error {}", err);
     }
@@ -427,8 +442,7 @@ proptest! {
 
     #[test]
     fn event_jacobian_stick_slip((s, m, mu) in regime_strategy(), constant in any::<bool>()) {
-        let (mut u, v) = coefficients(&s, 1e-4, 1e-4, 3e-5);
-        u[1] += 5e-4;
+        let (u, v) = stick_slip_inputs(&s);
         let (err, state) = event_jacobian_error(law(1e5, 1e5, mu, m), effects(constant, true), &u, &v);
         prop_assert_eq!(state, ContactState::StickSlip);
         prop_assert!(err < 1e-6, "relative error {}", err);
@@ -436,9 +450,7 @@ proptest! {
 
     #[test]
     fn event_jacobian_stick_slip_liftoff((s, m, mu) in regime_strategy()) {
-        let (mut u, mut v) = coefficients(&s, 1e-4, 2e-5, 2e-5);
-        u[1] += 2e-4;
-        v[2] += 1e-4;
+        let (u, v) = liftoff_inputs(&s, 1e-4);
         let (err, state) = event_jacobian_error(law(1e5, 1e5, mu, m), effects(false, true), &u, &v);
         prop_assert_eq!(state, ContactState::StickSlipLiftoff);
         prop_assert!(err < 1e-6, "relative error {}", err);
@@ -458,21 +470,14 @@ proptest! {
     fn event_jacobian_grazing((s, m, mu) in regime_strategy(), touch in 0.97..1.03f64) {
         // The contact just touches or just separates once per period: no input is excluded,
         // the closing instant being located, not sampled.
-        let mut u = vec![0.0; 7];
-        let mut v = vec![0.0; 7];
-        v[1] = 3e-5;
-        v[0] = 3e-5 * touch;
-        for j in 0..7 { u[j] = 1e-5 * s[j]; }
-        u[1] += 1e-4;
+        let (u, v) = grazing_inputs(&s, touch);
         let (err, _) = event_jacobian_error(law(1e5, 1e5, mu, m), effects(false, true), &u, &v);
         prop_assert!(err < 1e-5, "relative error {}", err);
     }
 
     #[test]
     fn event_jacobian_without_liftoff((s, m, mu) in regime_strategy()) {
-        let (mut u, mut v) = coefficients(&s, 1e-4, 2e-5, 2e-5);
-        u[1] += 2e-4;
-        v[2] += 4e-5;
+        let (u, v) = liftoff_inputs(&s, 4e-5);
         let (err, _) = event_jacobian_error(law(1e5, 1e5, mu, m), effects(false, false), &u, &v);
         prop_assert!(err < 1e-6, "relative error {}", err);
     }
@@ -482,9 +487,7 @@ proptest! {
         // Both laws on the same stick-slip-liftoff input: the sampled law's error falls like
         // 1/N (each transition snapped to the grid), so at 8 192 samples the two agree to a
         // few 1e-4 of the force scale.
-        let (mut u, mut v) = coefficients(&s, 1e-4, 2e-5, 2e-5);
-        u[1] += 2e-4;
-        v[2] += 1e-4;
+        let (u, v) = liftoff_inputs(&s, 1e-4);
         let l = law(1e5, 1e5, mu, m);
         let set = HarmonicSet::up_to(3);
         let mut events = AftWorkspace::new(&set, 64);
