@@ -1,14 +1,11 @@
 //! Resonance peaks and anti-resonances along a solved path: which local maxima (minima) of an
 //! output's amplitude are resonances (anti-resonances), and where exactly each one is.
 //!
-//! The AFT samples the contact law, so the amplitude along a path carries small wiggles (about
-//! 10⁻⁴ relative where a contact transition moves across a sample): a plain "local maximum"
-//! test finds many near one resonance, and a golden-section search alone can stop on a wiggle
-//! below a higher point of the same bracket. Here a local maximum counts as a peak only when it
-//! stands out of its surroundings by at least [`MIN_PROMINENCE`] of its amplitude (its
-//! prominence: the drop to the higher of the lowest points between it and a higher point on
-//! either side), and the refinement first scans the bracket, then searches around the best
-//! point found, and returns the highest point solved.
+//! With the event-resolved contact laws the amplitude along a path is smooth, so every interior
+//! local maximum of it is a resonance peak (a sampled law, `jenkins-1d-sampled`, leaves wiggles
+//! of about 10⁻⁴ where a transition crosses a sample, and each is then listed: they are local
+//! maxima of what that law computes). The refinement first scans the bracket, then searches
+//! around the best point found, and returns the highest point solved.
 //!
 //! Anti-resonances are the same question for the amplitude with its sign flipped: one routine
 //! ([`extremum_indices`], [`refine_extremum_at`]) serves both kinds ([`ExtremumKind`]), and
@@ -20,8 +17,9 @@ use crate::contact::ContactState;
 use crate::model::Problem;
 use crate::numerics::golden;
 
-/// Smallest prominence of a peak, relative to its amplitude: local maxima that stand out less
-/// are wiggles of the sampled contact law (about 10⁻⁴) or numerical noise.
+/// Smallest prominence, relative to its amplitude, of a resonance that stands out only toward
+/// a break between branches ([`branch_end_peak_indices`]): one that stands out less is the
+/// junction with the branch that carries the response on.
 pub const MIN_PROMINENCE: f64 = 1e-3;
 
 /// Scan points per chord of the bracket before the search (the bracket is two chords).
@@ -89,36 +87,19 @@ impl ExtremumKind {
 }
 
 /// Indices of the extrema of kind `kind` of output `output` along `points` (path order):
-/// interior local maxima of `kind.sign()` × amplitude whose prominence is at least
-/// [`MIN_PROMINENCE`] of their amplitude. Of a run of equal values, the first counts.
+/// interior local maxima of `kind.sign()` × amplitude. Of a run of equal values, the first
+/// counts.
 pub fn extremum_indices(points: &[FrfPoint], output: usize, kind: ExtremumKind) -> Vec<usize> {
     let sign = kind.sign();
     let amp: Vec<f64> = points.iter().map(|p| sign * p.amplitudes[output]).collect();
     let n = amp.len();
     (1..n.saturating_sub(1))
         .filter(|&i| amp[i] > amp[i - 1] && amp[i] >= amp[i + 1])
-        .filter(|&i| {
-            // The lowest point on each side before a higher one (or the end).
-            let base = |range: &mut dyn Iterator<Item = usize>| {
-                let mut low = amp[i];
-                for j in range {
-                    if amp[j] > amp[i] {
-                        break;
-                    }
-                    low = low.min(amp[j]);
-                }
-                low
-            };
-            let left = base(&mut (0..i).rev());
-            let right = base(&mut (i + 1..n));
-            amp[i] - left.max(right) >= MIN_PROMINENCE * amp[i].abs()
-        })
         .collect()
 }
 
 /// Indices of the resonance peaks of output `output` along `points` (path order): interior
-/// local maxima whose prominence is at least [`MIN_PROMINENCE`] of their amplitude
-/// ([`extremum_indices`] for [`ExtremumKind::Resonance`]).
+/// local maxima ([`extremum_indices`] for [`ExtremumKind::Resonance`]).
 pub fn peak_indices(points: &[FrfPoint], output: usize) -> Vec<usize> {
     extremum_indices(points, output, ExtremumKind::Resonance)
 }

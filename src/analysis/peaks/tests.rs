@@ -75,10 +75,10 @@ fn point(freq_hz: f64, amplitude: f64) -> FrfPoint {
     }
 }
 
-/// A maximum and a minimum that stand out are found, with their kinds; wiggles of 10⁻⁴
-/// (the sampled law's) and the ends of the path are not extrema.
+/// Every interior local maximum and minimum is found, with its kind, small ones (wiggles of
+/// 10⁻⁴, as a sampled law leaves) included; the ends of the path are not extrema.
 #[test]
-fn extrema_are_told_from_wiggles() {
+fn every_interior_extremum_is_found_wiggles_included() {
     let amps = [
         1.0, 2.0, 3.0, 2.0, 1.0, 0.5, 1.0, 1.0001, 1.00005, 1.0002, 1.5, 0.9999, 0.99995, 0.9,
     ];
@@ -89,12 +89,12 @@ fn extrema_are_told_from_wiggles() {
         .collect();
     assert_eq!(
         extremum_indices(&points, 0, ExtremumKind::Resonance),
-        vec![2, 10]
+        vec![2, 7, 10, 12]
     );
-    assert_eq!(peak_indices(&points, 0), vec![2, 10]);
+    assert_eq!(peak_indices(&points, 0), vec![2, 7, 10, 12]);
     assert_eq!(
         extremum_indices(&points, 0, ExtremumKind::AntiResonance),
-        vec![5]
+        vec![5, 8, 11]
     );
 }
 
@@ -220,12 +220,12 @@ fn a_branch_rising_to_its_end_has_a_peak_there() {
     assert!(branch_end_peak_indices(&points, 0, &[]).is_empty());
 }
 
-/// The layout of the 3D blade pair's bridge: a branch whose highest point is its second,
-/// its first only 3·10⁻⁴ lower (less than the prominence), is reported at that second
-/// point; the same points as one branch, or with the rise at the path's own last point,
-/// are not.
+/// A branch whose highest point is its second, its first only 3·10⁻⁴ lower: an interior
+/// local maximum of the branch, so a resonance of its own and not one at a branch end; the
+/// same points as one branch, or with the rise at the path's own last point, have no
+/// resonance at a branch end either.
 #[test]
-fn a_maximum_next_to_a_branch_start_is_reported() {
+fn a_maximum_next_to_a_branch_start_is_an_ordinary_peak() {
     let mut points = path(&[
         (0.0, 1.0),
         (1.0, 2.0),
@@ -238,8 +238,12 @@ fn a_maximum_next_to_a_branch_start_is_reported() {
         (7.0, 1.5),
         (8.0, 1.0),
     ]);
-    assert_eq!(branch_end_peak_indices(&points, 0, &[5]), vec![6]);
-    assert!(extremum_indices(&points[5..], 0, ExtremumKind::Resonance).is_empty());
+    assert_eq!(
+        extremum_indices(&points[5..], 0, ExtremumKind::Resonance),
+        vec![1]
+    );
+    assert_eq!(peak_indices(&points, 0), vec![2, 6]);
+    assert!(branch_end_peak_indices(&points, 0, &[5]).is_empty());
     assert!(branch_end_peak_indices(&points, 0, &[]).is_empty());
     // A higher point of the first branch within its reach takes it over.
     points[2].amplitudes[0] = 3.0;
