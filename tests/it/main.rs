@@ -5,7 +5,8 @@
 //! the tests here. Helpers shared by several modules: [`support`] (running the binary,
 //! reading what it wrote), [`common`] (scenes, references and comparisons) and
 //! [`fe_support`] (FE test meshes). Proptest keeps the failing cases it found, which every run
-//! tries first, in `tests/proptest-regressions/<module>.txt`.
+//! tries first, in `tests/proptest-regressions/`, a file per source file (`<module>.txt`, or
+//! `<module>/<file>.txt` for a module in a folder).
 
 mod common;
 mod fe_support;
