@@ -17,12 +17,10 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-#[path = "support/rust_source.rs"]
-mod rust_source;
-use rust_source::{code_only, declared_for_tests, tokens, without_test_modules, Token};
-
-#[path = "support/doc_links.rs"]
-mod doc_links;
+use crate::support::doc_links;
+use crate::support::rust_source::{
+    code_only, declared_for_tests, tokens, without_test_modules, Token,
+};
 
 /// Top-level modules of `src/`, lowest layer first. A module may use the ones before it.
 const LAYERS: &[&str] = &[

@@ -497,6 +497,16 @@ fn a_wider_set_beyond_the_step_budget_is_not_stepped_on() {
     assert_eq!(json["accuracy"]["unsolved_points"].as_u64(), Some(flagged));
 }
 
+/// The pages written for users: README.md and the guide's chapters (`docs/src/*.md`; not the
+/// contributors' pages in `docs/src/dev/`), of the pages the link check reads.
+fn user_pages() -> Vec<std::path::PathBuf> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    support::doc_links::documentation_files(root)
+        .into_iter()
+        .filter(|p| *p == root.join("README.md") || p.parent() == Some(&root.join("docs/src")))
+        .collect()
+}
+
 /// The scene files a user meets: every `.toml` scene shipped under `meshes/` and `tests/data/`,
 /// and every complete scene (one with a `[model]` or `[mesh]` table) in a `toml` block of
 /// README.md or the guide (`docs/src`), written to a temporary file.
@@ -514,14 +524,7 @@ fn shipped_and_shown_scenes(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
             }
         }
     }
-    let mut pages = vec![root.join("README.md")];
-    for entry in std::fs::read_dir(root.join("docs/src")).unwrap() {
-        let path = entry.unwrap().path();
-        if path.extension().is_some_and(|e| e == "md") {
-            pages.push(path);
-        }
-    }
-    for page in pages {
+    for page in user_pages() {
         let text = std::fs::read_to_string(&page).unwrap();
         for (i, block) in text.split("```toml\n").skip(1).enumerate() {
             let block = block.split("```").next().unwrap();
@@ -560,7 +563,6 @@ fn every_shipped_or_shown_scene_passes_check() {
 
 /// Commands of README.md and the guide that this test does not run, with the reason.
 const COMMANDS_NOT_RUN: &[(&str, &str)] = &[
-    ("cargo test", "the test suite itself"),
     (
         "paper --quick",
         "tests/it/paper.rs runs it and checks what it writes",
@@ -598,33 +600,23 @@ fn shell_words(line: &str) -> Vec<String> {
     words
 }
 
-/// The fricbound commands in the `sh` blocks of README.md and the guide: the arguments after
+/// The fricbound commands in the `sh` blocks of README.md and the guide (other commands, such
+/// as `cargo test`, are not fricbound's): the arguments after
 /// `fricbound` or `cargo run --release --`, and the exit code the text gives (3 where its
 /// comment says "exits 3", else 0). Lines with placeholders (`scene.toml`, `SCENE`, `DIR`,
 /// `[--…]`, `F=V`) are templates, not commands.
 fn documented_commands() -> Vec<(String, Vec<String>, i32)> {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut pages = vec![root.join("README.md")];
-    let mut guide: Vec<_> = std::fs::read_dir(root.join("docs/src"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "md"))
-        .collect();
-    guide.sort();
-    pages.extend(guide);
     let mut commands = Vec::new();
-    for page in pages {
+    for page in user_pages() {
         let text = std::fs::read_to_string(&page).unwrap();
         for block in text.split("```sh\n").skip(1) {
             for line in block.split("```").next().unwrap().lines() {
                 let (command, comment) = line.split_once(" #").unwrap_or((line, ""));
-                let args = match command.trim() {
-                    c if c.starts_with("fricbound ") => &c["fricbound ".len()..],
-                    c if c.starts_with("cargo run --release -- ") => {
-                        &c["cargo run --release -- ".len()..]
-                    }
-                    c if c.starts_with("cargo ") => c,
-                    _ => continue,
+                let Some(args) = ["fricbound ", "cargo run --release -- "]
+                    .iter()
+                    .find_map(|prefix| command.trim().strip_prefix(prefix))
+                else {
+                    continue;
                 };
                 let template = ["scene.toml", "SCENE", "DIR", "[--", "F=V"];
                 if template.iter().any(|t| args.contains(t)) {

@@ -3,6 +3,9 @@
 // Not every test file uses every helper.
 #![allow(dead_code)]
 
+pub mod doc_links;
+pub mod rust_source;
+
 use std::path::Path;
 use std::process::{Command, Output};
 
