@@ -11,7 +11,7 @@
 //! | [`aft`] | `AftWorkspace`, `MarchSettings`, `AftError` | the alternating frequency/time march of the Jenkins law (paper Eqs. 4-6) and its analytic Jacobian |
 //! | [`aft2d`] | `Aft2dWorkspace` | the isotropic 2D Jenkins element in a contact's tangent plane: its sampled march (radial return onto the friction circle, `jenkins-2d-sampled`) and the event-resolved evaluation (`jenkins-2d`, [`events2d`]), each with its analytic Jacobian through the periodic steady state |
 //! | [`events`] | `EventSolver`, `march::periodic_orbit` | the event-resolved Jenkins law: stick, slip, opening and closing located in continuous time, forces integrated exactly between them (a C¹ residual), and its analytic Jacobian |
-//! | [`events2d`] | `march::PeriodMarch`, `dopri::Dopri` | the event-resolved 2D Jenkins law: one period of stick, slip (the slip angle's ODE by Dormand–Prince 5(4) with dense output and forward sensitivities), opening and closing located in continuous time; the periodic state and the outputs are `Aft2dWorkspace::evaluate_events` |
+//! | [`events2d`] | `march::PeriodMarch`, `dopri::Dopri` | the event-resolved 2D Jenkins law: one period of stick, slip (the slip angle's ODE by Dormand–Prince 8(5,3) with dense output and forward sensitivities), opening and closing located in continuous time; the periodic state and the outputs are `Aft2dWorkspace::evaluate_events` |
 //! | [`describing_function`] | [`jenkins_describing_function`] | the exact first harmonic under constant normal load (paper Eqs. 17-18), the AFT's reference |
 
 pub mod aft;

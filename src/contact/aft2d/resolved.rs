@@ -152,15 +152,10 @@ impl Aft2dWorkspace {
         } else {
             u0
         };
-        s.buffers.resize(&march.columns);
         initial_derivative(law, march, limit0 > 0.0, &mut s.start_derivative);
-        s.buffers.dw.copy_from_slice(&s.start_derivative);
-        let first = march.run(&mut s.buffers, self.initial_slider, None)?;
-        if !(first.slipped || first.opened) {
-            let start = Start::History(x_part(&s.start_derivative, march));
-            return Ok((start, self.initial_slider, 1));
-        }
-        let after_first = x_part(&s.buffers.dw, march);
+        // The periods before the final one carry only the two columns of A = ∂Φ/∂w: the
+        // first period's coefficient columns are needed only when the march then rests stuck
+        // (the history's derivative), and are marched again for that case alone.
         let small = PeriodMarch {
             columns: Columns {
                 count: 2,
@@ -169,6 +164,13 @@ impl Aft2dWorkspace {
             ..*march
         };
         s.buffers.resize(&small.columns);
+        s.buffers.dw.iter_mut().for_each(|x| *x = 0.0);
+        let first = small.run(&mut s.buffers, self.initial_slider, None)?;
+        if !(first.slipped || first.opened) {
+            s.buffers.resize(&march.columns);
+            let start = Start::History(x_part(&s.start_derivative, march));
+            return Ok((start, self.initial_slider, 1));
+        }
         let settled = self.newton(&small, s, first.w)?;
         s.buffers.resize(&march.columns);
         match settled {
@@ -177,7 +179,11 @@ impl Aft2dWorkspace {
                 w,
                 periods,
                 used_newton: false,
-            } => Ok((Start::History(after_first), w, periods)),
+            } => {
+                s.buffers.dw.copy_from_slice(&s.start_derivative);
+                march.run(&mut s.buffers, self.initial_slider, None)?;
+                Ok((Start::History(x_part(&s.buffers.dw, march)), w, periods))
+            }
             Settled::Stuck { .. } => self.plain(march, s),
         }
     }

@@ -183,6 +183,8 @@ impl PeriodMarch<'_> {
         mut record: Option<&mut Record>,
     ) -> Result<PeriodEnd, MarchFailure> {
         let end = 2.0 * PI;
+        // Each period's steps depend on its own start only (not on an earlier evaluation).
+        buf.h_guess = 0.0;
         let mut phase = self.start_phase(buf, w_start);
         let mut t = 0.0;
         let mut events = 0;
@@ -305,8 +307,7 @@ impl PeriodMarch<'_> {
 
     /// θ = angle of T = kₜ(u − w) at τ and S = kₜ e⊥·(du − dw)/|T| into `buf.y`.
     fn start_slip(&self, buf: &mut Buffers, tau: f64, w: [f64; 2]) {
-        let k = self.path.at(tau);
-        self.path.basis(tau, &mut buf.b, &mut buf.db);
+        let k = self.path.at_with_basis(tau, &mut buf.b, &mut buf.db);
         let kt = self.law.kt;
         let t = [kt * (k.u[0][0] - w[0]), kt * (k.u[1][0] - w[1])];
         let magnitude = t[0].hypot(t[1]).max(f64::MIN_POSITIVE);
@@ -326,8 +327,7 @@ impl PeriodMarch<'_> {
     /// The slider w = u − L e(θ)/kₜ at the end of a slip at τ (θ, S in `buf.y`), with its
     /// derivative dw = du − (dL e + L e⊥ S)/kₜ into `buf.dw`.
     fn slip_slider(&self, buf: &mut Buffers, tau: f64) -> [f64; 2] {
-        let k = self.path.at(tau);
-        self.path.basis(tau, &mut buf.b, &mut buf.db);
+        let k = self.path.at_with_basis(tau, &mut buf.b, &mut buf.db);
         let l = self.law.limit(&k)[0].max(0.0);
         let kt = self.law.kt;
         let (s, co) = buf.y[0].sin_cos();
@@ -351,8 +351,7 @@ impl PeriodMarch<'_> {
 
     /// The slider of an open contact, w = u(τ), with dw = du(τ) into `buf.dw`.
     fn open_slider(&self, buf: &mut Buffers, tau: f64) -> [f64; 2] {
-        let k = self.path.at(tau);
-        self.path.basis(tau, &mut buf.b, &mut buf.db);
+        let k = self.path.at_with_basis(tau, &mut buf.b, &mut buf.db);
         let c = self.columns.count;
         buf.dw.iter_mut().for_each(|x| *x = 0.0);
         for a in 0..2 {
@@ -522,12 +521,12 @@ impl PeriodMarch<'_> {
         if buf.h_guess <= 0.0 {
             buf.h_guess = 0.1 * cell;
         }
+        let mut k = self.path.at(t);
         loop {
             let remaining = t_stop - t;
             if remaining <= h_min {
                 return Ok((t_stop, stop_exit));
             }
-            let k = self.path.at(t);
             let limit = self.law.limit(&k);
             let closing_in = limit[1] < 0.0;
             if stop_exit.is_some()
@@ -561,7 +560,7 @@ impl PeriodMarch<'_> {
                 return Err(MarchFailure::TooManyEvents);
             }
             let factor = if error > 0.0 {
-                0.9 * (ODE_TOLERANCE / error).powf(0.2)
+                0.9 * (ODE_TOLERANCE / error).powf(0.125)
             } else {
                 5.0
             };
@@ -571,10 +570,13 @@ impl PeriodMarch<'_> {
             }
             let fa = self.exit(Exit::StickOnset, [0.0; 2], y[0], &k);
             let zero = self.zero_level(Exit::StickOnset, [0.0; 2], &k);
-            dopri.accept(t, y, h);
             let t1 = t + h;
             let kb = self.path.at(t1);
             let fb = self.exit(Exit::StickOnset, [0.0; 2], dopri.y_new[0], &kb);
+            // The dense output serves the force quadrature and a possible end of the slip in
+            // the step (a sign change or a graze of the exit function, as `crossing` tests).
+            let dense = record.is_some() || fb.0 > zero || (fa.1 > 0.0 && fb.1 < 0.0);
+            dopri.accept(&mut rhs, t, y, h, dense);
             let g = |tau: f64| {
                 self.exit(
                     Exit::StickOnset,
@@ -597,6 +599,7 @@ impl PeriodMarch<'_> {
             }
             buf.y.copy_from_slice(&buf.dopri.y_new);
             t = t1;
+            k = kb;
             if t >= t_stop {
                 return Ok((t_stop, stop_exit));
             }
@@ -605,13 +608,17 @@ impl PeriodMarch<'_> {
 
     /// The slip angle's rate θ′ = kₜ (u′·e⊥)/L and its sensitivities' rates (module doc).
     fn slip_rate(&self, tau: f64, y: &[f64], dy: &mut [f64], b: &mut [f64], db: &mut [f64]) {
-        let k = self.path.at(tau);
-        let l = self.law.limit(&k)[0];
+        let (up, v) = if self.columns.full() {
+            self.path.slip_inputs(tau, Some((&mut *b, &mut *db)))
+        } else {
+            self.path.slip_inputs(tau, None)
+        };
+        let l = self.law.constant_limit.unwrap_or(self.law.mu_kn * v);
         let kt = self.law.kt;
         let (s, c) = y[0].sin_cos();
-        let up = [k.u[0][1], k.u[1][1]];
         if l <= OPENING_LIMIT_FRACTION * self.limit_scale {
             // At a closing that slips at once: θ follows the direction of u′.
+            let k = self.path.at(tau);
             let speed2 = up[0] * up[0] + up[1] * up[1];
             dy.iter_mut().for_each(|x| *x = 0.0);
             if speed2 > 0.0 {
@@ -626,7 +633,6 @@ impl PeriodMarch<'_> {
             *d = damping * x;
         }
         if self.columns.full() {
-            self.path.basis(tau, b, db);
             let out = &mut dy[1..];
             self.columns.add_du(0, -kt * s / l, db, out);
             self.columns.add_du(1, kt * c / l, db, out);
@@ -678,9 +684,8 @@ impl PeriodMarch<'_> {
 
     /// One quadrature node at τ with weight `weight`, θ and S in `buf.dense`.
     fn slip_node(&self, buf: &mut Buffers, r: &mut Record, tau: f64, weight: f64) {
-        let k = self.path.at(tau);
+        let k = self.path.at_with_basis(tau, &mut buf.b, &mut buf.db);
         let l = self.law.limit(&k)[0].max(0.0);
-        self.path.basis(tau, &mut buf.b, &mut buf.db);
         let (s, c) = buf.dense[0].sin_cos();
         let e = [c, s];
         let ep = [-s, c];

@@ -15,7 +15,7 @@
 //! | open | T = 0 | v rises through 0 | stick, w = u (or slip at once when kₜ\|u′\| > L′) |
 //!
 //! In slip the e⊥ component of T′ = kₜ(u′ − λ e) gives the angle's ODE
-//! θ′ = kₜ (u′·e⊥)/L, e⊥ = (−sin θ, cos θ), integrated by Dormand–Prince 5(4) ([`dopri`]) to
+//! θ′ = kₜ (u′·e⊥)/L, e⊥ = (−sin θ, cos θ), integrated by Dormand–Prince 8(5,3) ([`dopri`]) to
 //! [`ODE_TOLERANCE`] with steps no longer than a cell of the bracketing grid (the samples);
 //! its dense output locates the slip's end (Brent on the exit function) and carries the
 //! Gauss–Legendre quadrature of the force harmonics over each step. Stick pieces are
@@ -71,96 +71,116 @@ pub struct Path2<'a> {
 impl Path2<'_> {
     /// u₁, u₂, v and their derivatives at τ.
     pub fn at(&self, tau: f64) -> Kinematics2 {
-        let mut k = Kinematics2::default();
-        let table = Harmonics::at(self.blocks, tau);
-        for (j, block) in self.blocks.iter().enumerate() {
-            let (b0, b1, b2) = table.derivatives(*block, tau);
-            let [u0, u1] = &mut k.u;
-            for (out, coef) in [
-                (u0, self.u[0][j]),
-                (u1, self.u[1][j]),
-                (&mut k.v, self.v[j]),
-            ] {
-                out[0] += coef * b0;
-                out[1] += coef * b1;
-                out[2] += coef * b2;
+        self.kinematics(tau, None)
+    }
+
+    /// u₁, u₂, v and their derivatives at τ, with the basis b_i(τ) and its rate b_i′(τ)
+    /// (as [`Self::basis`]) from the same table of harmonics.
+    pub fn at_with_basis(&self, tau: f64, b: &mut [f64], db: &mut [f64]) -> Kinematics2 {
+        self.kinematics(tau, Some((b, db)))
+    }
+
+    fn kinematics(&self, tau: f64, mut basis: Option<(&mut [f64], &mut [f64])>) -> Kinematics2 {
+        let mut table = Harmonics::at(tau);
+        let (mut u0, mut u1, mut v) = ([0.0; 3], [0.0; 3], [0.0; 3]);
+        let coefficients = self.u[0].iter().zip(self.u[1]).zip(self.v);
+        for (j, (block, ((&c0, &c1), &cv))) in self.blocks.iter().zip(coefficients).enumerate() {
+            let (b0, b1, b2) = table.derivatives(*block);
+            if let Some((b, db)) = basis.as_mut() {
+                b[j] = b0;
+                db[j] = b1;
             }
+            u0 = [u0[0] + c0 * b0, u0[1] + c0 * b1, u0[2] + c0 * b2];
+            u1 = [u1[0] + c1 * b0, u1[1] + c1 * b1, u1[2] + c1 * b2];
+            v = [v[0] + cv * b0, v[1] + cv * b1, v[2] + cv * b2];
         }
-        k
+        Kinematics2 { u: [u0, u1], v }
+    }
+
+    /// u₁′, u₂′ and v at τ alone (what the slip angle's rate needs), with the basis and its
+    /// rate when `basis` is given.
+    pub fn slip_inputs(
+        &self,
+        tau: f64,
+        mut basis: Option<(&mut [f64], &mut [f64])>,
+    ) -> ([f64; 2], f64) {
+        let mut table = Harmonics::at(tau);
+        let (mut du, mut v) = ([0.0; 2], 0.0);
+        let coefficients = self.u[0].iter().zip(self.u[1]).zip(self.v);
+        for (j, (block, ((&c0, &c1), &cv))) in self.blocks.iter().zip(coefficients).enumerate() {
+            let (b0, b1, _) = table.derivatives(*block);
+            if let Some((b, db)) = basis.as_mut() {
+                b[j] = b0;
+                db[j] = b1;
+            }
+            du = [du[0] + c0 * b1, du[1] + c1 * b1];
+            v += cv * b0;
+        }
+        (du, v)
     }
 
     /// The basis b_i(τ) and its rate b_i′(τ) over the blocks.
     pub fn basis(&self, tau: f64, b: &mut [f64], db: &mut [f64]) {
-        let table = Harmonics::at(self.blocks, tau);
+        let mut table = Harmonics::at(tau);
         for ((block, x), dx) in self.blocks.iter().zip(b).zip(db) {
-            let (b0, b1, _) = table.derivatives(*block, tau);
+            let (b0, b1, _) = table.derivatives(*block);
             *x = b0;
             *dx = b1;
         }
     }
 }
 
-/// Highest harmonic whose sine and cosine [`Harmonics`] tabulates by recurrence.
-const TABLE_HARMONICS: usize = 32;
+/// Longest run of the angle-addition recurrence between two harmonics of a block list;
+/// a larger gap (or a harmonic below the last) takes its sine and cosine directly.
+const RECURRENCE_GAP: usize = 32;
 
-/// cos hτ and sin hτ for h = 0..=H at one τ, from one `sin_cos` and the angle-addition
-/// recurrence (rounding grows like h·ε), or none when H exceeds [`TABLE_HARMONICS`].
+/// cos hτ and sin hτ for the harmonics of the blocks in turn, from one `sin_cos` of τ and the
+/// angle-addition recurrence (rounding grows like h·ε): the blocks come in increasing
+/// harmonic order, so each step of the recurrence serves the next block.
 struct Harmonics {
-    cos: [f64; TABLE_HARMONICS + 1],
-    sin: [f64; TABLE_HARMONICS + 1],
-    len: usize,
+    tau: f64,
+    s1: f64,
+    c1: f64,
+    h: usize,
+    c: f64,
+    s: f64,
 }
 
 impl Harmonics {
-    fn at(blocks: &[Block], tau: f64) -> Self {
-        let top = blocks.iter().map(|b| b.harmonic()).max().unwrap_or(0);
-        let mut t = Self {
-            cos: [0.0; TABLE_HARMONICS + 1],
-            sin: [0.0; TABLE_HARMONICS + 1],
-            len: 0,
-        };
-        if top > TABLE_HARMONICS {
-            return t;
-        }
+    fn at(tau: f64) -> Self {
         let (s1, c1) = tau.sin_cos();
-        t.cos[0] = 1.0;
-        for h in 1..=top {
-            t.cos[h] = t.cos[h - 1] * c1 - t.sin[h - 1] * s1;
-            t.sin[h] = t.sin[h - 1] * c1 + t.cos[h - 1] * s1;
+        Self {
+            tau,
+            s1,
+            c1,
+            h: 0,
+            c: 1.0,
+            s: 0.0,
         }
-        t.len = top + 1;
-        t
     }
 
     /// b(τ), b′(τ), b″(τ) of one basis function.
-    fn derivatives(&self, block: Block, tau: f64) -> (f64, f64, f64) {
+    fn derivatives(&mut self, block: Block) -> (f64, f64, f64) {
         let h = block.harmonic();
-        if h >= self.len {
-            return basis_derivatives(block, tau);
+        if h == 0 {
+            return (1.0, 0.0, 0.0);
+        }
+        if h < self.h || h > self.h + RECURRENCE_GAP {
+            let (s, c) = (h as f64 * self.tau).sin_cos();
+            (self.h, self.c, self.s) = (h, c, s);
+        }
+        while self.h < h {
+            let c = self.c * self.c1 - self.s * self.s1;
+            self.s = self.s * self.c1 + self.c * self.s1;
+            self.c = c;
+            self.h += 1;
         }
         let hf = h as f64;
-        let (s, c) = (self.sin[h], self.cos[h]);
+        let (s, c) = (self.s, self.c);
         match block {
             Block::Constant => (1.0, 0.0, 0.0),
             Block::Cos(_) => (c, -hf * s, -hf * hf * c),
             Block::Sin(_) => (s, hf * c, -hf * hf * s),
-        }
-    }
-}
-
-/// b(τ), b′(τ), b″(τ) of one basis function.
-fn basis_derivatives(block: Block, tau: f64) -> (f64, f64, f64) {
-    match block {
-        Block::Constant => (1.0, 0.0, 0.0),
-        Block::Cos(h) => {
-            let h = h as f64;
-            let (s, c) = (h * tau).sin_cos();
-            (c, -h * s, -h * h * c)
-        }
-        Block::Sin(h) => {
-            let h = h as f64;
-            let (s, c) = (h * tau).sin_cos();
-            (s, h * c, -h * h * s)
         }
     }
 }

@@ -315,23 +315,31 @@ fn a_partial_one_directional_slip_reaches_its_periodic_state() {
         };
         line.evaluate_events(&l1, effects(false), &along, &v, false)
             .unwrap();
-        let mut worst = 0.0_f64;
+        let (mut along, mut across) = (0.0_f64, 0.0_f64);
         for j in 0..set.n_blocks() {
             let (t1, t2) = (plane.t_hat[0][j], plane.t_hat[1][j]);
-            worst = worst.max((co * t1 + si * t2 - line.t_hat[j]).abs());
-            worst = worst.max((-si * t1 + co * t2).abs());
+            along = along.max((co * t1 + si * t2 - line.t_hat[j]).abs());
+            across = across.max((-si * t1 + co * t2).abs());
         }
         println!(
             "excess {excess:e}: {:?} in {} periods (sampled law with Newton restarts: {}), \
-             largest difference from the 1D event law {:.2e} of μN",
+             largest difference from the 1D event law {:.2e} of μN along the path, \
+             force across it {:.2e} of μN",
             report.state,
             report.periods,
             sampled_report.periods,
-            worst / friction
+            along / friction,
+            across / friction
         );
         assert_eq!(report.state, ContactState::StickSlip);
         assert!(report.periods <= 30, "{report:?}");
-        assert!(worst < 1e-11 * friction, "{:.2e}", worst / friction);
+        assert!(along < 1e-13 * friction, "{:.2e}", along / friction);
+        // Across the path the fixed point is degenerate (the offset contracts by
+        // 1 − O(offset²) per period, so the mismatch is cubic in it): the polish ends where
+        // the mismatch reaches round-off, and the offset left is its cube root, of order
+        // 10⁻¹¹ of the stick range in the mean force (measured 3e-13 at an excess of 10⁻³
+        // and 5e-11 at 10⁻⁶), while the along-path forces agree to round-off.
+        assert!(across < 1e-10 * friction, "{:.2e}", across / friction);
         assert!(plane.dt_dx.iter().all(|x| x.is_finite()));
     }
 }
