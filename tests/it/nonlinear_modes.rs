@@ -1,0 +1,273 @@
+//! Nonlinear modes by EPMC (`analysis::nonlinear_modes`): a linear structure gives its natural
+//! frequencies and modal damping ratios, a 1-DOF Jenkins oscillator at H = 1 its
+//! describing-function backbone, and the extended Jacobian equals central differences.
+
+use fricbound::analysis::linear::LinearCase;
+use fricbound::analysis::modes::damped_modes;
+use fricbound::analysis::nonlinear_modes::{
+    self, ModeChoice, NonlinearModeRun, NonlinearModeSettings,
+};
+use fricbound::contact::{jenkins_describing_function, ContactState};
+use fricbound::model::Problem;
+
+use crate::common::scenes;
+
+/// The single-DOF Jenkins oscillator of `docs/scene.md` (m = 1 kg, k = 1e4 N/m,
+/// c = 2 N·s/m, kₜ = 1e5 N/m, μ = 0.3, N₀ = kₙ·1e-4 m = 10 N constant) at H = 1.
+const JENKINS_OSCILLATOR: &str = r#"
+[model]
+dofs = ["x"]
+mass = [[1.0]]
+stiffness = [[1.0e4]]
+damping = [[2.0]]
+
+[[contacts]]
+name = "ground"
+damper = ["x"]
+tangent = [1.0]
+normal = [0.0]
+kt = 1.0e5
+kn = 1.0e5
+mu = 0.3
+gap = -1.0e-4
+
+[[harmonic_loads]]
+dof = "x"
+harmonic = 1
+cos = 5.0
+
+[harmonics]
+max = 1
+samples = 256
+
+[effects]
+normal_load = "constant"
+
+[analysis]
+freq_start_hz = 5.0
+freq_end_hz = 40.0
+residual_tolerance = 1e-13
+
+[output]
+dofs = ["x"]
+"#;
+
+/// (m, k, c, kₜ, μ, N₀) of [`JENKINS_OSCILLATOR`].
+const JENKINS: (f64, f64, f64, f64, f64, f64) = (1.0, 1.0e4, 2.0, 1.0e5, 0.3, 10.0);
+
+fn settings(mode: ModeChoice, dof: usize, amplitude: [f64; 2]) -> NonlinearModeSettings {
+    NonlinearModeSettings {
+        mode,
+        dof,
+        amplitude,
+        max_points: 400,
+        initial_states: None,
+    }
+}
+
+fn solve(problem: &Problem, settings: &NonlinearModeSettings) -> NonlinearModeRun {
+    let run = nonlinear_modes::solve(problem, settings).unwrap_or_else(|e| panic!("{e}"));
+    assert!(run.is_complete(), "{:?}", run.incomplete_reason());
+    run
+}
+
+/// The describing-function backbone of the oscillator at amplitude A (m): ω² = (k + k_eq)/m
+/// and D = (c/m + c_eq/(m ω)) / (2ω), with the first harmonic k_eq A cos τ − c_eq A sin τ of
+/// the contact force (paper Appendix, Eqs. 17-18).
+fn closed_form(amplitude: f64) -> (f64, f64) {
+    let (m, k, c, kt, mu, n0) = JENKINS;
+    let (k_eq, c_eq) = jenkins_describing_function(kt, mu, n0, amplitude);
+    let omega = ((k + k_eq) / m).sqrt();
+    (omega, (c / m + c_eq / (m * omega)) / (2.0 * omega))
+}
+
+/// Backbone frequency and modal damping ratio of the Jenkins oscillator equal the closed form
+/// to 1e-9 at every point from stuck (A < μN₀/kₜ = 3e-5 m) to near full slip (A = 1e-2 m,
+/// μN₀/(kₜA) = 3e-3), with the event-resolved law; the sampled law at 256 samples is off by
+/// its sampling error, more than 1e-7 somewhere in slip.
+#[test]
+fn jenkins_oscillator_backbone_equals_the_describing_function() {
+    for (law, tolerance) in [("jenkins-1d", 1e-9), ("jenkins-1d-sampled", 1e-2)] {
+        let overrides = [format!("contacts.0.law=\"{law}\"")];
+        let overrides: Vec<&str> = overrides.iter().map(|s| s.as_str()).collect();
+        let problem = scenes::problem(JENKINS_OSCILLATOR, &overrides);
+        let run = solve(&problem, &settings(ModeChoice::Number(1), 0, [1e-6, 1e-2]));
+        assert!(run.points.len() > 20, "{law}: {} points", run.points.len());
+        let (mut worst_f, mut worst_d) = (0.0_f64, 0.0_f64);
+        let (mut stuck, mut slipping) = (0, 0);
+        for p in &run.points {
+            // m = 1 kg: ψ = 1, the amplitude at the DOF is the modal amplitude.
+            assert!((p.dof_amplitude - p.modal_amplitude).abs() <= 1e-12 * p.modal_amplitude);
+            let (omega, d) = closed_form(p.dof_amplitude);
+            worst_f = worst_f.max((p.omega - omega).abs() / omega);
+            worst_d = worst_d.max((p.damping_ratio - d).abs() / d);
+            match p.states[0] {
+                ContactState::Stuck => stuck += 1,
+                _ => slipping += 1,
+            }
+        }
+        eprintln!(
+            "{law}: {} points ({stuck} stuck, {slipping} slipping), largest relative error \
+             of the frequency {worst_f:.2e}, of the damping ratio {worst_d:.2e}; {:.3} s",
+            run.points.len(),
+            run.elapsed_s
+        );
+        assert!(
+            stuck > 2 && slipping > 10,
+            "{law}: {stuck} stuck, {slipping} slipping"
+        );
+        assert!(worst_f < tolerance && worst_d < tolerance, "{law}");
+        if law == "jenkins-1d-sampled" {
+            assert!(
+                worst_d > 1e-7,
+                "the sampled law's sampling error: {worst_d:.2e}"
+            );
+        }
+        let last = run.points.last().unwrap();
+        assert!((last.dof_amplitude - 1e-2).abs() < 1e-12);
+        // At 1e-2 m the contact dissipates 4 μN₀ (A − μN₀/kₜ) per cycle (the hysteresis loop).
+        let (_, _, _, kt, mu, n0) = JENKINS;
+        let loop_area = 4.0 * mu * n0 * (1e-2 - mu * n0 / kt);
+        let e = (last.friction_energy - loop_area).abs() / loop_area;
+        assert!(e < tolerance.max(1e-9), "{law}: friction energy {e:.2e}");
+    }
+}
+
+/// A chain of three masses with a contact that never slips (μN₀ = 1e4 N) and Rayleigh damping
+/// of the stuck structure: every nonlinear mode is the linear one at all amplitudes, its
+/// frequency the natural frequency |s|/2π and its damping ratio the modal damping ratio of
+/// `analysis::modes::damped_modes`, to 1e-9.
+#[test]
+fn linear_structure_gives_its_modes_and_modal_damping() {
+    let (alpha, beta) = (3.0, 2e-5);
+    let k = [
+        [2.0e4, -1.0e4, 0.0],
+        [-1.0e4, 2.0e4, -1.0e4],
+        [0.0, -1.0e4, 1.0e4],
+    ];
+    let m = [1.0, 2.0, 0.5];
+    let kt = 5.0e3;
+    let rows = |f: &dyn Fn(usize, usize) -> f64| {
+        (0..3)
+            .map(|i| {
+                let r: Vec<String> = (0..3).map(|j| format!("{:e}", f(i, j))).collect();
+                format!("[{}]", r.join(", "))
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let k_stuck = |i: usize, j: usize| k[i][j] + if i == 2 && j == 2 { kt } else { 0.0 };
+    let mass = |i: usize, j: usize| if i == j { m[i] } else { 0.0 };
+    let scene = format!(
+        r#"
+[model]
+dofs = ["a", "b", "c"]
+mass = [{}]
+stiffness = [{}]
+damping = [{}]
+
+[[contacts]]
+name = "ground"
+damper = ["c"]
+tangent = [1.0]
+normal = [0.0]
+kt = {kt:e}
+kn = 1.0e5
+mu = 1.0e3
+gap = -1.0e-4
+
+[[harmonic_loads]]
+dof = "a"
+cos = 1.0
+
+[harmonics]
+max = 3
+
+[effects]
+normal_load = "constant"
+
+[analysis]
+freq_start_hz = 5.0
+freq_end_hz = 40.0
+residual_tolerance = 1e-13
+
+[output]
+dofs = ["a"]
+"#,
+        rows(&mass),
+        rows(&|i, j| k[i][j]),
+        rows(&|i, j| alpha * mass(i, j) + beta * k_stuck(i, j)),
+    );
+    let problem = scenes::problem(&scene, &[]);
+    let reference = damped_modes(&problem, LinearCase::Stuck, 3)
+        .unwrap()
+        .unwrap();
+    for (number, linear) in reference.modes.iter().enumerate() {
+        let dof = 0;
+        let run = solve(
+            &problem,
+            &settings(ModeChoice::Number(number + 1), dof, [1e-6, 1e-3]),
+        );
+        for p in &run.points {
+            let f = (p.freq_hz - linear.natural_hz).abs() / linear.natural_hz;
+            let d = (p.damping_ratio - linear.damping_ratio).abs() / linear.damping_ratio;
+            assert!(
+                f < 1e-9 && d < 1e-9,
+                "mode {}: {f:.2e}, {d:.2e}",
+                number + 1
+            );
+            assert!(p.states.iter().all(|s| *s == ContactState::Stuck));
+        }
+        // The same mode chosen by its nearest frequency.
+        let near = solve(
+            &problem,
+            &settings(
+                ModeChoice::NearestHz(linear.natural_hz * 1.01),
+                dof,
+                [1e-6, 1e-5],
+            ),
+        );
+        assert_eq!(near.mode, number + 1);
+    }
+}
+
+/// The extended Jacobian (harmonics, ω, ξ and the log-amplitude column) equals central
+/// differences on the Jenkins oscillator at H = 3 in the stuck and stick-slip regimes and on
+/// the paper's wedge damper (variable normal load, lift-off) at H = 3.
+#[test]
+fn extended_jacobian_equals_central_differences() {
+    let jenkins = scenes::problem(JENKINS_OSCILLATOR, &["harmonics.max=3"]);
+    let paper = scenes::paper(&["harmonics.max=3"]);
+    for (name, problem, mode, dof, amplitude) in [
+        ("jenkins stuck", &jenkins, 1, 0, [1e-6, 1e-5]),
+        ("jenkins slipping", &jenkins, 1, 0, [1e-6, 2e-4]),
+        ("paper, 3rd mode", &paper, 3, 3, [1e-7, 1e-4]),
+    ] {
+        let run = solve(problem, &settings(ModeChoice::Number(mode), dof, amplitude));
+        let last = run.points.last().unwrap();
+        let free = nonlinear_modes::autonomous(problem);
+        let start = nonlinear_modes::linear_start(&free, ModeChoice::Number(mode), dof).unwrap();
+        let map = nonlinear_modes::LogAmplitude {
+            a_min: run.modal_range[0],
+        };
+        let mut op =
+            nonlinear_modes::EpmcOperator::new(&free, start.statics.clone(), dof, map, 1.0)
+                .unwrap();
+        let a = last.modal_amplitude;
+        let mut y = op.normalised(&last.coefficients, a);
+        y.push(last.omega);
+        y.push(last.xi);
+        let lambda = std::f64::consts::TAU * map.decade(a);
+        let check = nonlinear_modes::check_jacobian(&mut op, &y, lambda, 1e-6).unwrap();
+        eprintln!(
+            "{name}: states {:?}, relative error {:.2e} (linear mode at {:.3} Hz)",
+            last.states,
+            check.relative(),
+            start.omega / std::f64::consts::TAU
+        );
+        assert!(check.relative() < 1e-6, "{name}: {:.2e}", check.relative());
+        if name == "jenkins slipping" {
+            assert_eq!(last.states[0], ContactState::StickSlip);
+        }
+    }
+}
