@@ -195,12 +195,40 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
             .collect::<Vec<_>>()
             .join(", ")
     );
+    if let Some(m) = problem.analysis.nonlinear_modes {
+        let free = crate::analysis::nonlinear_modes::autonomous(&problem);
+        let start = crate::analysis::nonlinear_modes::linear_start(&free, m.mode, m.dof).map_err(
+            |source| CommandError::NonlinearMode {
+                scene: label.clone(),
+                source,
+            },
+        )?;
+        let _ = writeln!(
+            s,
+            "nonlinear mode {} by EPMC (linear at rest: {:.4} Hz, modal damping ratio {:.3e}); amplitude {:e} .. {:e} m at {}; harmonic loads left out{}",
+            start.number,
+            start.omega / std::f64::consts::TAU,
+            start.xi / (2.0 * start.omega),
+            m.amplitude[0],
+            m.amplitude[1],
+            problem.model.dof_names[m.dof],
+            if limits.is_some() {
+                ", one mode per limit case"
+            } else {
+                ""
+            }
+        );
+    }
     if let Some(l) = &limits {
-        let cases: Vec<String> = crate::analysis::limits::two_point_cases(&problem)
-            .into_iter()
-            .chain(l.intermediate_cases(&problem))
-            .map(|c| c.name)
-            .collect();
+        let cases = if problem.analysis.nonlinear_modes.is_some() {
+            crate::analysis::nonlinear_modes::mode_cases(&problem, l)
+        } else {
+            crate::analysis::limits::two_point_cases(&problem)
+                .into_iter()
+                .chain(l.intermediate_cases(&problem))
+                .collect()
+        };
+        let cases: Vec<String> = cases.into_iter().map(|c| c.name).collect();
         let _ = writeln!(
             s,
             "limits       curves {}; grid {} points; bound scan {:?}; peak window {}",

@@ -11,6 +11,7 @@ use fricbound::contact::{jenkins_describing_function, ContactState};
 use fricbound::model::Problem;
 
 use crate::common::scenes;
+use crate::support;
 
 /// The single-DOF Jenkins oscillator of `docs/scene.md` (m = 1 kg, k = 1e4 N/m,
 /// c = 2 N·s/m, kₜ = 1e5 N/m, μ = 0.3, N₀ = kₙ·1e-4 m = 10 N constant) at H = 1.
@@ -61,7 +62,6 @@ fn settings(mode: ModeChoice, dof: usize, amplitude: [f64; 2]) -> NonlinearModeS
         dof,
         amplitude,
         max_points: 400,
-        initial_states: None,
     }
 }
 
@@ -269,5 +269,109 @@ fn extended_jacobian_equals_central_differences() {
         if name == "jenkins slipping" {
             assert_eq!(last.states[0], ContactState::StickSlip);
         }
+    }
+}
+
+/// The shipped nonlinear-mode scene passes `fricbound check`, which names the mode and its
+/// linear frequency at rest, and `fricbound run` writes `modes_nl.csv`, `modes_nl.json`
+/// (status complete, one case per sign combination per side and the intermediate one), the band
+/// and the figures, and exits 0. Every case starts at the linear mode at rest and reaches the
+/// highest amplitude asked.
+#[test]
+fn shipped_scene_checks_and_runs() {
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/meshes/paper-wedge/modes-3rd.toml"
+    );
+    let o = support::fricbound(&["check", scene]);
+    assert!(o.status.success(), "{}", support::text(&o.stderr));
+    let described = support::text(&o.stdout);
+    assert!(
+        described.contains("nonlinear mode 3 by EPMC (linear at rest: 225.0791 Hz"),
+        "{described}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let o = support::run_scene(scene, dir.path(), &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", support::text(&o.stderr));
+    let names = support::names(dir.path());
+    for f in [
+        "modes_nl.csv",
+        "modes_nl.json",
+        "modes_nl_band.csv",
+        "modes_nl_frequency.png",
+        "modes_nl_frequency.svg",
+        "modes_nl_damping.png",
+        "modes_nl_damping.svg",
+    ] {
+        assert!(names.contains(&f.to_string()), "{f} missing: {names:?}");
+    }
+    let json = support::json(&dir.path().join("modes_nl.json"));
+    assert_eq!(json["status"], "complete");
+    let cases = json["cases"].as_array().unwrap();
+    let case_names: Vec<&str> = cases.iter().map(|c| c["name"].as_str().unwrap()).collect();
+    assert_eq!(
+        case_names,
+        ["m+1", "m-1", "left-1_right+1", "left+1_right-1", "m0"]
+    );
+    for c in cases {
+        let points = c["mode"]["points"].as_array().unwrap();
+        let first = &points[0];
+        let last = points.last().unwrap();
+        assert!((first["freq_hz"].as_f64().unwrap() - 225.0791).abs() < 1e-3);
+        assert_eq!(c["status"], "complete");
+        assert!(
+            last["dof_amplitude"].as_f64().unwrap() > 0.9e-3,
+            "{}",
+            c["name"]
+        );
+    }
+    let (header, rows) = support::csv(&dir.path().join("modes_nl.csv"));
+    assert!(header.starts_with("case,modal_amplitude,y2_amp,freq_hz,damping_ratio"));
+    assert!(rows.len() > 100);
+}
+
+/// A nonlinear-mode scene without its mode, with a mode field in an FRF scene, with a reversed
+/// amplitude range, an unknown DOF or a mode that does not exist is refused with the field
+/// named; a phase DOF at a node of the mode is refused by `check` with the reason.
+#[test]
+fn bad_mode_fields_are_refused_with_the_field_named() {
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/meshes/paper-wedge/modes-3rd.toml"
+    );
+    for (overrides, expected) in [
+        (
+            vec!["analysis.kind=\"frf\""],
+            "field `analysis.mode`: belongs to a nonlinear-mode analysis",
+        ),
+        (
+            vec!["analysis.amplitude=[1e-3, 1e-7]"],
+            "field `analysis.amplitude`: the range is reversed",
+        ),
+        (
+            vec!["analysis.dof=\"z9\""],
+            "field `analysis.dof`: unknown DOF `z9`",
+        ),
+        (
+            vec!["analysis.mode=0"],
+            "field `analysis.mode`: modes are numbered from 1",
+        ),
+        (
+            vec!["analysis.mode_freq_hz=200.0"],
+            "field `analysis.mode_freq_hz`: give the mode by its number",
+        ),
+        (
+            vec!["analysis.mode=9"],
+            "mode 9 asked, the structure at rest has 6 elastic modes",
+        ),
+    ] {
+        let mut args = vec!["check", scene];
+        for o in &overrides {
+            args.extend(["--set", o]);
+        }
+        let o = support::fricbound(&args);
+        let err = support::text(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{overrides:?}: {err}");
+        assert!(err.contains(expected), "{overrides:?}: {err}");
     }
 }

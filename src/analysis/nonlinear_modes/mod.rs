@@ -25,12 +25,18 @@
 //! | [`operator`] | [`EpmcOperator`], [`LogAmplitude`] | the extended residual and its analytic Jacobian |
 //! | [`start`] | [`linear_start`], [`linearised_modes`] | the linear modes at rest and the mode asked |
 //! | [`run`] | [`solve`], [`NonlinearModeRun`], [`NonlinearModePoint`] | the continuation and its points |
+//! | [`predict`] | [`predicted_peak`], [`predicted_frf`] | the forced response near the resonance from the mode (single-nonlinear-mode theory) |
+//! | [`limits`] | [`mode_limits`], [`ModeBand`] | the mode per initial tangential state (m = ±1 per side) and the band they span |
 
+pub mod limits;
 pub mod operator;
+pub mod predict;
 pub mod run;
 pub mod start;
 
+pub use limits::{band, mode_cases, mode_limits, ModeBand, ModeCase, ModeLimits};
 pub use operator::{EpmcOperator, LogAmplitude};
+pub use predict::{modal_force, predicted_frf, predicted_peak, PredictedPeak};
 pub use run::{
     autonomous, solve, ModeChoice, NonlinearModeEnd, NonlinearModeError, NonlinearModePoint,
     NonlinearModeRun, NonlinearModeSettings,

@@ -13,14 +13,7 @@ use crate::model::Problem;
 use crate::numerics::path::{ContinuationError, Observer, PathPoint};
 use crate::numerics::{Continuation, ContinuationSettings, NewtonFailure, PathEnd};
 
-/// Which linear mode the nonlinear mode continues.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-pub enum ModeChoice {
-    /// The k-th elastic mode of the structure at rest (1-based, ascending frequency).
-    Number(usize),
-    /// The elastic mode whose frequency is nearest this one (Hz).
-    NearestHz(f64),
-}
+pub use crate::model::ModeChoice;
 
 /// What a nonlinear-mode run is asked.
 #[derive(Debug, Clone, PartialEq)]
@@ -36,9 +29,19 @@ pub struct NonlinearModeSettings {
     pub amplitude: [f64; 2],
     /// Most continuation points.
     pub max_points: usize,
-    /// Initial tangential states (m₁, m₂) of every contact in place of the problem's (the
-    /// limit cases); None: the problem's.
-    pub initial_states: Option<Vec<[f64; 2]>>,
+}
+
+impl NonlinearModeSettings {
+    /// The settings of the problem's nonlinear-mode analysis (scene `analysis.kind =
+    /// "nonlinear-modes"`), with the point budget `analysis.max_points`; None for an FRF scene.
+    pub fn of_problem(problem: &Problem) -> Option<Self> {
+        problem.analysis.nonlinear_modes.map(|m| Self {
+            mode: m.mode,
+            dof: m.dof,
+            amplitude: m.amplitude,
+            max_points: problem.analysis.continuation.max_points,
+        })
+    }
 }
 
 /// Why a nonlinear-mode run could not be made.
@@ -212,9 +215,6 @@ pub fn solve(
     let m_phi = mass_times(&free, &start.shape);
     let row_scale = start.omega * start.omega * crate::numerics::linalg::norm(&m_phi);
     let mut op = EpmcOperator::new(&free, start.statics.clone(), settings.dof, map, row_scale)?;
-    if let Some(m) = &settings.initial_states {
-        op.system().set_initial_states_2d(m);
-    }
     let y0 = start_guess(&free, &set, &start);
     let base = problem.analysis.continuation;
     let continuation_settings = ContinuationSettings {
