@@ -85,7 +85,7 @@ fn summary(ctx: &RunContext<'_>, limits: &ModeLimits, elapsed: f64) -> String {
                 let (first, last) = (r.points.first(), r.points.last());
                 match (first, last) {
                     (Some(a), Some(b)) => format!(
-                        "{}: mode {} ({:.4} Hz, D = {:.3e} at rest); {} points, {:.4} Hz and D = {:.3e} at {:.3e} m ({dof_name}); {:.3} s",
+                        "{}: mode {} ({:.4} Hz, D = {:.3e} at rest); {} points, {:.4} Hz and D = {:.3e} at {:.3e} m ({dof_name}); {:.3} s{}",
                         c.case.name,
                         r.mode,
                         a.freq_hz,
@@ -94,7 +94,14 @@ fn summary(ctx: &RunContext<'_>, limits: &ModeLimits, elapsed: f64) -> String {
                         b.freq_hz,
                         b.damping_ratio,
                         b.dof_amplitude,
-                        r.elapsed_s
+                        r.elapsed_s,
+                        match nonlinear_modes::predicted_peak(&ctx.problem, r) {
+                            Some(p) => format!(
+                                "; predicted peak under the scene's harmonic loads {:.4e} m at {:.4} Hz",
+                                p.dof_amplitude, p.freq_hz
+                            ),
+                            None => String::new(),
+                        }
                     ),
                     _ => format!("{}: no point", c.case.name),
                 }

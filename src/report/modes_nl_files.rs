@@ -1,6 +1,7 @@
 //! The files of a nonlinear-mode run: `modes_nl.csv` (every point of every case),
-//! `modes_nl.json` (status, run metadata, each case's mode with its shape harmonics, and the
-//! band of the cases), `modes_nl_band.csv` (with `[limits]`), and the figures
+//! `modes_nl.json` (status, run metadata, each case's mode with its shape harmonics, the
+//! resonance peak and forced response predicted from it for the scene's harmonic loads, and
+//! the band of the cases), `modes_nl_band.csv` (with `[limits]`), and the figures
 //! `modes_nl_frequency` and `modes_nl_damping` (frequency and modal damping ratio against the
 //! first-harmonic amplitude at the mode's DOF, on a log₁₀ amplitude axis, one curve per case).
 
@@ -9,7 +10,9 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::analysis::nonlinear_modes::{ModeBand, ModeLimits, NonlinearModeRun};
+use crate::analysis::nonlinear_modes::{
+    predicted_frf, predicted_peak, ModeBand, ModeLimits, NonlinearModeRun, PredictedPeak,
+};
 use crate::model::Problem;
 use crate::report::files::{write_atomic, RunInfo, WriteError};
 use crate::report::plot::{self, figure_files, palette, Curve, PlotError};
@@ -81,6 +84,12 @@ struct CaseEntry<'a> {
     status: String,
     #[serde(skip_serializing_if = "Option::is_none")]
     mode: Option<&'a NonlinearModeRun>,
+    /// The resonance peak predicted from the mode for the scene's first-harmonic loads.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    predicted_peak: Option<PredictedPeak>,
+    /// The forced response predicted from the mode near the resonance: (Hz, m at the DOF).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    predicted_frf: Vec<(f64, f64)>,
 }
 
 #[derive(Serialize)]
@@ -126,6 +135,12 @@ pub fn write_modes_nl(
                 Err(e) => format!("failed: {e}"),
             },
             mode: c.run.as_ref().ok(),
+            predicted_peak: c.run.as_ref().ok().and_then(|r| predicted_peak(problem, r)),
+            predicted_frf: c
+                .run
+                .as_ref()
+                .map(|r| predicted_frf(problem, r))
+                .unwrap_or_default(),
         })
         .collect();
     let file = ModesFile {

@@ -375,3 +375,62 @@ fn bad_mode_fields_are_refused_with_the_field_named() {
         assert!(err.contains(expected), "{overrides:?}: {err}");
     }
 }
+
+/// Single-nonlinear-mode theory on the paper's system around its 2nd resonance, where the
+/// response is unique (paper §4.2): the peak predicted from the 2nd nonlinear mode and the
+/// modal force of the paper's excitation is the HBM forced response's refined peak within 2 %
+/// in amplitude and 0.5 Hz in frequency at the pre-loads 60, 120 and 240 N; the predicted
+/// forced response reaches up to the predicted peak.
+#[test]
+fn predicted_peaks_equal_the_hbm_peaks_around_the_2nd_resonance() {
+    for preload in [60.0, 120.0, 240.0] {
+        let overrides = [
+            format!("static_loads.0.value={}", -preload),
+            "analysis.freq_start_hz=140.0".to_string(),
+            "analysis.freq_end_hz=185.0".to_string(),
+            "analysis.max_step=0.1".to_string(),
+        ];
+        let overrides: Vec<&str> = overrides.iter().map(String::as_str).collect();
+        let problem = scenes::paper(&overrides);
+        let dof = problem.outputs[0];
+        let run = solve(
+            &problem,
+            &settings(ModeChoice::Number(2), dof, [1e-8, 3e-3]),
+        );
+        let predicted = nonlinear_modes::predicted_peak(&problem, &run).expect("a peak");
+        let frf = fricbound::analysis::frf::solve(&problem, &mut fricbound::analysis::frf::Silent)
+            .unwrap();
+        assert!(frf.is_complete());
+        let peaks = fricbound::analysis::peaks::path_peaks(&problem, &frf.points).unwrap();
+        assert_eq!(peaks[0].len(), 1, "{:?}", peaks[0]);
+        let peak = &peaks[0][0];
+        let error = (predicted.dof_amplitude - peak.amplitude).abs() / peak.amplitude;
+        eprintln!(
+            "F0 = {preload} N: predicted {:.5e} m at {:.3} Hz, HBM {:.5e} m at {:.3} Hz \
+             (relative error {error:.2e}); mode {:.3} s, FRF {:.3} s",
+            predicted.dof_amplitude,
+            predicted.freq_hz,
+            peak.amplitude,
+            peak.freq_hz,
+            run.elapsed_s,
+            frf.elapsed_s
+        );
+        assert!(error < 0.02, "F0 = {preload} N: {error:.2e}");
+        assert!((predicted.freq_hz - peak.freq_hz).abs() < 0.5);
+        let curve = nonlinear_modes::predicted_frf(&problem, &run);
+        // Its highest point is the last backbone point at or below the peak (the amplitude
+        // maximum lies above the phase resonance by a relative D²/2 only).
+        let highest = curve.iter().map(|p| p.1).fold(0.0, f64::max);
+        let below = run
+            .points
+            .iter()
+            .map(|p| p.dof_amplitude)
+            .filter(|&a| a <= predicted.dof_amplitude)
+            .fold(0.0, f64::max);
+        assert!(
+            highest >= below && highest <= predicted.dof_amplitude * (1.0 + 1e-3),
+            "{highest:e} vs {below:e} .. {:e}",
+            predicted.dof_amplitude
+        );
+    }
+}

@@ -28,6 +28,7 @@
 //! | [`predict`] | [`predicted_peak`], [`predicted_frf`] | the forced response near the resonance from the mode (single-nonlinear-mode theory) |
 //! | [`limits`] | [`mode_limits`], [`ModeBand`] | the mode per initial tangential state (m = ±1 per side) and the band they span |
 
+pub mod error;
 pub mod limits;
 pub mod operator;
 pub mod predict;

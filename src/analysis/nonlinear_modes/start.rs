@@ -4,9 +4,10 @@
 
 use faer::Mat;
 
-use super::run::{ModeChoice, NonlinearModeError};
+use super::error::NonlinearModeError;
 use crate::contact::harmonic::HarmonicSet;
 use crate::hbm::HbmSystem;
+use crate::model::ModeChoice;
 use crate::model::Problem;
 use crate::numerics::jacobian::Storage;
 use crate::numerics::Continuation;
