@@ -311,26 +311,6 @@ fn more_line(s: &mut String, total: usize) {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn abbreviates_long_lists() {
-        assert_eq!(abbreviated_list(&[0, 1, 2]), "0, 1, 2");
-        let long: Vec<usize> = (0..=10_000).collect();
-        assert_eq!(
-            abbreviated_list(&long),
-            "0, 1, 2, 3, 4, …, 9996, 9997, 9998, 9999, 10000"
-        );
-        let twelve: Vec<usize> = (0..CHECK_LISTED).collect();
-        assert_eq!(
-            abbreviated_list(&twelve).matches(", ").count(),
-            CHECK_LISTED - 1
-        );
-    }
-}
-
 /// The line of a nonlinear-mode scene: the mode, its linear frequency and damping ratio at
 /// rest, the amplitude range and DOF; an error when the mode cannot start (no such mode, the
 /// DOF at a node of it). None for an FRF scene.
@@ -364,4 +344,24 @@ fn mode_line(
             ""
         }
     )))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn abbreviates_long_lists() {
+        assert_eq!(abbreviated_list(&[0, 1, 2]), "0, 1, 2");
+        let long: Vec<usize> = (0..=10_000).collect();
+        assert_eq!(
+            abbreviated_list(&long),
+            "0, 1, 2, 3, 4, …, 9996, 9997, 9998, 9999, 10000"
+        );
+        let twelve: Vec<usize> = (0..CHECK_LISTED).collect();
+        assert_eq!(
+            abbreviated_list(&twelve).matches(", ").count(),
+            CHECK_LISTED - 1
+        );
+    }
 }

@@ -26,6 +26,7 @@
 //! | [`start`] | [`linear_start`], [`linearised_modes`] | the linear modes at rest and the mode asked |
 //! | [`run`] | [`solve`], [`NonlinearModeRun`], [`NonlinearModePoint`] | the continuation and its points |
 //! | [`predict`] | [`predicted_peak`], [`predicted_frf`] | the forced response near the resonance from the mode (single-nonlinear-mode theory) |
+//! | [`verify`] | [`verify_mode_point`] | a point checked by time integration with the artificial damping applied |
 //! | [`limits`] | [`mode_limits`], [`ModeBand`] | the mode per initial tangential state (m = ±1 per side) and the band they span |
 
 pub mod error;
@@ -34,6 +35,7 @@ pub mod operator;
 pub mod predict;
 pub mod run;
 pub mod start;
+pub mod verify;
 
 pub use limits::{band, mode_cases, mode_limits, ModeBand, ModeCase, ModeLimits};
 pub use operator::{EpmcOperator, LogAmplitude};
@@ -43,6 +45,7 @@ pub use run::{
     NonlinearModeRun, NonlinearModeSettings,
 };
 pub use start::{linear_start, linearised_modes, rest_statics, start_guess, LinearStart};
+pub use verify::{negatively_damped, verify_mode_point};
 
 use crate::numerics::derivatives::JacobianCheck;
 use crate::numerics::ParametricResidual;

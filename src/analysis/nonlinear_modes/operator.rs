@@ -387,6 +387,16 @@ impl ParametricResidual for EpmcOperator<'_> {
         self.residual_scale
     }
 
+    /// The harmonic balance's round-off level at the motion (its sums of K x, M x, C x and the
+    /// loads, [`HbmSystem::round_off`]) divided by a, as the rows are: at small amplitudes the
+    /// static rows' round-off (K x_s against the pre-load, large on an FE model) is amplified
+    /// by 1/a, and Newton cannot go below it.
+    fn round_off(&mut self, y: &[f64], lambda: f64) -> f64 {
+        let a = self.map.amplitude(lambda);
+        let x = self.physical(y, a);
+        self.system.round_off(&x, y[self.harmonic_dim()]) / a
+    }
+
     fn residual(&mut self, y: &[f64], lambda: f64, r: &mut [f64]) -> Result<(), HbmError> {
         self.evaluate(y, lambda, r, None)
     }

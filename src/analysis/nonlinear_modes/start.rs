@@ -29,6 +29,10 @@ pub struct LinearStart {
     pub statics: Vec<f64>,
 }
 
+/// The static state at rest (m) and the elastic modes there: (ω² (rad²/s²), mass-normalised
+/// shape), ascending.
+pub type RestModes = (Vec<f64>, Vec<(f64, Vec<f64>)>);
+
 /// Relative size of the shape at the phase DOF (to its largest entry) below which the DOF is
 /// a node of the mode and cannot fix its phase.
 pub const NODE_TOLERANCE: f64 = 1e-6;
@@ -37,9 +41,7 @@ pub const NODE_TOLERANCE: f64 = 1e-6;
 /// state with no motion (the structure's K with each contact's stuck tangential stiffness, and
 /// its normal stiffness where it is closed), against M. Returns the static state and the
 /// elastic modes (ω² (rad²/s²), mass-normalised shape), ascending.
-pub fn linearised_modes(
-    problem: &Problem,
-) -> Result<(Vec<f64>, Vec<(f64, Vec<f64>)>), NonlinearModeError> {
+pub fn linearised_modes(problem: &Problem) -> Result<RestModes, NonlinearModeError> {
     let mut system = HbmSystem::new(problem)?;
     system.set_storage(Storage::Dense)?;
     let set = system.unknowns().clone();
