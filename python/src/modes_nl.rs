@@ -35,7 +35,11 @@ pub fn nonlinear_modes<'py>(
         None => {
             let case = LimitCase {
                 name: "scene".to_string(),
-                contact_states: problem.contacts.iter().map(|c| c.law.initial_state).collect(),
+                contact_states: problem
+                    .contacts
+                    .iter()
+                    .map(|c| c.law.initial_state)
+                    .collect(),
                 second_states: None,
             };
             let cases = vec![ModeCase {
@@ -82,9 +86,18 @@ pub fn nonlinear_modes<'py>(
         let pair = |v: &[[f64; 2]], k: usize| v.iter().map(|p| p[k]).collect::<Vec<f64>>();
         band.set_item("freq_min_hz", PyArray1::from_vec(py, pair(&b.freq_hz, 0)))?;
         band.set_item("freq_max_hz", PyArray1::from_vec(py, pair(&b.freq_hz, 1)))?;
-        band.set_item("damping_min", PyArray1::from_vec(py, pair(&b.damping_ratio, 0)))?;
-        band.set_item("damping_max", PyArray1::from_vec(py, pair(&b.damping_ratio, 1)))?;
-        band.set_item("wide", b.wide.iter().map(|w| w.to_vec()).collect::<Vec<_>>())?;
+        band.set_item(
+            "damping_min",
+            PyArray1::from_vec(py, pair(&b.damping_ratio, 0)),
+        )?;
+        band.set_item(
+            "damping_max",
+            PyArray1::from_vec(py, pair(&b.damping_ratio, 1)),
+        )?;
+        band.set_item(
+            "wide",
+            b.wide.iter().map(|w| w.to_vec()).collect::<Vec<_>>(),
+        )?;
         d.set_item("band", band)?;
     }
     Ok(d)
@@ -128,12 +141,15 @@ fn case_dict(
         .collect();
     d.set_item("states", states)?;
     let width = p.first().map_or(0, |x| x.coefficients.len());
-    let flat: Vec<f64> = p.iter().flat_map(|x| x.coefficients.iter().copied()).collect();
-    d.set_item("coefficients", crate::convert::array2(py, p.len(), width, flat)?)?;
+    let flat: Vec<f64> = p
+        .iter()
+        .flat_map(|x| x.coefficients.iter().copied())
+        .collect();
     d.set_item(
-        "blocks",
-        problem.unknown_harmonics().block_labels(),
+        "coefficients",
+        crate::convert::array2(py, p.len(), width, flat)?,
     )?;
+    d.set_item("blocks", problem.unknown_harmonics().block_labels())?;
     if let Some(peak) = nm::predicted_peak(problem, run) {
         let pk = PyDict::new(py);
         pk.set_item("amplitude", peak.dof_amplitude)?;

@@ -205,7 +205,11 @@ const SIGNAL_POLL: Duration = Duration::from_millis(100);
 /// `check_signals`), or an exception raised by the callback, requests the library's
 /// continuation runs to stop ([`interrupt::request`]); the job then ends within about one
 /// continuation step per thread, the request is withdrawn and the exception raised.
-pub(crate) fn in_background<T, F>(py: Python<'_>, progress: Option<&Py<PyAny>>, job: F) -> PyResult<T>
+pub(crate) fn in_background<T, F>(
+    py: Python<'_>,
+    progress: Option<&Py<PyAny>>,
+    job: F,
+) -> PyResult<T>
 where
     T: Send,
     F: FnOnce(mpsc::Sender<Event>) -> T + Send,
