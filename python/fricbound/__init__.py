@@ -37,6 +37,8 @@ from ._results import (
     LimitsResult,
     LinearResult,
     ModesResult,
+    NonlinearMode,
+    NonlinearModesResult,
     ReducedModel,
     SweepResult,
     VerifyResult,
@@ -57,6 +59,7 @@ __all__ = [
     "limits",
     "sweep",
     "modes",
+    "nonlinear_modes",
     "reduce",
     "SolveError",
     "ContinuationPath",
@@ -66,6 +69,8 @@ __all__ = [
     "LinearResult",
     "linear",
     "ModesResult",
+    "NonlinearMode",
+    "NonlinearModesResult",
     "ReducedModel",
     "SweepResult",
     "VerifyResult",
@@ -222,6 +227,55 @@ def modes(scene: "Scene | str", count: int = 10, case: str = "stuck") -> ModesRe
     count = _args.integer("modes", "count", count, 1)
     case = _args.text("modes", "case", case)
     return ModesResult(_native.modes(*s._args(), count, case))
+
+
+def nonlinear_modes(
+    scene: "Scene | str",
+    mode: Optional[int] = None,
+    mode_freq_hz: Optional[float] = None,
+    dof: Optional[str] = None,
+    amplitude: Optional[Sequence[float]] = None,
+    max_points: Optional[int] = None,
+) -> NonlinearModesResult:
+    """The scene's nonlinear mode by EPMC (what ``fricbound run`` computes for a scene with
+    ``analysis.kind = "nonlinear-modes"``; with ``[limits]``, one mode per initial tangential
+    state and their band): frequency (Hz), modal damping ratio D = ξ/2ω and shape against the
+    vibration level, from the linear mode at rest (contacts stuck) to the highest amplitude.
+
+    The keyword arguments set the scene's fields of the same name (``analysis.mode``: the
+    mode's number among the elastic modes at rest, see :func:`modes`; ``analysis.mode_freq_hz``:
+    the mode nearest this frequency, Hz; ``analysis.dof``: the DOF that fixes the phase and at
+    which ``analysis.amplitude`` = [low, high], the first-harmonic amplitude range (m), is
+    given; ``analysis.max_points``), and ``analysis.kind`` to ``"nonlinear-modes"``.
+
+    Returns a :class:`NonlinearModesResult`; raises ``ValueError`` naming the field on bad
+    input, :class:`SolveError` when the mode cannot be computed.
+    """
+    s = _scene("nonlinear_modes", scene).copy()
+    s.set("analysis.kind", "nonlinear-modes")
+    if mode is not None:
+        s.set("analysis.mode", _args.integer("nonlinear_modes", "mode", mode, 1))
+        _remove(s, "analysis.mode_freq_hz")
+    if mode_freq_hz is not None:
+        s.set("analysis.mode_freq_hz", float(mode_freq_hz))
+        _remove(s, "analysis.mode")
+    if dof is not None:
+        s.set("analysis.dof", _args.text("nonlinear_modes", "dof", dof))
+    if amplitude is not None:
+        low, high = (float(v) for v in amplitude)
+        s.set("analysis.amplitude", [low, high])
+    if max_points is not None:
+        s.set("analysis.max_points", _args.integer("nonlinear_modes", "max_points", max_points, 1))
+    return NonlinearModesResult(_native.nonlinear_modes(*s._args()))
+
+
+def _remove(scene: Scene, field: str) -> None:
+    """Removes ``field`` from ``scene`` where the scene has it (the other way of choosing the
+    mode, replaced by the keyword given)."""
+    try:
+        scene.set(field, None)
+    except ValueError:
+        pass
 
 
 def reduce(

@@ -186,6 +186,36 @@ class ModesResult:
     dofs: List[str]
     def to_pandas(self) -> Any: ...
 
+class NonlinearMode:
+    mode: int
+    linear_freq_hz: float
+    linear_damping_ratio: float
+    status: str
+    modal_amplitude: _F
+    amplitude: _F
+    freq_hz: _F
+    damping_ratio: _F
+    xi: _F
+    dissipated_energy: _F
+    friction_energy: _F
+    states: List[List[str]]
+    coefficients: _F
+    predicted_peak: Optional[Dict[str, float]]
+    def to_pandas(self) -> Any: ...
+
+class NonlinearModesResult:
+    status: str
+    complete: bool
+    dof: str
+    amplitude_range: List[float]
+    case_names: List[str]
+    cases: Dict[str, Any]
+    band: Optional[Dict[str, Any]]
+    freq_hz: _F
+    damping_ratio: _F
+    amplitude: _F
+    def to_pandas(self) -> Any: ...
+
 class ReducedModel:
     stiffness: _F
     mass: _F
@@ -219,6 +249,14 @@ def accuracy_study(
 ) -> AccuracyStudy: ...
 def linear(scene: Union[Scene, str], case: str = ..., points: Optional[int] = ...) -> LinearResult: ...
 def modes(scene: Union[Scene, str], count: int = ..., case: str = ...) -> ModesResult: ...
+def nonlinear_modes(
+    scene: Union[Scene, str],
+    mode: Optional[int] = ...,
+    mode_freq_hz: Optional[float] = ...,
+    dof: Optional[str] = ...,
+    amplitude: Optional[Sequence[float]] = ...,
+    max_points: Optional[int] = ...,
+) -> NonlinearModesResult: ...
 def reduce(
     K: Any, M: Any, boundary: Sequence[int], modes: int, recover: Optional[Sequence[int]] = ...
 ) -> ReducedModel: ...

@@ -400,6 +400,86 @@ class ModesResult(_Result):
         return f"ModesResult({self.case}: {np.round(self.frequency_hz, 3).tolist()} Hz)"
 
 
+class NonlinearMode(_Result):
+    """One nonlinear mode (a case of :class:`NonlinearModesResult`), one entry per continuation
+    point, rising along the path: ``modal_amplitude`` a (kg^½·m; the first-harmonic motion is
+    a ψ₁ with ψ₁ᵀMψ₁ = 1), ``amplitude`` (first-harmonic amplitude at the mode's DOF, m),
+    ``freq_hz``, ``damping_ratio`` (D = ξ/2ω), ``xi`` (the artificial damping ξ, 1/s),
+    ``dissipated_energy`` and ``friction_energy`` (per cycle, J), ``states`` (points ×
+    contacts, str), ``coefficients`` (points × DOFs·blocks, m, harmonic-major as
+    :attr:`ContinuationPath.coefficients`), ``newton_iterations``; and ``mode`` (its number),
+    ``linear_freq_hz``, ``linear_damping_ratio`` (the linear mode at rest), ``status``, and
+    ``predicted_peak`` (``amplitude`` m, ``freq_hz``, ``modal_amplitude``: the resonance peak
+    under the scene's harmonic loads by single-nonlinear-mode theory) or None."""
+
+    predicted_peak: Optional[dict] = None
+
+    def to_pandas(self):
+        """One row per point: ``modal_amplitude``, ``amplitude``, ``freq_hz``,
+        ``damping_ratio``, ``xi``, ``dissipated_energy``, ``friction_energy``,
+        ``<contact>_state``."""
+        pd = _pandas()
+        columns = {
+            k: getattr(self, k)
+            for k in (
+                "modal_amplitude",
+                "amplitude",
+                "freq_hz",
+                "damping_ratio",
+                "xi",
+                "dissipated_energy",
+                "friction_energy",
+            )
+        }
+        for j, name in enumerate(self.contacts):
+            columns[f"{name}_state"] = [row[j] for row in self.states]
+        return pd.DataFrame(columns)
+
+    def __repr__(self) -> str:
+        return f"NonlinearMode(mode {self.mode}, {len(self.freq_hz)} points, {self.status})"
+
+
+class NonlinearModesResult(_Result):
+    """The nonlinear mode(s) of a scene (:func:`fricbound.nonlinear_modes`, as ``fricbound run``
+    writes ``modes_nl.csv``): ``cases`` maps each case name (``scene`` without ``[limits]``;
+    ``m+1``, ``m-1``, per-side combinations and the intermediate cases with it) to a
+    :class:`NonlinearMode` (or, for a failed case, a dict with its ``status``); ``case_names``
+    in order; ``dof`` and ``amplitude_range`` (m); ``status``; ``band`` (with ``[limits]``):
+    ``amplitude``, ``freq_min_hz``, ``freq_max_hz``, ``damping_min``, ``damping_max`` arrays
+    and ``wide`` stretches [from, to] (m). The arrays of the first case are also attributes of
+    the result itself (``result.freq_hz`` is ``result.cases[result.case_names[0]].freq_hz``)."""
+
+    band: Optional[dict] = None
+
+    def __init__(self, fields: Dict[str, Any]):
+        names = {k: fields[k] for k in ("dofs", "outputs", "contacts")}
+        cases = {}
+        for name, entry in fields.pop("cases").items():
+            cases[name] = NonlinearMode({**entry, **names}) if "freq_hz" in entry else entry
+        fields["cases"] = cases
+        super().__init__(fields)
+        first = cases.get(self.case_names[0])
+        if isinstance(first, NonlinearMode):
+            for k, v in first.__dict__.items():
+                if k not in self.__dict__:
+                    self.__dict__[k] = v
+
+    def to_pandas(self):
+        """One row per point of every case, with a ``case`` column first."""
+        pd = _pandas()
+        frames = []
+        for name in self.case_names:
+            mode = self.cases[name]
+            if isinstance(mode, NonlinearMode):
+                frame = mode.to_pandas()
+                frame.insert(0, "case", name)
+                frames.append(frame)
+        return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
+
+    def __repr__(self) -> str:
+        return f"NonlinearModesResult({', '.join(self.case_names)}: {self.status})"
+
+
 class ReducedModel(_Result):
     """A Craig-Bampton reduced model (:func:`fricbound.reduce`): ``stiffness`` and ``mass``
     (r × r, r = boundary DOFs + modes), ``boundary`` (full indices of the first coordinates),

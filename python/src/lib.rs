@@ -16,6 +16,7 @@
 //! ([`fricbound::numerics::interrupt`]) and is raised once they have.
 
 mod convert;
+mod modes_nl;
 mod solve;
 
 use pyo3::prelude::*;
@@ -41,6 +42,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve::limits, m)?)?;
     m.add_function(wrap_pyfunction!(solve::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(solve::modes, m)?)?;
+    m.add_function(wrap_pyfunction!(modes_nl::nonlinear_modes, m)?)?;
     m.add_function(wrap_pyfunction!(solve::reduce, m)?)?;
     m.add_function(wrap_pyfunction!(solve::verify, m)?)?;
     m.add_function(wrap_pyfunction!(solve::linear, m)?)?;

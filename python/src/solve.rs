@@ -73,7 +73,7 @@ pub fn scene_from_json(json: &str, label: &str) -> PyResult<String> {
 }
 
 /// Parses and validates a scene: the scene, the checked problem, its limit settings.
-fn load(
+pub(crate) fn load(
     text: &str,
     label: &str,
     overrides: &[String],
@@ -126,7 +126,7 @@ pub fn check<'py>(
 }
 
 /// A progress event sent by a solve on the worker thread.
-enum Event {
+pub(crate) enum Event {
     /// An FRF point converged.
     Point {
         freq_hz: f64,
@@ -205,7 +205,11 @@ const SIGNAL_POLL: Duration = Duration::from_millis(100);
 /// `check_signals`), or an exception raised by the callback, requests the library's
 /// continuation runs to stop ([`interrupt::request`]); the job then ends within about one
 /// continuation step per thread, the request is withdrawn and the exception raised.
-fn in_background<T, F>(py: Python<'_>, progress: Option<&Py<PyAny>>, job: F) -> PyResult<T>
+pub(crate) fn in_background<T, F>(
+    py: Python<'_>,
+    progress: Option<&Py<PyAny>>,
+    job: F,
+) -> PyResult<T>
 where
     T: Send,
     F: FnOnce(mpsc::Sender<Event>) -> T + Send,

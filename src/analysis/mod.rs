@@ -50,6 +50,9 @@
 //!   above the dense limit (`analysis.hill_solver`, [`stability_sparse::point_stability_with`]).
 //! - [`verify::verify_point`]: time integration (Newmark, implicit contact return mapping) from
 //!   a harmonic-balance point to its steady state, with a dt check ([`verify::PointVerification`]).
+//! - [`nonlinear_modes::solve`]: a nonlinear mode by EPMC (backbone frequency, modal damping
+//!   ratio and shape against the modal amplitude, Krack 2015) as a
+//!   [`nonlinear_modes::NonlinearModeRun`].
 //! - [`monodromy::monodromy_stability`]: Floquet multipliers of the time integration's periodic
 //!   orbit (shooting, monodromy matrix by central differences of the period map, sliders as
 //!   state), the independent check of Hill's verdict ([`monodromy::MonodromyStability`]).
@@ -61,6 +64,7 @@ pub mod limits;
 pub mod linear;
 pub mod modes;
 pub mod monodromy;
+pub mod nonlinear_modes;
 pub mod peaks;
 pub mod stability;
 pub mod stability_sparse;

@@ -195,12 +195,19 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
             .collect::<Vec<_>>()
             .join(", ")
     );
+    if let Some(line) = mode_line(&label, &problem, limits.is_some())? {
+        s.push_str(&line);
+    }
     if let Some(l) = &limits {
-        let cases: Vec<String> = crate::analysis::limits::two_point_cases(&problem)
-            .into_iter()
-            .chain(l.intermediate_cases(&problem))
-            .map(|c| c.name)
-            .collect();
+        let cases = if problem.analysis.nonlinear_modes.is_some() {
+            crate::analysis::nonlinear_modes::mode_cases(&problem, l)
+        } else {
+            crate::analysis::limits::two_point_cases(&problem)
+                .into_iter()
+                .chain(l.intermediate_cases(&problem))
+                .collect()
+        };
+        let cases: Vec<String> = cases.into_iter().map(|c| c.name).collect();
         let _ = writeln!(
             s,
             "limits       curves {}; grid {} points; bound scan {:?}; peak window {}",
@@ -302,6 +309,41 @@ fn more_line(s: &mut String, total: usize) {
     if total > CHECK_LISTED {
         let _ = writeln!(s, "  ... and {} more", total - CHECK_LISTED);
     }
+}
+
+/// The line of a nonlinear-mode scene: the mode, its linear frequency and damping ratio at
+/// rest, the amplitude range and DOF; an error when the mode cannot start (no such mode, the
+/// DOF at a node of it). None for an FRF scene.
+fn mode_line(
+    label: &str,
+    problem: &crate::model::Problem,
+    with_limits: bool,
+) -> Result<Option<String>, CommandError> {
+    let Some(m) = problem.analysis.nonlinear_modes else {
+        return Ok(None);
+    };
+    let free = crate::analysis::nonlinear_modes::autonomous(problem);
+    let start =
+        crate::analysis::nonlinear_modes::linear_start(&free, m.mode, m.dof).map_err(|source| {
+            CommandError::NonlinearMode {
+                scene: label.to_string(),
+                source,
+            }
+        })?;
+    Ok(Some(format!(
+        "nonlinear mode {} by EPMC (linear at rest: {:.4} Hz, modal damping ratio {:.3e}); amplitude {:e} .. {:e} m at {}; harmonic loads left out{}\n",
+        start.number,
+        start.omega / std::f64::consts::TAU,
+        start.xi / (2.0 * start.omega),
+        m.amplitude[0],
+        m.amplitude[1],
+        problem.model.dof_names[m.dof],
+        if with_limits {
+            ", one mode per limit case"
+        } else {
+            ""
+        }
+    )))
 }
 
 #[cfg(test)]

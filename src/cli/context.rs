@@ -100,6 +100,14 @@ pub enum CommandError {
         /// What failed.
         reason: String,
     },
+    /// A nonlinear mode could not be computed.
+    #[error("{scene}: {source}")]
+    NonlinearMode {
+        /// Scene label.
+        scene: String,
+        /// Cause.
+        source: crate::analysis::nonlinear_modes::NonlinearModeError,
+    },
     /// A linear reference failed.
     #[error("{scene}: linear reference: {reason}")]
     Linear {
@@ -166,6 +174,9 @@ pub enum RunOutcome {
     Limits(Box<crate::analysis::limits::LimitAnalysis>),
     /// A parameter sweep, points in [`crate::study::sweep::sweep_points`] order.
     Sweep(Vec<crate::study::sweep::SweepPoint>),
+    /// Nonlinear modes: the scene's (one case named `scene`), or one per limit case with their
+    /// band.
+    NonlinearModes(Box<crate::analysis::nonlinear_modes::ModeLimits>),
 }
 
 /// Everything a run kind needs: the scene, the checked problem, the output folder and the

@@ -14,8 +14,9 @@
 //! - [`mesh`] (`fricbound mesh`): generates the blade-pair mesh;
 //! - [`modes`] (`fricbound modes`, `fricbound reduce`): natural frequencies of the full and
 //!   reduced models, the reduced model written out;
-//! - `frf_run`, `limits_run`, `sweep_run`: the three kinds of `fricbound run`, one FRF, a limit
-//!   analysis (`[limits]`), a parameter sweep of it (`[sweep]`);
+//! - `frf_run`, `limits_run`, `sweep_run`, `modes_nl_run`: the kinds of `fricbound run`, one
+//!   FRF, a limit analysis (`[limits]`), a parameter sweep of it (`[sweep]`), nonlinear modes
+//!   (`analysis.kind = "nonlinear-modes"`, with or without `[limits]`);
 //! - [`run()`] (`fricbound run`): reads and checks the scene, prepares the output folder and
 //!   hands the run to its kind;
 //! - [`paper`] (`fricbound paper`): runs the scenes of the paper's §4 study
@@ -34,6 +35,7 @@ mod frf_run;
 mod limits_run;
 pub mod mesh;
 pub mod modes;
+mod modes_nl_run;
 pub mod paper;
 mod run;
 pub mod study;

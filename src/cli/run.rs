@@ -1,12 +1,13 @@
 //! `fricbound run` itself: reads and checks the scene, refuses a problem too large for the
 //! machine, prepares the output folder and the linear references, then hands the run to its
-//! kind: a sweep (`sweep_run`), a limit analysis (`limits_run`) or one FRF (`frf_run`).
+//! kind: nonlinear modes (`modes_nl_run`), a sweep (`sweep_run`), a limit analysis
+//! (`limits_run`) or one FRF (`frf_run`).
 
 use super::context::{
     create_dir, default_out_dir, figure_title, linear_references, parallel_solves, CommandError,
     RunContext, RunOptions, RunReport,
 };
-use super::{frf_run, limits_run, sweep_run};
+use super::{frf_run, limits_run, modes_nl_run, sweep_run};
 use crate::scene::{self, SceneError};
 
 /// `fricbound run`: solves the scene and writes results, linear references and figures.
@@ -58,6 +59,9 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
         stuck,
         options,
     };
+    if ctx.problem.analysis.nonlinear_modes.is_some() {
+        return modes_nl_run::run_modes(&ctx);
+    }
     if ctx.scene.sweep.is_some() {
         return sweep_run::run_sweep(&ctx);
     }

@@ -16,6 +16,6 @@ pub mod reduce;
 
 pub use problem::{
     Analysis, BeyondLinearRange, Coupling, DofSplit, Effects, ErrorEstimateSettings, FeOrigin,
-    Formulation, HarmonicLoad, HillSolve, JacobianStrategy, LinearModel, Problem, StabilityMethod,
-    CHORD_MIN_UNKNOWNS,
+    Formulation, HarmonicLoad, HillSolve, JacobianStrategy, LinearModel, ModeAnalysis, ModeChoice,
+    Problem, StabilityMethod, CHORD_MIN_UNKNOWNS,
 };

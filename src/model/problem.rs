@@ -196,6 +196,30 @@ pub struct Analysis {
     pub hill_max_freq_hz: Option<f64>,
     /// The a-posteriori error estimate on every converged point (scene table `[accuracy]`).
     pub error_estimate: ErrorEstimateSettings,
+    /// A nonlinear-mode analysis (`analysis.kind = "nonlinear-modes"`) in place of the FRF;
+    /// None: the FRF over the range.
+    pub nonlinear_modes: Option<ModeAnalysis>,
+}
+
+/// Which linear mode of the structure at rest a nonlinear mode continues.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub enum ModeChoice {
+    /// The k-th elastic mode (1-based, ascending frequency).
+    Number(usize),
+    /// The elastic mode whose frequency is nearest this one (Hz).
+    NearestHz(f64),
+}
+
+/// What a nonlinear-mode analysis asks (scene fields `analysis.mode` or
+/// `analysis.mode_freq_hz`, `analysis.dof`, `analysis.amplitude`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ModeAnalysis {
+    /// The mode.
+    pub mode: ModeChoice,
+    /// DOF whose first-harmonic sine is fixed at zero and at which the range is given.
+    pub dof: usize,
+    /// First-harmonic amplitude range at `dof` (m), low to high.
+    pub amplitude: [f64; 2],
 }
 
 /// Settings of the a-posteriori error estimate computed on every converged continuation point

@@ -17,6 +17,8 @@
 //! - [`mesh_modes`]: the stuck-contact modes on the FE mesh (VTU);
 //! - [`modes_files`]: the files of `fricbound modes` (frequencies of the full and reduced
 //!   models side by side, damped modes, mode shapes, `modes.json`);
+//! - [`modes_nl_files`]: the files of a nonlinear-mode run (`modes_nl.csv`, `modes_nl.json`,
+//!   the band of its limit cases, the backbone figures);
 //! - [`reduced_files`]: the files of `fricbound reduce` (K_r, M_r, C_r as Matrix Market, the
 //!   reduced DOF map, the recovery rows) and the reduction report in JSON.
 //! - [`stability_columns`]: the Hill-stability columns of `frf.csv` and `curve_*.csv`.
@@ -26,6 +28,7 @@ pub mod limit_files;
 pub mod mesh_modes;
 pub mod mesh_results;
 pub mod modes_files;
+pub mod modes_nl_files;
 pub mod owned;
 pub mod plot;
 pub mod reduced_files;

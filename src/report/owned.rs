@@ -7,7 +7,9 @@
 //! [`crate::report::plot`] as `fricbound run` names them (`frf_*`, `limits_*`, `hysteresis_*`,
 //! `optimal_*`, `resonance_*`, `bands_*`, PNG and SVG), the limit-analysis tables of
 //! [`crate::report::limit_files`] (`limits.csv`, `peaks.csv`, `curve_*.csv`,
-//! `hysteresis_*.csv`, `limits.json`), the sweep's (`sweep.csv`, `sweep.json`,
+//! `hysteresis_*.csv`, `limits.json`), the nonlinear modes' of
+//! [`crate::report::modes_nl_files`] (`modes_nl.csv`, `modes_nl.json`, `modes_nl_band.csv`,
+//! `modes_nl_*` figures), the sweep's (`sweep.csv`, `sweep.json`,
 //! `variability.csv`), the results on the mesh of [`crate::report::mesh_results`] and
 //! [`crate::report::mesh_modes`] (`response_peak.vtu`, `peak_*.vtu`, `modes_stuck.vtu`), and
 //! the temporaries of atomic writes (`<owned name>.partial`). A sweep with
@@ -37,6 +39,9 @@ pub const OWNED_FILES: &[&str] = &[
     "sweep.csv",
     "sweep.json",
     "variability.csv",
+    "modes_nl.csv",
+    "modes_nl.json",
+    "modes_nl_band.csv",
 ];
 
 /// Result files named `<prefix><anything><suffix>`: figures per output DOF or contact, one
@@ -50,6 +55,7 @@ pub const OWNED_PATTERNS: &[(&str, &[&str])] = &[
     ("bands_", &[".png", ".svg"]),
     ("curve_", &[".csv"]),
     ("peak_", &[".vtu"]),
+    ("modes_nl_", &[".png", ".svg"]),
 ];
 
 /// Suffix of the temporary file of an atomic write ([`crate::report::files::write_atomic`]).

@@ -205,6 +205,7 @@ pub(super) fn analysis(a: &AnalysisSpec, ck: &Checker) -> Result<Analysis, Scene
         hill_solver: a.hill_solver.unwrap_or_default(),
         hill_max_freq_hz: a.hill_max_freq_hz,
         error_estimate: ErrorEstimateSettings::default(),
+        nonlinear_modes: None,
     })
 }
 

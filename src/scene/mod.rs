@@ -36,6 +36,7 @@ mod check_contacts;
 mod check_limits;
 mod check_loads;
 mod check_model;
+mod check_modes;
 mod check_sweep;
 mod checker;
 mod cone;

@@ -363,6 +363,41 @@ pub struct AnalysisSpec {
     /// every mode of the model. Applies to the shift-invert solve only.
     #[serde(default)]
     pub hill_max_freq_hz: Option<f64>,
+    /// What is computed: `"frf"` (default, the forced response over the range) or
+    /// `"nonlinear-modes"` (a nonlinear mode by EPMC, `docs/src/nonlinear-modes.md`).
+    #[serde(default, skip_serializing_if = "AnalysisKind::is_frf")]
+    pub kind: AnalysisKind,
+    /// Nonlinear modes: the mode's number among the elastic modes at rest (1-based).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mode: Option<usize>,
+    /// Nonlinear modes: the mode nearest this frequency (Hz), in place of `mode`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mode_freq_hz: Option<f64>,
+    /// Nonlinear modes: the DOF that fixes the phase and at which the amplitude range is given;
+    /// default the first output DOF.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dof: Option<String>,
+    /// Nonlinear modes: the first-harmonic amplitude range [low, high] at `dof` (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub amplitude: Option<[f64; 2]>,
+}
+
+/// What an analysis computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AnalysisKind {
+    /// The forced response over the frequency range.
+    #[default]
+    Frf,
+    /// A nonlinear mode by EPMC.
+    NonlinearModes,
+}
+
+impl AnalysisKind {
+    /// Whether this is the default (then left out of the canonical scene).
+    pub fn is_frf(&self) -> bool {
+        *self == AnalysisKind::Frf
+    }
 }
 
 /// Default most continuation points.

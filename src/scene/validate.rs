@@ -23,6 +23,7 @@ use crate::scene::check_loads::{harmonic_loads, harmonic_set, static_load};
 use crate::scene::check_model::{
     build_model, check_stuck_structure, reduce_problem, reduction_settings, stiffness_scale,
 };
+use crate::scene::check_modes::mode_analysis;
 use crate::scene::check_sweep::{check_sweep, check_sweep_points};
 use crate::scene::checker::{Checker, DofNames};
 use crate::scene::error::SceneError;
@@ -72,6 +73,8 @@ impl Scene {
         let problem = reduce_problem(reduction.as_ref(), &ck, problem)?;
         check_stuck_structure(&ck, &problem)?;
         held?;
+        let mut problem = problem;
+        problem.analysis.nonlinear_modes = mode_analysis(self, &ck, &problem, limits.as_ref())?;
         if problem.analysis.formulation == Formulation::Schur {
             check_relative_coordinates(&problem)
                 .map_err(|e| ck.err("analysis.formulation", e.to_string()))?;

@@ -39,6 +39,7 @@ mod hard_cases;
 mod limits;
 mod limits_unfinished;
 mod monodromy;
+mod nonlinear_modes;
 mod outputs;
 mod paper;
 mod paper_case;

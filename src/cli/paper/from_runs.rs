@@ -309,7 +309,7 @@ pub fn key_numbers(figures: &[FigureResult]) -> KeyNumbers {
                     }
                 }
             }
-            RunOutcome::Frf(_) => {}
+            RunOutcome::Frf(_) | RunOutcome::NonlinearModes(_) => {}
         }
     }
     // Figures that compute the envelope in the full study, run without it (`--quick`).

@@ -1,0 +1,55 @@
+"""fricbound.nonlinear_modes against the CLI's modes_nl.csv and the scene checks."""
+
+import subprocess
+
+import numpy as np
+import pytest
+
+import fricbound
+from fricbound import Scene
+
+from conftest import PAPER
+
+
+def test_mode_equals_the_cli_and_has_a_pandas_table(cli_binary, tmp_path):
+    """The shipped nonlinear-mode scene solved from Python gives the CLI's modes_nl.csv numbers
+    case by case, and the tables hold every point."""
+    scene = PAPER / "modes-3rd.toml"
+    out = tmp_path / "cli"
+    subprocess.run([str(cli_binary), "run", str(scene), "--quiet", "--out", str(out)], check=True)
+    rows = np.genfromtxt(out / "modes_nl.csv", delimiter=",", names=True, dtype=None, encoding="utf-8")
+
+    result = fricbound.nonlinear_modes(str(scene))
+    assert result.complete, result.status
+    assert result.case_names == ["m+1", "m-1", "left-1_right+1", "left+1_right-1", "m0"]
+    for name in result.case_names:
+        mode = result.cases[name]
+        mine = rows[rows["case"] == name]
+        np.testing.assert_allclose(mode.freq_hz, mine["freq_hz"], rtol=1e-9)
+        np.testing.assert_allclose(mode.damping_ratio, mine["damping_ratio"], rtol=1e-9)
+        np.testing.assert_allclose(mode.amplitude, mine["y2_amp"], rtol=1e-9)
+        assert mode.mode == 3
+        assert abs(mode.linear_freq_hz - 225.0791) < 1e-3
+    assert result.band is not None and len(result.band["amplitude"]) > 10
+    table = result.to_pandas()
+    assert len(table) == len(rows)
+    assert list(table.columns[:4]) == ["case", "modal_amplitude", "amplitude", "freq_hz"]
+    assert "right_state" in table.columns
+
+
+def test_keywords_set_the_mode_and_bad_input_names_the_field():
+    """Without [limits] one case, the scene's; the 2nd mode of the paper scene chosen by its
+    nearest frequency falls from 162 Hz as the damper slips, with a predicted peak for the
+    paper's excitation; a reversed range raises ValueError naming analysis.amplitude."""
+    scene = Scene.paper()
+    result = fricbound.nonlinear_modes(scene, mode_freq_hz=150.0, dof="y2", amplitude=[1e-7, 1e-3])
+    assert result.complete, result.status
+    assert result.case_names == ["scene"]
+    assert result.cases["scene"].mode == 2
+    assert abs(result.freq_hz[0] - 161.981) < 1e-2
+    assert result.freq_hz[-1] < result.freq_hz[0] - 1.0
+    assert np.all(np.diff(result.amplitude) != 0)
+    peak = result.predicted_peak
+    assert peak is not None and 1e-4 < peak["amplitude"] < 1e-3
+    with pytest.raises(ValueError, match="analysis.amplitude"):
+        fricbound.nonlinear_modes(scene, mode=2, dof="y2", amplitude=[1e-3, 1e-7])

@@ -1,0 +1,326 @@
+//! The nonlinear-mode run: settings, the continuation in log amplitude from the linear mode,
+//! and what each converged point reports.
+
+use std::f64::consts::{PI, TAU};
+use std::time::Instant;
+
+pub use super::error::NonlinearModeError;
+use super::operator::{EpmcOperator, LogAmplitude};
+use super::start::{linear_start, start_guess, LinearStart};
+use crate::contact::harmonic::{Block, HarmonicSet};
+use crate::contact::ContactState;
+use crate::model::Problem;
+use crate::numerics::path::{ContinuationError, Observer, PathPoint};
+use crate::numerics::{Continuation, ContinuationSettings, PathEnd};
+
+pub use crate::model::ModeChoice;
+
+/// What a nonlinear-mode run is asked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NonlinearModeSettings {
+    /// The mode.
+    pub mode: ModeChoice,
+    /// DOF whose first-harmonic sine is fixed at zero (the phase condition) and whose
+    /// first-harmonic amplitude the range is given at.
+    pub dof: usize,
+    /// First-harmonic amplitude range at `dof` (m), low to high. Converted to the modal
+    /// amplitude a with the linear mode's shape (a = A / |φ_dof|): the continuation runs from
+    /// a_min to a_max; the amplitude at the DOF of each point is the computed one.
+    pub amplitude: [f64; 2],
+    /// Most continuation points.
+    pub max_points: usize,
+}
+
+impl NonlinearModeSettings {
+    /// The settings of the problem's nonlinear-mode analysis (scene `analysis.kind =
+    /// "nonlinear-modes"`), with the point budget `analysis.max_points`; None for an FRF scene.
+    pub fn of_problem(problem: &Problem) -> Option<Self> {
+        problem.analysis.nonlinear_modes.map(|m| Self {
+            mode: m.mode,
+            dof: m.dof,
+            amplitude: m.amplitude,
+            max_points: problem.analysis.continuation.max_points,
+        })
+    }
+}
+
+/// One converged point of a nonlinear mode.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct NonlinearModePoint {
+    /// Modal amplitude a (kg^½·m): the first-harmonic part of the motion is a ψ₁ with
+    /// ψ₁ᵀ M ψ₁ = 1 (cosine and sine blocks).
+    pub modal_amplitude: f64,
+    /// First-harmonic amplitude at the settings' DOF (m).
+    pub dof_amplitude: f64,
+    /// Angular frequency ω (rad/s).
+    pub omega: f64,
+    /// Frequency ω/2π (Hz).
+    pub freq_hz: f64,
+    /// Artificial damping ξ (1/s) of M q̈ + (C − ξ M) q̇ + … (Krack 2015).
+    pub xi: f64,
+    /// Modal damping ratio D = ξ / (2ω) (–).
+    pub damping_ratio: f64,
+    /// Energy dissipated per cycle by the viscous damping and the contacts (J):
+    /// ξ π ω Σ_h h² (q_chᵀ M q_ch + q_shᵀ M q_sh), the energy the artificial damping feeds in.
+    pub dissipated_energy: f64,
+    /// Of it, the part dissipated by the contacts (J): the above less
+    /// π ω Σ_h h² (q_chᵀ C q_ch + q_shᵀ C q_sh).
+    pub friction_energy: f64,
+    /// Contact state of each contact over the period.
+    pub states: Vec<ContactState>,
+    /// The motion's Fourier coefficients (m), harmonic-major, as in an FRF point.
+    pub coefficients: Vec<f64>,
+    /// Newton iterations.
+    pub newton_iterations: usize,
+    /// Final residual relative to the residual scale.
+    pub residual: f64,
+}
+
+/// How a nonlinear-mode run ended.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub enum NonlinearModeEnd {
+    /// The continuation reached the highest amplitude asked.
+    Reached,
+    /// The point budget ran out first.
+    MaxPoints,
+    /// The path turned back below the lowest amplitude.
+    LeftRange,
+    /// The continuation stalled (the reason as text).
+    Stalled(String),
+}
+
+/// A nonlinear mode: the linear mode it starts from and the converged points, rising in
+/// amplitude.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct NonlinearModeRun {
+    /// The linear mode's number (1-based).
+    pub mode: usize,
+    /// Its frequency (Hz).
+    pub linear_freq_hz: f64,
+    /// Its modal damping ratio φᵀCφ / (2ω₀) (–).
+    pub linear_damping_ratio: f64,
+    /// The modal amplitude range asked (kg^½·m).
+    pub modal_range: [f64; 2],
+    /// The points.
+    pub points: Vec<NonlinearModePoint>,
+    /// How it ended.
+    pub end: NonlinearModeEnd,
+    /// Wall-clock time (s).
+    pub elapsed_s: f64,
+}
+
+impl NonlinearModeRun {
+    /// Whether the run reached the highest amplitude asked.
+    pub fn is_complete(&self) -> bool {
+        self.end == NonlinearModeEnd::Reached
+    }
+
+    /// Why the run is incomplete, in words; None when complete.
+    pub fn incomplete_reason(&self) -> Option<String> {
+        let reached = self.points.last().map_or(0.0, |p| p.modal_amplitude);
+        match &self.end {
+            NonlinearModeEnd::Reached => None,
+            NonlinearModeEnd::MaxPoints => Some(format!(
+                "point budget used up at modal amplitude {reached:.4e} of {:.4e}",
+                self.modal_range[1]
+            )),
+            NonlinearModeEnd::LeftRange => {
+                Some("the path turned back below the lowest amplitude".to_string())
+            }
+            NonlinearModeEnd::Stalled(reason) => Some(format!(
+                "continuation stalled at modal amplitude {reached:.4e} of {:.4e}: {reason}",
+                self.modal_range[1]
+            )),
+        }
+    }
+}
+
+/// Arc-length step settings (in decades of a, and the scales of [`arc_length_scale`]).
+const INITIAL_STEP: f64 = 0.05;
+const MIN_STEP: f64 = 1e-6;
+const MAX_STEP: f64 = 0.25;
+
+/// The autonomous problem: the same structure, contacts and static loads, no harmonic loads.
+pub fn autonomous(problem: &Problem) -> Problem {
+    let mut p = problem.clone();
+    p.harmonic_loads.clear();
+    p
+}
+
+/// Computes a nonlinear mode of `problem` by EPMC (module docs).
+pub fn solve(
+    problem: &Problem,
+    settings: &NonlinearModeSettings,
+) -> Result<NonlinearModeRun, NonlinearModeError> {
+    let started = Instant::now();
+    let [low, high] = settings.amplitude;
+    if !(low > 0.0 && high > low && high.is_finite()) {
+        return Err(NonlinearModeError::BadRange { low, high });
+    }
+    let free = autonomous(problem);
+    let set = free.unknown_harmonics();
+    if set.cos_block(1).is_none() {
+        return Err(NonlinearModeError::NoFirstHarmonic);
+    }
+    let start = linear_start(&free, settings.mode, settings.dof)?;
+    let at_dof = start.shape[settings.dof].abs();
+    let map = LogAmplitude {
+        a_min: low / at_dof,
+    };
+    let a_max = high / at_dof;
+    let m_phi = mass_times(&free, &start.shape);
+    let row_scale = start.omega * start.omega * crate::numerics::linalg::norm(&m_phi);
+    let mut op = EpmcOperator::new(&free, start.statics.clone(), settings.dof, map, row_scale)?;
+    let y0 = start_guess(&free, &set, &start);
+    let base = problem.analysis.continuation;
+    let continuation_settings = ContinuationSettings {
+        freq_start_hz: 1.0,
+        freq_end_hz: map.decade(a_max),
+        initial_step: INITIAL_STEP,
+        min_step: MIN_STEP,
+        max_step: MAX_STEP,
+        max_points: settings.max_points,
+        ..base
+    };
+    let scale = arc_length_scale(&free, &set, &start);
+    let mut continuation = Continuation::new(continuation_settings, scale);
+    let mut collect = Collect {
+        points: Vec::new(),
+        settings,
+    };
+    let outcome = continuation.run(&mut op, &y0, &mut collect);
+    let end = match outcome {
+        Ok(summary) => match summary.end {
+            PathEnd::EndFrequency => NonlinearModeEnd::Reached,
+            PathEnd::MaxPoints => NonlinearModeEnd::MaxPoints,
+            PathEnd::LeftRangeBelow => NonlinearModeEnd::LeftRange,
+        },
+        Err(ContinuationError::Start { reason, .. }) => {
+            return Err(NonlinearModeError::Start(reason))
+        }
+        Err(e @ ContinuationError::Stalled { .. })
+        | Err(e @ ContinuationError::Interrupted { .. }) => {
+            NonlinearModeEnd::Stalled(stall_reason(&e))
+        }
+    };
+    Ok(NonlinearModeRun {
+        mode: start.number,
+        linear_freq_hz: start.omega / TAU,
+        linear_damping_ratio: start.xi / (2.0 * start.omega),
+        modal_range: [map.a_min, a_max],
+        points: collect.points,
+        end,
+        elapsed_s: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// The continuation's error in the words of a mode (its "frequency" is the decade of a).
+fn stall_reason(e: &ContinuationError) -> String {
+    match e {
+        ContinuationError::Stalled { step, reason, .. } => {
+            format!("step {step:.3e} below minimum: {reason}")
+        }
+        ContinuationError::Interrupted { .. } => "interrupted".to_string(),
+        ContinuationError::Start { reason, .. } => reason.to_string(),
+    }
+}
+
+/// M v.
+fn mass_times(problem: &Problem, v: &[f64]) -> Vec<f64> {
+    let mut out = vec![0.0; v.len()];
+    problem.model.mass.mul_add(1.0, v, &mut out);
+    out
+}
+
+/// Scales of the unknowns in the arc length, so that one unit (a decade of a) is also a change
+/// of a quarter of the shape's norm in the harmonics h ≥ 1 of ψ, of the shape's norm in its 0th
+/// harmonic (the static shift relative to a, which can be many times the motion where the
+/// structure is soft against the contacts: a contact that slipped once and stuck again holds
+/// an offset of μN over the structure's stiffness), of 5 % of the linear frequency, or of 1 %
+/// in the damping ratio (Δξ = 0.02 ω₀).
+fn arc_length_scale(problem: &Problem, set: &HarmonicSet, start: &LinearStart) -> Vec<f64> {
+    let n = problem.model.n_dofs();
+    let norm = crate::numerics::linalg::norm(&start.shape).max(f64::MIN_POSITIVE);
+    let mut scale: Vec<f64> = set
+        .blocks()
+        .iter()
+        .flat_map(|b| {
+            let s = if *b == Block::Constant {
+                norm
+            } else {
+                0.25 * norm
+            };
+            std::iter::repeat_n(s, n)
+        })
+        .collect();
+    scale.push(0.05 * start.omega);
+    scale.push(0.02 * start.omega);
+    scale
+}
+
+/// Collects the converged points as [`NonlinearModePoint`]s.
+struct Collect<'s> {
+    points: Vec<NonlinearModePoint>,
+    settings: &'s NonlinearModeSettings,
+}
+
+impl<'p> Observer<EpmcOperator<'p>> for Collect<'_> {
+    fn accepted(&mut self, op: &mut EpmcOperator<'p>, point: &PathPoint, _normal: Option<&[f64]>) {
+        let states = op.system().states.clone();
+        self.points
+            .push(mode_point(op, point, self.settings.dof, states));
+    }
+}
+
+/// A converged path point as a mode point.
+fn mode_point(
+    op: &EpmcOperator<'_>,
+    point: &PathPoint,
+    dof: usize,
+    states: Vec<ContactState>,
+) -> NonlinearModePoint {
+    let a = op.map().amplitude(point.omega);
+    let dim_h = op.harmonic_dim();
+    let (omega, xi) = (point.x[dim_h], point.x[dim_h + 1]);
+    let x = op.physical(&point.x, a);
+    let (cos1, sin1) = op.first_harmonic();
+    let n = x.len() / op.unknowns().n_blocks();
+    let dof_amplitude = x[cos1 * n + dof].hypot(x[sin1 * n + dof]);
+    let (kinetic, viscous) = velocity_norms(op, &x);
+    let dissipated = xi * PI * omega * kinetic;
+    NonlinearModePoint {
+        modal_amplitude: a,
+        dof_amplitude,
+        omega,
+        freq_hz: omega / TAU,
+        xi,
+        damping_ratio: xi / (2.0 * omega),
+        dissipated_energy: dissipated,
+        friction_energy: dissipated - PI * omega * viscous,
+        states,
+        coefficients: x,
+        newton_iterations: point.iterations,
+        residual: point.residual,
+    }
+}
+
+/// Σ_h h² (q_chᵀ M q_ch + q_shᵀ M q_sh) and the same with C.
+fn velocity_norms(op: &EpmcOperator<'_>, x: &[f64]) -> (f64, f64) {
+    let set = op.unknowns().clone();
+    let model = &op.problem().model;
+    let n = model.n_dofs();
+    let (mut m_sum, mut c_sum) = (0.0, 0.0);
+    for (j, b) in set.blocks().iter().enumerate() {
+        let h = b.harmonic() as f64;
+        if h == 0.0 {
+            continue;
+        }
+        let q = &x[j * n..(j + 1) * n];
+        let (mut mq, mut cq) = (vec![0.0; n], vec![0.0; n]);
+        model.mass.mul_add(1.0, q, &mut mq);
+        model.damping.mul_add(1.0, q, &mut cq);
+        m_sum += h * h * q.iter().zip(&mq).map(|(a, b)| a * b).sum::<f64>();
+        c_sum += h * h * q.iter().zip(&cq).map(|(a, b)| a * b).sum::<f64>();
+    }
+    (m_sum, c_sum)
+}

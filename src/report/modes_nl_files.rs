@@ -1,0 +1,215 @@
+//! The files of a nonlinear-mode run: `modes_nl.csv` (every point of every case),
+//! `modes_nl.json` (status, run metadata, each case's mode with its shape harmonics, the
+//! resonance peak and forced response predicted from it for the scene's harmonic loads, and
+//! the band of the cases), `modes_nl_band.csv` (with `[limits]`), and the figures
+//! `modes_nl_frequency` and `modes_nl_damping` (frequency and modal damping ratio against the
+//! first-harmonic amplitude at the mode's DOF, on a log₁₀ amplitude axis, one curve per case).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::analysis::nonlinear_modes::{
+    predicted_frf, predicted_peak, ModeBand, ModeLimits, NonlinearModeRun, PredictedPeak,
+};
+use crate::model::Problem;
+use crate::report::files::{write_atomic, RunInfo, WriteError};
+use crate::report::plot::{self, figure_files, palette, Curve, PlotError};
+
+/// Header of `modes_nl.csv`: `case`, `modal_amplitude` (kg^½·m), `<dof>_amp` (m), `freq_hz`,
+/// `damping_ratio`, `xi_per_s`, `dissipated_energy_j`, `friction_energy_j`,
+/// `<contact>_state` per contact, `newton_iterations`, `residual`.
+pub fn modes_nl_header(problem: &Problem, dof: usize) -> String {
+    let mut s = format!(
+        "case,modal_amplitude,{}_amp,freq_hz,damping_ratio,xi_per_s,dissipated_energy_j,friction_energy_j",
+        problem.model.dof_names[dof]
+    );
+    for c in &problem.contacts {
+        let _ = write!(s, ",{}_state", c.name);
+    }
+    s.push_str(",newton_iterations,residual\n");
+    s
+}
+
+/// `modes_nl.csv` of the cases' modes (failed cases have no rows).
+pub fn modes_nl_csv(problem: &Problem, dof: usize, limits: &ModeLimits) -> String {
+    let mut s = modes_nl_header(problem, dof);
+    for case in &limits.cases {
+        let Ok(run) = &case.run else { continue };
+        for p in &run.points {
+            let _ = write!(
+                s,
+                "{},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e}",
+                case.case.name,
+                p.modal_amplitude,
+                p.dof_amplitude,
+                p.freq_hz,
+                p.damping_ratio,
+                p.xi,
+                p.dissipated_energy,
+                p.friction_energy
+            );
+            for state in &p.states {
+                let _ = write!(s, ",{}", state.label());
+            }
+            let _ = writeln!(s, ",{},{:.3e}", p.newton_iterations, p.residual);
+        }
+    }
+    s
+}
+
+/// `modes_nl_band.csv`: `<dof>_amp` (m), `freq_min_hz`, `freq_max_hz`, `damping_min`,
+/// `damping_max`, `cases` (how many reach the amplitude).
+pub fn band_csv(problem: &Problem, dof: usize, band: &ModeBand) -> String {
+    let mut s = format!(
+        "{}_amp,freq_min_hz,freq_max_hz,damping_min,damping_max,cases\n",
+        problem.model.dof_names[dof]
+    );
+    for i in 0..band.amplitude.len() {
+        let (f, d) = (band.freq_hz[i], band.damping_ratio[i]);
+        let _ = writeln!(
+            s,
+            "{:.10e},{:.10e},{:.10e},{:.10e},{:.10e},{}",
+            band.amplitude[i], f[0], f[1], d[0], d[1], band.cases[i]
+        );
+    }
+    s
+}
+
+#[derive(Serialize)]
+struct CaseEntry<'a> {
+    name: &'a str,
+    contact_states: &'a [f64],
+    status: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    mode: Option<&'a NonlinearModeRun>,
+    /// The resonance peak predicted from the mode for the scene's first-harmonic loads.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    predicted_peak: Option<PredictedPeak>,
+    /// The forced response predicted from the mode near the resonance: (Hz, m at the DOF).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    predicted_frf: Vec<(f64, f64)>,
+}
+
+#[derive(Serialize)]
+struct ModesFile<'a> {
+    info: &'a RunInfo,
+    status: &'a str,
+    dof: &'a str,
+    amplitude_range_m: [f64; 2],
+    cases: Vec<CaseEntry<'a>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    band: Option<&'a ModeBand>,
+}
+
+/// Writes `modes_nl.csv`, `modes_nl.json` (status `status`) and, when there are several cases,
+/// `modes_nl_band.csv` into `dir`.
+pub fn write_modes_nl(
+    dir: &Path,
+    info: &RunInfo,
+    status: &str,
+    problem: &Problem,
+    (dof, range): (usize, [f64; 2]),
+    limits: &ModeLimits,
+) -> Result<(), WriteError> {
+    write_atomic(
+        &dir.join("modes_nl.csv"),
+        modes_nl_csv(problem, dof, limits).as_bytes(),
+    )?;
+    let several = limits.cases.len() > 1;
+    if several {
+        write_atomic(
+            &dir.join("modes_nl_band.csv"),
+            band_csv(problem, dof, &limits.band).as_bytes(),
+        )?;
+    }
+    let cases = limits
+        .cases
+        .iter()
+        .map(|c| CaseEntry {
+            name: &c.case.name,
+            contact_states: &c.case.contact_states,
+            status: match &c.run {
+                Ok(r) => crate::report::files::status_text(r.incomplete_reason().as_deref()),
+                Err(e) => format!("failed: {e}"),
+            },
+            mode: c.run.as_ref().ok(),
+            predicted_peak: c.run.as_ref().ok().and_then(|r| predicted_peak(problem, r)),
+            predicted_frf: c
+                .run
+                .as_ref()
+                .map(|r| predicted_frf(problem, r))
+                .unwrap_or_default(),
+        })
+        .collect();
+    let file = ModesFile {
+        info,
+        status,
+        dof: &problem.model.dof_names[dof],
+        amplitude_range_m: range,
+        cases,
+        band: several.then_some(&limits.band),
+    };
+    let json =
+        serde_json::to_string_pretty(&file).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"));
+    write_atomic(&dir.join("modes_nl.json"), json.as_bytes())
+}
+
+/// Draws `modes_nl_frequency` and `modes_nl_damping` (PNG and SVG) into `dir`: one curve per
+/// case against log₁₀ of the first-harmonic amplitude at the DOF.
+pub fn plot_modes_nl(
+    dir: &Path,
+    title: &str,
+    problem: &Problem,
+    dof: usize,
+    limits: &ModeLimits,
+) -> Result<(), PlotError> {
+    let runs: Vec<(&str, &NonlinearModeRun)> = limits
+        .cases
+        .iter()
+        .filter_map(|c| c.run.as_ref().ok().map(|r| (c.case.name.as_str(), r)))
+        .collect();
+    let log_a: Vec<Vec<f64>> = runs
+        .iter()
+        .map(|(_, r)| r.points.iter().map(|p| p.dof_amplitude.log10()).collect())
+        .collect();
+    let x_label = format!(
+        "log10 of the first-harmonic amplitude at {} (m)",
+        problem.model.dof_names[dof]
+    );
+    let single = runs.len() == 1;
+    for (stem, y_label, value) in [
+        (
+            "modes_nl_frequency",
+            "frequency (Hz)",
+            (|p: &crate::analysis::nonlinear_modes::NonlinearModePoint| p.freq_hz)
+                as fn(&crate::analysis::nonlinear_modes::NonlinearModePoint) -> f64,
+        ),
+        (
+            "modes_nl_damping",
+            "modal damping ratio D = ξ/2ω (-)",
+            |p| p.damping_ratio,
+        ),
+    ] {
+        let ys: Vec<Vec<f64>> = runs
+            .iter()
+            .map(|(_, r)| r.points.iter().map(value).collect())
+            .collect();
+        let curves: Vec<Curve> = runs
+            .iter()
+            .enumerate()
+            .map(|(i, (name, _))| Curve {
+                label: if single { "" } else { name },
+                x: &log_a[i],
+                y: &ys[i],
+                color: palette(i),
+                dashed: false,
+                markers: false,
+            })
+            .collect();
+        let (png, svg) = figure_files(dir, stem);
+        plot::plot_lines(title, &x_label, y_label, false, &curves, &png, &svg)?;
+    }
+    Ok(())
+}
