@@ -112,7 +112,9 @@ pub fn unknowns_for(p: &Problem, formulation: Formulation) -> usize {
 
 /// Rows of the matrix factorised per Newton iteration on `p`: the unknowns, except for the
 /// schur formulation (2 relative coordinates per contact point, 3 per 2D-friction point, 1
-/// fewer where a direction is zero, and coefficient block).
+/// fewer where a direction is zero, and coefficient block) and the schur-krylov formulation
+/// (the relative coordinates: its preconditioner factorises one such matrix per harmonic,
+/// complex for h ≥ 1).
 pub fn factored_size(p: &Problem) -> usize {
     factored_size_for(p, p.formulation())
 }
@@ -121,6 +123,7 @@ pub fn factored_size(p: &Problem) -> usize {
 pub fn factored_size_for(p: &Problem, formulation: Formulation) -> usize {
     match formulation {
         Formulation::Schur => p.relative_coordinate_count() * p.unknown_harmonics().n_blocks(),
+        Formulation::SchurKrylov => p.relative_coordinate_count(),
         _ => unknowns_for(p, formulation),
     }
 }
@@ -133,6 +136,31 @@ pub fn formulation_name(f: Formulation) -> &'static str {
         Formulation::Sparse => "sparse",
         Formulation::Condensed => "condensed",
         Formulation::Schur => "schur",
+        Formulation::SchurKrylov => "schur-krylov",
+    }
+}
+
+/// The formulation written `name` in scenes ([`formulation_name`]), if any.
+pub fn formulation_from_name(name: &str) -> Option<Formulation> {
+    [
+        Formulation::Auto,
+        Formulation::Dense,
+        Formulation::Sparse,
+        Formulation::Condensed,
+        Formulation::Schur,
+        Formulation::SchurKrylov,
+    ]
+    .into_iter()
+    .find(|&f| formulation_name(f) == name)
+}
+
+/// The linear solver of a formulation, as `fricbound check` and the benches name it.
+pub fn linear_solver_name(f: Formulation) -> &'static str {
+    match f {
+        Formulation::Auto | Formulation::Dense | Formulation::Condensed => "dense LU",
+        Formulation::Sparse => "sparse LU",
+        Formulation::Schur => "dense LU on the relative coordinates",
+        Formulation::SchurKrylov => "BiCGSTAB, per-harmonic LU preconditioner",
     }
 }
 
@@ -272,7 +300,7 @@ pub fn estimate_for(p: &Problem, formulation: Formulation) -> CostEstimate {
     let contact_bytes = match formulation {
         // The schur Jacobian keeps each contact's (k·b)² block on its k relative coordinates
         // (k = 2, or 3 for a 2D-friction point).
-        Formulation::Schur => {
+        Formulation::Schur | Formulation::SchurKrylov => {
             let k2: f64 = p
                 .contacts
                 .iter()
@@ -348,6 +376,7 @@ pub fn estimate_for(p: &Problem, formulation: Formulation) -> CostEstimate {
                 6.0 * n * n * b + 2.0 * q * q + 8.0 * dynamic * n * n,
             )
         }
+        Formulation::SchurKrylov => krylov_cost(p, (n, b), dynamic, has_static),
         Formulation::Dense | Formulation::Auto => {
             (F64 * 4.0 * m * m, 2.0 / 3.0 * m * m * m, 4.0 * m * m)
         }
@@ -368,6 +397,57 @@ pub fn estimate_for(p: &Problem, formulation: Formulation) -> CostEstimate {
         scalar_flops: aft_flops + assembly_flops,
         chord: unknowns >= p.analysis.continuation.chord_min_unknowns,
     }
+}
+
+/// Preconditioner builds per continuation point assumed for the schur-krylov formulation's
+/// time estimate (the preconditioner is kept over points until a solve needs more than
+/// `krylov::REFRESH_ITERATIONS` iterations).
+pub const KRYLOV_BUILDS_PER_POINT: f64 = 0.15;
+
+/// BiCGSTAB iterations per solve assumed for the schur-krylov formulation's time estimate.
+pub const KRYLOV_ITERATIONS_PER_SOLVE: f64 = 6.0;
+
+/// Krylov solves per evaluation assumed for the schur-krylov formulation's time estimate (a
+/// new bordered factorisation solves for its border column and the right-hand side, a chord
+/// step for the right-hand side only).
+pub const KRYLOV_SOLVES_PER_EVALUATION: f64 = 1.5;
+
+/// Memory, preconditioner-build flops per factorisation and flops per evaluation of the
+/// schur-krylov formulation on `p` (n DOFs, b blocks): the schur formulation's elimination at
+/// the preconditioner's ω (kept, twice while a new one is built), one LU of n_q rows per
+/// harmonic and no reduced matrix; each evaluation's Krylov solves cost two products with J
+/// (three dense n × n products per block) and two preconditioner applications per iteration.
+fn krylov_cost(p: &Problem, (n, b): (f64, f64), dynamic: f64, has_static: bool) -> (f64, f64, f64) {
+    let n_q = p.relative_coordinate_count() as f64;
+    let n_z = (n - n_q).max(0.0);
+    let per_harmonic = dynamic * C64 * (n * n + n_q * n_q)
+        + if has_static {
+            F64 * (n * n + n_q * n_q)
+        } else {
+            0.0
+        };
+    let bytes = F64 * 6.0 * n * n + 2.0 * per_harmonic;
+    let elimination = 2.0 / 3.0 * n_z * n_z * n_z
+        + 2.0 * n_z * n_z * n_q
+        + 2.0 * n_q * n_q * n_z
+        + 2.0 / 3.0 * n_q * n_q * n_q;
+    let build = dynamic * 4.0 * elimination + if has_static { elimination } else { 0.0 };
+    let chord = p.model.n_dofs() as f64 * b >= p.analysis.continuation.chord_min_unknowns as f64;
+    let factorisations = if chord {
+        CHORD_FACTORISATIONS_PER_POINT
+    } else {
+        ITERATIONS_PER_POINT
+    };
+    let apply = (dynamic * 4.0 + if has_static { 1.0 } else { 0.0 })
+        * 2.0
+        * (n_z * n_z + 2.0 * n_q * n_z + n_q * n_q);
+    let iteration = 2.0 * (6.0 * n * n * b + apply);
+    let per_evaluation = KRYLOV_SOLVES_PER_EVALUATION * KRYLOV_ITERATIONS_PER_SOLVE * iteration;
+    (
+        bytes,
+        build * KRYLOV_BUILDS_PER_POINT / factorisations,
+        6.0 * n * n * b + per_evaluation,
+    )
 }
 
 /// Bytes as MiB (or GiB from 10 GiB), e.g. "1.3 MiB", "51.2 GiB".

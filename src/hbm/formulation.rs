@@ -130,8 +130,8 @@ impl Problem {
     /// What `auto` picks, and why. Sparse models: the sparse formulation. Dense models: the
     /// formulation with the lowest estimated time per continuation point
     /// ([`crate::hbm::cost::estimate_for`]) among dense, sparse, condensed (when the contact
-    /// DOFs are at most half of the DOFs) and schur (when the contact points have independent
-    /// relative coordinates, [`check_relative_coordinates`]); dense unless another is estimated
+    /// DOFs are at most half of the DOFs), schur and schur-krylov (when the contact points have
+    /// independent relative coordinates, [`check_relative_coordinates`]); dense unless another is estimated
     /// at least [`AUTO_MARGIN`] times faster. On a chain of 40 masses with 10 Jenkins elements
     /// to ground at H = 5 (440 unknowns) this is sparse: the same FRF took 5.5 s against 17 s
     /// condensed and 62 s dense (measured on the loaded 2-core machine).
@@ -149,6 +149,7 @@ impl Problem {
         }
         if check_relative_coordinates(self).is_ok() {
             candidates.push(Formulation::Schur);
+            candidates.push(Formulation::SchurKrylov);
         }
         let times: Vec<(Formulation, f64)> = candidates
             .iter()

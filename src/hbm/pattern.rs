@@ -264,7 +264,8 @@ impl JacobianLayout {
     /// The layout of the schur formulation ([`crate::hbm::schur`]): no linear slots (the linear
     /// part is formed from ω when the Jacobian is factorised) and, per contact, its block on
     /// the contact's own k relative coordinates (u, v; or u₁, u₂, v for a 2D point), slot
-    /// offset + ((j·blocks + i)·k + a)·k + b.
+    /// offset + ((j·blocks + i)·k + a)·k + b. Solved by the dense reduced LU, or by the Krylov
+    /// solver when the problem's formulation is `schur-krylov`.
     pub fn relative(
         problem: &Problem,
         set: &HarmonicSet,
@@ -276,9 +277,13 @@ impl JacobianLayout {
         let rows: Vec<usize> = (0..problem.contacts.len())
             .map(|p| coords.contact_rows(p))
             .collect();
-        let template = AssembledJacobian::implicit(std::sync::Arc::new(
-            crate::hbm::schur::SchurJacobian(coords),
-        ));
+        let operator: std::sync::Arc<dyn crate::numerics::ImplicitJacobian> =
+            if problem.formulation() == crate::model::Formulation::SchurKrylov {
+                std::sync::Arc::new(crate::hbm::schur::KrylovSchurJacobian::new(coords))
+            } else {
+                std::sync::Arc::new(crate::hbm::schur::SchurJacobian(coords))
+            };
+        let template = AssembledJacobian::implicit(operator);
         let contacts = (0..problem.contacts.len())
             .map(|p| {
                 let k = rows[p];

@@ -101,6 +101,11 @@ pub enum Formulation {
     /// contact coordinates (two per contact point) per harmonic, and factorises a dense
     /// matrix on those only ([`crate::hbm::schur`]). For dense (lumped or reduced) models.
     Schur,
+    /// The schur formulation's unknowns and residual, each linear solve by BiCGSTAB on all DOFs
+    /// preconditioned by one LU per harmonic on the relative contact coordinates
+    /// ([`crate::hbm::schur::krylov`]): no factorisation of the whole reduced matrix, for many
+    /// contact points.
+    SchurKrylov,
 }
 
 /// Which method gives each converged point its stability verdict (scene field

@@ -72,7 +72,10 @@ impl Scene {
         let problem = reduce_problem(reduction.as_ref(), &ck, problem)?;
         check_stuck_structure(&ck, &problem)?;
         held?;
-        if problem.analysis.formulation == Formulation::Schur {
+        if matches!(
+            problem.analysis.formulation,
+            Formulation::Schur | Formulation::SchurKrylov
+        ) {
             check_relative_coordinates(&problem)
                 .map_err(|e| ck.err("analysis.formulation", e.to_string()))?;
         }
