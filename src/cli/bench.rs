@@ -61,6 +61,9 @@ pub enum BenchError {
     /// A file could not be written or a child process failed.
     #[error("{0}")]
     Io(String),
+    /// `bench contacts` failed.
+    #[error(transparent)]
+    Contacts(#[from] super::bench_contacts::ContactsBenchError),
 }
 
 /// Runs a bench subcommand; returns the text to print.
@@ -82,7 +85,7 @@ pub fn run(command: &BenchCommand) -> Result<String, BenchError> {
             let m = scaling::measure_reduction(size, *modes)?;
             serde_json::to_string(&m).map_err(|e| BenchError::Io(e.to_string()))
         }
-        BenchCommand::Contacts(args) => super::bench_contacts::run(args),
+        BenchCommand::Contacts(args) => Ok(super::bench_contacts::run(args)?),
         BenchCommand::Scaling { out, quick } => {
             let dir = out.clone().unwrap_or_else(|| PathBuf::from("out/scaling"));
             std::fs::create_dir_all(&dir)
@@ -199,7 +202,7 @@ fn scaling_study(dir: &Path, quick: bool) -> Result<String, BenchError> {
             let limit = if config.jacobian == JacobianStrategy::Analytic
                 || matches!(
                     p.formulation(),
-                    Formulation::Schur | Formulation::SchurKrylov
+                    Formulation::Schur | Formulation::SchurLowRank
                 ) {
                 ANALYTIC_LIMIT
             } else {

@@ -6,10 +6,23 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use super::bench::BenchError;
 use crate::hbm::cost::{format_bytes, formulation_from_name};
 use crate::report::files::write_atomic;
 use crate::study::contacts::{self, ContactCase, ContactMeasure};
+
+/// Errors of `fricbound bench contacts`.
+#[derive(Debug, thiserror::Error)]
+pub enum ContactsBenchError {
+    /// A case could not be set up or run.
+    #[error(transparent)]
+    Case(#[from] crate::study::scaling::ScalingError),
+    /// An unknown formulation name.
+    #[error("unknown formulation `{0}` (auto, dense, sparse, condensed, schur, schur-lowrank)")]
+    Formulation(String),
+    /// A file or folder could not be written.
+    #[error("{0}")]
+    Io(String),
+}
 
 /// Options of `fricbound bench contacts`.
 #[derive(Debug, Clone, clap::Args)]
@@ -20,8 +33,8 @@ pub struct ContactsArgs {
     /// Highest harmonics H.
     #[arg(long = "harmonics", value_delimiter = ',', default_values_t = [3, 5])]
     pub harmonics: Vec<usize>,
-    /// Formulations (as in scenes: auto, dense, sparse, condensed, schur, schur-krylov).
-    #[arg(long, value_delimiter = ',', default_values_t = ["schur".to_string(), "schur-krylov".to_string()])]
+    /// Formulations (as in scenes: auto, dense, sparse, condensed, schur, schur-lowrank).
+    #[arg(long, value_delimiter = ',', default_values_t = ["schur".to_string(), "schur-lowrank".to_string()])]
     pub formulation: Vec<String>,
     /// Most continuation points per curve.
     #[arg(long, default_value_t = 150)]
@@ -41,14 +54,11 @@ pub struct ContactsArgs {
 }
 
 /// Runs the benchmark; returns the table.
-pub fn run(args: &ContactsArgs) -> Result<String, BenchError> {
+pub fn run(args: &ContactsArgs) -> Result<String, ContactsBenchError> {
     let formulations = args
         .formulation
         .iter()
-        .map(|f| {
-            formulation_from_name(f)
-                .ok_or_else(|| BenchError::Io(format!("unknown formulation `{f}`")))
-        })
+        .map(|f| formulation_from_name(f).ok_or_else(|| ContactsBenchError::Formulation(f.clone())))
         .collect::<Result<Vec<_>, _>>()?;
     let (refines, harmonics, points) = if args.quick {
         (vec![4], vec![3], 20)
@@ -60,7 +70,8 @@ pub fn run(args: &ContactsArgs) -> Result<String, BenchError> {
         )
     };
     let dir = std::env::temp_dir().join(format!("fricbound-contacts-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).map_err(|e| BenchError::Io(format!("{}: {e}", dir.display())))?;
+    std::fs::create_dir_all(&dir)
+        .map_err(|e| ContactsBenchError::Io(format!("{}: {e}", dir.display())))?;
     let mut measures = Vec::new();
     for &h in &harmonics {
         for &contact_refine in &refines {
@@ -100,10 +111,12 @@ fn args_name(f: crate::model::Formulation) -> &'static str {
 }
 
 /// Writes contacts.md and contacts.json into `out`.
-fn write(out: &std::path::Path, measures: &[ContactMeasure]) -> Result<(), BenchError> {
-    std::fs::create_dir_all(out).map_err(|e| BenchError::Io(format!("{}: {e}", out.display())))?;
-    let io = |e: crate::report::files::WriteError| BenchError::Io(e.to_string());
-    let json = serde_json::to_string_pretty(measures).map_err(|e| BenchError::Io(e.to_string()))?;
+fn write(out: &std::path::Path, measures: &[ContactMeasure]) -> Result<(), ContactsBenchError> {
+    std::fs::create_dir_all(out)
+        .map_err(|e| ContactsBenchError::Io(format!("{}: {e}", out.display())))?;
+    let io = |e: crate::report::files::WriteError| ContactsBenchError::Io(e.to_string());
+    let json = serde_json::to_string_pretty(measures)
+        .map_err(|e| ContactsBenchError::Io(e.to_string()))?;
     write_atomic(&out.join("contacts.json"), json.as_bytes()).map_err(io)?;
     write_atomic(&out.join("contacts.md"), markdown(measures).as_bytes()).map_err(io)
 }
@@ -112,24 +125,20 @@ fn write(out: &std::path::Path, measures: &[ContactMeasure]) -> Result<(), Bench
 fn row(m: &ContactMeasure) -> String {
     let w = &m.work;
     format!(
-        "| {} | {} | {} | {} | {} | {} | {:.2} | {}{} | {} | {} | {} | {} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {} |",
+        "| {} | {} | {} | {} | {} | {:.2} | {}{} | {} | {} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} | {} |",
         m.pairs_per_side,
         m.harmonics,
         m.unknowns,
         m.formulation,
-        m.linear_solver,
         m.points,
         m.slipping_fraction,
         m.newton_iterations,
         if m.complete { "" } else { " (incomplete)" },
         factorisations(w),
-        w.krylov_iterations,
-        w.preconditioners,
         w.solves,
         m.per_iteration_ms,
         m.curve_s,
         w.factorisation_s,
-        w.preconditioner_s,
         w.solve_s,
         w.evaluation_s,
         m.peak_memory_bytes
@@ -156,11 +165,20 @@ fn markdown(measures: &[ContactMeasure]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "| pairs/side | H | unknowns | formulation | linear solver | points | slipping | Newton iterations | factorisations | Krylov iterations | preconditioners | solves | per iteration (ms) | curve (s) | factorising (s) | preconditioning (s) | solving (s) | evaluating (s) | peak memory |\n\
-         | ---: | ---: | ---: | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+        "| pairs/side | H | unknowns | formulation | points | slipping | Newton iterations | factorisations | solves | per iteration (ms) | curve (s) | factorising (s) | solving (s) | evaluating (s) | peak memory |\n\
+         | ---: | ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
     );
     for m in measures {
         let _ = writeln!(s, "{}", row(m));
+    }
+    let mut solvers: Vec<(&str, &str)> = measures
+        .iter()
+        .map(|m| (m.formulation.as_str(), m.linear_solver.as_str()))
+        .collect();
+    solvers.sort();
+    solvers.dedup();
+    for (f, solver) in solvers {
+        let _ = writeln!(s, "\n{f}: {solver}");
     }
     let mut keys: Vec<(usize, String)> = measures
         .iter()

@@ -130,7 +130,7 @@ impl Problem {
     /// What `auto` picks, and why. Sparse models: the sparse formulation. Dense models: the
     /// formulation with the lowest estimated time per continuation point
     /// ([`crate::hbm::cost::estimate_for`]) among dense, sparse, condensed (when the contact
-    /// DOFs are at most half of the DOFs), schur and schur-krylov (when the contact points have
+    /// DOFs are at most half of the DOFs), schur and schur-lowrank (when the contact points have
     /// independent relative coordinates, [`check_relative_coordinates`]); dense unless another is estimated
     /// at least [`AUTO_MARGIN`] times faster. On a chain of 40 masses with 10 Jenkins elements
     /// to ground at H = 5 (440 unknowns) this is sparse: the same FRF took 5.5 s against 17 s
@@ -149,7 +149,7 @@ impl Problem {
         }
         if check_relative_coordinates(self).is_ok() {
             candidates.push(Formulation::Schur);
-            candidates.push(Formulation::SchurKrylov);
+            candidates.push(Formulation::SchurLowRank);
         }
         let times: Vec<(Formulation, f64)> = candidates
             .iter()
@@ -165,6 +165,18 @@ impl Problem {
             best
         } else {
             Formulation::Dense
+        };
+        // Schur-lowrank only where it is estimated AUTO_MARGIN× faster than schur, whose
+        // dense reduced LU is the simpler and is exact whatever the contacts do.
+        let schur = times
+            .iter()
+            .find(|t| t.0 == Formulation::Schur)
+            .map(|t| t.1);
+        let chosen = match (chosen, schur) {
+            (Formulation::SchurLowRank, Some(s)) if s <= AUTO_MARGIN * best_time => {
+                Formulation::Schur
+            }
+            _ => chosen,
         };
         let listed: Vec<String> = times
             .iter()

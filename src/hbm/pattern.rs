@@ -264,8 +264,8 @@ impl JacobianLayout {
     /// The layout of the schur formulation ([`crate::hbm::schur`]): no linear slots (the linear
     /// part is formed from ω when the Jacobian is factorised) and, per contact, its block on
     /// the contact's own k relative coordinates (u, v; or u₁, u₂, v for a 2D point), slot
-    /// offset + ((j·blocks + i)·k + a)·k + b. Solved by the dense reduced LU, or by the Krylov
-    /// solver when the problem's formulation is `schur-krylov`.
+    /// offset + ((j·blocks + i)·k + a)·k + b. Its reduced matrix is factorised by a dense LU, or
+    /// by structure when the problem's formulation is `schur-lowrank`.
     pub fn relative(
         problem: &Problem,
         set: &HarmonicSet,
@@ -277,13 +277,14 @@ impl JacobianLayout {
         let rows: Vec<usize> = (0..problem.contacts.len())
             .map(|p| coords.contact_rows(p))
             .collect();
-        let operator: std::sync::Arc<dyn crate::numerics::ImplicitJacobian> =
-            if problem.formulation() == crate::model::Formulation::SchurKrylov {
-                std::sync::Arc::new(crate::hbm::schur::KrylovSchurJacobian::new(coords))
-            } else {
-                std::sync::Arc::new(crate::hbm::schur::SchurJacobian(coords))
-            };
-        let template = AssembledJacobian::implicit(operator);
+        let solver = if problem.formulation() == crate::model::Formulation::SchurLowRank {
+            crate::hbm::schur::ReducedSolver::Structured
+        } else {
+            crate::hbm::schur::ReducedSolver::Dense
+        };
+        let template = AssembledJacobian::implicit(std::sync::Arc::new(
+            crate::hbm::schur::SchurJacobian(coords, solver),
+        ));
         let contacts = (0..problem.contacts.len())
             .map(|p| {
                 let k = rows[p];

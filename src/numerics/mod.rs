@@ -16,7 +16,7 @@
 //! | [`broyden`] | `BroydenUpdates` | secant updates of a factorised Newton matrix (chord steps) |
 //! | [`path`] | [`PathPoint`], [`PathSummary`], [`Observer`], [`NewtonFailure`] | what continuation produces and reports |
 //! | [`interrupt`] | `request`, `clear`, `requested` | a process-wide request to stop the runs in progress (Ctrl-C of an embedding caller) |
-//! | [`work`] | `Work`, `WorkReading`, `reading` | process-wide counters of factorisations, solves, Krylov iterations and evaluations, for benchmarks |
+//! | [`work`] | `Work`, `WorkReading`, `reading` | process-wide counters of factorisations, solves and evaluations, for benchmarks |
 
 pub mod box_minimize;
 pub mod broyden;

@@ -1,6 +1,6 @@
-//! Process-wide counters of the linear-algebra work done so far: factorisations, solves,
-//! Krylov iterations, preconditioner builds, and the wall time spent in each, plus the time
-//! spent evaluating residuals and Jacobians. Benchmarks (`fricbound bench contacts`) read them
+//! Process-wide counters of the linear-algebra work done so far: factorisations (and how many
+//! were structured low-rank ones, with their rank) and solves, with the wall time spent in each,
+//! plus the time spent evaluating residuals and Jacobians. Benchmarks (`fricbound bench contacts`) read them
 //! before and after a run to say where its time went; nothing in the solvers depends on them.
 //!
 //! The counters are plain relaxed atomics shared by every thread: two runs in one process at
@@ -16,14 +16,8 @@ pub enum Work {
     /// Numeric factorisations of a Newton matrix (dense, sparse or the schur formulation's
     /// reduced LU), with their wall time.
     Factorisation,
-    /// Solves with a factorisation or a Krylov method (each right-hand side), with their wall
-    /// time.
+    /// Solves with a factorisation (each right-hand side), with their wall time.
     Solve,
-    /// Krylov iterations (each one product with the Newton matrix and one with the
-    /// preconditioner; BiCGSTAB counts two of each per iteration).
-    KrylovIteration,
-    /// Preconditioner builds of a Krylov solver, with their wall time.
-    Preconditioner,
     /// Residual and Jacobian evaluations (contact forces by AFT, their Jacobian, the linear
     /// part), with their wall time.
     Evaluation,
@@ -34,7 +28,7 @@ pub enum Work {
     LowRankRows,
 }
 
-const KINDS: usize = 7;
+const KINDS: usize = 5;
 
 static COUNTS: [AtomicU64; KINDS] = [const { AtomicU64::new(0) }; KINDS];
 static NANOS: [AtomicU64; KINDS] = [const { AtomicU64::new(0) }; KINDS];
@@ -43,11 +37,9 @@ fn index(w: Work) -> usize {
     match w {
         Work::Factorisation => 0,
         Work::Solve => 1,
-        Work::KrylovIteration => 2,
-        Work::Preconditioner => 3,
-        Work::Evaluation => 4,
-        Work::LowRankFactorisation => 5,
-        Work::LowRankRows => 6,
+        Work::Evaluation => 2,
+        Work::LowRankFactorisation => 3,
+        Work::LowRankRows => 4,
     }
 }
 
@@ -72,14 +64,8 @@ pub struct WorkReading {
     pub factorisation_s: f64,
     /// Solves (right-hand sides).
     pub solves: u64,
-    /// Wall time in solves, Krylov iterations included (s).
+    /// Wall time in solves (s).
     pub solve_s: f64,
-    /// Krylov iterations.
-    pub krylov_iterations: u64,
-    /// Preconditioner builds.
-    pub preconditioners: u64,
-    /// Wall time in preconditioner builds (s).
-    pub preconditioner_s: f64,
     /// Residual (and Jacobian) evaluations.
     pub evaluations: u64,
     /// Wall time in evaluations (s).
@@ -99,9 +85,6 @@ pub fn reading() -> WorkReading {
         factorisation_s: seconds(Work::Factorisation),
         solves: count(Work::Solve),
         solve_s: seconds(Work::Solve),
-        krylov_iterations: count(Work::KrylovIteration),
-        preconditioners: count(Work::Preconditioner),
-        preconditioner_s: seconds(Work::Preconditioner),
         evaluations: count(Work::Evaluation),
         evaluation_s: seconds(Work::Evaluation),
         low_rank_factorisations: count(Work::LowRankFactorisation),
@@ -117,9 +100,6 @@ impl WorkReading {
             factorisation_s: self.factorisation_s - before.factorisation_s,
             solves: self.solves - before.solves,
             solve_s: self.solve_s - before.solve_s,
-            krylov_iterations: self.krylov_iterations - before.krylov_iterations,
-            preconditioners: self.preconditioners - before.preconditioners,
-            preconditioner_s: self.preconditioner_s - before.preconditioner_s,
             evaluations: self.evaluations - before.evaluations,
             evaluation_s: self.evaluation_s - before.evaluation_s,
             low_rank_factorisations: self.low_rank_factorisations - before.low_rank_factorisations,
@@ -135,12 +115,12 @@ mod tests {
     #[test]
     fn readings_difference_counts_what_was_recorded() {
         let before = reading();
-        add(Work::KrylovIteration, 3);
-        record(Work::Preconditioner, Instant::now());
+        add(Work::LowRankRows, 3);
+        record(Work::Solve, Instant::now());
         let done = reading().since(&before);
         // Other tests may add work meanwhile: at least what this one recorded.
-        assert!(done.krylov_iterations >= 3);
-        assert!(done.preconditioners >= 1);
-        assert!(done.preconditioner_s >= 0.0);
+        assert!(done.low_rank_rows >= 3);
+        assert!(done.solves >= 1);
+        assert!(done.solve_s >= 0.0);
     }
 }

@@ -74,7 +74,7 @@ impl Scene {
         held?;
         if matches!(
             problem.analysis.formulation,
-            Formulation::Schur | Formulation::SchurKrylov
+            Formulation::Schur | Formulation::SchurLowRank
         ) {
             check_relative_coordinates(&problem)
                 .map_err(|e| ck.err("analysis.formulation", e.to_string()))?;

@@ -54,7 +54,7 @@ fn newton_iteration_sizes_and_steps_agree_across_formulations() {
         assert_eq!(iteration.unknowns(), scaling::unknowns(&p));
         let blocks = 7;
         let expected_factored = match config.formulation {
-            Formulation::Schur => 2 * 4 * blocks,
+            Formulation::Schur | Formulation::SchurLowRank => 2 * 4 * blocks,
             Formulation::Condensed => p.contact_dofs().len() * blocks,
             _ => p.model.n_dofs() * blocks,
         };

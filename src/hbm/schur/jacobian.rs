@@ -145,12 +145,13 @@ impl RelativeCoordinates {
         self: &Arc<Self>,
         omega: f64,
         contact_values: &[f64],
+        solver: ReducedSolver,
     ) -> Result<SchurFactor, LinearSolveError> {
         if !omega.is_finite() || contact_values.iter().any(|v| !v.is_finite()) {
             return Err(LinearSolveError::NonFinite);
         }
         let eliminated = self.eliminated_at(omega)?;
-        let reduced = self.reduced_factor(&eliminated, contact_values, true)?;
+        let reduced = self.reduced_factor(&eliminated, contact_values, solver)?;
         Ok(SchurFactor {
             coords: Arc::clone(self),
             harmonics: eliminated,
@@ -159,35 +160,28 @@ impl RelativeCoordinates {
     }
 
     /// The factorised reduced matrix blockdiag_h S_h + N_c of the eliminated `harmonics` with
-    /// the contact blocks `contact_values`: by the low-rank update of a per-harmonic baseline
-    /// ([`super::lowrank`]) when its estimated flops are below the dense LU's, else (with
-    /// `allow_dense`) by the dense LU, or (without) by the baseline alone, an approximation for
-    /// a preconditioner. A baseline that cannot be factorised falls back to the dense LU.
+    /// the contact blocks `contact_values`: with [`ReducedSolver::Structured`], by the low-rank
+    /// update of a per-harmonic baseline ([`super::lowrank`]) when its estimated flops are below
+    /// the dense LU's (and the baseline can be factorised); else by the dense LU.
     pub(super) fn reduced_factor(
         &self,
         harmonics: &[EliminatedHarmonic],
         contact_values: &[f64],
-        allow_dense: bool,
+        solver: ReducedSolver,
     ) -> Result<ReducedFactor, LinearSolveError> {
         let (n_q, nb) = (self.n_q, self.blocks.len());
-        let dim_q = (n_q * nb) as f64;
-        let mut rows = self.coupling_rows(contact_values);
-        let low_rank = low_rank_flops(n_q, harmonics.len(), rows.len());
-        if low_rank < 2.0 / 3.0 * dim_q.powi(3) || !allow_dense {
-            if low_rank >= 2.0 / 3.0 * dim_q.powi(3) {
-                rows.clear();
-            }
-            let factor = self
-                .harmonic_lus(harmonics, contact_values)
-                .and_then(|lus| LowRankFactor::new(n_q, lus, rows));
-            match factor {
-                Ok(f) => {
+        if solver == ReducedSolver::Structured {
+            let rows = self.coupling_rows(contact_values);
+            let dense = 2.0 / 3.0 * ((n_q * nb) as f64).powi(3);
+            if low_rank_flops(n_q, harmonics.len(), rows.len()) < dense {
+                let factor = self
+                    .harmonic_lus(harmonics, contact_values)
+                    .and_then(|lus| LowRankFactor::new(n_q, lus, rows));
+                if let Ok(f) = factor {
                     work::add(Work::LowRankFactorisation, 1);
                     work::add(Work::LowRankRows, f.rank() as u64);
                     return Ok(ReducedFactor::LowRank(f));
                 }
-                Err(e) if !allow_dense => return Err(e),
-                Err(_) => {}
             }
         }
         let mut s = Mat::<f64>::zeros(n_q * nb, n_q * nb);
@@ -304,13 +298,24 @@ impl RelativeCoordinates {
     }
 }
 
+/// How the reduced matrix blockdiag_h S_h + N_c is factorised.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ReducedSolver {
+    /// Dense LU (the `schur` formulation).
+    Dense,
+    /// Per-harmonic baseline and low-rank update where that is estimated cheaper, else dense
+    /// LU (the `schur-lowrank` formulation, [`super::lowrank`]).
+    Structured,
+}
+
 /// The schur formulation's Jacobian storage for [`AssembledJacobian::implicit`]: the values
 /// are one (k·blocks)² block per contact point (k = 2 rows, 3 for a 2D point) (see [`RelativeCoordinates::factor`]); the
-/// linear part is formed from the structural matrices at ω.
+/// linear part is formed from the structural matrices at ω; the reduced matrix is factorised
+/// by the [`ReducedSolver`].
 ///
 /// [`AssembledJacobian::implicit`]: crate::numerics::jacobian::AssembledJacobian::implicit
 #[derive(Debug)]
-pub struct SchurJacobian(pub Arc<RelativeCoordinates>);
+pub struct SchurJacobian(pub Arc<RelativeCoordinates>, pub ReducedSolver);
 
 impl ImplicitJacobian for SchurJacobian {
     fn dim(&self) -> usize {
@@ -334,7 +339,7 @@ impl ImplicitJacobian for SchurJacobian {
         omega: f64,
         values: &[f64],
     ) -> Result<Box<dyn ImplicitFactor>, LinearSolveError> {
-        Ok(Box::new(self.0.factor(omega, values)?))
+        Ok(Box::new(self.0.factor(omega, values, self.1)?))
     }
 }
 
@@ -355,6 +360,17 @@ pub(super) enum ReducedFactor {
     },
     /// Per-harmonic baseline and low-rank update ([`super::lowrank`]).
     LowRank(LowRankFactor),
+}
+
+impl SchurFactor {
+    /// The rank of the low-rank update when the reduced matrix was factorised by structure
+    /// ([`super::lowrank`]); None for the dense LU.
+    pub fn low_rank(&self) -> Option<usize> {
+        match &self.reduced {
+            ReducedFactor::LowRank(f) => Some(f.rank()),
+            ReducedFactor::Dense { .. } => None,
+        }
+    }
 }
 
 impl ReducedFactor {
@@ -392,8 +408,8 @@ impl ImplicitFactor for SchurFactor {
 /// Solves (Ã + [R 0; 0 0]) y = Tᵀ b by the per-harmonic elimination `harmonics` and returns
 /// x = T y (problem coordinates, harmonic-major, length n·blocks): `reduced` solves the reduced
 /// system on the relative coordinates, blockdiag_h S_h + R, for its right-hand side (n_q·blocks
-/// rows, block-major). The schur factorisation passes the LU of the whole reduced matrix; the
-/// Krylov solver's preconditioner one LU per harmonic ([`super::krylov`]).
+/// rows, block-major): the dense LU of the whole reduced matrix, or its structured factorisation
+/// ([`super::lowrank`]).
 pub(super) fn solve_eliminated(
     co: &RelativeCoordinates,
     harmonics: &[EliminatedHarmonic],
