@@ -39,7 +39,7 @@
 //! - `schur-lowrank`: as schur, with the reduced matrix's structured factorisation in place of
 //!   its dense LU where that is cheaper: per harmonic a complex LU of n_q rows, P⁻¹U on each
 //!   harmonic's rows, M and the r × r capacitance matrix, r assumed [`LOW_RANK_ROW_FRACTION`] of
-//!   the reduced rows.
+//!   the reduced rows ([`low_rank_flops`]).
 //!
 //! **Time model** (an estimate, good to a factor of a few): per Newton iteration, the
 //! factorisation's floating-point operations (dense LU (2/3)·m³; complex LU 4× a real one;
@@ -408,7 +408,7 @@ pub const LOW_RANK_ROW_FRACTION: f64 = 0.4;
 /// when `has_static`): per harmonic the complex elimination of the n_z = n − n_q other
 /// coordinates, then the dense LU of the reduced matrix (schur), or for schur-lowrank whichever
 /// of it and the structured factorisation with [`LOW_RANK_ROW_FRACTION`]·q update rows
-/// ([`crate::hbm::schur::lowrank::low_rank_flops`]) is cheaper, as the formulation chooses.
+/// ([`low_rank_flops`]) is cheaper, as the formulation chooses.
 fn schur_cost(
     p: &Problem,
     (n, q): (f64, f64),
@@ -424,8 +424,7 @@ fn schur_cost(
     let dense_bytes = (F64 + 4.0) * q * q;
     let harmonics = dynamic as usize + usize::from(has_static);
     let r = (LOW_RANK_ROW_FRACTION * q).round();
-    let structured =
-        crate::hbm::schur::lowrank::low_rank_flops(n_q as usize, harmonics, r as usize);
+    let structured = low_rank_flops(n_q as usize, harmonics, r as usize);
     let (reduced_bytes, reduced_flops) = if low_rank && structured < dense_flops {
         // Per harmonic LU (complex n_q²), P⁻¹U on its harmonic's 2·n_q rows, M and C.
         let bytes = C64 * harmonics as f64 * n_q * n_q + F64 * (2.0 * n_q * r + q * r + r * r);
@@ -437,6 +436,16 @@ fn schur_cost(
         F64 * 6.0 * n * n + 2.0 * (per_harmonic + reduced_bytes),
         elimination + reduced_flops,
     )
+}
+
+/// Estimated flops of the schur-lowrank factorisation of the reduced matrix
+/// ([`crate::hbm::schur::lowrank`]) with n_q relative coordinates, `harmonics` harmonics and `r`
+/// update rows, against the dense LU's (2/3)·(n_q·blocks)³: per harmonic the LU of n_q complex
+/// rows (4× a real LU), P⁻¹U (8·n_q² per complex column) and the LU of the r × r capacitance
+/// matrix.
+pub fn low_rank_flops(n_q: usize, harmonics: usize, r: usize) -> f64 {
+    let (n_q, r) = (n_q as f64, r as f64);
+    harmonics as f64 * 8.0 / 3.0 * n_q.powi(3) + 8.0 * n_q * n_q * r + 2.0 / 3.0 * r.powi(3)
 }
 
 /// Bytes as MiB (or GiB from 10 GiB), e.g. "1.3 MiB", "51.2 GiB".

@@ -115,6 +115,13 @@ pub fn check_relative_coordinates(problem: &Problem) -> Result<(), RelativeCoord
 /// this margin the dense LU, the simplest and most robust, is kept.
 pub const AUTO_MARGIN: f64 = 1.5;
 
+/// Reduced rows (relative coordinates × blocks) from which `auto` considers schur-lowrank:
+/// below, both schur formulations cost microseconds per factorisation and the flop counts of the
+/// cost model say nothing of which is faster. The smallest case measured, the reduced blade pair
+/// with 25 pairs per side at H = 3 (700 reduced rows), took 0.8× schur's time with it
+/// (benches/README.md, "Contact count").
+pub const LOW_RANK_AUTO_MIN_ROWS: usize = 500;
+
 /// The formulation choice belongs to the harmonic-balance layer, which knows the formulations'
 /// limits; it is a method of [`Problem`] so that every caller asks the problem the same way.
 impl Problem {
@@ -149,32 +156,39 @@ impl Problem {
         }
         if check_relative_coordinates(self).is_ok() {
             candidates.push(Formulation::Schur);
-            candidates.push(Formulation::SchurLowRank);
+            if crate::hbm::cost::factored_size_for(self, Formulation::SchurLowRank)
+                >= LOW_RANK_AUTO_MIN_ROWS
+            {
+                candidates.push(Formulation::SchurLowRank);
+            }
         }
         let times: Vec<(Formulation, f64)> = candidates
             .iter()
             .map(|&f| (f, estimate_for(self, f).seconds_per_point()))
             .collect();
         let dense = times[0].1;
+        // The choice among the formulations with a dense reduced LU, then schur-lowrank in its
+        // place only where it is estimated AUTO_MARGIN× faster than that choice and than schur
+        // (the dense reduced LU is the simpler, and exact whatever the contacts do; on small
+        // problems the estimates of both are dominated by what the cost model leaves out).
         let (best, best_time) = times
             .iter()
             .copied()
+            .filter(|t| t.0 != Formulation::SchurLowRank)
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .unwrap_or((Formulation::Dense, dense));
-        let chosen = if best_time * AUTO_MARGIN < dense {
-            best
+        let (chosen, chosen_time) = if best_time * AUTO_MARGIN < dense {
+            (best, best_time)
         } else {
-            Formulation::Dense
+            (Formulation::Dense, dense)
         };
-        // Schur-lowrank only where it is estimated AUTO_MARGIN× faster than schur, whose
-        // dense reduced LU is the simpler and is exact whatever the contacts do.
-        let schur = times
-            .iter()
-            .find(|t| t.0 == Formulation::Schur)
-            .map(|t| t.1);
-        let chosen = match (chosen, schur) {
-            (Formulation::SchurLowRank, Some(s)) if s <= AUTO_MARGIN * best_time => {
-                Formulation::Schur
+        let time_of = |f: Formulation| times.iter().find(|t| t.0 == f).map(|t| t.1);
+        let chosen = match (
+            time_of(Formulation::SchurLowRank),
+            time_of(Formulation::Schur),
+        ) {
+            (Some(t), Some(schur)) if t * AUTO_MARGIN < chosen_time.min(schur) => {
+                Formulation::SchurLowRank
             }
             _ => chosen,
         };
@@ -183,7 +197,8 @@ impl Problem {
             .map(|(f, t)| format!("{} {:.3} ms", formulation_name(*f), 1e3 * t))
             .collect();
         let reason = format!(
-            "estimated time per point: {}; dense unless another is estimated {AUTO_MARGIN}× faster",
+            "estimated time per point: {}; dense unless another is estimated {AUTO_MARGIN}× faster, \
+             schur-lowrank only where estimated {AUTO_MARGIN}× faster than that and than schur",
             listed.join(", ")
         );
         (chosen, reason)

@@ -20,7 +20,7 @@ fn two_pairs() -> fricbound::model::Problem {
 #[test]
 fn grid_covers_every_formulation_and_jacobian_per_harmonic_count() {
     let grid = SolverConfig::grid(&[1, 3]);
-    assert_eq!(grid.len(), 2 * 4 * 2);
+    assert_eq!(grid.len(), 2 * 5 * 2);
     for h in [1, 3] {
         for f in scaling::FORMULATIONS {
             for j in scaling::JACOBIANS {

@@ -7,7 +7,8 @@ use faer::{c64, Mat};
 
 use super::coordinates::{HarmonicBlocks, RelativeCoordinates};
 use super::elimination::{EliminatedHarmonic, Elimination, ZPart};
-use super::lowrank::{low_rank_flops, LowRankFactor};
+use super::lowrank::LowRankFactor;
+use crate::hbm::cost::low_rank_flops;
 use crate::numerics::jacobian::{ImplicitFactor, ImplicitJacobian};
 use crate::numerics::linalg::{packed_complex_lu, packed_lu, LinearSolveError, PackedLu};
 use crate::numerics::work::{self, Work};

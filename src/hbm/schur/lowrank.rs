@@ -18,7 +18,8 @@
 //!
 //! Factorising costs per harmonic (8/3)·n_q³ for P, 8·n_q² per column of U for P⁻¹U and (2/3)·r³
 //! for C, against (2/3)·(n_q·blocks)³ for the dense LU of Q: [`LowRankFactor::new`] is asked only
-//! when that estimate is lower, that is when few enough contacts slip ([`low_rank_flops`]). The
+//! when that estimate is lower, that is when few enough contacts slip
+//! ([`crate::hbm::cost::low_rank_flops`]). The
 //! solve is exact up to rounding, like the dense LU's.
 
 use faer::{c64, Mat};
@@ -256,14 +257,6 @@ fn inverse_columns(lu: &HarmonicLu, n_q: usize, at: impl Iterator<Item = usize>)
             })
         }
     }
-}
-
-/// Estimated flops of the low-rank factorisation with `r` coupling rows, against the dense
-/// LU's (2/3)·(n_q·blocks)³: per harmonic the LU of P_h (complex: 4× a real LU), P⁻¹U (8·n_q²
-/// per complex column) and the LU of C.
-pub fn low_rank_flops(n_q: usize, harmonics: usize, r: usize) -> f64 {
-    let (n_q, r) = (n_q as f64, r as f64);
-    harmonics as f64 * 8.0 / 3.0 * n_q.powi(3) + 8.0 * n_q * n_q * r + 2.0 / 3.0 * r.powi(3)
 }
 
 /// The factorised reduced matrix Q = P + U M (see the module docs).
