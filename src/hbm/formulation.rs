@@ -115,12 +115,14 @@ pub fn check_relative_coordinates(problem: &Problem) -> Result<(), RelativeCoord
 /// this margin the dense LU, the simplest and most robust, is kept.
 pub const AUTO_MARGIN: f64 = 1.5;
 
-/// Reduced rows (relative coordinates × blocks) from which `auto` considers schur-lowrank:
-/// below, both schur formulations cost microseconds per factorisation and the flop counts of the
-/// cost model say nothing of which is faster. The smallest case measured, the reduced blade pair
-/// with 25 pairs per side at H = 3 (700 reduced rows), took 0.8× schur's time with it
-/// (benches/README.md, "Contact count").
-pub const LOW_RANK_AUTO_MIN_ROWS: usize = 500;
+/// Relative contact coordinates from which `auto` considers schur-lowrank. Its structure pays
+/// with many contact points: with few, its per-harmonic blocks are tiny and the flop counts of
+/// the cost model (which leave out the work per block) say nothing of which schur formulation
+/// is faster, so a problem with few contacts and many harmonics (the paper case at H = 31 or 63,
+/// in the error estimate's extended sets) stays on schur. The smallest case measured, the
+/// reduced blade pair with 25 pairs per side (100 coordinates) at H = 3, took 0.8× schur's time
+/// with it (benches/README.md, "Contact count").
+pub const LOW_RANK_AUTO_MIN_COORDINATES: usize = 100;
 
 /// The formulation choice belongs to the harmonic-balance layer, which knows the formulations'
 /// limits; it is a method of [`Problem`] so that every caller asks the problem the same way.
@@ -156,9 +158,7 @@ impl Problem {
         }
         if check_relative_coordinates(self).is_ok() {
             candidates.push(Formulation::Schur);
-            if crate::hbm::cost::factored_size_for(self, Formulation::SchurLowRank)
-                >= LOW_RANK_AUTO_MIN_ROWS
-            {
+            if self.relative_coordinate_count() >= LOW_RANK_AUTO_MIN_COORDINATES {
                 candidates.push(Formulation::SchurLowRank);
             }
         }
