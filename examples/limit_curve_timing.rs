@@ -2,7 +2,7 @@
 //! contact pairs per side: `cargo run --release --example limit_curve_timing -- [contact_refine]
 //! [H] [max_points] [chord_min_unknowns] [fd] [formulation]` (defaults 8, 3, 150, the library
 //! default, 0, auto; `fd` = 1 for forward differences; formulation `auto`, `dense`, `sparse`,
-//! `condensed` or `schur`). The scaling study (`fricbound bench scaling`) measures the same
+//! `condensed`, `schur` or `schur-lowrank`). The scaling study (`fricbound bench scaling`) measures the same
 //! case among others.
 
 use fricbound::model::{Formulation, JacobianStrategy};
@@ -16,6 +16,7 @@ fn main() {
         Some("sparse") => Formulation::Sparse,
         Some("condensed") => Formulation::Condensed,
         Some("schur") => Formulation::Schur,
+        Some("schur-lowrank") => Formulation::SchurLowRank,
         Some(other) => panic!("unknown formulation `{other}`"),
     };
     let args: Vec<usize> = raw

@@ -256,7 +256,9 @@ fn main() {
             "schur factorisation alone, same ω every call (RelativeCoordinates::factor)"
                 .to_string(),
             time_per_call(3, || {
-                coords.factor(omega, &values).unwrap();
+                coords
+                    .factor(omega, &values, fricbound::hbm::schur::ReducedSolver::Dense)
+                    .unwrap();
             }),
         ));
         let mut step = 0.0;
@@ -264,7 +266,13 @@ fn main() {
             "schur factorisation alone, a new ω every call".to_string(),
             time_per_call(3, || {
                 step += 1.0;
-                coords.factor(omega * (1.0 + 1e-9 * step), &values).unwrap();
+                coords
+                    .factor(
+                        omega * (1.0 + 1e-9 * step),
+                        &values,
+                        fricbound::hbm::schur::ReducedSolver::Dense,
+                    )
+                    .unwrap();
             }),
         ));
         let entry = |i: usize, j: usize| {

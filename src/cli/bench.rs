@@ -45,6 +45,11 @@ pub enum BenchCommand {
         #[arg(long, default_value_t = 50)]
         modes: usize,
     },
+    /// One limit curve (m = +1 on every point) of the reduced 2D blade pair per contact
+    /// refinement, H and formulation: unknowns, Newton and Krylov iterations, factorisations,
+    /// time per iteration and curve and where it went, peak memory, and the fitted exponent of
+    /// the time per iteration against the contact count.
+    Contacts(super::bench_contacts::ContactsArgs),
 }
 
 /// Errors of the bench command.
@@ -56,6 +61,9 @@ pub enum BenchError {
     /// A file could not be written or a child process failed.
     #[error("{0}")]
     Io(String),
+    /// `bench contacts` failed.
+    #[error(transparent)]
+    Contacts(#[from] super::bench_contacts::ContactsBenchError),
 }
 
 /// Runs a bench subcommand; returns the text to print.
@@ -77,6 +85,7 @@ pub fn run(command: &BenchCommand) -> Result<String, BenchError> {
             let m = scaling::measure_reduction(size, *modes)?;
             serde_json::to_string(&m).map_err(|e| BenchError::Io(e.to_string()))
         }
+        BenchCommand::Contacts(args) => Ok(super::bench_contacts::run(args)?),
         BenchCommand::Scaling { out, quick } => {
             let dir = out.clone().unwrap_or_else(|| PathBuf::from("out/scaling"));
             std::fs::create_dir_all(&dir)
@@ -191,8 +200,10 @@ fn scaling_study(dir: &Path, quick: bool) -> Result<String, BenchError> {
             // The cost grows with the factorised size; the schur formulation's finite
             // differences are per contact point, not per unknown.
             let limit = if config.jacobian == JacobianStrategy::Analytic
-                || p.formulation() == Formulation::Schur
-            {
+                || matches!(
+                    p.formulation(),
+                    Formulation::Schur | Formulation::SchurLowRank
+                ) {
                 ANALYTIC_LIMIT
             } else {
                 FD_LIMIT

@@ -59,6 +59,11 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
     if problem.analysis.formulation == crate::model::Formulation::Auto {
         let _ = writeln!(s, "  auto       {}", problem.auto_formulation().1);
     }
+    let _ = writeln!(
+        s,
+        "  solver     {}",
+        crate::hbm::cost::linear_solver_name(cost.formulation)
+    );
     let _ = writeln!(s, "cost         {}", cost.summary());
     let parallel = parallel_solves(&scene, &problem, limits.as_ref());
     use crate::hbm::cost::{available_memory, memory_refusal, MEMINFO};

@@ -22,13 +22,15 @@
 //! - [`paper`] (`fricbound paper`): runs the scenes of the paper's §4 study
 //!   (`meshes/paper-wedge/fig*.toml`, built into the binary) and writes a summary of the key
 //!   numbers next to the paper's statements;
-//! - [`bench`](mod@bench) (`fricbound bench`): the scaling study of the reduction and the solves;
+//! - [`bench`](mod@bench) (`fricbound bench`): the scaling study of the reduction and the solves,
+//!   and (`bench_contacts`) the cost of one limit curve against the contact count;
 //! - [`study`] (`fricbound study accuracy`, `fricbound study jacobian`): what each solver
 //!   setting costs and gives in accuracy, and the formulations side by side;
 //! - [`verify_run`] (`fricbound verify`): time integration of HBM points, against the HBM and
 //!   Hill.
 
 pub mod bench;
+mod bench_contacts;
 mod check;
 mod context;
 mod frf_run;

@@ -35,7 +35,11 @@
 //!   elimination of everything but the n_q ≤ 2c relative coordinates (one per non-zero contact row; n² complex values:
 //!   LU, coupling blocks and the Schur complement; n² real for h = 0), and the reduced matrix
 //!   of (n_q·b)² values with its single-precision copy; twice all of the factor part, since
-//!   the continuation keeps the previous factorisation while it builds the next one.
+//!   the continuation keeps the previous factorisation while it builds the next one;
+//! - `schur-lowrank`: as schur, with the reduced matrix's structured factorisation in place of
+//!   its dense LU where that is cheaper: per harmonic a complex LU of n_q rows, P⁻¹U on each
+//!   harmonic's rows, M and the r × r capacitance matrix, r assumed [`LOW_RANK_ROW_FRACTION`] of
+//!   the reduced rows ([`low_rank_flops`]).
 //!
 //! **Time model** (an estimate, good to a factor of a few): per Newton iteration, the
 //! factorisation's floating-point operations (dense LU (2/3)·m³; complex LU 4× a real one;
@@ -112,7 +116,8 @@ pub fn unknowns_for(p: &Problem, formulation: Formulation) -> usize {
 
 /// Rows of the matrix factorised per Newton iteration on `p`: the unknowns, except for the
 /// schur formulation (2 relative coordinates per contact point, 3 per 2D-friction point, 1
-/// fewer where a direction is zero, and coefficient block).
+/// fewer where a direction is zero, and coefficient block) (the schur-lowrank formulation
+/// factorises the same reduced matrix, by structure where that is cheaper).
 pub fn factored_size(p: &Problem) -> usize {
     factored_size_for(p, p.formulation())
 }
@@ -120,7 +125,9 @@ pub fn factored_size(p: &Problem) -> usize {
 /// [`factored_size`] of `p` solved in `formulation`.
 pub fn factored_size_for(p: &Problem, formulation: Formulation) -> usize {
     match formulation {
-        Formulation::Schur => p.relative_coordinate_count() * p.unknown_harmonics().n_blocks(),
+        Formulation::Schur | Formulation::SchurLowRank => {
+            p.relative_coordinate_count() * p.unknown_harmonics().n_blocks()
+        }
         _ => unknowns_for(p, formulation),
     }
 }
@@ -133,6 +140,33 @@ pub fn formulation_name(f: Formulation) -> &'static str {
         Formulation::Sparse => "sparse",
         Formulation::Condensed => "condensed",
         Formulation::Schur => "schur",
+        Formulation::SchurLowRank => "schur-lowrank",
+    }
+}
+
+/// The formulation written `name` in scenes ([`formulation_name`]), if any.
+pub fn formulation_from_name(name: &str) -> Option<Formulation> {
+    [
+        Formulation::Auto,
+        Formulation::Dense,
+        Formulation::Sparse,
+        Formulation::Condensed,
+        Formulation::Schur,
+        Formulation::SchurLowRank,
+    ]
+    .into_iter()
+    .find(|&f| formulation_name(f) == name)
+}
+
+/// The linear solver of a formulation, as `fricbound check` and the benches name it.
+pub fn linear_solver_name(f: Formulation) -> &'static str {
+    match f {
+        Formulation::Auto | Formulation::Dense | Formulation::Condensed => "dense LU",
+        Formulation::Sparse => "sparse LU",
+        Formulation::Schur => "dense LU on the relative coordinates",
+        Formulation::SchurLowRank => {
+            "per-harmonic LU + low-rank update of the slipping contacts (dense LU where cheaper)"
+        }
     }
 }
 
@@ -272,7 +306,7 @@ pub fn estimate_for(p: &Problem, formulation: Formulation) -> CostEstimate {
     let contact_bytes = match formulation {
         // The schur Jacobian keeps each contact's (k·b)² block on its k relative coordinates
         // (k = 2, or 3 for a 2D-friction point).
-        Formulation::Schur => {
+        Formulation::Schur | Formulation::SchurLowRank => {
             let k2: f64 = p
                 .contacts
                 .iter()
@@ -328,18 +362,10 @@ pub fn estimate_for(p: &Problem, formulation: Formulation) -> CostEstimate {
                 + 2.0 / 3.0 * m * m * m;
             (bytes, flops, 4.0 * m * m)
         }
-        Formulation::Schur => {
-            let n_q = p.relative_coordinate_count() as f64;
-            let n_z = (n - n_q).max(0.0);
+        Formulation::Schur | Formulation::SchurLowRank => {
             let q = factored as f64;
-            let per_harmonic = dynamic * C64 * n * n + if has_static { F64 * n * n } else { 0.0 };
-            let reduced = (F64 + 4.0) * q * q;
-            let bytes = F64 * 6.0 * n * n + 2.0 * (per_harmonic + reduced);
-            // Per harmonic: LU of the z block (complex: 4× real), the solves for W and the
-            // Schur product; then the dense LU of the reduced matrix.
-            let real = 2.0 / 3.0 * n_z * n_z * n_z + 2.0 * n_z * n_z * n_q + 2.0 * n_q * n_q * n_z;
-            let flops =
-                dynamic * 4.0 * real + if has_static { real } else { 0.0 } + 2.0 / 3.0 * q * q * q;
+            let low_rank = formulation == Formulation::SchurLowRank;
+            let (bytes, flops) = schur_cost(p, (n, q), (dynamic, has_static), low_rank);
             // The residual: a dense product per block with K, M, C; a solve: the reduced
             // factors and the eliminated blocks of every harmonic.
             (
@@ -368,6 +394,58 @@ pub fn estimate_for(p: &Problem, formulation: Formulation) -> CostEstimate {
         scalar_flops: aft_flops + assembly_flops,
         chord: unknowns >= p.analysis.continuation.chord_min_unknowns,
     }
+}
+
+/// Fraction of the reduced rows (n_q·blocks) that the schur-lowrank formulation's update is
+/// assumed to hold for its estimates: the rows of the contacts that slip or lift off, and the
+/// constant-harmonic rows of those stuck with their initial condition. Measured: 0.36 on average
+/// over a limit curve of the reduced blade pair with 49 pairs per side at H = 3 (39 % of its
+/// contacts slipping), `fricbound bench contacts`.
+pub const LOW_RANK_ROW_FRACTION: f64 = 0.4;
+
+/// Memory and factorisation flops of the schur and schur-lowrank formulations on `p` (n DOFs,
+/// n_q relative coordinates, q = n_q·b reduced rows; `dynamic` harmonics h ≥ 1 and the 0th
+/// when `has_static`): per harmonic the complex elimination of the n_z = n − n_q other
+/// coordinates, then the dense LU of the reduced matrix (schur), or for schur-lowrank whichever
+/// of it and the structured factorisation with [`LOW_RANK_ROW_FRACTION`]·q update rows
+/// ([`low_rank_flops`]) is cheaper, as the formulation chooses.
+fn schur_cost(
+    p: &Problem,
+    (n, q): (f64, f64),
+    (dynamic, has_static): (f64, bool),
+    low_rank: bool,
+) -> (f64, f64) {
+    let n_q = p.relative_coordinate_count() as f64;
+    let n_z = (n - n_q).max(0.0);
+    let per_harmonic = dynamic * C64 * n * n + if has_static { F64 * n * n } else { 0.0 };
+    let real = 2.0 / 3.0 * n_z * n_z * n_z + 2.0 * n_z * n_z * n_q + 2.0 * n_q * n_q * n_z;
+    let elimination = dynamic * 4.0 * real + if has_static { real } else { 0.0 };
+    let dense_flops = 2.0 / 3.0 * q * q * q;
+    let dense_bytes = (F64 + 4.0) * q * q;
+    let harmonics = dynamic as usize + usize::from(has_static);
+    let r = (LOW_RANK_ROW_FRACTION * q).round();
+    let structured = low_rank_flops(n_q as usize, harmonics, r as usize);
+    let (reduced_bytes, reduced_flops) = if low_rank && structured < dense_flops {
+        // Per harmonic LU (complex n_q²), P⁻¹U on its harmonic's 2·n_q rows, M and C.
+        let bytes = C64 * harmonics as f64 * n_q * n_q + F64 * (2.0 * n_q * r + q * r + r * r);
+        (bytes, structured)
+    } else {
+        (dense_bytes, dense_flops)
+    };
+    (
+        F64 * 6.0 * n * n + 2.0 * (per_harmonic + reduced_bytes),
+        elimination + reduced_flops,
+    )
+}
+
+/// Estimated flops of the schur-lowrank factorisation of the reduced matrix
+/// ([`crate::hbm::schur::lowrank`]) with n_q relative coordinates, `harmonics` harmonics and `r`
+/// update rows, against the dense LU's (2/3)·(n_q·blocks)³: per harmonic the LU of n_q complex
+/// rows (4× a real LU), P⁻¹U (8·n_q² per complex column) and the LU of the r × r capacitance
+/// matrix.
+pub fn low_rank_flops(n_q: usize, harmonics: usize, r: usize) -> f64 {
+    let (n_q, r) = (n_q as f64, r as f64);
+    harmonics as f64 * 8.0 / 3.0 * n_q.powi(3) + 8.0 * n_q * n_q * r + 2.0 / 3.0 * r.powi(3)
 }
 
 /// Bytes as MiB (or GiB from 10 GiB), e.g. "1.3 MiB", "51.2 GiB".

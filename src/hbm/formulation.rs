@@ -115,6 +115,15 @@ pub fn check_relative_coordinates(problem: &Problem) -> Result<(), RelativeCoord
 /// this margin the dense LU, the simplest and most robust, is kept.
 pub const AUTO_MARGIN: f64 = 1.5;
 
+/// Relative contact coordinates from which `auto` considers schur-lowrank. Its structure pays
+/// with many contact points: with few, its per-harmonic blocks are tiny and the flop counts of
+/// the cost model (which leave out the work per block) say nothing of which schur formulation
+/// is faster, so a problem with few contacts and many harmonics (the paper case at H = 31 or 63,
+/// in the error estimate's extended sets) stays on schur. The smallest case measured, the
+/// reduced blade pair with 25 pairs per side (100 coordinates) at H = 3, took 0.8× schur's time
+/// with it (benches/README.md, "Contact count").
+pub const LOW_RANK_AUTO_MIN_COORDINATES: usize = 100;
+
 /// The formulation choice belongs to the harmonic-balance layer, which knows the formulations'
 /// limits; it is a method of [`Problem`] so that every caller asks the problem the same way.
 impl Problem {
@@ -130,8 +139,8 @@ impl Problem {
     /// What `auto` picks, and why. Sparse models: the sparse formulation. Dense models: the
     /// formulation with the lowest estimated time per continuation point
     /// ([`crate::hbm::cost::estimate_for`]) among dense, sparse, condensed (when the contact
-    /// DOFs are at most half of the DOFs) and schur (when the contact points have independent
-    /// relative coordinates, [`check_relative_coordinates`]); dense unless another is estimated
+    /// DOFs are at most half of the DOFs), schur and schur-lowrank (when the contact points have
+    /// independent relative coordinates, [`check_relative_coordinates`]); dense unless another is estimated
     /// at least [`AUTO_MARGIN`] times faster. On a chain of 40 masses with 10 Jenkins elements
     /// to ground at H = 5 (440 unknowns) this is sparse: the same FRF took 5.5 s against 17 s
     /// condensed and 62 s dense (measured on the loaded 2-core machine).
@@ -149,28 +158,47 @@ impl Problem {
         }
         if check_relative_coordinates(self).is_ok() {
             candidates.push(Formulation::Schur);
+            if self.relative_coordinate_count() >= LOW_RANK_AUTO_MIN_COORDINATES {
+                candidates.push(Formulation::SchurLowRank);
+            }
         }
         let times: Vec<(Formulation, f64)> = candidates
             .iter()
             .map(|&f| (f, estimate_for(self, f).seconds_per_point()))
             .collect();
         let dense = times[0].1;
+        // The choice among the formulations with a dense reduced LU, then schur-lowrank in its
+        // place only where it is estimated AUTO_MARGIN× faster than that choice and than schur
+        // (the dense reduced LU is the simpler, and exact whatever the contacts do; on small
+        // problems the estimates of both are dominated by what the cost model leaves out).
         let (best, best_time) = times
             .iter()
             .copied()
+            .filter(|t| t.0 != Formulation::SchurLowRank)
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .unwrap_or((Formulation::Dense, dense));
-        let chosen = if best_time * AUTO_MARGIN < dense {
-            best
+        let (chosen, chosen_time) = if best_time * AUTO_MARGIN < dense {
+            (best, best_time)
         } else {
-            Formulation::Dense
+            (Formulation::Dense, dense)
+        };
+        let time_of = |f: Formulation| times.iter().find(|t| t.0 == f).map(|t| t.1);
+        let chosen = match (
+            time_of(Formulation::SchurLowRank),
+            time_of(Formulation::Schur),
+        ) {
+            (Some(t), Some(schur)) if t * AUTO_MARGIN < chosen_time.min(schur) => {
+                Formulation::SchurLowRank
+            }
+            _ => chosen,
         };
         let listed: Vec<String> = times
             .iter()
             .map(|(f, t)| format!("{} {:.3} ms", formulation_name(*f), 1e3 * t))
             .collect();
         let reason = format!(
-            "estimated time per point: {}; dense unless another is estimated {AUTO_MARGIN}× faster",
+            "estimated time per point: {}; dense unless another is estimated {AUTO_MARGIN}× faster, \
+             schur-lowrank only where estimated {AUTO_MARGIN}× faster than that and than schur",
             listed.join(", ")
         );
         (chosen, reason)

@@ -10,7 +10,7 @@
 //! | [`pattern`] | `JacobianLayout`, `ContactSlots` | the fixed Jacobian pattern and the slots every Newton iteration fills |
 //! | [`formulation`] | `Problem::formulation`, `check_relative_coordinates` | which formulation `auto` picks, and whether schur applies |
 //! | [`condensed`] | `CondensedHbm` | unknowns on the contact DOFs only, the rest eliminated per harmonic |
-//! | [`schur`] | `RelativeCoordinates`, `SchurJacobian` | all DOFs, each linear solve reduced to the relative contact coordinates |
+//! | [`schur`] | `RelativeCoordinates`, `SchurJacobian`, `ReducedSolver` | all DOFs, each linear solve reduced to the relative contact coordinates (dense, or by structure for many contacts) |
 //! | [`operator`] | `HbmOperator` | the operator a run solves, dispatching to the formulation |
 //! | [`cost`] | `CostEstimate`, `estimate` | size of the unknowns, memory of one Newton iteration and time per point, estimated before anything is allocated |
 //! | [`statics`] | [`static_solve`], [`statics::StaticSystem`], [`statics::static_point_2d`] | the static pre-solve of the uncoupled mode (1D and 2D friction points from rest) |

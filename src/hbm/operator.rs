@@ -10,6 +10,7 @@ use crate::hbm::condensed::CondensedHbm;
 use crate::hbm::{HbmError, HbmSystem};
 use crate::model::{Formulation, JacobianStrategy, Problem};
 use crate::numerics::jacobian::AssembledJacobian;
+use crate::numerics::work::{self, Work};
 use crate::numerics::ParametricResidual;
 
 /// Full or condensed harmonic balance.
@@ -100,10 +101,13 @@ impl ParametricResidual for HbmOperator<'_> {
     }
 
     fn residual(&mut self, x: &[f64], lambda: f64, r: &mut [f64]) -> Result<(), HbmError> {
-        match self {
+        let started = std::time::Instant::now();
+        let out = match self {
             HbmOperator::Full(s) => s.residual(x, lambda, r),
             HbmOperator::Condensed(c) => c.residual(x, lambda, r),
-        }
+        };
+        work::record(Work::Evaluation, started);
+        out
     }
 
     fn new_jacobian(&mut self) -> AssembledJacobian {
@@ -114,6 +118,23 @@ impl ParametricResidual for HbmOperator<'_> {
     }
 
     fn residual_and_jacobian(
+        &mut self,
+        x: &[f64],
+        lambda: f64,
+        r: &mut [f64],
+        jac: &mut AssembledJacobian,
+        dr_dlambda: &mut [f64],
+    ) -> Result<(), HbmError> {
+        let started = std::time::Instant::now();
+        let out = self.evaluate_with_jacobian(x, lambda, r, jac, dr_dlambda);
+        work::record(Work::Evaluation, started);
+        out
+    }
+}
+
+impl HbmOperator<'_> {
+    /// [`ParametricResidual::residual_and_jacobian`] without its timing.
+    fn evaluate_with_jacobian(
         &mut self,
         x: &[f64],
         lambda: f64,

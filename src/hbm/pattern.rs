@@ -264,7 +264,8 @@ impl JacobianLayout {
     /// The layout of the schur formulation ([`crate::hbm::schur`]): no linear slots (the linear
     /// part is formed from ω when the Jacobian is factorised) and, per contact, its block on
     /// the contact's own k relative coordinates (u, v; or u₁, u₂, v for a 2D point), slot
-    /// offset + ((j·blocks + i)·k + a)·k + b.
+    /// offset + ((j·blocks + i)·k + a)·k + b. Its reduced matrix is factorised by a dense LU, or
+    /// by structure when the problem's formulation is `schur-lowrank`.
     pub fn relative(
         problem: &Problem,
         set: &HarmonicSet,
@@ -276,8 +277,13 @@ impl JacobianLayout {
         let rows: Vec<usize> = (0..problem.contacts.len())
             .map(|p| coords.contact_rows(p))
             .collect();
+        let solver = if problem.formulation() == crate::model::Formulation::SchurLowRank {
+            crate::hbm::schur::ReducedSolver::Structured
+        } else {
+            crate::hbm::schur::ReducedSolver::Dense
+        };
         let template = AssembledJacobian::implicit(std::sync::Arc::new(
-            crate::hbm::schur::SchurJacobian(coords),
+            crate::hbm::schur::SchurJacobian(coords, solver),
         ));
         let contacts = (0..problem.contacts.len())
             .map(|p| {

@@ -132,7 +132,7 @@ impl<'p> HbmSystem<'p> {
         };
         let storage = match problem.formulation() {
             Formulation::Sparse => Storage::Sparse,
-            Formulation::Schur => Storage::Schur,
+            Formulation::Schur | Formulation::SchurLowRank => Storage::Schur,
             _ => Storage::Dense,
         };
         let relative = match storage {

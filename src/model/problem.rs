@@ -101,6 +101,13 @@ pub enum Formulation {
     /// contact coordinates (two per contact point) per harmonic, and factorises a dense
     /// matrix on those only ([`crate::hbm::schur`]). For dense (lumped or reduced) models.
     Schur,
+    /// The schur formulation with its reduced matrix factorised by structure
+    /// ([`crate::hbm::schur::lowrank`]): one LU per harmonic of the linear part with each contact's
+    /// mean stiffness, and a low-rank update for the contacts whose Jacobian couples harmonics
+    /// (those that slip or lift off); a dense LU where that update would cost more. For many
+    /// contact points.
+    #[serde(rename = "schur-lowrank")]
+    SchurLowRank,
 }
 
 /// Which method gives each converged point its stability verdict (scene field

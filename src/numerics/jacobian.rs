@@ -34,6 +34,7 @@ use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::Mat;
 
 use crate::numerics::linalg::{checked_lu, norm, solve_dense, LinearSolveError};
+use crate::numerics::work::{self, Work};
 
 /// A Jacobian whose linear part is implied by an operator instead of stored: its values are
 /// only the blocks the operator needs (for the harmonic balance's schur formulation, one dense
@@ -162,6 +163,7 @@ impl BorderedFactor {
             return Err(LinearSolveError::NonFinite);
         }
         let n1 = rhs.len();
+        let started = std::time::Instant::now();
         let y: Vec<f64> = match &self.kind {
             FactorKind::Dense(lu) => {
                 let x = lu.solve(Mat::from_fn(n1, 1, |i, _| rhs[i]));
@@ -181,6 +183,7 @@ impl BorderedFactor {
                 y
             }
         };
+        work::record(Work::Solve, started);
         if y.iter().any(|v| !v.is_finite()) {
             return Err(LinearSolveError::Singular { ratio: 0.0 });
         }
@@ -409,7 +412,10 @@ impl AssembledJacobian {
             Storage::Dense => {
                 let n = self.n;
                 let a = Mat::from_fn(n, n, |i, j| self.values[i + j * n]);
-                solve_dense(&a, b)
+                let started = std::time::Instant::now();
+                let x = solve_dense(&a, b);
+                work::record(Work::Factorisation, started);
+                x
             }
             Storage::Sparse | Storage::Schur => {
                 let ones = vec![1.0; self.n];
@@ -430,7 +436,9 @@ impl AssembledJacobian {
                     return Err(LinearSolveError::NonFinite);
                 }
                 let a = Mat::from_fn(n, n, |i, j| self.values[i + j * n]);
+                let started = std::time::Instant::now();
                 let lu = checked_lu(&a)?;
+                work::record(Work::Factorisation, started);
                 let b = Mat::from_fn(n, rhs.len(), |i, k| rhs[k][i]);
                 let x = lu.solve(&b);
                 let out: Vec<Vec<f64>> = (0..rhs.len())
@@ -487,7 +495,9 @@ impl AssembledJacobian {
                     (true, false) => col[i],
                     (false, _) => row[j],
                 });
+                let started = std::time::Instant::now();
                 let lu = checked_lu(&a)?;
+                work::record(Work::Factorisation, started);
                 self.factorisations += 1;
                 FactorKind::Dense(lu)
             }
@@ -514,6 +524,7 @@ impl AssembledJacobian {
         if col_scale.len() != self.n || col_scale.iter().any(|s| !s.is_finite() || *s == 0.0) {
             return Err(LinearSolveError::NonFinite);
         }
+        let started = std::time::Instant::now();
         let kind = match &self.implicit {
             Some(r) => {
                 let f = r.factor(self.omega, &self.values)?;
@@ -522,6 +533,7 @@ impl AssembledJacobian {
             }
             None => InnerKind::Sparse(Box::new(self.sparse_lu()?)),
         };
+        work::record(Work::Factorisation, started);
         Ok(InnerFactor {
             kind,
             col_scale: col_scale.to_vec(),
@@ -580,7 +592,9 @@ impl AssembledJacobian {
             return Err(LinearSolveError::NonFinite);
         }
         let solve = |rhs: &[f64]| -> Result<Vec<f64>, LinearSolveError> {
+            let started = std::time::Instant::now();
             let out = lu.solve(rhs);
+            work::record(Work::Solve, started);
             if out.iter().any(|v| !v.is_finite()) {
                 return Err(LinearSolveError::Singular { ratio: 0.0 });
             }

@@ -16,6 +16,7 @@
 //! | [`broyden`] | `BroydenUpdates` | secant updates of a factorised Newton matrix (chord steps) |
 //! | [`path`] | [`PathPoint`], [`PathSummary`], [`Observer`], [`NewtonFailure`] | what continuation produces and reports |
 //! | [`interrupt`] | `request`, `clear`, `requested` | a process-wide request to stop the runs in progress (Ctrl-C of an embedding caller) |
+//! | [`work`] | `Work`, `WorkReading`, `reading` | process-wide counters of factorisations, solves and evaluations, for benchmarks |
 
 pub mod box_minimize;
 pub mod broyden;
@@ -27,6 +28,7 @@ pub mod jacobian;
 pub mod linalg;
 pub mod path;
 pub mod residual;
+pub mod work;
 
 pub use continuation::{Continuation, ContinuationSettings};
 pub use jacobian::{AssembledJacobian, BorderedFactor, ImplicitFactor, ImplicitJacobian, Storage};

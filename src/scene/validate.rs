@@ -75,7 +75,10 @@ impl Scene {
         held?;
         let mut problem = problem;
         problem.analysis.nonlinear_modes = mode_analysis(self, &ck, &problem, limits.as_ref())?;
-        if problem.analysis.formulation == Formulation::Schur {
+        if matches!(
+            problem.analysis.formulation,
+            Formulation::Schur | Formulation::SchurLowRank
+        ) {
             check_relative_coordinates(&problem)
                 .map_err(|e| ck.err("analysis.formulation", e.to_string()))?;
         }

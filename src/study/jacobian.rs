@@ -1,5 +1,5 @@
 //! The Jacobian study: the analytic Jacobian against finite differences, and the dense,
-//! sparse, condensed and schur formulations side by side, on a scene and on a ladder of
+//! sparse, condensed, schur and schur-lowrank formulations side by side, on a scene and on a ladder of
 //! reference problems (the paper case at growing H, chains of unit masses with Jenkins
 //! elements to ground, the reduced FE blade pair at growing contact counts and H).
 //!
@@ -37,11 +37,12 @@ use crate::scene;
 use crate::study::scaling::{self, ModelSize};
 
 /// Formulations the study compares, in the order they run.
-pub const FORMULATIONS: [Formulation; 4] = [
+pub const FORMULATIONS: [Formulation; 5] = [
     Formulation::Dense,
     Formulation::Sparse,
     Formulation::Condensed,
     Formulation::Schur,
+    Formulation::SchurLowRank,
 ];
 
 /// Errors of the study's set-up (a ladder problem that cannot be built).

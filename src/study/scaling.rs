@@ -337,11 +337,12 @@ pub struct SolveMeasure {
 }
 
 /// Formulations the study and the criterion bench compare.
-pub const FORMULATIONS: [Formulation; 4] = [
+pub const FORMULATIONS: [Formulation; 5] = [
     Formulation::Dense,
     Formulation::Sparse,
     Formulation::Condensed,
     Formulation::Schur,
+    Formulation::SchurLowRank,
 ];
 
 /// Jacobian strategies the study and the criterion bench compare: the analytic AFT Jacobian

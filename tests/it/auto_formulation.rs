@@ -92,3 +92,26 @@ fn sparse_estimate_is_bounded_by_the_dense_fill() {
     let m = c.unknowns as f64;
     assert!(c.factor_flops < 0.01 * 2.0 * m * m * m, "{c:?}");
 }
+
+/// Many contact points: at 97 pairs per side and H = 5 the reduced blade pair goes
+/// schur-lowrank (measured 0.43× schur's time on a limit curve, benches/README.md "Contact
+/// count"); the paper case keeps its choice at every H (above).
+#[test]
+fn auto_on_many_contact_points_picks_the_structured_reduced_solve() {
+    let dir = tempfile::tempdir().unwrap();
+    let size = ModelSize {
+        contact_refine: 16,
+        ..ModelSize::uniform(false, 2)
+    };
+    let reduced = scaling::reduced_problem(size, 20, dir.path()).unwrap();
+    let mut p = reduced.clone();
+    p.harmonics = (1..=5).collect();
+    assert_eq!(p.contacts.len(), 2 * 97);
+    assert_eq!(picks(&p), Formulation::SchurLowRank);
+    let (lowrank, schur) = (
+        estimate_for(&p, Formulation::SchurLowRank),
+        estimate_for(&p, Formulation::Schur),
+    );
+    assert!(lowrank.factor_flops < schur.factor_flops);
+    assert!(lowrank.solver_bytes < schur.solver_bytes);
+}

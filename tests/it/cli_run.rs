@@ -572,6 +572,10 @@ const COMMANDS_NOT_RUN: &[(&str, &str)] = &[
         "the full study takes minutes; tests/it/paper.rs runs `paper --quick`",
     ),
     ("bench scaling", "the scaling study takes minutes"),
+    (
+        "bench contacts",
+        "its curves take up to minutes each; tests/it/schur_lowrank.rs runs its library code",
+    ),
 ];
 
 /// A shell command line split into words ('…' and "…" quote, no other shell syntax).

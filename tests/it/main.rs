@@ -46,6 +46,7 @@ mod paper_case;
 mod reduction_repeatable;
 mod scaling;
 mod scene_errors;
+mod schur_lowrank;
 mod stability;
 mod stability_method;
 mod stability_sparse;

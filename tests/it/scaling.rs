@@ -20,7 +20,7 @@ fn two_pairs() -> fricbound::model::Problem {
 #[test]
 fn grid_covers_every_formulation_and_jacobian_per_harmonic_count() {
     let grid = SolverConfig::grid(&[1, 3]);
-    assert_eq!(grid.len(), 2 * 4 * 2);
+    assert_eq!(grid.len(), 2 * 5 * 2);
     for h in [1, 3] {
         for f in scaling::FORMULATIONS {
             for j in scaling::JACOBIANS {
@@ -54,7 +54,7 @@ fn newton_iteration_sizes_and_steps_agree_across_formulations() {
         assert_eq!(iteration.unknowns(), scaling::unknowns(&p));
         let blocks = 7;
         let expected_factored = match config.formulation {
-            Formulation::Schur => 2 * 4 * blocks,
+            Formulation::Schur | Formulation::SchurLowRank => 2 * 4 * blocks,
             Formulation::Condensed => p.contact_dofs().len() * blocks,
             _ => p.model.n_dofs() * blocks,
         };

@@ -48,15 +48,19 @@ fn quick_jacobian_study_runs_end_to_end() {
         column("jacobian_vs_central"),
         column("point_ms"),
     );
-    // The scene, the paper case at H = 1 and 5, one chain, one blade pair: 5 cases × 4.
-    assert_eq!(rows.len(), 20, "{rows:?}");
+    // The scene, the paper case at H = 1 and 5, one chain, one blade pair: 5 cases × 5.
+    assert_eq!(rows.len(), 25, "{rows:?}");
     let mut cases: Vec<&str> = rows.iter().map(|r| r[case].as_str()).collect();
     cases.dedup();
     assert_eq!(cases.len(), 5, "{cases:?}");
     for c in &cases {
         let of_case: Vec<&Vec<String>> = rows.iter().filter(|r| r[case] == *c).collect();
         let names: Vec<&str> = of_case.iter().map(|r| r[formulation].as_str()).collect();
-        assert_eq!(names, ["dense", "sparse", "condensed", "schur"], "{c}");
+        assert_eq!(
+            names,
+            ["dense", "sparse", "condensed", "schur", "schur-lowrank"],
+            "{c}"
+        );
         // Exactly one formulation is auto's, and one the fastest.
         assert_eq!(
             of_case.iter().filter(|r| r[auto] == "true").count(),

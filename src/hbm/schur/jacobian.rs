@@ -7,8 +7,11 @@ use faer::{c64, Mat};
 
 use super::coordinates::{HarmonicBlocks, RelativeCoordinates};
 use super::elimination::{EliminatedHarmonic, Elimination, ZPart};
+use super::lowrank::LowRankFactor;
+use crate::hbm::cost::low_rank_flops;
 use crate::numerics::jacobian::{ImplicitFactor, ImplicitJacobian};
 use crate::numerics::linalg::{packed_complex_lu, packed_lu, LinearSolveError, PackedLu};
+use crate::numerics::work::{self, Work};
 
 impl RelativeCoordinates {
     /// K − (hω)²M on y-coordinate ranges `rows` × `cols` (real: h = 0, or a harmonic without
@@ -110,7 +113,10 @@ impl RelativeCoordinates {
     /// Every harmonic's elimination at ω: the last factorisation's when it was at this ω exactly
     /// ([`EliminationCache`](super::elimination::EliminationCache)), else computed (without holding
     /// the cache meanwhile) and kept.
-    fn eliminated_at(&self, omega: f64) -> Result<Arc<Vec<EliminatedHarmonic>>, LinearSolveError> {
+    pub(super) fn eliminated_at(
+        &self,
+        omega: f64,
+    ) -> Result<Arc<Vec<EliminatedHarmonic>>, LinearSolveError> {
         let cache = || {
             self.last_elimination
                 .0
@@ -140,15 +146,47 @@ impl RelativeCoordinates {
         self: &Arc<Self>,
         omega: f64,
         contact_values: &[f64],
+        solver: ReducedSolver,
     ) -> Result<SchurFactor, LinearSolveError> {
         if !omega.is_finite() || contact_values.iter().any(|v| !v.is_finite()) {
             return Err(LinearSolveError::NonFinite);
         }
-        let (n_q, nb) = (self.n_q, self.blocks.len());
-        let dim_q = n_q * nb;
-        let mut s = Mat::<f64>::zeros(dim_q, dim_q);
         let eliminated = self.eliminated_at(omega)?;
-        for eh in eliminated.iter() {
+        let reduced = self.reduced_factor(&eliminated, contact_values, solver)?;
+        Ok(SchurFactor {
+            coords: Arc::clone(self),
+            harmonics: eliminated,
+            reduced,
+        })
+    }
+
+    /// The factorised reduced matrix blockdiag_h S_h + N_c of the eliminated `harmonics` with
+    /// the contact blocks `contact_values`: with [`ReducedSolver::Structured`], by the low-rank
+    /// update of a per-harmonic baseline ([`super::lowrank`]) when its estimated flops are below
+    /// the dense LU's (and the baseline can be factorised); else by the dense LU.
+    pub(super) fn reduced_factor(
+        &self,
+        harmonics: &[EliminatedHarmonic],
+        contact_values: &[f64],
+        solver: ReducedSolver,
+    ) -> Result<ReducedFactor, LinearSolveError> {
+        let (n_q, nb) = (self.n_q, self.blocks.len());
+        if solver == ReducedSolver::Structured {
+            let rows = self.coupling_rows(contact_values);
+            let dense = 2.0 / 3.0 * ((n_q * nb) as f64).powi(3);
+            if low_rank_flops(n_q, harmonics.len(), rows.len()) < dense {
+                let factor = self
+                    .harmonic_lus(harmonics, contact_values)
+                    .and_then(|lus| LowRankFactor::new(n_q, lus, rows));
+                if let Ok(f) = factor {
+                    work::add(Work::LowRankFactorisation, 1);
+                    work::add(Work::LowRankRows, f.rank() as u64);
+                    return Ok(ReducedFactor::LowRank(f));
+                }
+            }
+        }
+        let mut s = Mat::<f64>::zeros(n_q * nb, n_q * nb);
+        for eh in harmonics.iter() {
             eh.add_schur_complement(&mut s, n_q);
         }
         for p in 0..self.rows.len() {
@@ -169,14 +207,9 @@ impl RelativeCoordinates {
                 }
             }
         }
-        let lu_q = packed_lu(s)?;
-        let lu_q_single = lu_q.to_single();
-        Ok(SchurFactor {
-            coords: Arc::clone(self),
-            harmonics: eliminated,
-            lu_q,
-            lu_q_single,
-        })
+        let lu = packed_lu(s)?;
+        let single = lu.to_single();
+        Ok(ReducedFactor::Dense { lu, single })
     }
 
     /// y += s·J x with J at ω and contact blocks `contact_values` (x, y of length n·blocks).
@@ -266,13 +299,24 @@ impl RelativeCoordinates {
     }
 }
 
+/// How the reduced matrix blockdiag_h S_h + N_c is factorised.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ReducedSolver {
+    /// Dense LU (the `schur` formulation).
+    Dense,
+    /// Per-harmonic baseline and low-rank update where that is estimated cheaper, else dense
+    /// LU (the `schur-lowrank` formulation, [`super::lowrank`]).
+    Structured,
+}
+
 /// The schur formulation's Jacobian storage for [`AssembledJacobian::implicit`]: the values
 /// are one (k·blocks)² block per contact point (k = 2 rows, 3 for a 2D point) (see [`RelativeCoordinates::factor`]); the
-/// linear part is formed from the structural matrices at ω.
+/// linear part is formed from the structural matrices at ω; the reduced matrix is factorised
+/// by the [`ReducedSolver`].
 ///
 /// [`AssembledJacobian::implicit`]: crate::numerics::jacobian::AssembledJacobian::implicit
 #[derive(Debug)]
-pub struct SchurJacobian(pub Arc<RelativeCoordinates>);
+pub struct SchurJacobian(pub Arc<RelativeCoordinates>, pub ReducedSolver);
 
 impl ImplicitJacobian for SchurJacobian {
     fn dim(&self) -> usize {
@@ -296,7 +340,7 @@ impl ImplicitJacobian for SchurJacobian {
         omega: f64,
         values: &[f64],
     ) -> Result<Box<dyn ImplicitFactor>, LinearSolveError> {
-        Ok(Box::new(self.0.factor(omega, values)?))
+        Ok(Box::new(self.0.factor(omega, values, self.1)?))
     }
 }
 
@@ -304,10 +348,50 @@ impl ImplicitJacobian for SchurJacobian {
 pub struct SchurFactor {
     coords: Arc<RelativeCoordinates>,
     pub(super) harmonics: Arc<Vec<EliminatedHarmonic>>,
-    /// LU of blockdiag_h S_h + N_c.
-    lu_q: PackedLu<f64>,
-    /// The same LU rounded to single precision, for approximate solves.
-    lu_q_single: PackedLu<f32>,
+    /// blockdiag_h S_h + N_c factorised.
+    reduced: ReducedFactor,
+}
+
+/// The reduced matrix blockdiag_h S_h + N_c factorised.
+pub(super) enum ReducedFactor {
+    /// Dense LU, and the same LU rounded to single precision for approximate solves.
+    Dense {
+        lu: PackedLu<f64>,
+        single: PackedLu<f32>,
+    },
+    /// Per-harmonic baseline and low-rank update ([`super::lowrank`]).
+    LowRank(LowRankFactor),
+}
+
+impl SchurFactor {
+    /// The rank of the low-rank update when the reduced matrix was factorised by structure
+    /// ([`super::lowrank`]); None for the dense LU.
+    pub fn low_rank(&self) -> Option<usize> {
+        match &self.reduced {
+            ReducedFactor::LowRank(f) => Some(f.rank()),
+            ReducedFactor::Dense { .. } => None,
+        }
+    }
+}
+
+impl ReducedFactor {
+    /// The reduced matrix's inverse applied to `r` (with `single`, the dense LU's
+    /// single-precision factors).
+    pub(super) fn solve(&self, r: Mat<f64>, single: bool) -> Mat<f64> {
+        match self {
+            ReducedFactor::Dense { lu, single: lu32 } if single => {
+                let mut y = Mat::from_fn(r.nrows(), r.ncols(), |i, j| r[(i, j)] as f32);
+                lu32.solve_in_place(&mut y);
+                Mat::from_fn(y.nrows(), y.ncols(), |i, j| y[(i, j)] as f64)
+            }
+            ReducedFactor::Dense { lu, .. } => {
+                let mut y = r;
+                lu.solve_in_place(&mut y);
+                y
+            }
+            ReducedFactor::LowRank(f) => f.solve(r),
+        }
+    }
 }
 
 impl ImplicitFactor for SchurFactor {
@@ -316,96 +400,103 @@ impl ImplicitFactor for SchurFactor {
     /// fast on large factors, with a relative error of about 10⁻⁷ times the condition number
     /// (for the chord steps of a corrector, whose convergence is judged on the true residual).
     fn solve(&self, b: &[f64], single: bool) -> Vec<f64> {
-        let co = &self.coords;
-        let (n, n_q, nb) = (co.n, co.n_q, co.blocks.len());
-        let bm = Mat::from_fn(n, nb, |i, j| b[j * n + i]);
-        let by = co.to_relative_coordinates(&bm);
-        let mut r_q = Mat::<f64>::zeros(n_q * nb, 1);
-        let mut kept: Vec<ZPart> = Vec::with_capacity(self.harmonics.len());
-        for eh in self.harmonics.iter() {
-            match &eh.elimination {
-                Elimination::Real { lu_zz, a_qz, .. } => {
-                    let j = eh.blocks[0];
-                    let mut rq = Mat::from_fn(n_q, 1, |i, _| by[(i, j)]);
-                    let g = lu_zz.as_ref().map(|lu| {
-                        let g = lu.solve(&Mat::from_fn(n - n_q, 1, |i, _| by[(n_q + i, j)]));
-                        rq -= a_qz * &g;
-                        g
-                    });
-                    for i in 0..n_q {
-                        r_q[(j * n_q + i, 0)] = rq[(i, 0)];
-                    }
-                    kept.push(ZPart::Real(g));
-                }
-                Elimination::Complex { lu_zz, a_qz, .. } => {
-                    let (jc, js) = (eh.blocks[0], eh.blocks[1]);
-                    let packed = |i: usize| c64::new(by[(i, jc)], -by[(i, js)]);
-                    let mut rq = Mat::from_fn(n_q, 1, |i, _| packed(i));
-                    let g = lu_zz.as_ref().map(|lu| {
-                        let g = lu.solve(&Mat::from_fn(n - n_q, 1, |i, _| packed(n_q + i)));
-                        rq -= a_qz * &g;
-                        g
-                    });
-                    for i in 0..n_q {
-                        r_q[(jc * n_q + i, 0)] = rq[(i, 0)].re;
-                        r_q[(js * n_q + i, 0)] = -rq[(i, 0)].im;
-                    }
-                    kept.push(ZPart::Complex(g));
-                }
-            }
-        }
-        let y_q = if single {
-            let mut y = Mat::from_fn(r_q.nrows(), 1, |i, _| r_q[(i, 0)] as f32);
-            self.lu_q_single.solve_in_place(&mut y);
-            Mat::from_fn(y.nrows(), 1, |i, _| y[(i, 0)] as f64)
-        } else {
-            let mut y_q = r_q;
-            self.lu_q.solve_in_place(&mut y_q);
-            y_q
-        };
-        let mut y = Mat::<f64>::zeros(n, nb);
-        for (eh, g) in self.harmonics.iter().zip(kept) {
-            match (&eh.elimination, g) {
-                (Elimination::Real { w, .. }, ZPart::Real(g)) => {
-                    let j = eh.blocks[0];
-                    let yq = Mat::from_fn(n_q, 1, |i, _| y_q[(j * n_q + i, 0)]);
-                    for i in 0..n_q {
-                        y[(i, j)] = yq[(i, 0)];
-                    }
-                    if let Some(g) = g {
-                        let yz = g - w * &yq;
-                        for i in 0..n - n_q {
-                            y[(n_q + i, j)] = yz[(i, 0)];
-                        }
-                    }
-                }
-                (Elimination::Complex { w, .. }, ZPart::Complex(g)) => {
-                    let (jc, js) = (eh.blocks[0], eh.blocks[1]);
-                    let yq = Mat::from_fn(n_q, 1, |i, _| {
-                        c64::new(y_q[(jc * n_q + i, 0)], -y_q[(js * n_q + i, 0)])
-                    });
-                    for i in 0..n_q {
-                        y[(i, jc)] = yq[(i, 0)].re;
-                        y[(i, js)] = -yq[(i, 0)].im;
-                    }
-                    if let Some(g) = g {
-                        let yz = g - w * &yq;
-                        for i in 0..n - n_q {
-                            y[(n_q + i, jc)] = yz[(i, 0)].re;
-                            y[(n_q + i, js)] = -yz[(i, 0)].im;
-                        }
-                    }
-                }
-                _ => unreachable!("z parts are kept in the order of the eliminations"),
-            }
-        }
-        let x = co.to_problem_coordinates(&y);
-        let mut out = vec![0.0; n * nb];
-        for j in 0..nb {
-            for i in 0..n {
-                out[j * n + i] = x[(i, j)];
-            }
-        }
-        out
+        solve_eliminated(&self.coords, &self.harmonics, b, |r_q| {
+            self.reduced.solve(r_q, single)
+        })
     }
+}
+
+/// Solves (Ã + [R 0; 0 0]) y = Tᵀ b by the per-harmonic elimination `harmonics` and returns
+/// x = T y (problem coordinates, harmonic-major, length n·blocks): `reduced` solves the reduced
+/// system on the relative coordinates, blockdiag_h S_h + R, for its right-hand side (n_q·blocks
+/// rows, block-major): the dense LU of the whole reduced matrix, or its structured factorisation
+/// ([`super::lowrank`]).
+pub(super) fn solve_eliminated(
+    co: &RelativeCoordinates,
+    harmonics: &[EliminatedHarmonic],
+    b: &[f64],
+    reduced: impl FnOnce(Mat<f64>) -> Mat<f64>,
+) -> Vec<f64> {
+    let (n, n_q, nb) = (co.n, co.n_q, co.blocks.len());
+    let bm = Mat::from_fn(n, nb, |i, j| b[j * n + i]);
+    let by = co.to_relative_coordinates(&bm);
+    let mut r_q = Mat::<f64>::zeros(n_q * nb, 1);
+    let mut kept: Vec<ZPart> = Vec::with_capacity(harmonics.len());
+    for eh in harmonics.iter() {
+        match &eh.elimination {
+            Elimination::Real { lu_zz, a_qz, .. } => {
+                let j = eh.blocks[0];
+                let mut rq = Mat::from_fn(n_q, 1, |i, _| by[(i, j)]);
+                let g = lu_zz.as_ref().map(|lu| {
+                    let g = lu.solve(&Mat::from_fn(n - n_q, 1, |i, _| by[(n_q + i, j)]));
+                    rq -= a_qz * &g;
+                    g
+                });
+                for i in 0..n_q {
+                    r_q[(j * n_q + i, 0)] = rq[(i, 0)];
+                }
+                kept.push(ZPart::Real(g));
+            }
+            Elimination::Complex { lu_zz, a_qz, .. } => {
+                let (jc, js) = (eh.blocks[0], eh.blocks[1]);
+                let packed = |i: usize| c64::new(by[(i, jc)], -by[(i, js)]);
+                let mut rq = Mat::from_fn(n_q, 1, |i, _| packed(i));
+                let g = lu_zz.as_ref().map(|lu| {
+                    let g = lu.solve(&Mat::from_fn(n - n_q, 1, |i, _| packed(n_q + i)));
+                    rq -= a_qz * &g;
+                    g
+                });
+                for i in 0..n_q {
+                    r_q[(jc * n_q + i, 0)] = rq[(i, 0)].re;
+                    r_q[(js * n_q + i, 0)] = -rq[(i, 0)].im;
+                }
+                kept.push(ZPart::Complex(g));
+            }
+        }
+    }
+    let y_q = reduced(r_q);
+    let mut y = Mat::<f64>::zeros(n, nb);
+    for (eh, g) in harmonics.iter().zip(kept) {
+        match (&eh.elimination, g) {
+            (Elimination::Real { w, .. }, ZPart::Real(g)) => {
+                let j = eh.blocks[0];
+                let yq = Mat::from_fn(n_q, 1, |i, _| y_q[(j * n_q + i, 0)]);
+                for i in 0..n_q {
+                    y[(i, j)] = yq[(i, 0)];
+                }
+                if let Some(g) = g {
+                    let yz = g - w * &yq;
+                    for i in 0..n - n_q {
+                        y[(n_q + i, j)] = yz[(i, 0)];
+                    }
+                }
+            }
+            (Elimination::Complex { w, .. }, ZPart::Complex(g)) => {
+                let (jc, js) = (eh.blocks[0], eh.blocks[1]);
+                let yq = Mat::from_fn(n_q, 1, |i, _| {
+                    c64::new(y_q[(jc * n_q + i, 0)], -y_q[(js * n_q + i, 0)])
+                });
+                for i in 0..n_q {
+                    y[(i, jc)] = yq[(i, 0)].re;
+                    y[(i, js)] = -yq[(i, 0)].im;
+                }
+                if let Some(g) = g {
+                    let yz = g - w * &yq;
+                    for i in 0..n - n_q {
+                        y[(n_q + i, jc)] = yz[(i, 0)].re;
+                        y[(n_q + i, js)] = -yz[(i, 0)].im;
+                    }
+                }
+            }
+            _ => unreachable!("z parts are kept in the order of the eliminations"),
+        }
+    }
+    let x = co.to_problem_coordinates(&y);
+    let mut out = vec![0.0; n * nb];
+    for j in 0..nb {
+        for i in 0..n {
+            out[j * n + i] = x[(i, j)];
+        }
+    }
+    out
 }

@@ -37,11 +37,14 @@
 //!
 //! The files: [`coordinates`] (the relative contact coordinates and the change to them),
 //! [`elimination`] (what the per-harmonic elimination keeps) and [`jacobian`] (the
-//! elimination and the Newton matrix on the relative coordinates, its factorisation and products).
+//! elimination and the Newton matrix on the relative coordinates, its factorisation and products)
+//! and [`lowrank`] (the reduced matrix factorised as a per-harmonic baseline plus a low-rank update
+//! for the contacts that slip: the `schur-lowrank` formulation, for many contact points).
 
 mod coordinates;
 mod elimination;
 mod jacobian;
+pub mod lowrank;
 
 pub use coordinates::RelativeCoordinates;
-pub use jacobian::{SchurFactor, SchurJacobian};
+pub use jacobian::{ReducedSolver, SchurFactor, SchurJacobian};

@@ -1,0 +1,142 @@
+//! The schur-lowrank formulation: its structured factorisation of the reduced matrix (a
+//! per-harmonic baseline and a low-rank update for the contacts that couple harmonics) solves as
+//! the dense LU does, and a limit curve of the reduced blade pair with 49 contact pairs per side
+//! at H = 3 has the schur formulation's peaks.
+
+use std::sync::Arc;
+
+use fricbound::hbm::schur::{ReducedSolver, RelativeCoordinates};
+use fricbound::model::Formulation;
+use fricbound::numerics::ImplicitFactor;
+use fricbound::study::contacts::{self, ContactCase};
+use fricbound::study::scaling::{self, ModelSize};
+
+/// Contact blocks where every contact is stuck (kt, kn on every coefficient block, no coupling
+/// of harmonics) except `slipping` ones, whose blocks are full (deterministic pseudo-random).
+fn contact_values(coords: &RelativeCoordinates, slipping: &[usize]) -> Vec<f64> {
+    let offsets = coords.value_offsets();
+    let nb = coords.n_blocks();
+    let mut values = vec![0.0; *offsets.last().unwrap()];
+    let mut seed = 12345_u64;
+    let mut random = move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((seed >> 33) as f64 / (1u64 << 31) as f64) - 0.5
+    };
+    for (p, &offset) in offsets.iter().enumerate().take(coords.n_contacts()) {
+        let k = coords.contact_rows(p);
+        for j in 0..nb {
+            for i in 0..nb {
+                for a in 0..k {
+                    for b in 0..k {
+                        let at = offset + ((j * nb + i) * k + a) * k + b;
+                        values[at] = if slipping.contains(&p) {
+                            2.0e7 * random()
+                        } else if i == j && a == b {
+                            2.0e7
+                        } else {
+                            0.0
+                        };
+                    }
+                }
+            }
+        }
+    }
+    values
+}
+
+#[test]
+fn the_structured_factorisation_solves_as_the_dense_lu() {
+    let dir = tempfile::tempdir().unwrap();
+    let size = ModelSize {
+        contact_refine: 2,
+        ..ModelSize::uniform(false, 2)
+    };
+    let mut p = scaling::reduced_problem(size, 8, dir.path()).unwrap();
+    p.harmonics = vec![1, 2, 3];
+    let set = p.unknown_harmonics();
+    let coords = Arc::new(RelativeCoordinates::new(&p, &set).unwrap());
+    let n = coords.n_dofs() * coords.n_blocks();
+    let b: Vec<f64> = (0..n).map(|i| ((i * 37) % 101) as f64 - 50.0).collect();
+    let omega = 2.0 * std::f64::consts::PI * 850.0;
+    for slipping in [vec![], vec![0, 3, 7]] {
+        let values = contact_values(&coords, &slipping);
+        let dense = coords.factor(omega, &values, ReducedSolver::Dense).unwrap();
+        let structured = coords
+            .factor(omega, &values, ReducedSolver::Structured)
+            .unwrap();
+        assert_eq!(dense.low_rank(), None);
+        // Each slipping contact couples all its rows (2 per block); a stuck one none.
+        assert_eq!(
+            structured.low_rank(),
+            Some(2 * coords.n_blocks() * slipping.len()),
+            "slipping {slipping:?}"
+        );
+        let (x, y) = (dense.solve(&b, false), structured.solve(&b, false));
+        let scale = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let diff = x
+            .iter()
+            .zip(&y)
+            .fold(0.0_f64, |m, (a, c)| m.max((a - c).abs()));
+        assert!(
+            diff <= 1e-9 * scale,
+            "slipping {slipping:?}: {diff:e} of {scale:e}"
+        );
+        // And it solves J x = b: the residual of the structured solution.
+        let mut r: Vec<f64> = b.iter().map(|v| -v).collect();
+        coords.mul_add(omega, &values, 1.0, &y, &mut r);
+        let rn = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let bn = b.iter().map(|v| v * v).sum::<f64>().sqrt();
+        assert!(rn <= 1e-9 * bn, "residual {rn:e} of {bn:e}");
+    }
+}
+
+#[test]
+fn a_limit_curve_with_49_pairs_per_side_has_the_schur_peaks() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |formulation| {
+        let case = ContactCase {
+            contact_refine: 8,
+            harmonics: 3,
+            formulation,
+            max_points: 150,
+        };
+        contacts::measure_case(&case, dir.path(), true).unwrap()
+    };
+    let schur = run(Formulation::Schur);
+    let structured = run(Formulation::SchurLowRank);
+    assert_eq!(schur.pairs_per_side, 49);
+    assert_eq!(structured.formulation, "schur-lowrank");
+    // The structured factorisation was used, with a rank below the reduced rows.
+    let w = &structured.work;
+    assert!(w.low_rank_factorisations > 0);
+    assert!(w.low_rank_rows / w.low_rank_factorisations < 49 * 2 * 2 * 7);
+    assert!(!schur.peaks.is_empty());
+    assert_eq!(schur.peaks.len(), structured.peaks.len());
+    for (a, b) in schur.peaks.iter().zip(&structured.peaks) {
+        let rel = (a.1 - b.1).abs() / a.1.abs();
+        assert!(
+            rel <= 1e-8,
+            "peak at {} Hz: {} against {} ({rel:e})",
+            a.0,
+            a.1,
+            b.1
+        );
+        assert!(
+            (a.0 - b.0).abs() <= 1e-6 * a.0,
+            "peak frequency {} against {}",
+            a.0,
+            b.0
+        );
+    }
+    // Exact solves: Newton takes the same iterations (within round-off effects on a few points).
+    let (i0, i1) = (
+        schur.newton_iterations as f64,
+        structured.newton_iterations as f64,
+    );
+    assert!(
+        (i1 - i0).abs() <= 0.05 * i0,
+        "{i0} against {i1} Newton iterations"
+    );
+}
