@@ -4,10 +4,11 @@
 //! the band of the cases), `modes_nl_band.csv` (with `[limits]`), and the figures
 //! `modes_nl_frequency` and `modes_nl_damping` (frequency and modal damping ratio against the
 //! first-harmonic amplitude at the mode's DOF, on a logarithmic amplitude axis, one curve per
-//! case, with the contact-state strips below).
+//! case, with the contact-state strips below), and for FE scenes the mode shape on the mesh
+//! (`modes_nl_first.vtu`, `modes_nl_last.vtu`, `modes_nl_max_damping.vtu`).
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
@@ -15,8 +16,10 @@ use crate::analysis::nonlinear_modes::{
     predicted_frf, predicted_peak, ModeBand, ModeLimits, NonlinearModePoint, NonlinearModeRun,
     PredictedPeak,
 };
+use crate::fe::VtuError;
 use crate::model::Problem;
 use crate::report::files::{write_atomic, RunInfo, WriteError};
+use crate::report::mesh_results::write_point;
 use crate::report::plot::{
     self, figure_files, palette, BackboneFigure, Curve, PlotError, StateRow,
 };
@@ -158,6 +161,45 @@ pub fn write_modes_nl(
     let json =
         serde_json::to_string_pretty(&file).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"));
     write_atomic(&dir.join("modes_nl.json"), json.as_bytes())
+}
+
+/// Writes the mode shape on the mesh (FE scenes) at the first point, the last point and the
+/// point of largest modal damping ratio of each case's mode: `modes_nl_first.vtu`,
+/// `modes_nl_last.vtu`, `modes_nl_max_damping.vtu`, named `modes_nl_<case>_first.vtu` etc.
+/// with several cases. Each holds the static displacement (m), the first-harmonic amplitude
+/// per direction (m) and the contact states, as `response_peak.vtu` of a forced response.
+/// Returns the files written (none without a mesh or a kept reduction basis).
+pub fn write_mode_shapes(
+    dir: &Path,
+    problem: &Problem,
+    limits: &ModeLimits,
+) -> Result<Vec<PathBuf>, VtuError> {
+    let several = limits.cases.len() > 1;
+    let mut written = Vec::new();
+    for case in &limits.cases {
+        let Ok(run) = &case.run else { continue };
+        let most_damped = run
+            .points
+            .iter()
+            .max_by(|a, b| a.damping_ratio.total_cmp(&b.damping_ratio));
+        let chosen = [
+            ("first", run.points.first()),
+            ("last", run.points.last()),
+            ("max_damping", most_damped),
+        ];
+        for (which, point) in chosen {
+            let Some(p) = point else { continue };
+            let name = if several {
+                format!("modes_nl_{}_{which}", case.case.name)
+            } else {
+                format!("modes_nl_{which}")
+            };
+            if let Some(path) = write_point(dir, &name, problem, &p.coefficients, &p.states)? {
+                written.push(path);
+            }
+        }
+    }
+    Ok(written)
 }
 
 /// A backbone figure: file stem, y-axis description and the property drawn.

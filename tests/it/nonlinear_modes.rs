@@ -305,6 +305,7 @@ fn shipped_scene_checks_and_runs() {
     ] {
         assert!(names.contains(&f.to_string()), "{f} missing: {names:?}");
     }
+    assert!(names.iter().all(|n| !n.ends_with(".vtu")), "{names:?}");
     let json = support::json(&dir.path().join("modes_nl.json"));
     assert_eq!(json["status"], "complete");
     let cases = json["cases"].as_array().unwrap();
@@ -583,4 +584,43 @@ fn mode_scene_without_frequency_range_takes_it_from_the_mode() {
         err.contains("field `analysis.freq_start_hz`: missing"),
         "{err}"
     );
+}
+
+/// On the reduced 2D blade pair (an FE scene) a nonlinear-mode run writes the mode shape on the
+/// mesh at the first and last points and at the largest damping ratio, each with the
+/// first-harmonic amplitude and the contact states (a lumped scene writes none, see
+/// `shipped_scene_checks_and_runs`).
+#[test]
+fn fe_scene_writes_the_mode_shapes_on_the_mesh() {
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/meshes/blade-pair/blade-pair-2d.toml"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let o = support::run_scene(
+        scene,
+        dir.path(),
+        &[
+            "analysis.kind=\"nonlinear-modes\"",
+            "analysis.mode_freq_hz=900.0",
+            "analysis.amplitude=[1e-9, 1e-5]",
+            "accuracy.estimate=false",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", support::text(&o.stderr));
+    for f in [
+        "modes_nl_first.vtu",
+        "modes_nl_last.vtu",
+        "modes_nl_max_damping.vtu",
+    ] {
+        let text =
+            std::fs::read_to_string(dir.path().join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+        for field in [
+            "first_harmonic_amplitude",
+            "contact_state",
+            "static_displacement",
+        ] {
+            assert!(text.contains(field), "{f}: no {field}");
+        }
+    }
 }
