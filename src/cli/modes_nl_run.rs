@@ -1,6 +1,7 @@
 //! The nonlinear-mode kind of `fricbound run` (`analysis.kind = "nonlinear-modes"`): the mode
 //! of the scene, or with `[limits]` the mode per initial tangential state and their band, then
-//! `modes_nl.csv`, `modes_nl.json` and the backbone figures.
+//! `modes_nl.csv`, `modes_nl.json`, the backbone figures and, for FE scenes, the mode shapes
+//! on the mesh.
 
 use super::context::{CommandError, RunContext, RunOutcome, RunReport};
 use crate::analysis::limits::LimitCase;
@@ -8,7 +9,7 @@ use crate::analysis::nonlinear_modes::{
     self, band, mode_limits, ModeCase, ModeLimits, NonlinearModeSettings,
 };
 use crate::report::files::status_text;
-use crate::report::modes_nl_files::{plot_modes_nl, write_modes_nl};
+use crate::report::modes_nl_files::{plot_modes_nl, write_mode_shapes, write_modes_nl};
 
 /// A nonlinear-mode run.
 pub(super) fn run_modes(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
@@ -60,6 +61,7 @@ pub(super) fn run_modes(ctx: &RunContext<'_>) -> Result<RunReport, CommandError>
         }
     }
     plot_modes_nl(&ctx.dir, ctx.title(), problem, dof, &limits)?;
+    write_mode_shapes(&ctx.dir, problem, &limits)?;
     let summary = summary(ctx, &limits, elapsed);
     Ok(RunReport {
         dir: ctx.dir.clone(),

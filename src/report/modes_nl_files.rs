@@ -3,19 +3,26 @@
 //! resonance peak and forced response predicted from it for the scene's harmonic loads, and
 //! the band of the cases), `modes_nl_band.csv` (with `[limits]`), and the figures
 //! `modes_nl_frequency` and `modes_nl_damping` (frequency and modal damping ratio against the
-//! first-harmonic amplitude at the mode's DOF, on a log₁₀ amplitude axis, one curve per case).
+//! first-harmonic amplitude at the mode's DOF, on a logarithmic amplitude axis, one curve per
+//! case, with the contact-state strips below), and for FE scenes the mode shape on the mesh
+//! (`modes_nl_first.vtu`, `modes_nl_last.vtu`, `modes_nl_max_damping.vtu`).
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
 use crate::analysis::nonlinear_modes::{
-    predicted_frf, predicted_peak, ModeBand, ModeLimits, NonlinearModeRun, PredictedPeak,
+    predicted_frf, predicted_peak, ModeBand, ModeLimits, NonlinearModePoint, NonlinearModeRun,
+    PredictedPeak,
 };
+use crate::fe::VtuError;
 use crate::model::Problem;
 use crate::report::files::{write_atomic, RunInfo, WriteError};
-use crate::report::plot::{self, figure_files, palette, Curve, PlotError};
+use crate::report::mesh_results::write_point;
+use crate::report::plot::{
+    self, figure_files, palette, BackboneFigure, Curve, PlotError, StateRow,
+};
 
 /// Header of `modes_nl.csv`: `case`, `modal_amplitude` (kg^½·m), `<dof>_amp` (m), `freq_hz`,
 /// `damping_ratio`, `xi_per_s`, `dissipated_energy_j`, `friction_energy_j`,
@@ -156,8 +163,51 @@ pub fn write_modes_nl(
     write_atomic(&dir.join("modes_nl.json"), json.as_bytes())
 }
 
+/// Writes the mode shape on the mesh (FE scenes) at the first point, the last point and the
+/// point of largest modal damping ratio of each case's mode: `modes_nl_first.vtu`,
+/// `modes_nl_last.vtu`, `modes_nl_max_damping.vtu`, named `modes_nl_<case>_first.vtu` etc.
+/// with several cases. Each holds the static displacement (m), the first-harmonic amplitude
+/// per direction (m) and the contact states, as `response_peak.vtu` of a forced response.
+/// Returns the files written (none without a mesh or a kept reduction basis).
+pub fn write_mode_shapes(
+    dir: &Path,
+    problem: &Problem,
+    limits: &ModeLimits,
+) -> Result<Vec<PathBuf>, VtuError> {
+    let several = limits.cases.len() > 1;
+    let mut written = Vec::new();
+    for case in &limits.cases {
+        let Ok(run) = &case.run else { continue };
+        let most_damped = run
+            .points
+            .iter()
+            .max_by(|a, b| a.damping_ratio.total_cmp(&b.damping_ratio));
+        let chosen = [
+            ("first", run.points.first()),
+            ("last", run.points.last()),
+            ("max_damping", most_damped),
+        ];
+        for (which, point) in chosen {
+            let Some(p) = point else { continue };
+            let name = if several {
+                format!("modes_nl_{}_{which}", case.case.name)
+            } else {
+                format!("modes_nl_{which}")
+            };
+            if let Some(path) = write_point(dir, &name, problem, &p.coefficients, &p.states)? {
+                written.push(path);
+            }
+        }
+    }
+    Ok(written)
+}
+
+/// A backbone figure: file stem, y-axis description and the property drawn.
+type Property = (&'static str, &'static str, fn(&NonlinearModePoint) -> f64);
+
 /// Draws `modes_nl_frequency` and `modes_nl_damping` (PNG and SVG) into `dir`: one curve per
-/// case against log₁₀ of the first-harmonic amplitude at the DOF.
+/// case against the first-harmonic amplitude at the DOF (m) on a logarithmic axis, with one
+/// contact-state strip per contact (per case and contact with several cases) below the chart.
 pub fn plot_modes_nl(
     dir: &Path,
     title: &str,
@@ -170,28 +220,47 @@ pub fn plot_modes_nl(
         .iter()
         .filter_map(|c| c.run.as_ref().ok().map(|r| (c.case.name.as_str(), r)))
         .collect();
-    let log_a: Vec<Vec<f64>> = runs
+    let amps: Vec<Vec<f64>> = runs
         .iter()
-        .map(|(_, r)| r.points.iter().map(|p| p.dof_amplitude.log10()).collect())
+        .map(|(_, r)| r.points.iter().map(|p| p.dof_amplitude).collect())
         .collect();
     let x_label = format!(
-        "log10 of the first-harmonic amplitude at {} (m)",
+        "first-harmonic amplitude at {} (m)",
         problem.model.dof_names[dof]
     );
     let single = runs.len() == 1;
-    for (stem, y_label, value) in [
-        (
-            "modes_nl_frequency",
-            "frequency (Hz)",
-            (|p: &crate::analysis::nonlinear_modes::NonlinearModePoint| p.freq_hz)
-                as fn(&crate::analysis::nonlinear_modes::NonlinearModePoint) -> f64,
-        ),
+    let states: Vec<StateRow> = runs
+        .iter()
+        .zip(&amps)
+        .flat_map(|((name, run), x)| {
+            problem
+                .contacts
+                .iter()
+                .enumerate()
+                .map(move |(k, c)| StateRow {
+                    name: if single {
+                        c.name.clone()
+                    } else {
+                        format!("{name}: {}", c.name)
+                    },
+                    x,
+                    states: run
+                        .points
+                        .iter()
+                        .map(|p| p.states.get(k).copied())
+                        .collect(),
+                })
+        })
+        .collect();
+    let figures: [Property; 2] = [
+        ("modes_nl_frequency", "frequency (Hz)", |p| p.freq_hz),
         (
             "modes_nl_damping",
             "modal damping ratio D = ξ/2ω (-)",
             |p| p.damping_ratio,
         ),
-    ] {
+    ];
+    for (stem, y_label, value) in figures {
         let ys: Vec<Vec<f64>> = runs
             .iter()
             .map(|(_, r)| r.points.iter().map(value).collect())
@@ -201,7 +270,7 @@ pub fn plot_modes_nl(
             .enumerate()
             .map(|(i, (name, _))| Curve {
                 label: if single { "" } else { name },
-                x: &log_a[i],
+                x: &amps[i],
                 y: &ys[i],
                 color: palette(i),
                 dashed: false,
@@ -209,7 +278,14 @@ pub fn plot_modes_nl(
             })
             .collect();
         let (png, svg) = figure_files(dir, stem);
-        plot::plot_lines(title, &x_label, y_label, false, &curves, &png, &svg)?;
+        let fig = BackboneFigure {
+            title,
+            x_label: &x_label,
+            y_label,
+            curves: &curves,
+            states: &states,
+        };
+        plot::plot_backbone(&fig, &png, &svg)?;
     }
     Ok(())
 }

@@ -9,7 +9,7 @@
 //! [`crate::report::limit_files`] (`limits.csv`, `peaks.csv`, `curve_*.csv`,
 //! `hysteresis_*.csv`, `limits.json`), the nonlinear modes' of
 //! [`crate::report::modes_nl_files`] (`modes_nl.csv`, `modes_nl.json`, `modes_nl_band.csv`,
-//! `modes_nl_*` figures), the sweep's (`sweep.csv`, `sweep.json`,
+//! `modes_nl_*` figures and mesh files), the sweep's (`sweep.csv`, `sweep.json`,
 //! `variability.csv`), the results on the mesh of [`crate::report::mesh_results`] and
 //! [`crate::report::mesh_modes`] (`response_peak.vtu`, `peak_*.vtu`, `modes_stuck.vtu`), and
 //! the temporaries of atomic writes (`<owned name>.partial`). A sweep with
@@ -55,7 +55,7 @@ pub const OWNED_PATTERNS: &[(&str, &[&str])] = &[
     ("bands_", &[".png", ".svg"]),
     ("curve_", &[".csv"]),
     ("peak_", &[".vtu"]),
-    ("modes_nl_", &[".png", ".svg"]),
+    ("modes_nl_", &[".png", ".svg", ".vtu"]),
 ];
 
 /// Suffix of the temporary file of an atomic write ([`crate::report::files::write_atomic`]).

@@ -16,7 +16,7 @@ use crate::scene::check_model::diagonal;
 use crate::scene::checker::{Checker, DofNames};
 use crate::scene::error::SceneError;
 use crate::scene::fe_input::FeStructure;
-use crate::scene::schema::{AccuracySpec, AnalysisSpec, OutputSpec};
+use crate::scene::schema::{AccuracySpec, AnalysisKind, AnalysisSpec, OutputSpec};
 
 /// Most continuation points or linear-reference points a scene may ask for.
 pub const MAX_POINTS: usize = 10_000_000;
@@ -65,7 +65,9 @@ pub(super) fn frequency_bound(
     let two_pi = 2.0 * std::f64::consts::PI;
     let natural = ratio.sqrt() / two_pi;
     let limit = (MAX_INERTIA_RATIO * ratio).sqrt() / (two_pi * h);
-    let f1 = analysis.freq_end_hz;
+    let Some(f1) = analysis.freq_end_hz else {
+        return Ok(());
+    };
     if f1.is_finite() && f1 > limit {
         return Err(ck.err(
             "analysis.freq_end_hz",
@@ -82,11 +84,41 @@ pub(super) fn frequency_bound(
     Ok(())
 }
 
-/// The analysis settings of the `[analysis]` table: the frequency range (Hz), the arc-length
-/// steps (defaults from the range), iteration counts and tolerances.
-pub(super) fn analysis(a: &AnalysisSpec, ck: &Checker) -> Result<Analysis, SceneError> {
-    let f0 = ck.positive("analysis.freq_start_hz", a.freq_start_hz)?;
-    let f1 = ck.finite("analysis.freq_end_hz", a.freq_end_hz)?;
+/// Fraction of the chosen mode's linear frequency (contacts stuck) at which the linear
+/// references of a nonlinear-mode scene start when `analysis.freq_start_hz` is not given.
+pub const MODE_RANGE_START: f64 = 0.5;
+/// Multiple of the chosen mode's linear frequency at which they end when
+/// `analysis.freq_end_hz` is not given.
+pub const MODE_RANGE_END: f64 = 1.5;
+
+/// The frequency range (Hz) of the `[analysis]` table: both ends as given, or None for a
+/// nonlinear-mode scene that gives neither (the range then follows from the mode, see
+/// [`set_range`]); an error for a missing end otherwise.
+fn given_range(a: &AnalysisSpec, ck: &Checker) -> Result<Option<(f64, f64)>, SceneError> {
+    match (a.freq_start_hz, a.freq_end_hz) {
+        (Some(f0), Some(f1)) => Ok(Some((f0, f1))),
+        (None, None) if a.kind == AnalysisKind::NonlinearModes => Ok(None),
+        (None, _) => Err(ck.err(
+            "analysis.freq_start_hz",
+            "missing: give the start of the frequency range (Hz)",
+        )),
+        (Some(_), None) => Err(ck.err(
+            "analysis.freq_end_hz",
+            "missing: give the end of the frequency range (Hz)",
+        )),
+    }
+}
+
+/// Sets the frequency range `f0 .. f1` (Hz) of `settings` and the arc-length steps not given
+/// in `a` (defaults from the range: initial range/200, min range·1e-7, max range/50).
+pub(super) fn set_range(
+    settings: &mut ContinuationSettings,
+    a: &AnalysisSpec,
+    ck: &Checker,
+    (f0, f1): (f64, f64),
+) -> Result<(), SceneError> {
+    let f0 = ck.positive("analysis.freq_start_hz", f0)?;
+    let f1 = ck.finite("analysis.freq_end_hz", f1)?;
     if f1 <= f0 {
         return Err(ck.err(
             "analysis.freq_end_hz",
@@ -106,6 +138,34 @@ pub(super) fn analysis(a: &AnalysisSpec, ck: &Checker) -> Result<Analysis, Scene
             format!("{min_step} exceeds max_step {max_step}"),
         ));
     }
+    settings.freq_start_hz = f0;
+    settings.freq_end_hz = f1;
+    settings.initial_step = initial_step;
+    settings.min_step = min_step;
+    settings.max_step = max_step;
+    Ok(())
+}
+
+/// The analysis settings of the `[analysis]` table: the frequency range (Hz), the arc-length
+/// steps (defaults from the range), iteration counts and tolerances. A nonlinear-mode scene
+/// without a range gets the provisional range 1 .. 2 Hz here, replaced by [`set_range`] once
+/// the mode's linear frequency is known.
+pub(super) fn analysis(a: &AnalysisSpec, ck: &Checker) -> Result<Analysis, SceneError> {
+    let range = given_range(a, ck)?.unwrap_or((1.0, 2.0));
+    let mut continuation = ContinuationSettings {
+        freq_start_hz: range.0,
+        freq_end_hz: range.1,
+        initial_step: 0.0,
+        min_step: 0.0,
+        max_step: 0.0,
+        max_points: a.max_points,
+        target_iterations: a.target_iterations,
+        max_iterations: a.max_iterations,
+        residual_tolerance: a.residual_tolerance,
+        step_tolerance: a.step_tolerance,
+        chord_min_unknowns: CHORD_MIN_UNKNOWNS,
+    };
+    set_range(&mut continuation, a, ck, range)?;
     for (field, v) in [
         ("analysis.max_points", a.max_points),
         ("analysis.target_iterations", a.target_iterations),
@@ -182,20 +242,10 @@ pub(super) fn analysis(a: &AnalysisSpec, ck: &Checker) -> Result<Analysis, Scene
     }
     let residual_tolerance = ck.positive("analysis.residual_tolerance", a.residual_tolerance)?;
     let step_tolerance = ck.positive("analysis.step_tolerance", a.step_tolerance)?;
+    continuation.residual_tolerance = residual_tolerance;
+    continuation.step_tolerance = step_tolerance;
     Ok(Analysis {
-        continuation: ContinuationSettings {
-            freq_start_hz: f0,
-            freq_end_hz: f1,
-            initial_step,
-            min_step,
-            max_step,
-            max_points: a.max_points,
-            target_iterations: a.target_iterations,
-            max_iterations: a.max_iterations,
-            residual_tolerance,
-            step_tolerance,
-            chord_min_unknowns: CHORD_MIN_UNKNOWNS,
-        },
+        continuation,
         jacobian: a.jacobian,
         formulation: a.formulation,
         linear_points: a.linear_points,

@@ -263,7 +263,10 @@ pub(super) fn limit_settings(
         });
     }
 
-    let (f_lo, f_hi) = (scene.analysis.freq_start_hz, scene.analysis.freq_end_hz);
+    let (f_lo, f_hi) = (
+        scene.analysis.freq_start_hz.unwrap_or(0.0),
+        scene.analysis.freq_end_hz.unwrap_or(f64::INFINITY),
+    );
     let peak_window_hz = match l.peak_window_hz {
         None => None,
         Some([lo, hi]) => {

@@ -3,10 +3,42 @@
 //! combine with. The DOF is looked up in the problem as solved (after any reduction).
 
 use crate::analysis::limits::LimitSettings;
+use crate::analysis::nonlinear_modes::linear_start;
 use crate::model::{ModeAnalysis, ModeChoice, Problem};
+use crate::scene::check_analysis::{set_range, MODE_RANGE_END, MODE_RANGE_START};
 use crate::scene::checker::Checker;
 use crate::scene::error::SceneError;
 use crate::scene::schema::{AnalysisKind, Scene};
+
+/// For a nonlinear-mode scene without `analysis.freq_start_hz` / `freq_end_hz`: sets the range
+/// of the linear references to [`MODE_RANGE_START`] .. [`MODE_RANGE_END`] times the chosen
+/// mode's linear frequency (Hz, contacts stuck, as the continuation starts), with the step
+/// defaults of that range. Nothing for an FRF scene or a scene that gives the range.
+pub(super) fn mode_range(
+    scene: &Scene,
+    ck: &Checker,
+    problem: &mut Problem,
+) -> Result<(), SceneError> {
+    let a = &scene.analysis;
+    let Some(m) = problem.analysis.nonlinear_modes else {
+        return Ok(());
+    };
+    if a.freq_start_hz.is_some() || a.freq_end_hz.is_some() {
+        return Ok(());
+    }
+    let field = match m.mode {
+        ModeChoice::Number(_) => "analysis.mode",
+        ModeChoice::NearestHz(_) => "analysis.mode_freq_hz",
+    };
+    let start = linear_start(problem, m.mode, m.dof).map_err(|e| ck.err(field, e.to_string()))?;
+    let f = start.omega / (2.0 * std::f64::consts::PI);
+    set_range(
+        &mut problem.analysis.continuation,
+        a,
+        ck,
+        (MODE_RANGE_START * f, MODE_RANGE_END * f),
+    )
+}
 
 /// The nonlinear-mode settings of the scene's `[analysis]` table, None for an FRF scene; an
 /// error naming the field for a missing or bad value, or a mode field in an FRF scene.

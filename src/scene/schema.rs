@@ -308,10 +308,15 @@ fn yes() -> bool {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AnalysisSpec {
-    /// Start frequency (Hz).
-    pub freq_start_hz: f64,
-    /// End frequency (Hz).
-    pub freq_end_hz: f64,
+    /// Start frequency (Hz). Required for a forced response; optional for a nonlinear mode
+    /// (`kind = "nonlinear-modes"`), where it only sets the range of the linear references
+    /// and defaults to half the chosen mode's linear frequency (contacts stuck).
+    #[serde(default)]
+    pub freq_start_hz: Option<f64>,
+    /// End frequency (Hz). Required for a forced response; optional for a nonlinear mode,
+    /// where it defaults to 1.5 times the chosen mode's linear frequency (contacts stuck).
+    #[serde(default)]
+    pub freq_end_hz: Option<f64>,
     /// First arc-length step (Hz-equivalent); default range/200.
     #[serde(default)]
     pub initial_step: Option<f64>,

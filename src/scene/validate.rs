@@ -23,7 +23,7 @@ use crate::scene::check_loads::{harmonic_loads, harmonic_set, static_load};
 use crate::scene::check_model::{
     build_model, check_stuck_structure, reduce_problem, reduction_settings, stiffness_scale,
 };
-use crate::scene::check_modes::mode_analysis;
+use crate::scene::check_modes::{mode_analysis, mode_range};
 use crate::scene::check_sweep::{check_sweep, check_sweep_points};
 use crate::scene::checker::{Checker, DofNames};
 use crate::scene::error::SceneError;
@@ -75,6 +75,7 @@ impl Scene {
         held?;
         let mut problem = problem;
         problem.analysis.nonlinear_modes = mode_analysis(self, &ck, &problem, limits.as_ref())?;
+        mode_range(self, &ck, &mut problem)?;
         if matches!(
             problem.analysis.formulation,
             Formulation::Schur | Formulation::SchurLowRank

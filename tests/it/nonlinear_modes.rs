@@ -305,6 +305,7 @@ fn shipped_scene_checks_and_runs() {
     ] {
         assert!(names.contains(&f.to_string()), "{f} missing: {names:?}");
     }
+    assert!(names.iter().all(|n| !n.ends_with(".vtu")), "{names:?}");
     let json = support::json(&dir.path().join("modes_nl.json"));
     assert_eq!(json["status"], "complete");
     let cases = json["cases"].as_array().unwrap();
@@ -530,4 +531,96 @@ fn predicted_peak_equals_the_hbm_peak_on_the_blade_pair() {
     );
     assert!(error < 0.02, "{error:.2e}");
     assert!((predicted.freq_hz - peak.freq_hz).abs() < 0.5);
+}
+
+/// A nonlinear-mode scene without `analysis.freq_start_hz` / `freq_end_hz` gets the range of
+/// its linear references from the chosen mode: 0.5 to 1.5 times its linear frequency with the
+/// contact stuck, √((k + kₜ)/m)/2π for the Jenkins oscillator; it runs. An FRF scene without
+/// the range is refused with the field named.
+#[test]
+fn mode_scene_without_frequency_range_takes_it_from_the_mode() {
+    let (m, k, _, kt, _, _) = JENKINS;
+    let f = ((k + kt) / m).sqrt() / (2.0 * std::f64::consts::PI);
+    let text = JENKINS_OSCILLATOR
+        .replace("freq_start_hz = 5.0\nfreq_end_hz = 40.0\n", "")
+        .replace(
+            "[analysis]\n",
+            "[analysis]\nkind = \"nonlinear-modes\"\nmode = 1\ndof = \"x\"\namplitude = [1.0e-6, 1.0e-3]\n",
+        );
+    assert!(!text.contains("freq_start_hz"));
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("mode.toml");
+    std::fs::write(&scene, &text).unwrap();
+    let scene = scene.to_str().unwrap();
+    let o = support::fricbound(&["check", scene]);
+    assert!(o.status.success(), "{}", support::text(&o.stderr));
+    let described = support::text(&o.stdout);
+    let line = described
+        .lines()
+        .find(|l| l.starts_with("analysis "))
+        .unwrap_or_else(|| panic!("{described}"));
+    let ends: Vec<f64> = line
+        .split_whitespace()
+        .filter_map(|w| w.trim_end_matches(',').parse().ok())
+        .take(2)
+        .collect();
+    assert_eq!(ends.len(), 2, "{line}");
+    assert!((ends[0] / (0.5 * f) - 1.0).abs() < 1e-9, "{line}: {f} Hz");
+    assert!((ends[1] / (1.5 * f) - 1.0).abs() < 1e-9, "{line}: {f} Hz");
+    let out = dir.path().join("out");
+    let o = support::run_scene(scene, &out, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", support::text(&o.stderr));
+    let json = support::json(&out.join("modes_nl.json"));
+    let first = &json["cases"][0]["mode"]["points"][0];
+    assert!((first["freq_hz"].as_f64().unwrap() / f - 1.0).abs() < 1e-6);
+
+    let frf = JENKINS_OSCILLATOR.replace("freq_start_hz = 5.0\n", "");
+    let scene = dir.path().join("frf.toml");
+    std::fs::write(&scene, frf).unwrap();
+    let o = support::fricbound(&["check", scene.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = support::text(&o.stderr);
+    assert!(
+        err.contains("field `analysis.freq_start_hz`: missing"),
+        "{err}"
+    );
+}
+
+/// On the reduced 2D blade pair (an FE scene) a nonlinear-mode run writes the mode shape on the
+/// mesh at the first and last points and at the largest damping ratio, each with the
+/// first-harmonic amplitude and the contact states (a lumped scene writes none, see
+/// `shipped_scene_checks_and_runs`).
+#[test]
+fn fe_scene_writes_the_mode_shapes_on_the_mesh() {
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/meshes/blade-pair/blade-pair-2d.toml"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let o = support::run_scene(
+        scene,
+        dir.path(),
+        &[
+            "analysis.kind=\"nonlinear-modes\"",
+            "analysis.mode_freq_hz=900.0",
+            "analysis.amplitude=[1e-9, 1e-5]",
+            "accuracy.estimate=false",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", support::text(&o.stderr));
+    for f in [
+        "modes_nl_first.vtu",
+        "modes_nl_last.vtu",
+        "modes_nl_max_damping.vtu",
+    ] {
+        let text =
+            std::fs::read_to_string(dir.path().join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+        for field in [
+            "first_harmonic_amplitude",
+            "contact_state",
+            "static_displacement",
+        ] {
+            assert!(text.contains(field), "{f}: no {field}");
+        }
+    }
 }

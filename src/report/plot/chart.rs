@@ -2,7 +2,6 @@
 //! (solid or dashed, with optional markers) over them, and the legend.
 
 use plotters::coord::ranged1d::ValueFormatter;
-use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
@@ -12,10 +11,12 @@ use super::legend::legend_position;
 use super::series::{Band, Line};
 use super::style::{font, BAND_ALPHA, DESC_SIZE, LABEL_SIZE, LEGEND_SIZE, RIGHT_MARGIN, X_LABELS};
 
-/// Axes, bands and lines of one chart; the x axis is linear.
+/// Axes, bands and lines of one chart.
 pub(super) struct ChartSpec {
-    /// Range of the x axis.
+    /// Range of the x axis (both positive when `x_log`).
     pub(super) x: (f64, f64),
+    /// Put the x axis on a log scale (decade ticks, as a log y axis).
+    pub(super) x_log: bool,
     /// Range and scale of the y axis.
     pub(super) y: YAxis,
     /// Description of the x axis, with unit.
@@ -43,6 +44,16 @@ pub(super) fn draw_chart<'a, DB: DrawingBackend + 'a>(
         .x_label_area_size(if x_ticks { 65 } else { 8 })
         .y_label_area_size(y_label_area);
     let x = spec.x.0..spec.x.1;
+    let x_scale = spec.x.0.abs().max(spec.x.1.abs());
+    let x_lin = move |v: &f64| format_linear(*v, x_scale);
+    let x_log = |v: &f64| format_log(*v);
+    let (x_bold, x_light) = log_ticks(spec.x.0, spec.x.1);
+    let x_log_coord = || {
+        x.clone()
+            .log_scale()
+            .with_key_points(x_bold.clone())
+            .with_light_points(x_light.clone())
+    };
     match spec.y {
         YAxis::Log(lo, hi) => {
             let (bold, light) = log_ticks(lo, hi);
@@ -50,32 +61,44 @@ pub(super) fn draw_chart<'a, DB: DrawingBackend + 'a>(
                 .log_scale()
                 .with_key_points(bold)
                 .with_light_points(light);
-            let chart = builder.build_cartesian_2d(x, y)?;
-            finish_chart(chart, spec, x_ticks, &|v: &f64| format_log(*v))
+            let y_format = |v: &f64| format_log(*v);
+            if spec.x_log {
+                let chart = builder.build_cartesian_2d(x_log_coord(), y)?;
+                finish_chart(chart, spec, x_ticks, (&x_log, &y_format))
+            } else {
+                let chart = builder.build_cartesian_2d(x.clone(), y)?;
+                finish_chart(chart, spec, x_ticks, (&x_lin, &y_format))
+            }
         }
         YAxis::Linear(lo, hi) => {
             let scale = lo.abs().max(hi.abs());
-            let chart = builder.build_cartesian_2d(x, lo..hi)?;
-            finish_chart(chart, spec, x_ticks, &move |v: &f64| {
-                format_linear(*v, scale)
-            })
+            let y_format = move |v: &f64| format_linear(*v, scale);
+            if spec.x_log {
+                let chart = builder.build_cartesian_2d(x_log_coord(), lo..hi)?;
+                finish_chart(chart, spec, x_ticks, (&x_log, &y_format))
+            } else {
+                let chart = builder.build_cartesian_2d(x.clone(), lo..hi)?;
+                finish_chart(chart, spec, x_ticks, (&x_lin, &y_format))
+            }
         }
     }
 }
 
-/// Draws the mesh, bands, lines and legend of a built chart; `y_format` labels the y ticks.
-fn finish_chart<'a, DB: DrawingBackend + 'a, Y>(
-    mut chart: ChartContext<'a, DB, Cartesian2d<RangedCoordf64, Y>>,
+/// Label formatters of the x and y ticks.
+type Formats<'f> = (&'f dyn Fn(&f64) -> String, &'f dyn Fn(&f64) -> String);
+
+/// Draws the mesh, bands, lines and legend of a built chart; `formats` label the x and y ticks.
+fn finish_chart<'a, DB: DrawingBackend + 'a, X, Y>(
+    mut chart: ChartContext<'a, DB, Cartesian2d<X, Y>>,
     spec: &ChartSpec,
     x_ticks: bool,
-    y_format: &dyn Fn(&f64) -> String,
+    (x_format, y_format): Formats,
 ) -> DrawResult<(), DB>
 where
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
     Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
 {
     let hide = |_: &f64| String::new();
-    let x_scale = spec.x.0.abs().max(spec.x.1.abs());
-    let x_format = |v: &f64| format_linear(*v, x_scale);
     let mut mesh = chart.configure_mesh();
     mesh.x_labels(X_LABELS)
         .y_labels(10)
@@ -87,7 +110,7 @@ where
         .y_desc(spec.y_desc.as_str());
     if x_ticks {
         mesh.x_desc(spec.x_desc.as_str())
-            .x_label_formatter(&x_format);
+            .x_label_formatter(x_format);
     } else {
         mesh.x_label_formatter(&hide);
     }

@@ -49,6 +49,7 @@ pub fn plot_hysteresis(
         .collect();
     let chart = ChartSpec {
         x: linear_range(points(&curves).map(|p| p.0), 0.05),
+        x_log: false,
         y: YAxis::fit(points(&curves).map(|p| p.1), false),
         x_desc: "tangential relative displacement u (m)".to_string(),
         y_desc: "tangential force T (N)".to_string(),

@@ -1,7 +1,6 @@
 //! Where the legend goes: the corner (or edge middle) of the chart that covers the fewest
 //! curve pixels, so that the legend hides as little of the data as possible.
 
-use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use super::series::{Band, Line};
@@ -9,13 +8,14 @@ use super::style::{font, LEGEND_SIZE};
 
 /// The legend corner covering the fewest pixels of the chart's `curves` (pixels of its `bands`
 /// count a quarter) for a legend of `entries`.
-pub(super) fn legend_position<DB: DrawingBackend, Y>(
-    chart: &ChartContext<DB, Cartesian2d<RangedCoordf64, Y>>,
+pub(super) fn legend_position<DB: DrawingBackend, X, Y>(
+    chart: &ChartContext<DB, Cartesian2d<X, Y>>,
     curves: &[Line],
     bands: &[Band],
     entries: &[&str],
 ) -> DrawResult<SeriesLabelPosition, DB>
 where
+    X: Ranged<ValueType = f64>,
     Y: Ranged<ValueType = f64>,
 {
     let area = chart.plotting_area();

@@ -94,6 +94,7 @@ pub fn plot_limits(fig: &LimitFigure, png: &Path, svg: &Path) -> Result<(), Plot
         title: fig.title.to_string(),
         chart: ChartSpec {
             x,
+            x_log: false,
             y: YAxis::Log(y.0, y.1),
             x_desc: "frequency (Hz)".to_string(),
             y_desc: format!("{} first-harmonic amplitude (m)", fig.output_name),

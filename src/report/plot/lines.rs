@@ -25,6 +25,7 @@ pub fn plot_lines(
     let y = YAxis::fit(points(&curves).map(|p| p.1), log_y);
     let chart = ChartSpec {
         x,
+        x_log: false,
         y,
         x_desc: x_label.to_string(),
         y_desc: y_label.to_string(),

@@ -9,7 +9,9 @@
 //! - [`plot_sweep`] (`sweep`): quantities against a swept parameter (optimal curves, resonance
 //!   frequencies) over shaded bands, or the FRF bands of several sweep values;
 //! - [`plot_hysteresis`] (`hysteresis`): closed tangential force–displacement loops;
-//! - [`plot_lines`] (`lines`): labelled curves on a linear or log y axis.
+//! - [`plot_lines`] (`lines`): labelled curves on a linear or log y axis;
+//! - [`plot_backbone`] (`backbone`): a nonlinear mode's frequency or damping ratio against the
+//!   amplitude on a log axis, with one contact-state strip per contact below it.
 //!
 //! The drawing they share, lowest first: `style` (size, fonts, colours, [`palette`]), `axes`
 //! (ranges, log ticks, tick labels), `series` (the caller's [`Curve`]s made into drawable lines
@@ -22,6 +24,7 @@
 //! bands into separate regions. Empty inputs give an empty chart, never a panic.
 
 mod axes;
+mod backbone;
 mod backend;
 mod chart;
 mod frf;
@@ -36,6 +39,7 @@ mod sweep;
 #[cfg(test)]
 mod testing;
 
+pub use backbone::{plot_backbone, BackboneFigure, StateRow};
 pub use backend::{figure_files, PlotError};
 pub use frf::{plot_frf, FrfFigure};
 pub use hysteresis::{plot_hysteresis, Loop};

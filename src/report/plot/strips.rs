@@ -7,7 +7,10 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::axes::format_linear;
+use plotters::coord::ranged1d::ValueFormatter;
+use plotters::coord::types::RangedCoordf64;
+
+use super::axes::{format_linear, format_log, log_ticks};
 use super::backend::Figure;
 use super::chart::{draw_chart, ChartSpec};
 use super::style::{
@@ -103,7 +106,7 @@ impl Figure for StripChart {
         draw_strips(
             &strip_area,
             &self.strips,
-            self.chart.x,
+            (self.chart.x, self.chart.x_log),
             &self.chart.x_desc,
             y_label_area,
             &layout,
@@ -213,56 +216,100 @@ pub(super) fn wrap_title(
     lines
 }
 
-/// Draws one row per strip (the first on top) with a coloured marker at each of its abscissae.
+/// Draws one row per strip (the first on top) with a coloured marker at each of its abscissae,
+/// over the x range `x.0`, on a log scale if `x.1`.
 fn draw_strips<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     strips: &[Strip],
-    x: (f64, f64),
+    x: ((f64, f64), bool),
     x_desc: &str,
     y_label_area: u32,
     layout: &StripLayout,
 ) -> DrawResult<(), DB> {
+    let ((lo, hi), log) = x;
     let n = strips.len();
-    let x_scale = x.0.abs().max(x.1.abs());
-    let x_format = |v: &f64| format_linear(*v, x_scale);
-    let mut chart = ChartBuilder::on(area)
+    let mut builder = ChartBuilder::on(area);
+    builder
         .margin_right(RIGHT_MARGIN)
         .x_label_area_size(layout.x_label_area)
-        .y_label_area_size(y_label_area)
-        .build_cartesian_2d(x.0..x.1, 0.0..n as f64)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_labels(X_LABELS)
-        .y_labels(0)
-        .x_label_formatter(&x_format)
-        .label_style(font(LABEL_SIZE))
-        .axis_desc_style(font(DESC_SIZE))
-        .x_desc(x_desc)
-        .draw()?;
+        .y_label_area_size(y_label_area);
+    let rows = StripRows {
+        strips,
+        x: (lo, hi),
+        x_desc,
+        layout,
+    };
+    if log {
+        let (bold, light) = log_ticks(lo, hi);
+        let coord = (lo..hi)
+            .log_scale()
+            .with_key_points(bold)
+            .with_light_points(light);
+        let chart = builder.build_cartesian_2d(coord, 0.0..n as f64)?;
+        rows.draw(area, chart, &|v: &f64| format_log(*v))
+    } else {
+        let scale = lo.abs().max(hi.abs());
+        let chart = builder.build_cartesian_2d(lo..hi, 0.0..n as f64)?;
+        rows.draw(area, chart, &move |v: &f64| format_linear(*v, scale))
+    }
+}
 
-    let name_style = font(LABEL_SIZE).pos(Pos::new(HPos::Right, VPos::Center));
-    let every = (LABEL_SIZE as u32 + 2).div_ceil(layout.row.max(1)).max(1) as usize;
-    let base = area.get_base_pixel();
-    for (c, strip) in strips.iter().enumerate().step_by(every) {
-        let (px, py) = chart.backend_coord(&(x.0, row_center(n, c)));
-        area.draw_text(&strip.name, &name_style, (px - base.0 - 10, py - base.1))?;
-    }
-    let separators = if layout.row >= 8 { 1..n } else { 0..0 };
-    chart.draw_series(separators.map(|r| {
-        PathElement::new(
-            vec![(x.0, r as f64), (x.1, r as f64)],
-            RGBColor(200, 200, 200),
-        )
-    }))?;
-    let half_h = ((layout.row as f64 * 0.4).round() as i32).max(1);
-    for (c, strip) in strips.iter().enumerate() {
-        let y = row_center(n, c);
-        chart.draw_series(strip.marks.iter().map(|&(f, color)| {
-            EmptyElement::at((f, y)) + Rectangle::new([(-2, -half_h), (2, half_h)], color.filled())
+/// The strip rows to draw on a built chart.
+struct StripRows<'s> {
+    strips: &'s [Strip],
+    x: (f64, f64),
+    x_desc: &'s str,
+    layout: &'s StripLayout,
+}
+
+impl StripRows<'_> {
+    /// Draws the x axis (ticks labelled by `x_format`), the row names, separators and markers.
+    fn draw<'a, DB: DrawingBackend + 'a, X>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        mut chart: ChartContext<'a, DB, Cartesian2d<X, RangedCoordf64>>,
+        x_format: &dyn Fn(&f64) -> String,
+    ) -> DrawResult<(), DB>
+    where
+        X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    {
+        let (strips, x, layout) = (self.strips, self.x, self.layout);
+        let n = strips.len();
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_labels(X_LABELS)
+            .y_labels(0)
+            .x_label_formatter(x_format)
+            .label_style(font(LABEL_SIZE))
+            .axis_desc_style(font(DESC_SIZE))
+            .x_desc(self.x_desc)
+            .draw()?;
+
+        let name_style = font(LABEL_SIZE).pos(Pos::new(HPos::Right, VPos::Center));
+        let every = (LABEL_SIZE as u32 + 2).div_ceil(layout.row.max(1)).max(1) as usize;
+        let base = area.get_base_pixel();
+        for (c, strip) in strips.iter().enumerate().step_by(every) {
+            let (px, py) = chart.backend_coord(&(x.0, row_center(n, c)));
+            area.draw_text(&strip.name, &name_style, (px - base.0 - 10, py - base.1))?;
+        }
+        let separators = if layout.row >= 8 { 1..n } else { 0..0 };
+        chart.draw_series(separators.map(|r| {
+            PathElement::new(
+                vec![(x.0, r as f64), (x.1, r as f64)],
+                RGBColor(200, 200, 200),
+            )
         }))?;
+        let half_h = ((layout.row as f64 * 0.4).round() as i32).max(1);
+        for (c, strip) in strips.iter().enumerate() {
+            let y = row_center(n, c);
+            chart.draw_series(strip.marks.iter().map(|&(f, color)| {
+                EmptyElement::at((f, y))
+                    + Rectangle::new([(-2, -half_h), (2, half_h)], color.filled())
+            }))?;
+        }
+        Ok(())
     }
-    Ok(())
 }
 
 /// Centre of contact `c`'s row, the first contact on top.

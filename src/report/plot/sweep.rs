@@ -78,6 +78,7 @@ pub fn plot_sweep(fig: &SweepFigure, png: &Path, svg: &Path) -> Result<(), PlotE
     let x = cover(x, &bands);
     let chart = ChartSpec {
         x,
+        x_log: false,
         y: YAxis::fit(ys(), fig.log_y),
         x_desc: fig.x_label.to_string(),
         y_desc: fig.y_label.to_string(),
