@@ -7,10 +7,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use fricbound::analysis::limits::LimitCase;
-use fricbound::analysis::nonlinear_modes::{
-    self as nm, band, mode_limits, ModeCase, ModeLimits, NonlinearModeRun, NonlinearModeSettings,
-};
+use fricbound::analysis::nonlinear_modes::{self as nm, NonlinearModeRun, NonlinearModeSettings};
 use fricbound::model::Problem;
 
 use crate::solve::{in_background, load};
@@ -30,25 +27,8 @@ pub fn nonlinear_modes<'py>(
             "{label}: field `analysis.kind`: nonlinear_modes needs analysis.kind = \"nonlinear-modes\""
         ))
     })?;
-    let result = in_background(py, None, |_| match &limits {
-        Some(l) => mode_limits(&problem, &settings, l),
-        None => {
-            let case = LimitCase {
-                name: "scene".to_string(),
-                contact_states: problem
-                    .contacts
-                    .iter()
-                    .map(|c| c.law.initial_state)
-                    .collect(),
-                second_states: None,
-            };
-            let cases = vec![ModeCase {
-                case,
-                run: nm::solve(&problem, &settings),
-            }];
-            let band = band(&cases, settings.amplitude);
-            ModeLimits { cases, band }
-        }
+    let result = in_background(py, None, |_| {
+        nm::scene_modes(&problem, &settings, limits.as_ref())
     })?;
     if limits.is_none() {
         if let Err(e) = &result.cases[0].run {

@@ -4,10 +4,7 @@
 //! on the mesh.
 
 use super::context::{CommandError, RunContext, RunOutcome, RunReport};
-use crate::analysis::limits::LimitCase;
-use crate::analysis::nonlinear_modes::{
-    self, band, mode_limits, ModeCase, ModeLimits, NonlinearModeSettings,
-};
+use crate::analysis::nonlinear_modes::{self, ModeLimits, NonlinearModeSettings};
 use crate::report::files::status_text;
 use crate::report::modes_nl_files::{plot_modes_nl, write_mode_shapes, write_modes_nl};
 
@@ -20,26 +17,7 @@ pub(super) fn run_modes(ctx: &RunContext<'_>) -> Result<RunReport, CommandError>
             reason: "the scene asks for no nonlinear mode".to_string(),
         })?;
     let started = std::time::Instant::now();
-    let limits = match &ctx.limits {
-        Some(l) => mode_limits(problem, &settings, l),
-        None => {
-            let case = LimitCase {
-                name: "scene".to_string(),
-                contact_states: problem
-                    .contacts
-                    .iter()
-                    .map(|c| c.law.initial_state)
-                    .collect(),
-                second_states: None,
-            };
-            let cases = vec![ModeCase {
-                case,
-                run: nonlinear_modes::solve(problem, &settings),
-            }];
-            let band = band(&cases, settings.amplitude);
-            ModeLimits { cases, band }
-        }
-    };
+    let limits = nonlinear_modes::scene_modes(problem, &settings, ctx.limits.as_ref());
     let elapsed = started.elapsed().as_secs_f64();
     let dof = settings.dof;
     let incomplete = limits.incomplete_reason();

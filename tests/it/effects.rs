@@ -87,46 +87,6 @@ fn jacobian_strategies_give_the_same_curve() {
     }
 }
 
-/// The single-DOF oscillator of `docs/scene.md` (m = 1 kg, k = 1e4 N/m, c = 2 N·s/m, a Jenkins
-/// contact to the ground with kₜ = 1e5 N/m, μN₀ = 3 N, F = 5 N) at H = 1 with a constant
-/// normal load.
-const JENKINS_OSCILLATOR: &str = r#"
-[model]
-dofs = ["x"]
-mass = [[1.0]]
-stiffness = [[1.0e4]]
-damping = [[2.0]]
-
-[[contacts]]
-name = "ground"
-damper = ["x"]
-tangent = [1.0]
-normal = [0.0]
-kt = 1.0e5
-kn = 1.0e5
-mu = 0.3
-gap = -1.0e-4
-
-[[harmonic_loads]]
-dof = "x"
-harmonic = 1
-cos = 5.0
-
-[harmonics]
-max = 1
-samples = 256
-
-[effects]
-normal_load = "constant"
-
-[analysis]
-freq_start_hz = 5.0
-freq_end_hz = 40.0
-
-[output]
-dofs = ["x"]
-"#;
-
 /// The resonance peak (frequency in Hz, amplitude in m) of that oscillator at H = 1 from the
 /// describing function (paper Appendix, Eqs. 17-18): the response is x = A cos(ωt − φ) with
 /// A² [(k + k_eq(A) − mω²)² + (cω + c_eq(A))²] = F², and the peak is the largest A for which
@@ -183,7 +143,7 @@ fn jenkins_oscillator_peak_equals_the_describing_function() {
             format!("harmonics.samples={samples}"),
         ];
         let overrides: Vec<&str> = overrides.iter().map(|s| s.as_str()).collect();
-        let problem = scenes::problem(JENKINS_OSCILLATOR, &overrides);
+        let problem = scenes::problem(scenes::JENKINS_OSCILLATOR, &overrides);
         let run = frf::solve(&problem, &mut Silent).unwrap();
         assert!(run.is_complete(), "{law}: {:?}", run.incomplete_reason());
         let peaks = fricbound::analysis::peaks::path_peaks(&problem, &run.points).unwrap();

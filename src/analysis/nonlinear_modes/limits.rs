@@ -117,6 +117,33 @@ pub fn mode_limits(
     ModeLimits { cases, band }
 }
 
+/// The scene's modes: per case of [`mode_limits`] with `[limits]`, else the one mode from the
+/// contacts' own initial states (a single case named `scene`), with the band either way.
+pub fn scene_modes(
+    problem: &Problem,
+    settings: &NonlinearModeSettings,
+    limits: Option<&LimitSettings>,
+) -> ModeLimits {
+    if let Some(l) = limits {
+        return mode_limits(problem, settings, l);
+    }
+    let case = LimitCase {
+        name: "scene".to_string(),
+        contact_states: problem
+            .contacts
+            .iter()
+            .map(|c| c.law.initial_state)
+            .collect(),
+        second_states: None,
+    };
+    let cases = vec![ModeCase {
+        case,
+        run: solve(problem, settings),
+    }];
+    let band = band(&cases, settings.amplitude);
+    ModeLimits { cases, band }
+}
+
 /// Values of `y` where the path (log A, y) crosses log A = `at`, linearly interpolated on each
 /// segment (a path that folds back in amplitude crosses more than once).
 fn crossings(log_a: &[f64], y: &[f64], at: f64) -> Vec<f64> {

@@ -37,7 +37,7 @@ pub mod run;
 pub mod start;
 pub mod verify;
 
-pub use limits::{band, mode_cases, mode_limits, ModeBand, ModeCase, ModeLimits};
+pub use limits::{band, mode_cases, mode_limits, scene_modes, ModeBand, ModeCase, ModeLimits};
 pub use operator::{EpmcOperator, LogAmplitude};
 pub use predict::{modal_force, predicted_frf, predicted_peak, PredictedPeak};
 pub use run::{
