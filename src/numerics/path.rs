@@ -56,16 +56,9 @@ pub enum ContinuationError {
         /// Cause.
         reason: NewtonFailure,
     },
-    /// The step fell below the minimum. With a sampled contact law, when Newton stagnates
-    /// just above the tolerance a contact transition (stick-slip or lift-off) usually sits
-    /// between two time samples, where the residual has a kink; the message names the remedy.
-    #[error(
-        "continuation stalled at {freq_hz:.4} Hz (step {step:.3e} below minimum): {reason}; \
-         with a sampled contact law (`jenkins-1d-sampled`, `jenkins-2d-sampled`) a residual \
-         stagnating just above tolerance means a contact transition falls between time \
-         samples: the event-resolved law (`jenkins-1d`, `jenkins-2d`) or more samples \
-         ([harmonics] samples) get past it"
-    )]
+    /// The step fell below the minimum: every step down to the minimum failed at the last
+    /// converged point.
+    #[error("continuation stalled at {freq_hz:.4} Hz (step {step:.3e} below minimum): {reason}")]
     Stalled {
         /// Frequency of the last converged point (Hz).
         freq_hz: f64,

@@ -95,7 +95,7 @@ fn solve_in<'scope, 'p, O: FrfObserver>(
         if let Some(e) = adapter.failure.take() {
             return Err(FrfError::Setup(e));
         }
-        let summary = outcome?;
+        let summary = outcome.map_err(|e| FrfError::from_continuation(e, problem))?;
         run.turning_points.extend(summary.turning_points);
         run.rejected_steps += summary.rejected_steps;
         run.end = summary.end;

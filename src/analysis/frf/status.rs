@@ -4,8 +4,9 @@
 use crate::analysis::error_estimate::PointAccuracy;
 use crate::analysis::estimate_pool::EstimateTicket;
 use crate::analysis::stability::PointStability;
-use crate::contact::ContactState;
+use crate::contact::{ContactState, TimeResolution};
 use crate::hbm::HbmError;
+use crate::model::Problem;
 use crate::numerics::linalg::LinearSolveError;
 use crate::numerics::{ContinuationError, PathEnd};
 
@@ -207,7 +208,39 @@ pub enum FrfError {
     Guess(#[from] LinearSolveError),
     /// Continuation failed.
     #[error("{0}")]
-    Continuation(#[from] ContinuationError),
+    Continuation(ContinuationError),
+    /// Continuation stalled on a problem with a contact on a sampled law: the message adds
+    /// the likely cause and its remedy (a residual that stagnates just above the tolerance
+    /// where a contact transition falls between two time samples, whose kink Newton cannot
+    /// converge across).
+    #[error("{source}; {SAMPLED_LAW_STALL}")]
+    StalledOnSampledLaw {
+        /// The continuation's error.
+        source: ContinuationError,
+    },
+}
+
+/// What a stall on a sampled contact law usually means, and what gets past it.
+const SAMPLED_LAW_STALL: &str = "with a sampled contact law (`jenkins-1d-sampled`, \
+    `jenkins-2d-sampled`) a residual stagnating just above tolerance means a contact \
+    transition falls between time samples: the event-resolved law (`jenkins-1d`, \
+    `jenkins-2d`) or more samples ([harmonics] samples) get past it";
+
+impl FrfError {
+    /// The error of a continuation run on `problem`: a stall on a problem with a contact on a
+    /// sampled law names that law's remedy, any other error is passed on as it is.
+    pub fn from_continuation(error: ContinuationError, problem: &Problem) -> Self {
+        let sampled = problem
+            .contacts
+            .iter()
+            .any(|c| c.resolution == TimeResolution::Samples);
+        match error {
+            ContinuationError::Stalled { .. } if sampled => {
+                FrfError::StalledOnSampledLaw { source: error }
+            }
+            other => FrfError::Continuation(other),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -223,6 +256,38 @@ mod tests {
             end: PathEnd::EndFrequency,
             elapsed_s: 0.0,
         }
+    }
+
+    /// A stall names the sampled law's remedy only when a contact of the problem is on a
+    /// sampled law; other continuation errors pass unchanged.
+    #[test]
+    fn a_stall_advises_the_sampled_law_remedy_only_on_a_sampled_law() {
+        const SCENE: &str = include_str!("../../../tests/data/two-dof-grounded.toml");
+        let problem = |law: &str| {
+            let set = format!("contacts.0.law={law}");
+            crate::scene::parse(SCENE, "two-dof", &[set])
+                .and_then(|s| s.validate("two-dof"))
+                .expect("the two-DOF scene is valid")
+        };
+        let stall = || ContinuationError::Stalled {
+            freq_hz: 12.0,
+            step: 1e-9,
+            reason: crate::numerics::NewtonFailure::Evaluation("kink".into()),
+        };
+        let on_sampled = FrfError::from_continuation(stall(), &problem("jenkins-1d-sampled"));
+        assert!(matches!(on_sampled, FrfError::StalledOnSampledLaw { .. }));
+        assert!(
+            on_sampled.to_string().contains("event-resolved law"),
+            "{on_sampled}"
+        );
+        let on_events = FrfError::from_continuation(stall(), &problem("jenkins-1d"));
+        assert_eq!(on_events, FrfError::Continuation(stall()));
+        assert!(!on_events.to_string().contains("sampled"), "{on_events}");
+        let interrupted = ContinuationError::Interrupted { freq_hz: 12.0 };
+        assert_eq!(
+            FrfError::from_continuation(interrupted.clone(), &problem("jenkins-1d-sampled")),
+            FrfError::Continuation(interrupted)
+        );
     }
 
     /// A path that reached the end frequency but jumped over a stretch at a fold that no branch
