@@ -331,8 +331,25 @@ impl Continuation {
 
     /// Corrector: Newton on R = 0 and tᵀ(y − y_p) = 0 in scaled space (y = (x / x_scale,
     /// ω / 2π), `tangent` a unit vector); returns the corrected y, the iterations and the
-    /// relative residual.
+    /// relative residual. A corrector that fails carries no factorisation to the next try:
+    /// its factorisations are of iterates that did not reach the path (past a fold, of a step
+    /// that overshot it), and chord steps on them would converge with a Jacobian of the wrong
+    /// piece, whose null direction would then orient the path.
     pub fn correct<S: ParametricResidual>(
+        &self,
+        system: &mut S,
+        predicted: &[f64],
+        tangent: &[f64],
+    ) -> Result<(Vec<f64>, usize, f64), NewtonFailure> {
+        let outcome = self.correct_from(system, predicted, tangent);
+        if outcome.is_err() {
+            *self.carried.borrow_mut() = None;
+        }
+        outcome
+    }
+
+    /// The corrector's Newton loop (see [`Self::correct`]).
+    fn correct_from<S: ParametricResidual>(
         &self,
         system: &mut S,
         predicted: &[f64],
