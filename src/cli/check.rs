@@ -104,7 +104,16 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
     let _ = writeln!(
         s,
         "accuracy     {}",
-        if estimate.enabled {
+        if estimate.enabled && problem.analysis.nonlinear_modes.is_some() {
+            let h_max = problem.harmonics.iter().copied().max().unwrap_or(1);
+            format!(
+                "error estimate on every mode point (the change of its frequency, damping \
+                 ratio and amplitude at the DOF on H = {} harmonics, solved to convergence), \
+                 warning above {} %",
+                crate::analysis::error_estimate::extended_harmonic(h_max),
+                100.0 * estimate.warn_threshold,
+            )
+        } else if estimate.enabled {
             let h_max = problem.harmonics.iter().copied().max().unwrap_or(1);
             format!(
                 "error estimate on every point (truncation to H = {}, or {} where contacts \
@@ -119,7 +128,10 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
             "error estimate off ([accuracy] estimate = false)".to_string()
         }
     );
-    if let Some(refined) = crate::analysis::error_estimate::EstimateProblems::new(&problem) {
+    let frf_estimate = problem.analysis.nonlinear_modes.is_none();
+    if let Some(refined) =
+        crate::analysis::error_estimate::EstimateProblems::new(&problem).filter(|_| frf_estimate)
+    {
         let budget = crate::analysis::error_estimate::SolveBudget::new(&problem, &refined);
         let _ = writeln!(
             s,
