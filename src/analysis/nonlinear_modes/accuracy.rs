@@ -11,9 +11,10 @@
 //! it equals the change to an independent run at 2H + 1 within 1 % at every point (the ratio
 //! 1.000 to three digits); against a run at H = 15 it is 0.15-16 times the true change point by
 //! point at H = 1 (near the slip onset the harmonics above 3 still matter) and 0.01-2.9 at
-//! H = 3 (`tests/it/nonlinear_modes/checks.rs`). Where several contacts slip and lift off (the paper's
-//! 2nd mode) the extended system may have several solutions near the point and Newton may not
-//! reach one: 2 of 63 points at H = 1 and 48 of 317 at H = 3 are not sized there.
+//! H = 3 (`tests/it/nonlinear_modes/checks.rs`). Where several contacts slip and lift off
+//! (the paper's 2nd mode) the extended system may have several solutions near the point and
+//! Newton may not reach one: 2 of 63 points at H = 1 and 48 of 317 at H = 3 are not sized
+//! there.
 //!
 //! The forced response takes one Newton step where it can and solves only where the step
 //! leaves its linear range; a mode has tens to a few hundred points instead of thousands, so

@@ -1,5 +1,6 @@
 //! The checks of a nonlinear mode's points: the error estimate of each point against
-//! independent runs at more harmonics.
+//! independent runs at more harmonics, and `fricbound verify` on mode points (time integration
+//! with the artificial damping applied).
 
 use fricbound::analysis::nonlinear_modes::{
     self, ModeChoice, NonlinearModeRun, NonlinearModeSettings,
@@ -9,6 +10,7 @@ use fricbound::model::Problem;
 
 use super::{jenkins_oscillator, settings, solve};
 use crate::common::scenes;
+use crate::support;
 
 /// `(ω, D, A)` of the mode of `problem` (whose run is `reference`) at the modal amplitude `a`:
 /// solved there from the run's nearest point (not interpolated between points, whose spacing,
@@ -201,4 +203,86 @@ fn error_estimate_is_off_when_the_scene_says_so() {
     problem.analysis.error_estimate.enabled = true;
     let header = fricbound::report::modes_nl_files::modes_nl_header(&problem, 0);
     assert!(header.contains("freq_trunc_err,damping_trunc_err,x_amp_trunc_err"));
+}
+
+/// The paper's 2nd mode (the shipped scene with `mode = 2`, without `[limits]`) as a file in
+/// `dir`.
+fn second_mode_scene(dir: &std::path::Path) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/meshes/paper-wedge/modes-3rd.toml"
+    ))
+    .unwrap();
+    let text = text.replace("\nmode = 3\n", "\nmode = 2\n");
+    let text = &text[..text.find("[limits]").unwrap()];
+    let path = dir.join("mode2.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// `fricbound verify` on a nonlinear-mode scene integrates the points nearest `--amplitudes`
+/// with the artificial damping applied: at H = 5 the points stuck (1e-6 m) and slipping
+/// (2e-4 m) keep the mode's first harmonic within 1 % over 4 periods (exit 0); at H = 1 the
+/// slipping point at 3e-4 m, whose harmonics above 1 the run left out, does not (first
+/// harmonic 26 % off), and the run says so (exit 3). `--freqs` on such a scene, and
+/// `--amplitudes` on a forced-response scene, are refused.
+#[test]
+fn verify_checks_mode_points_by_time_integration() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = second_mode_scene(tmp.path());
+    let scene = scene.to_str().unwrap();
+    let out = tmp.path().join("h5");
+    let o = support::fricbound(&[
+        "verify",
+        scene,
+        "--amplitudes",
+        "1e-6,2e-4",
+        "--set",
+        "harmonics.max=5",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", support::text(&o.stderr));
+    let (header, rows) = support::csv(&out.join("verify_modes.csv"));
+    assert!(header.starts_with("case,amplitude_asked,y2_amp,freq_hz,damping_ratio"));
+    assert_eq!(rows.len(), 2);
+    let json = support::json(&out.join("verify_modes.json"));
+    for c in json.as_array().unwrap() {
+        assert_eq!(c["passed"], true, "{c}");
+        let diff = c["verification"]["hbm_difference"].as_f64().unwrap();
+        assert!(diff < 1e-2, "{diff}");
+    }
+    let slipping = &json[1];
+    assert!(
+        slipping["damping_ratio"].as_f64().unwrap() > 9.682e-3,
+        "{slipping}"
+    );
+
+    let out = tmp.path().join("h1");
+    let o = support::fricbound(&[
+        "verify",
+        scene,
+        "--amplitudes",
+        "3e-4",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(3), "{}", support::text(&o.stdout));
+    let stderr = support::text(&o.stderr);
+    assert!(
+        stderr.contains("incomplete: mode check: scene at 3.000e-4 m: first harmonic"),
+        "{stderr}"
+    );
+    let json = support::json(&out.join("verify_modes.json"));
+    assert_eq!(json[0]["passed"], false);
+    assert!(json[0]["verification"]["hbm_difference"].as_f64().unwrap() > 0.1);
+
+    let o = support::fricbound(&["verify", scene, "--freqs", "160", "--quiet"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(support::text(&o.stderr).contains("--freqs is for forced-response scenes"));
+    let o = support::fricbound(&["verify", "--amplitudes", "1e-4", "--quiet"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(support::text(&o.stderr).contains("--amplitudes is for nonlinear-mode scenes"));
 }
