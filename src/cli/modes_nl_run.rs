@@ -71,7 +71,7 @@ fn accuracy_warnings(ctx: &RunContext<'_>, limits: &ModeLimits) -> Vec<String> {
     let mut out = Vec::new();
     for c in &limits.cases {
         let Ok(run) = &c.run else { continue };
-        for w in nonlinear_modes::accuracy::warnings(&run.points, dof_name, threshold) {
+        for w in nonlinear_modes::warnings::warnings(&run.points, dof_name, threshold) {
             out.push(if several {
                 format!("case {}: {w}", c.case.name)
             } else {
@@ -88,7 +88,7 @@ fn accuracy_warnings(ctx: &RunContext<'_>, limits: &ModeLimits) -> Vec<String> {
 fn accuracy_line(ctx: &RunContext<'_>, limits: &ModeLimits, warnings: usize) -> String {
     let mut largest: Option<([f64; 3], usize)> = None;
     for run in limits.cases.iter().filter_map(|c| c.run.as_ref().ok()) {
-        if let Some((l, n)) = nonlinear_modes::accuracy::largest(&run.points) {
+        if let Some((l, n)) = nonlinear_modes::warnings::largest(&run.points) {
             let (o, not_sized) = largest.get_or_insert(([0.0; 3], 0));
             *not_sized += n;
             for k in 0..3 {

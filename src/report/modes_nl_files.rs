@@ -191,7 +191,7 @@ pub fn write_modes_nl(
                 .unwrap_or_default(),
             largest_trunc_err: c.run.as_ref().ok().and_then(|r| {
                 let ([frequency, damping_ratio, dof_amplitude], not_sized) =
-                    crate::analysis::nonlinear_modes::accuracy::largest(&r.points)?;
+                    crate::analysis::nonlinear_modes::warnings::largest(&r.points)?;
                 Some(LargestEstimate {
                     frequency,
                     damping_ratio,

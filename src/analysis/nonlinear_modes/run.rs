@@ -4,7 +4,7 @@
 use std::f64::consts::{PI, TAU};
 use std::time::Instant;
 
-use super::accuracy::{extended_problem, ModeAccuracy, ModeEstimator};
+use super::accuracy::{extended_problem, ModeAccuracy, ModeEstimator, PointValues};
 pub use super::error::NonlinearModeError;
 use super::operator::{EpmcOperator, LogAmplitude};
 use super::start::{linear_start, start_guess, LinearStart};
@@ -224,7 +224,14 @@ pub fn solve(
         )?;
         for p in &mut points {
             let psi = op.normalised(&p.coefficients, p.modal_amplitude);
-            p.accuracy = Some(estimator.estimate(p, &psi));
+            let values = PointValues {
+                modal_amplitude: p.modal_amplitude,
+                omega: p.omega,
+                xi: p.xi,
+                damping_ratio: p.damping_ratio,
+                dof_amplitude: p.dof_amplitude,
+            };
+            p.accuracy = Some(estimator.estimate(&values, &psi));
         }
         estimate_elapsed_s = estimate_started.elapsed().as_secs_f64();
     }
