@@ -194,13 +194,14 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
     more_line(&mut s, problem.harmonic_loads.len());
     let _ = writeln!(
         s,
-        "analysis     {} .. {} Hz, steps {:.3e} (min {:.3e}, max {:.3e}), jacobian {:?}",
+        "analysis     {} .. {} Hz, steps {:.3e} (min {:.3e}, max {:.3e}), jacobian {:?}{}",
         a.freq_start_hz,
         a.freq_end_hz,
         a.initial_step,
         a.min_step,
         a.max_step,
-        problem.analysis.jacobian
+        problem.analysis.jacobian,
+        mode_range_note(&scene.analysis, &problem)
     );
     let _ = writeln!(
         s,
@@ -325,6 +326,28 @@ fn more_line(s: &mut String, total: usize) {
     use std::fmt::Write as _;
     if total > CHECK_LISTED {
         let _ = writeln!(s, "  ... and {} more", total - CHECK_LISTED);
+    }
+}
+
+/// For a nonlinear-mode scene, what its frequency range is: the range of the linear
+/// references written beside the mode, given by the scene or derived from the mode's linear
+/// frequency (0.5-1.5 times it) where the scene gives neither end. Empty for an FRF scene.
+fn mode_range_note(
+    analysis: &crate::scene::schema::AnalysisSpec,
+    problem: &crate::model::Problem,
+) -> String {
+    if problem.analysis.nonlinear_modes.is_none() {
+        return String::new();
+    }
+    if analysis.freq_start_hz.is_none() && analysis.freq_end_hz.is_none() {
+        format!(
+            "; range of the linear references derived: {}-{} times the mode's linear \
+             frequency (analysis.freq_start_hz / freq_end_hz not given)",
+            crate::scene::MODE_RANGE_START,
+            crate::scene::MODE_RANGE_END
+        )
+    } else {
+        "; range of the linear references, as given".to_string()
     }
 }
 

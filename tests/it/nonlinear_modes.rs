@@ -263,6 +263,10 @@ fn shipped_scene_checks_and_runs() {
         "{described}"
     );
     assert!(
+        described.contains("range of the linear references, as given"),
+        "{described}"
+    );
+    assert!(
         described.contains("error estimate on every mode point") && !described.contains("beyond"),
         "{described}"
     );
@@ -549,6 +553,12 @@ fn mode_scene_without_frequency_range_takes_it_from_the_mode() {
     assert_eq!(ends.len(), 2, "{line}");
     assert!((ends[0] / (0.5 * f) - 1.0).abs() < 1e-9, "{line}: {f} Hz");
     assert!((ends[1] / (1.5 * f) - 1.0).abs() < 1e-9, "{line}: {f} Hz");
+    assert!(
+        line.contains(
+            "range of the linear references derived: 0.5-1.5 times the mode's linear frequency"
+        ),
+        "{line}"
+    );
     let out = dir.path().join("out");
     let o = support::run_scene(scene, &out, &[]);
     assert_eq!(o.status.code(), Some(0), "{}", support::text(&o.stderr));
