@@ -82,13 +82,18 @@ enum Command {
     /// Check HBM points by time integration (Newmark, same contact law): steady-state
     /// amplitude against the HBM, dt convergence, periodicity, and Hill's verdict. Writes
     /// verify.csv, verify.json and a time-history figure per frequency; exit 3 if a case failed
-    /// or did not settle.
+    /// or did not settle. On a nonlinear-mode scene, the mode points nearest --amplitudes
+    /// with the artificial damping applied (verify_modes.csv, .json; exit 3 if one fails).
     Verify {
         /// Scene file (TOML; the built-in paper scene when omitted).
         scene: Option<PathBuf>,
-        /// Excitation frequencies (Hz), comma separated.
-        #[arg(long, value_delimiter = ',', required = true)]
+        /// Excitation frequencies (Hz), comma separated (forced-response scenes).
+        #[arg(long, value_delimiter = ',', required_unless_present = "amplitudes")]
         freqs: Vec<f64>,
+        /// First-harmonic amplitudes at the mode's DOF (m), comma separated (nonlinear-mode
+        /// scenes): the points nearest them are checked.
+        #[arg(long, value_delimiter = ',')]
+        amplitudes: Vec<f64>,
         /// Newmark steps per period (default 256·H; the dt check also runs twice as many).
         #[arg(long)]
         steps_per_period: Option<usize>,
@@ -234,6 +239,7 @@ fn main() -> ExitCode {
             quiet,
             from,
             initial_states,
+            amplitudes,
         } => fricbound::cli::verify_run::run(&fricbound::cli::verify_run::VerifyOptions {
             scene,
             freqs,
@@ -244,6 +250,7 @@ fn main() -> ExitCode {
             quiet,
             from,
             initial_states,
+            amplitudes,
         })
         .map(|r| {
             print!("{}", r.text);

@@ -410,14 +410,21 @@ class NonlinearMode(_Result):
     :attr:`ContinuationPath.coefficients`), ``newton_iterations``; and ``mode`` (its number),
     ``linear_freq_hz``, ``linear_damping_ratio`` (the linear mode at rest), ``status``, and
     ``predicted_peak`` (``amplitude`` m, ``freq_hz``, ``modal_amplitude``: the resonance peak
-    under the scene's harmonic loads by single-nonlinear-mode theory) or None."""
+    under the scene's harmonic loads by single-nonlinear-mode theory) or None. With the error
+    estimate (``accuracy.estimate``, on by default): ``freq_trunc_err``,
+    ``damping_trunc_err``, ``amplitude_trunc_err`` (the relative changes of the frequency,
+    damping ratio and amplitude at the DOF when the harmonics are raised to 2H + 1; NaN where
+    not sized), else None."""
 
     predicted_peak: Optional[dict] = None
+    freq_trunc_err: Optional[np.ndarray] = None
+    damping_trunc_err: Optional[np.ndarray] = None
+    amplitude_trunc_err: Optional[np.ndarray] = None
 
     def to_pandas(self):
         """One row per point: ``modal_amplitude``, ``amplitude``, ``freq_hz``,
         ``damping_ratio``, ``xi``, ``dissipated_energy``, ``friction_energy``,
-        ``<contact>_state``."""
+        ``<contact>_state``, and the error estimate's three columns when it was computed."""
         pd = _pandas()
         columns = {
             k: getattr(self, k)
@@ -433,6 +440,9 @@ class NonlinearMode(_Result):
         }
         for j, name in enumerate(self.contacts):
             columns[f"{name}_state"] = [row[j] for row in self.states]
+        for k in ("freq_trunc_err", "damping_trunc_err", "amplitude_trunc_err"):
+            if getattr(self, k) is not None:
+                columns[k] = getattr(self, k)
         return pd.DataFrame(columns)
 
     def __repr__(self) -> str:

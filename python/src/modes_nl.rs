@@ -111,6 +111,20 @@ fn case_dict(
     d.set_item("xi", column(&|x| x.xi))?;
     d.set_item("dissipated_energy", column(&|x| x.dissipated_energy))?;
     d.set_item("friction_energy", column(&|x| x.friction_energy))?;
+    // The error estimate (NaN where not sized), when the scene computes it.
+    if p.iter().any(|x| x.accuracy.is_some()) {
+        let estimate = |k: usize| {
+            PyArray1::from_vec(
+                py,
+                p.iter()
+                    .map(|x| x.accuracy.map_or(f64::NAN, |a| a.values()[k]))
+                    .collect(),
+            )
+        };
+        d.set_item("freq_trunc_err", estimate(0))?;
+        d.set_item("damping_trunc_err", estimate(1))?;
+        d.set_item("amplitude_trunc_err", estimate(2))?;
+    }
     d.set_item(
         "newton_iterations",
         PyArray1::from_vec(py, p.iter().map(|x| x.newton_iterations as i64).collect()),

@@ -28,6 +28,11 @@ def test_mode_equals_the_cli_and_has_a_pandas_table(cli_binary, tmp_path):
         np.testing.assert_allclose(mode.freq_hz, mine["freq_hz"], rtol=1e-9)
         np.testing.assert_allclose(mode.damping_ratio, mine["damping_ratio"], rtol=1e-9)
         np.testing.assert_allclose(mode.amplitude, mine["y2_amp"], rtol=1e-9)
+        sized = ~np.isnan(mine["freq_trunc_err"])
+        np.testing.assert_allclose(
+            mode.freq_trunc_err[sized], mine["freq_trunc_err"][sized], rtol=1e-3, atol=1e-15
+        )
+        assert np.isnan(mode.freq_trunc_err[~sized]).all()
         assert mode.mode == 3
         assert abs(mode.linear_freq_hz - 225.0791) < 1e-3
     assert result.band is not None and len(result.band["amplitude"]) > 10

@@ -104,7 +104,16 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
     let _ = writeln!(
         s,
         "accuracy     {}",
-        if estimate.enabled {
+        if estimate.enabled && problem.analysis.nonlinear_modes.is_some() {
+            let h_max = problem.harmonics.iter().copied().max().unwrap_or(1);
+            format!(
+                "error estimate on every mode point (the change of its frequency, damping \
+                 ratio and amplitude at the DOF on H = {} harmonics, solved to convergence), \
+                 warning above {} %",
+                crate::analysis::error_estimate::extended_harmonic(h_max),
+                100.0 * estimate.warn_threshold,
+            )
+        } else if estimate.enabled {
             let h_max = problem.harmonics.iter().copied().max().unwrap_or(1);
             format!(
                 "error estimate on every point (truncation to H = {}, or {} where contacts \
@@ -119,7 +128,10 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
             "error estimate off ([accuracy] estimate = false)".to_string()
         }
     );
-    if let Some(refined) = crate::analysis::error_estimate::EstimateProblems::new(&problem) {
+    let frf_estimate = problem.analysis.nonlinear_modes.is_none();
+    if let Some(refined) =
+        crate::analysis::error_estimate::EstimateProblems::new(&problem).filter(|_| frf_estimate)
+    {
         let budget = crate::analysis::error_estimate::SolveBudget::new(&problem, &refined);
         let _ = writeln!(
             s,
@@ -182,13 +194,14 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
     more_line(&mut s, problem.harmonic_loads.len());
     let _ = writeln!(
         s,
-        "analysis     {} .. {} Hz, steps {:.3e} (min {:.3e}, max {:.3e}), jacobian {:?}",
+        "analysis     {} .. {} Hz, steps {:.3e} (min {:.3e}, max {:.3e}), jacobian {:?}{}",
         a.freq_start_hz,
         a.freq_end_hz,
         a.initial_step,
         a.min_step,
         a.max_step,
-        problem.analysis.jacobian
+        problem.analysis.jacobian,
+        mode_range_note(&scene.analysis, &problem)
     );
     let _ = writeln!(
         s,
@@ -313,6 +326,28 @@ fn more_line(s: &mut String, total: usize) {
     use std::fmt::Write as _;
     if total > CHECK_LISTED {
         let _ = writeln!(s, "  ... and {} more", total - CHECK_LISTED);
+    }
+}
+
+/// For a nonlinear-mode scene, what its frequency range is: the range of the linear
+/// references written beside the mode, given by the scene or derived from the mode's linear
+/// frequency (0.5-1.5 times it) where the scene gives neither end. Empty for an FRF scene.
+fn mode_range_note(
+    analysis: &crate::scene::schema::AnalysisSpec,
+    problem: &crate::model::Problem,
+) -> String {
+    if problem.analysis.nonlinear_modes.is_none() {
+        return String::new();
+    }
+    if analysis.freq_start_hz.is_none() && analysis.freq_end_hz.is_none() {
+        format!(
+            "; range of the linear references derived: {}-{} times the mode's linear \
+             frequency (analysis.freq_start_hz / freq_end_hz not given)",
+            crate::scene::MODE_RANGE_START,
+            crate::scene::MODE_RANGE_END
+        )
+    } else {
+        "; range of the linear references, as given".to_string()
     }
 }
 

@@ -26,8 +26,10 @@
 //!   and (`bench_contacts`) the cost of one limit curve against the contact count;
 //! - [`study`] (`fricbound study accuracy`, `fricbound study jacobian`): what each solver
 //!   setting costs and gives in accuracy, and the formulations side by side;
+//! - [`verify_modes`] (`fricbound verify` on a nonlinear-mode scene): mode points integrated in
+//!   time with the artificial damping applied;
 //! - [`verify_run`] (`fricbound verify`): time integration of HBM points, against the HBM and
-//!   Hill.
+//!   Hill (and the mode points through `verify_modes`).
 
 pub mod bench;
 mod bench_contacts;
@@ -42,6 +44,7 @@ pub mod paper;
 mod run;
 pub mod study;
 mod sweep_run;
+pub mod verify_modes;
 pub mod verify_run;
 
 pub use check::{abbreviated_list, check};

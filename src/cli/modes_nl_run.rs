@@ -40,7 +40,14 @@ pub(super) fn run_modes(ctx: &RunContext<'_>) -> Result<RunReport, CommandError>
     }
     plot_modes_nl(&ctx.dir, ctx.title(), problem, dof, &limits)?;
     write_mode_shapes(&ctx.dir, problem, &limits)?;
-    let summary = summary(ctx, &limits, elapsed);
+    let warnings = accuracy_warnings(ctx, &limits);
+    if !ctx.options.quiet {
+        for w in &warnings {
+            eprintln!("warning: {w}");
+        }
+    }
+    let mut summary = summary(ctx, &limits, elapsed);
+    summary.push_str(&accuracy_line(ctx, &limits, warnings.len()));
     Ok(RunReport {
         dir: ctx.dir.clone(),
         summary,
@@ -49,6 +56,60 @@ pub(super) fn run_modes(ctx: &RunContext<'_>) -> Result<RunReport, CommandError>
         open: ctx.open.clone(),
         stuck: ctx.stuck.clone(),
     })
+}
+
+/// The error estimate's warnings of every case (prefixed by the case's name where there are
+/// several).
+fn accuracy_warnings(ctx: &RunContext<'_>, limits: &ModeLimits) -> Vec<String> {
+    let problem = &ctx.problem;
+    let Some(m) = problem.analysis.nonlinear_modes else {
+        return Vec::new();
+    };
+    let dof_name = &problem.model.dof_names[m.dof];
+    let threshold = problem.analysis.error_estimate.warn_threshold;
+    let several = limits.cases.len() > 1;
+    let mut out = Vec::new();
+    for c in &limits.cases {
+        let Ok(run) = &c.run else { continue };
+        for w in nonlinear_modes::warnings::warnings(&run.points, dof_name, threshold) {
+            out.push(if several {
+                format!("case {}: {w}", c.case.name)
+            } else {
+                w
+            });
+        }
+    }
+    out
+}
+
+/// The summary line of the error estimate: the largest estimates over every case's points,
+/// the points not sized, the threshold and the number of warnings (empty when the estimate is
+/// off).
+fn accuracy_line(ctx: &RunContext<'_>, limits: &ModeLimits, warnings: usize) -> String {
+    let mut largest: Option<([f64; 3], usize)> = None;
+    for run in limits.cases.iter().filter_map(|c| c.run.as_ref().ok()) {
+        if let Some((l, n)) = nonlinear_modes::warnings::largest(&run.points) {
+            let (o, not_sized) = largest.get_or_insert(([0.0; 3], 0));
+            *not_sized += n;
+            for k in 0..3 {
+                o[k] = o[k].max(l[k]);
+            }
+        }
+    }
+    let Some(([f, d, a], not_sized)) = largest else {
+        return String::new();
+    };
+    let threshold = ctx.problem.analysis.error_estimate.warn_threshold;
+    let not_sized = if not_sized > 0 {
+        format!("; {not_sized} point(s) not sized")
+    } else {
+        String::new()
+    };
+    format!(
+        "\nerror estimate (harmonics raised to 2H + 1): largest change of the frequency {f:.2e}, \
+         damping ratio {d:.2e}, amplitude at the DOF {a:.2e}{not_sized} (threshold \
+         {threshold:.2e}; {warnings} warning(s))"
+    )
 }
 
 /// What was computed, a line per case, and the band's wide stretches.

@@ -5,7 +5,8 @@
 //! integrated from it ([`crate::analysis::verify::verify_point`], at dt and dt/2). Cases run in
 //! parallel (rayon) with a progress bar. Writes `verify.csv`, `verify.json` and one time-history
 //! figure per frequency (`verify_<freq>Hz.png/.svg`: the output DOFs over the last integrated
-//! period against the HBM's periodic motion).
+//! period against the HBM's periodic motion). A nonlinear-mode scene is verified at mode points
+//! instead ([`super::verify_modes`]).
 
 use std::f64::consts::PI;
 use std::path::PathBuf;
@@ -62,6 +63,9 @@ pub struct VerifyOptions {
     /// Initial tangential states m ∈ [−1, 1], each applied to every contact (one case per
     /// frequency and state); empty: the scene's own `initial_state` per contact.
     pub initial_states: Vec<f64>,
+    /// Nonlinear-mode scenes: first-harmonic amplitudes at the mode's DOF (m) whose nearest
+    /// points are checked ([`super::verify_modes`]).
+    pub amplitudes: Vec<f64>,
 }
 
 /// One verified frequency.
@@ -113,8 +117,10 @@ pub struct VerifyReport {
     pub text: String,
     /// Why the run is incomplete (a case failed or did not settle).
     pub incomplete: Option<String>,
-    /// The cases in frequency order.
+    /// The cases in frequency order (forced-response scenes).
     pub cases: Vec<VerifyCase>,
+    /// The checked mode points (nonlinear-mode scenes).
+    pub mode_cases: Vec<super::verify_modes::ModeVerifyCase>,
 }
 
 /// The HBM point at `freq` (Hz) by Newton from the stuck linear guess, or from the
@@ -467,14 +473,56 @@ fn opt<T: std::fmt::Display>(v: Option<T>) -> String {
     v.map(|x| x.to_string()).unwrap_or_default()
 }
 
+/// Refuses, on a nonlinear-mode scene, the options that belong to forced-response scenes.
+fn refuse_frf_options(label: &str, options: &VerifyOptions) -> Result<(), CommandError> {
+    let used = [
+        (!options.freqs.is_empty(), "--freqs"),
+        (!options.initial_states.is_empty(), "--initial-states"),
+        (options.from != StartFrom::Hbm, "--from static"),
+    ];
+    match used.iter().find(|(on, _)| *on) {
+        Some((_, what)) => Err(CommandError::Study {
+            scene: label.to_string(),
+            reason: format!(
+                "{what} is for forced-response scenes; a nonlinear-mode scene is verified at \
+                 --amplitudes (m at analysis.dof)"
+            ),
+        }),
+        None => Ok(()),
+    }
+}
+
 /// Runs `fricbound verify`.
 pub fn run(options: &VerifyOptions) -> Result<VerifyReport, CommandError> {
     let (label, _scene, problem, limits) =
         load_scene(options.scene.as_deref(), &options.overrides)?;
-    let curves = compared_curves(&problem, limits.as_ref());
     let dir = options.out.clone().unwrap_or_else(|| {
         default_out_dir(options.scene.as_deref(), &options.overrides).join("verify")
     });
+    if problem.analysis.nonlinear_modes.is_some() {
+        refuse_frf_options(&label, options)?;
+        let mode_options = super::verify_modes::ModeVerifyOptions {
+            amplitudes: options.amplitudes.clone(),
+            steps_per_period: options.steps_per_period,
+            periods: options.max_periods,
+        };
+        let r = super::verify_modes::run(&mode_options, &label, &problem, limits.as_ref(), &dir)?;
+        return Ok(VerifyReport {
+            text: r.text,
+            incomplete: r.incomplete,
+            cases: Vec::new(),
+            mode_cases: r.cases,
+        });
+    }
+    if options.freqs.is_empty() || !options.amplitudes.is_empty() {
+        return Err(CommandError::Study {
+            scene: label,
+            reason: "a forced-response scene is verified at --freqs (Hz); --amplitudes is for \
+                     nonlinear-mode scenes"
+                .to_string(),
+        });
+    }
+    let curves = compared_curves(&problem, limits.as_ref());
     create_dir(&dir)?;
     let h_max = problem.harmonics.iter().copied().max().unwrap_or(1);
     let mut settings = VerifySettings::for_harmonics(h_max);
@@ -634,6 +682,7 @@ pub fn run(options: &VerifyOptions) -> Result<VerifyReport, CommandError> {
             )
         })),
         cases,
+        mode_cases: Vec::new(),
     })
 }
 

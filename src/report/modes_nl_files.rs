@@ -26,17 +26,36 @@ use crate::report::plot::{
 
 /// Header of `modes_nl.csv`: `case`, `modal_amplitude` (kg^½·m), `<dof>_amp` (m), `freq_hz`,
 /// `damping_ratio`, `xi_per_s`, `dissipated_energy_j`, `friction_energy_j`,
-/// `<contact>_state` per contact, `newton_iterations`, `residual`.
+/// `<contact>_state` per contact, `newton_iterations`, `residual`, and with the error estimate
+/// (`accuracy.estimate`, on by default) `freq_trunc_err`, `damping_trunc_err` and
+/// `<dof>_amp_trunc_err` (relative changes when the harmonics are raised to 2H + 1, empty
+/// where not sized).
 pub fn modes_nl_header(problem: &Problem, dof: usize) -> String {
+    let dof_name = &problem.model.dof_names[dof];
     let mut s = format!(
-        "case,modal_amplitude,{}_amp,freq_hz,damping_ratio,xi_per_s,dissipated_energy_j,friction_energy_j",
-        problem.model.dof_names[dof]
+        "case,modal_amplitude,{dof_name}_amp,freq_hz,damping_ratio,xi_per_s,dissipated_energy_j,friction_energy_j",
     );
     for c in &problem.contacts {
         let _ = write!(s, ",{}_state", c.name);
     }
-    s.push_str(",newton_iterations,residual\n");
+    s.push_str(",newton_iterations,residual");
+    if problem.analysis.error_estimate.enabled {
+        let _ = write!(
+            s,
+            ",freq_trunc_err,damping_trunc_err,{dof_name}_amp_trunc_err"
+        );
+    }
+    s.push('\n');
     s
+}
+
+/// A CSV field of an estimate: empty where it could not be sized.
+fn estimate_field(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:.3e}")
+    } else {
+        String::new()
+    }
 }
 
 /// `modes_nl.csv` of the cases' modes (failed cases have no rows).
@@ -60,7 +79,14 @@ pub fn modes_nl_csv(problem: &Problem, dof: usize, limits: &ModeLimits) -> Strin
             for state in &p.states {
                 let _ = write!(s, ",{}", state.label());
             }
-            let _ = writeln!(s, ",{},{:.3e}", p.newton_iterations, p.residual);
+            let _ = write!(s, ",{},{:.3e}", p.newton_iterations, p.residual);
+            if problem.analysis.error_estimate.enabled {
+                let values = p.accuracy.map_or([f64::NAN; 3], |a| a.values());
+                for v in values {
+                    let _ = write!(s, ",{}", estimate_field(v));
+                }
+            }
+            s.push('\n');
         }
     }
     s
@@ -97,6 +123,21 @@ struct CaseEntry<'a> {
     /// The forced response predicted from the mode near the resonance: (Hz, m at the DOF).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     predicted_frf: Vec<(f64, f64)>,
+    /// The largest error estimate over the sized points: frequency, damping ratio, amplitude at
+    /// the DOF (relative), and the points that could not be sized.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    largest_trunc_err: Option<LargestEstimate>,
+}
+
+#[derive(Serialize)]
+struct LargestEstimate {
+    frequency: f64,
+    damping_ratio: f64,
+    dof_amplitude: f64,
+    /// The highest harmonic compared with.
+    harmonic: usize,
+    /// Points whose estimate could not be formed.
+    not_sized: usize,
 }
 
 #[derive(Serialize)]
@@ -148,6 +189,17 @@ pub fn write_modes_nl(
                 .as_ref()
                 .map(|r| predicted_frf(problem, r))
                 .unwrap_or_default(),
+            largest_trunc_err: c.run.as_ref().ok().and_then(|r| {
+                let ([frequency, damping_ratio, dof_amplitude], not_sized) =
+                    crate::analysis::nonlinear_modes::warnings::largest(&r.points)?;
+                Some(LargestEstimate {
+                    frequency,
+                    damping_ratio,
+                    dof_amplitude,
+                    harmonic: r.points.iter().find_map(|p| p.accuracy)?.harmonic,
+                    not_sized,
+                })
+            }),
         })
         .collect();
     let file = ModesFile {

@@ -48,7 +48,7 @@ pub mod paper;
 pub mod schema;
 pub mod validate;
 
-pub use check_analysis::{MAX_INERTIA_RATIO, MAX_POINTS};
+pub use check_analysis::{MAX_INERTIA_RATIO, MAX_POINTS, MODE_RANGE_END, MODE_RANGE_START};
 pub use check_loads::MAX_SAMPLES;
 pub use checker::{MAX_CONTACT_STIFFNESS_RATIO, MAX_MAGNITUDE};
 pub use error::SceneError;

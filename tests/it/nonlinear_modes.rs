@@ -13,6 +13,8 @@ use fricbound::model::Problem;
 use crate::common::scenes;
 use crate::support;
 
+mod checks;
+
 /// The single-DOF Jenkins oscillator of `docs/scene.md` ([`scenes::JENKINS_OSCILLATOR`]:
 /// m = 1 kg, k = 1e4 N/m, c = 2 N·s/m, kₜ = 1e5 N/m, μ = 0.3, N₀ = kₙ·1e-4 m = 10 N constant)
 /// at H = 1, solved to a residual of 1e-13.
@@ -260,6 +262,14 @@ fn shipped_scene_checks_and_runs() {
         described.contains("nonlinear mode 3 by EPMC (linear at rest: 225.0791 Hz"),
         "{described}"
     );
+    assert!(
+        described.contains("range of the linear references, as given"),
+        "{described}"
+    );
+    assert!(
+        described.contains("error estimate on every mode point") && !described.contains("beyond"),
+        "{described}"
+    );
     let dir = tempfile::tempdir().unwrap();
     let o = support::run_scene(scene, dir.path(), &[]);
     assert_eq!(o.status.code(), Some(0), "{}", support::text(&o.stderr));
@@ -298,7 +308,13 @@ fn shipped_scene_checks_and_runs() {
     }
     let (header, rows) = support::csv(&dir.path().join("modes_nl.csv"));
     assert!(header.starts_with("case,modal_amplitude,y2_amp,freq_hz,damping_ratio"));
+    assert!(header.ends_with(",freq_trunc_err,damping_trunc_err,y2_amp_trunc_err"));
     assert!(rows.len() > 100);
+    for c in cases {
+        let largest = &c["largest_trunc_err"];
+        assert_eq!(largest["harmonic"], 3, "{}", c["name"]);
+        assert!(largest["frequency"].as_f64().unwrap() >= 0.0);
+    }
 }
 
 /// A nonlinear-mode scene without its mode, with a mode field in an FRF scene, with a reversed
@@ -537,6 +553,12 @@ fn mode_scene_without_frequency_range_takes_it_from_the_mode() {
     assert_eq!(ends.len(), 2, "{line}");
     assert!((ends[0] / (0.5 * f) - 1.0).abs() < 1e-9, "{line}: {f} Hz");
     assert!((ends[1] / (1.5 * f) - 1.0).abs() < 1e-9, "{line}: {f} Hz");
+    assert!(
+        line.contains(
+            "range of the linear references derived: 0.5-1.5 times the mode's linear frequency"
+        ),
+        "{line}"
+    );
     let out = dir.path().join("out");
     let o = support::run_scene(scene, &out, &[]);
     assert_eq!(o.status.code(), Some(0), "{}", support::text(&o.stderr));

@@ -26,9 +26,12 @@
 //! | [`start`] | [`linear_start`], [`linearised_modes`] | the linear modes at rest and the mode asked |
 //! | [`run`] | [`solve`], [`NonlinearModeRun`], [`NonlinearModePoint`] | the continuation and its points |
 //! | [`predict`] | [`predicted_peak`], [`predicted_frf`] | the forced response near the resonance from the mode (single-nonlinear-mode theory) |
+//! | [`accuracy`] | [`ModeAccuracy`] | each point's error estimate: the change when the harmonics are raised to 2H + 1 |
+//! | [`warnings`](mod@warnings) | [`warnings::largest`], [`warnings::warnings`] | the estimates of a run in words |
 //! | [`verify`] | [`verify_mode_point`] | a point checked by time integration with the artificial damping applied |
 //! | [`limits`] | [`mode_limits`], [`ModeBand`] | the mode per initial tangential state (m = ±1 per side) and the band they span |
 
+pub mod accuracy;
 pub mod error;
 pub mod limits;
 pub mod operator;
@@ -36,13 +39,15 @@ pub mod predict;
 pub mod run;
 pub mod start;
 pub mod verify;
+pub mod warnings;
 
+pub use accuracy::ModeAccuracy;
 pub use limits::{band, mode_cases, mode_limits, scene_modes, ModeBand, ModeCase, ModeLimits};
 pub use operator::{EpmcOperator, LogAmplitude};
 pub use predict::{modal_force, predicted_frf, predicted_peak, PredictedPeak};
 pub use run::{
-    autonomous, solve, ModeChoice, NonlinearModeEnd, NonlinearModeError, NonlinearModePoint,
-    NonlinearModeRun, NonlinearModeSettings,
+    autonomous, point_at, solve, ModeChoice, NonlinearModeEnd, NonlinearModeError,
+    NonlinearModePoint, NonlinearModeRun, NonlinearModeSettings,
 };
 pub use start::{linear_start, linearised_modes, rest_statics, start_guess, LinearStart};
 pub use verify::{negatively_damped, verify_mode_point};

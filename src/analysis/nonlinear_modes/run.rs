@@ -4,6 +4,7 @@
 use std::f64::consts::{PI, TAU};
 use std::time::Instant;
 
+use super::accuracy::{extended_problem, ModeAccuracy, ModeEstimator, PointValues};
 pub use super::error::NonlinearModeError;
 use super::operator::{EpmcOperator, LogAmplitude};
 use super::start::{linear_start, start_guess, LinearStart};
@@ -74,6 +75,10 @@ pub struct NonlinearModePoint {
     pub newton_iterations: usize,
     /// Final residual relative to the residual scale.
     pub residual: f64,
+    /// The error estimate (the changes when the harmonics are raised to 2H + 1,
+    /// [`super::accuracy`]); None where the scene switched it off (`accuracy.estimate`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<ModeAccuracy>,
 }
 
 /// How a nonlinear-mode run ended.
@@ -105,8 +110,10 @@ pub struct NonlinearModeRun {
     pub points: Vec<NonlinearModePoint>,
     /// How it ended.
     pub end: NonlinearModeEnd,
-    /// Wall-clock time (s).
+    /// Wall-clock time (s), the error estimate included.
     pub elapsed_s: f64,
+    /// Of it, the error estimate's (s; 0 without it).
+    pub estimate_elapsed_s: f64,
 }
 
 impl NonlinearModeRun {
@@ -189,6 +196,7 @@ pub fn solve(
         settings,
     };
     let outcome = continuation.run(&mut op, &y0, &mut collect);
+    let mut points = collect.points;
     let end = match outcome {
         Ok(summary) => match summary.end {
             PathEnd::EndFrequency => NonlinearModeEnd::Reached,
@@ -203,15 +211,75 @@ pub fn solve(
             NonlinearModeEnd::Stalled(stall_reason(&e))
         }
     };
+    let estimate_started = Instant::now();
+    let mut estimate_elapsed_s = 0.0;
+    if problem.analysis.error_estimate.enabled {
+        let extended = extended_problem(&free);
+        let mut estimator = ModeEstimator::new(
+            &free,
+            &extended,
+            (start.statics.clone(), settings.dof),
+            (map, row_scale),
+            &continuation,
+        )?;
+        for p in &mut points {
+            let psi = op.normalised(&p.coefficients, p.modal_amplitude);
+            let values = PointValues {
+                modal_amplitude: p.modal_amplitude,
+                omega: p.omega,
+                xi: p.xi,
+                damping_ratio: p.damping_ratio,
+                dof_amplitude: p.dof_amplitude,
+            };
+            p.accuracy = Some(estimator.estimate(&values, &psi));
+        }
+        estimate_elapsed_s = estimate_started.elapsed().as_secs_f64();
+    }
     Ok(NonlinearModeRun {
         mode: start.number,
         linear_freq_hz: start.omega / TAU,
         linear_damping_ratio: start.xi / (2.0 * start.omega),
         modal_range: [map.a_min, a_max],
-        points: collect.points,
+        points,
         end,
         elapsed_s: started.elapsed().as_secs_f64(),
+        estimate_elapsed_s,
     })
+}
+
+/// The point of the mode of `problem` (as [`solve`] computes it with `settings`) at the modal
+/// amplitude `a` (kg^½·m), by Newton at that amplitude from `near` (a point of the same mode
+/// of `problem`, e.g. its nearest continuation point): a point between a run's points, without
+/// interpolating them. Its error estimate is not formed.
+pub fn point_at(
+    problem: &Problem,
+    settings: &NonlinearModeSettings,
+    a: f64,
+    near: &NonlinearModePoint,
+) -> Result<NonlinearModePoint, NonlinearModeError> {
+    let free = autonomous(problem);
+    let set = free.unknown_harmonics();
+    if set.cos_block(1).is_none() {
+        return Err(NonlinearModeError::NoFirstHarmonic);
+    }
+    let start = linear_start(&free, settings.mode, settings.dof)?;
+    let map = LogAmplitude { a_min: a };
+    let m_phi = mass_times(&free, &start.shape);
+    let row_scale = start.omega * start.omega * crate::numerics::linalg::norm(&m_phi);
+    let mut op = EpmcOperator::new(&free, start.statics.clone(), settings.dof, map, row_scale)?;
+    let mut y = op.normalised(&near.coefficients, near.modal_amplitude);
+    y.truncate(op.harmonic_dim());
+    y.extend([near.omega, near.xi]);
+    let newton = Continuation::new(
+        problem.analysis.continuation,
+        arc_length_scale(&free, &set, &start),
+    );
+    let lambda = TAU * map.decade(a);
+    let solved = newton
+        .solve_fixed(&mut op, &y, lambda)
+        .map_err(NonlinearModeError::Start)?;
+    let states = op.system().states.clone();
+    Ok(mode_point(&op, &solved, settings.dof, states))
 }
 
 /// The continuation's error in the words of a mode (its "frequency" is the decade of a).
@@ -301,6 +369,7 @@ fn mode_point(
         coefficients: x,
         newton_iterations: point.iterations,
         residual: point.residual,
+        accuracy: None,
     }
 }
 
