@@ -45,6 +45,7 @@ mod coordinates;
 mod elimination;
 mod jacobian;
 pub mod lowrank;
+pub mod modal;
 
 pub use coordinates::RelativeCoordinates;
 pub use jacobian::{ReducedSolver, SchurFactor, SchurJacobian};
