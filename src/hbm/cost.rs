@@ -168,10 +168,27 @@ pub fn linear_solver_name(f: Formulation) -> &'static str {
         Formulation::Sparse => "sparse LU",
         Formulation::Schur => "dense LU on the relative coordinates",
         Formulation::SchurLowRank => {
-            "elimination from the glued structure's modes (LU where the damping is not of low \
-             rank), per-harmonic LU + low-rank update of the slipping contacts (dense LU where \
-             cheaper)"
+            "per-harmonic LU + low-rank update of the slipping contacts (dense LU where cheaper)"
         }
+    }
+}
+
+/// The linear solver of a formulation on problem `p`: [`linear_solver_name`], and for
+/// schur-lowrank how the rest of the model is eliminated per harmonic (from the glued
+/// structure's modes, or by LU where the damping is not of low rank,
+/// [`modal_elimination_expected`]).
+pub fn linear_solver_description(p: &Problem, f: Formulation) -> String {
+    let name = linear_solver_name(f);
+    if f != Formulation::SchurLowRank {
+        return name.to_string();
+    }
+    if modal_elimination_expected(p) {
+        format!("{name}; other coordinates eliminated from the glued structure's modes")
+    } else {
+        format!(
+            "{name}; other coordinates eliminated by LU per harmonic (the damping is not of low \
+             rank)"
+        )
     }
 }
 

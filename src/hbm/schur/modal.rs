@@ -153,6 +153,7 @@ impl ModalBasis {
     }
 
     /// Rank of the damping (0 without damping).
+    #[cfg(test)]
     pub(super) fn damping_rank(&self) -> usize {
         self.damping.as_ref().map_or(0, |d| d.2.len())
     }
@@ -529,8 +530,9 @@ mod tests {
                 2.0e7,
                 crate::hbm::schur::ReducedSolver::Structured,
             );
-            eprintln!("harmonics {harmonics:?}: residual {rel:e}, LU {lu:e}");
-            assert!(rel <= 1e-10, "harmonics {harmonics:?}: residual {rel:e}");
+            // As accurate as the LU elimination (4e-14 at the static harmonic).
+            assert!(lu <= 1e-12, "harmonics {harmonics:?}: LU residual {lu:e}");
+            assert!(rel <= 1e-12, "harmonics {harmonics:?}: residual {rel:e}");
         }
     }
 }
