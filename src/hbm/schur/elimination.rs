@@ -17,9 +17,10 @@ use crate::numerics::linalg::PackedLu;
 /// exactly, and whether it was made from the glued modes) and is shared by every factorisation
 /// of the coordinates, whatever thread makes it.
 #[derive(Default)]
-pub(super) struct EliminationCache(
-    pub(super) std::sync::Mutex<Option<(u64, bool, Arc<Vec<EliminatedHarmonic>>)>>,
-);
+pub(super) struct EliminationCache(pub(super) std::sync::Mutex<Option<CachedElimination>>);
+
+/// The cached elimination: ω (bits), whether from modes, and every harmonic's elimination.
+pub(super) type CachedElimination = (u64, bool, Arc<Vec<EliminatedHarmonic>>);
 
 impl std::fmt::Debug for EliminationCache {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {

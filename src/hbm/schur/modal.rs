@@ -237,7 +237,7 @@ impl ModalBasis {
     }
 
     /// Φ μ: the z displacements of modal coordinates μ.
-    pub(super) fn from_modes(&self, mu: &Mat<c64>) -> Mat<c64> {
+    pub(super) fn displacements_of_modes(&self, mu: &Mat<c64>) -> Mat<c64> {
         complex_product(self.phi.as_ref(), mu)
     }
 }
@@ -360,7 +360,7 @@ impl ModalHarmonic {
         y_q: &Mat<c64>,
     ) -> Mat<c64> {
         let correction = self.modal_inverse(basis, &self.coupling_transposed(basis, y_q));
-        basis.from_modes(&(m - correction))
+        basis.displacements_of_modes(&(m - correction))
     }
 }
 
