@@ -147,17 +147,25 @@ fn row(m: &ContactMeasure) -> String {
     )
 }
 
-/// Factorisations, with those by a low-rank update and their mean rank.
+/// Factorisations, with those by a low-rank update and their mean rank, and the harmonics
+/// eliminated from the glued structure's modes.
 fn factorisations(w: &crate::numerics::work::WorkReading) -> String {
-    if w.low_rank_factorisations == 0 {
-        return w.factorisations.to_string();
+    let mut parts = Vec::new();
+    if w.low_rank_factorisations > 0 {
+        parts.push(format!(
+            "{} low-rank, mean rank {}",
+            w.low_rank_factorisations,
+            w.low_rank_rows / w.low_rank_factorisations
+        ));
     }
-    format!(
-        "{} ({} low-rank, mean rank {})",
-        w.factorisations,
-        w.low_rank_factorisations,
-        w.low_rank_rows / w.low_rank_factorisations
-    )
+    if w.modal_eliminations > 0 {
+        parts.push(format!("{} harmonics from modes", w.modal_eliminations));
+    }
+    if parts.is_empty() {
+        w.factorisations.to_string()
+    } else {
+        format!("{} ({})", w.factorisations, parts.join("; "))
+    }
 }
 
 /// The table, the fitted exponents and the refined peaks.

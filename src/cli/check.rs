@@ -62,7 +62,7 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
     let _ = writeln!(
         s,
         "  solver     {}",
-        crate::hbm::cost::linear_solver_name(cost.formulation)
+        crate::hbm::cost::linear_solver_description(&problem, cost.formulation)
     );
     let _ = writeln!(s, "cost         {}", cost.summary());
     let parallel = parallel_solves(&scene, &problem, limits.as_ref());

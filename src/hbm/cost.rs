@@ -39,7 +39,10 @@
 //! - `schur-lowrank`: as schur, with the reduced matrix's structured factorisation in place of
 //!   its dense LU where that is cheaper: per harmonic a complex LU of n_q rows, P⁻¹U on each
 //!   harmonic's rows, M and the r × r capacitance matrix, r assumed [`LOW_RANK_ROW_FRACTION`] of
-//!   the reduced rows ([`low_rank_flops`]).
+//!   the reduced rows ([`low_rank_flops`]); and where the damping is of low rank
+//!   ([`modal_elimination_expected`]) the elimination from the glued modes instead of the LU
+//!   elimination: the modes (n_z² + 2·n_q·n_z real values, once) and per harmonic G (n_q·n_z
+//!   real) and S_h (n_q² complex), 2·n_q²·n_z flops.
 //!
 //! **Time model** (an estimate, good to a factor of a few): per Newton iteration, the
 //! factorisation's floating-point operations (dense LU (2/3)·m³; complex LU 4× a real one;
@@ -167,6 +170,25 @@ pub fn linear_solver_name(f: Formulation) -> &'static str {
         Formulation::SchurLowRank => {
             "per-harmonic LU + low-rank update of the slipping contacts (dense LU where cheaper)"
         }
+    }
+}
+
+/// The linear solver of a formulation on problem `p`: [`linear_solver_name`], and for
+/// schur-lowrank how the rest of the model is eliminated per harmonic (from the glued
+/// structure's modes, or by LU where the damping is not of low rank,
+/// [`modal_elimination_expected`]).
+pub fn linear_solver_description(p: &Problem, f: Formulation) -> String {
+    let name = linear_solver_name(f);
+    if f != Formulation::SchurLowRank {
+        return name.to_string();
+    }
+    if modal_elimination_expected(p) {
+        format!("{name}; other coordinates eliminated from the glued structure's modes")
+    } else {
+        format!(
+            "{name}; other coordinates eliminated by LU per harmonic (the damping is not of low \
+             rank)"
+        )
     }
 }
 
@@ -417,9 +439,26 @@ fn schur_cost(
 ) -> (f64, f64) {
     let n_q = p.relative_coordinate_count() as f64;
     let n_z = (n - n_q).max(0.0);
-    let per_harmonic = dynamic * C64 * n * n + if has_static { F64 * n * n } else { 0.0 };
-    let real = 2.0 / 3.0 * n_z * n_z * n_z + 2.0 * n_z * n_z * n_q + 2.0 * n_q * n_q * n_z;
-    let elimination = dynamic * 4.0 * real + if has_static { real } else { 0.0 };
+    let modal = low_rank && modal_elimination_expected(p);
+    let (per_harmonic, elimination) = if modal {
+        // Per harmonic G (n_q·n_z real) and S_h (n_q² complex), S₀ = A₀_qq − G Δ⁻¹ Gᵀ in
+        // 2·n_q²·n_z real flops; the modes once per scene are not counted per factorisation.
+        let per = C64 * n_q * n_q + F64 * n_q * n_z;
+        let harmonics = dynamic + if has_static { 1.0 } else { 0.0 };
+        (harmonics * per, harmonics * 2.0 * n_q * n_q * n_z)
+    } else {
+        let real = 2.0 / 3.0 * n_z * n_z * n_z + 2.0 * n_z * n_z * n_q + 2.0 * n_q * n_q * n_z;
+        (
+            dynamic * C64 * n * n + if has_static { F64 * n * n } else { 0.0 },
+            dynamic * 4.0 * real + if has_static { real } else { 0.0 },
+        )
+    };
+    // The modes Φ and K_qzΦ, M_qzΦ, kept once.
+    let modes = if modal {
+        F64 * (n_z * n_z + 2.0 * n_q * n_z)
+    } else {
+        0.0
+    };
     let dense_flops = 2.0 / 3.0 * q * q * q;
     let dense_bytes = (F64 + 4.0) * q * q;
     let harmonics = dynamic as usize + usize::from(has_static);
@@ -433,9 +472,29 @@ fn schur_cost(
         (dense_bytes, dense_flops)
     };
     (
-        F64 * 6.0 * n * n + 2.0 * (per_harmonic + reduced_bytes),
+        F64 * 6.0 * n * n + modes + 2.0 * (per_harmonic + reduced_bytes),
         elimination + reduced_flops,
     )
+}
+
+/// Whether the schur-lowrank formulation is expected to eliminate the harmonics from the glued
+/// structure's modes ([`crate::hbm::schur::modal`]): when the DOFs that the damping matrix
+/// touches (a bound on its rank) are at most
+/// [`MAX_DAMPING_RANK_FRACTION`](crate::hbm::schur::modal::MAX_DAMPING_RANK_FRACTION) of the
+/// relative coordinates. The other conditions (symmetric matrices, M_zz positive definite) hold
+/// for structural models and are checked when the modes are computed.
+pub fn modal_elimination_expected(p: &Problem) -> bool {
+    let mut touched = vec![false; p.model.n_dofs()];
+    p.model.damping.for_each_nonzero(|i, j, v| {
+        if v != 0.0 {
+            touched[i] = true;
+            touched[j] = true;
+        }
+    });
+    let rank_bound = touched.iter().filter(|&&t| t).count() as f64;
+    rank_bound
+        <= crate::hbm::schur::modal::MAX_DAMPING_RANK_FRACTION
+            * p.relative_coordinate_count() as f64
 }
 
 /// Estimated flops of the schur-lowrank factorisation of the reduced matrix

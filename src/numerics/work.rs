@@ -26,9 +26,12 @@ pub enum Work {
     LowRankFactorisation,
     /// Rows of those low-rank updates, summed.
     LowRankRows,
+    /// Harmonics eliminated from the glued structure's modes (the schur formulation's
+    /// per-harmonic elimination without an LU, [`crate::hbm::schur::modal`]).
+    ModalElimination,
 }
 
-const KINDS: usize = 5;
+const KINDS: usize = 6;
 
 static COUNTS: [AtomicU64; KINDS] = [const { AtomicU64::new(0) }; KINDS];
 static NANOS: [AtomicU64; KINDS] = [const { AtomicU64::new(0) }; KINDS];
@@ -40,6 +43,7 @@ fn index(w: Work) -> usize {
         Work::Evaluation => 2,
         Work::LowRankFactorisation => 3,
         Work::LowRankRows => 4,
+        Work::ModalElimination => 5,
     }
 }
 
@@ -74,6 +78,8 @@ pub struct WorkReading {
     pub low_rank_factorisations: u64,
     /// Rows of those updates, summed.
     pub low_rank_rows: u64,
+    /// Harmonics eliminated from the glued structure's modes.
+    pub modal_eliminations: u64,
 }
 
 /// The counters now.
@@ -89,6 +95,7 @@ pub fn reading() -> WorkReading {
         evaluation_s: seconds(Work::Evaluation),
         low_rank_factorisations: count(Work::LowRankFactorisation),
         low_rank_rows: count(Work::LowRankRows),
+        modal_eliminations: count(Work::ModalElimination),
     }
 }
 
@@ -104,6 +111,7 @@ impl WorkReading {
             evaluation_s: self.evaluation_s - before.evaluation_s,
             low_rank_factorisations: self.low_rank_factorisations - before.low_rank_factorisations,
             low_rank_rows: self.low_rank_rows - before.low_rank_rows,
+            modal_eliminations: self.modal_eliminations - before.modal_eliminations,
         }
     }
 }

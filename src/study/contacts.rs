@@ -159,7 +159,7 @@ pub fn measure_case(
         harmonics: case.harmonics,
         unknowns: scaling::unknowns(&p),
         formulation: scaling::formulation_name(formulation).to_string(),
-        linear_solver: crate::hbm::cost::linear_solver_name(formulation).to_string(),
+        linear_solver: crate::hbm::cost::linear_solver_description(&p, formulation),
         points: points.len(),
         complete: outcome.as_ref().is_ok_and(|run| run.is_complete()),
         newton_iterations,

@@ -5,6 +5,7 @@ use faer::prelude::Solve;
 use faer::Mat;
 
 use super::elimination::EliminationCache;
+use super::modal::ModalBasis;
 use crate::contact::harmonic::{Block, HarmonicSet};
 use crate::hbm::formulation::{check_relative_coordinates, RelativeCoordinatesError};
 use crate::model::{DofSplit, Problem};
@@ -55,6 +56,9 @@ pub struct RelativeCoordinates {
     pub(super) harmonics: Vec<HarmonicBlocks>,
     /// The per-harmonic elimination of the last factorisation, with its ω.
     pub(super) last_elimination: EliminationCache,
+    /// The glued structure's modes for the modal elimination ([`super::modal`]), computed at
+    /// the first factorisation that asks for them; None where the scene does not allow it.
+    pub(super) modal: std::sync::OnceLock<Option<ModalBasis>>,
 }
 
 /// The coordinate change on one group of contact points that share DOFs (contacts of
@@ -267,11 +271,28 @@ impl RelativeCoordinates {
             blocks,
             harmonics,
             last_elimination: EliminationCache::default(),
+            modal: std::sync::OnceLock::new(),
         };
         coords.k_y = coords.congruence(&coords.k);
         coords.m_y = coords.congruence(&coords.m);
         coords.c_y = coords.congruence(&coords.c);
         Ok(coords)
+    }
+
+    /// The glued structure's modes (computed once, at the first call): None when K, M, C in
+    /// relative coordinates are not symmetric, M_zz is not positive definite, or the damping is
+    /// not of low rank ([`ModalBasis::new`]).
+    pub(super) fn modal_basis(&self) -> Option<&ModalBasis> {
+        self.modal
+            .get_or_init(|| ModalBasis::new(&self.k_y, &self.m_y, &self.c_y, self.n_q))
+            .as_ref()
+    }
+
+    /// Whether the per-harmonic elimination can use the glued structure's modes (builds them at
+    /// the first call): the `schur-lowrank` formulation's elimination where this holds, else the
+    /// LU elimination of every harmonic.
+    pub fn has_modal_elimination(&self) -> bool {
+        self.modal_basis().is_some()
     }
 
     /// Number of DOFs n of the problem.

@@ -50,14 +50,27 @@ impl RelativeCoordinates {
         })
     }
 
-    /// Eliminates the z coordinates of one harmonic at ω.
+    /// Eliminates the z coordinates of one harmonic at ω: from the glued structure's modes
+    /// when `modal` and they exist ([`super::modal`], unless ω is too close to a glued mode),
+    /// else by LU.
     fn eliminate(
         &self,
         hb: &HarmonicBlocks,
         omega: f64,
+        modal: bool,
     ) -> Result<EliminatedHarmonic, LinearSolveError> {
         let (n, n_q) = (self.n, self.n_q);
         let blocks: Vec<usize> = std::iter::once(hb.first).chain(hb.second).collect();
+        if let Some(basis) = modal.then(|| self.modal_basis()).flatten() {
+            let s = hb.harmonic as f64 * omega;
+            if let Some(m) = basis.harmonic(s, hb.second.is_some())? {
+                work::add(Work::ModalElimination, 1);
+                return Ok(EliminatedHarmonic {
+                    blocks,
+                    elimination: Elimination::Modal(m),
+                });
+            }
+        }
         let elimination = if hb.second.is_none() {
             let a_qq = self.real_block(hb, omega, 0..n_q, 0..n_q);
             if n == n_q {
@@ -116,6 +129,7 @@ impl RelativeCoordinates {
     pub(super) fn eliminated_at(
         &self,
         omega: f64,
+        modal: bool,
     ) -> Result<Arc<Vec<EliminatedHarmonic>>, LinearSolveError> {
         let cache = || {
             self.last_elimination
@@ -123,18 +137,18 @@ impl RelativeCoordinates {
                 .lock()
                 .unwrap_or_else(std::sync::PoisonError::into_inner)
         };
-        if let Some((bits, eliminated)) = cache().as_ref() {
-            if *bits == omega.to_bits() {
+        if let Some((bits, cached_modal, eliminated)) = cache().as_ref() {
+            if *bits == omega.to_bits() && *cached_modal == modal {
                 return Ok(Arc::clone(eliminated));
             }
         }
         let eliminated = Arc::new(
             self.harmonics
                 .iter()
-                .map(|hb| self.eliminate(hb, omega))
+                .map(|hb| self.eliminate(hb, omega, modal))
                 .collect::<Result<Vec<_>, _>>()?,
         );
-        *cache() = Some((omega.to_bits(), Arc::clone(&eliminated)));
+        *cache() = Some((omega.to_bits(), modal, Arc::clone(&eliminated)));
         Ok(eliminated)
     }
 
@@ -151,7 +165,8 @@ impl RelativeCoordinates {
         if !omega.is_finite() || contact_values.iter().any(|v| !v.is_finite()) {
             return Err(LinearSolveError::NonFinite);
         }
-        let eliminated = self.eliminated_at(omega)?;
+        let modal = solver == ReducedSolver::Structured;
+        let eliminated = self.eliminated_at(omega, modal)?;
         let reduced = self.reduced_factor(&eliminated, contact_values, solver)?;
         Ok(SchurFactor {
             coords: Arc::clone(self),
@@ -420,76 +435,16 @@ pub(super) fn solve_eliminated(
     let (n, n_q, nb) = (co.n, co.n_q, co.blocks.len());
     let bm = Mat::from_fn(n, nb, |i, j| b[j * n + i]);
     let by = co.to_relative_coordinates(&bm);
+    let basis = co.modal.get().and_then(Option::as_ref);
     let mut r_q = Mat::<f64>::zeros(n_q * nb, 1);
-    let mut kept: Vec<ZPart> = Vec::with_capacity(harmonics.len());
-    for eh in harmonics.iter() {
-        match &eh.elimination {
-            Elimination::Real { lu_zz, a_qz, .. } => {
-                let j = eh.blocks[0];
-                let mut rq = Mat::from_fn(n_q, 1, |i, _| by[(i, j)]);
-                let g = lu_zz.as_ref().map(|lu| {
-                    let g = lu.solve(&Mat::from_fn(n - n_q, 1, |i, _| by[(n_q + i, j)]));
-                    rq -= a_qz * &g;
-                    g
-                });
-                for i in 0..n_q {
-                    r_q[(j * n_q + i, 0)] = rq[(i, 0)];
-                }
-                kept.push(ZPart::Real(g));
-            }
-            Elimination::Complex { lu_zz, a_qz, .. } => {
-                let (jc, js) = (eh.blocks[0], eh.blocks[1]);
-                let packed = |i: usize| c64::new(by[(i, jc)], -by[(i, js)]);
-                let mut rq = Mat::from_fn(n_q, 1, |i, _| packed(i));
-                let g = lu_zz.as_ref().map(|lu| {
-                    let g = lu.solve(&Mat::from_fn(n - n_q, 1, |i, _| packed(n_q + i)));
-                    rq -= a_qz * &g;
-                    g
-                });
-                for i in 0..n_q {
-                    r_q[(jc * n_q + i, 0)] = rq[(i, 0)].re;
-                    r_q[(js * n_q + i, 0)] = -rq[(i, 0)].im;
-                }
-                kept.push(ZPart::Complex(g));
-            }
-        }
-    }
+    let kept: Vec<ZPart> = harmonics
+        .iter()
+        .map(|eh| eh.reduce_rhs(basis, &by, n_q, &mut r_q))
+        .collect();
     let y_q = reduced(r_q);
     let mut y = Mat::<f64>::zeros(n, nb);
-    for (eh, g) in harmonics.iter().zip(kept) {
-        match (&eh.elimination, g) {
-            (Elimination::Real { w, .. }, ZPart::Real(g)) => {
-                let j = eh.blocks[0];
-                let yq = Mat::from_fn(n_q, 1, |i, _| y_q[(j * n_q + i, 0)]);
-                for i in 0..n_q {
-                    y[(i, j)] = yq[(i, 0)];
-                }
-                if let Some(g) = g {
-                    let yz = g - w * &yq;
-                    for i in 0..n - n_q {
-                        y[(n_q + i, j)] = yz[(i, 0)];
-                    }
-                }
-            }
-            (Elimination::Complex { w, .. }, ZPart::Complex(g)) => {
-                let (jc, js) = (eh.blocks[0], eh.blocks[1]);
-                let yq = Mat::from_fn(n_q, 1, |i, _| {
-                    c64::new(y_q[(jc * n_q + i, 0)], -y_q[(js * n_q + i, 0)])
-                });
-                for i in 0..n_q {
-                    y[(i, jc)] = yq[(i, 0)].re;
-                    y[(i, js)] = -yq[(i, 0)].im;
-                }
-                if let Some(g) = g {
-                    let yz = g - w * &yq;
-                    for i in 0..n - n_q {
-                        y[(n_q + i, jc)] = yz[(i, 0)].re;
-                        y[(n_q + i, js)] = -yz[(i, 0)].im;
-                    }
-                }
-            }
-            _ => unreachable!("z parts are kept in the order of the eliminations"),
-        }
+    for (eh, z) in harmonics.iter().zip(kept) {
+        eh.back_substitute(basis, &y_q, z, n_q, &mut y);
     }
     let x = co.to_problem_coordinates(&y);
     let mut out = vec![0.0; n * nb];

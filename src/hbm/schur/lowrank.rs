@@ -25,7 +25,7 @@
 use faer::{c64, Mat};
 
 use super::coordinates::RelativeCoordinates;
-use super::elimination::{EliminatedHarmonic, Elimination};
+use super::elimination::{EliminatedHarmonic, SchurRef};
 use crate::numerics::linalg::{packed_complex_lu, packed_lu, LinearSolveError, PackedLu};
 
 /// A row of E is kept when one of its entries exceeds this fraction of the largest entry of
@@ -129,8 +129,8 @@ impl RelativeCoordinates {
     ) -> Result<Vec<HarmonicLu>, LinearSolveError> {
         let mut lus = Vec::with_capacity(harmonics.len());
         for eh in harmonics {
-            lus.push(match &eh.elimination {
-                Elimination::Real { schur, .. } => {
+            lus.push(match eh.schur() {
+                SchurRef::Real(schur) => {
                     let block = eh.blocks[0];
                     let mut s = schur.clone();
                     self.for_each_contact_entry(|p, (a, qa), (b, qb)| {
@@ -141,7 +141,7 @@ impl RelativeCoordinates {
                         lu: packed_lu(s)?,
                     }
                 }
-                Elimination::Complex { schur, .. } => {
+                SchurRef::Complex(schur) => {
                     let (cos, sin) = (eh.blocks[0], eh.blocks[1]);
                     let mut s = schur.clone();
                     self.for_each_contact_entry(|p, (a, qa), (b, qb)| {

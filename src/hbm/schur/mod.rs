@@ -39,12 +39,15 @@
 //! [`elimination`] (what the per-harmonic elimination keeps) and [`jacobian`] (the
 //! elimination and the Newton matrix on the relative coordinates, its factorisation and products)
 //! and [`lowrank`] (the reduced matrix factorised as a per-harmonic baseline plus a low-rank update
-//! for the contacts that slip: the `schur-lowrank` formulation, for many contact points).
+//! for the contacts that slip: the `schur-lowrank` formulation, for many contact points) and
+//! [`modal`] (schur-lowrank's per-harmonic elimination from the modes of the glued structure,
+//! computed once per scene, instead of an LU of Ã_zz at every frequency).
 
 mod coordinates;
 mod elimination;
 mod jacobian;
 pub mod lowrank;
+pub mod modal;
 
 pub use coordinates::RelativeCoordinates;
 pub use jacobian::{ReducedSolver, SchurFactor, SchurJacobian};
