@@ -1,8 +1,8 @@
 //! The 3D blade pair with 2D tangential friction (`meshes/blade-pair/blade-pair-3d.toml`):
 //! the scene validates into a Craig-Bampton-reduced model whose 56 patch contact points all
 //! carry the `jenkins-2d` law; fixed-frequency solves near the first bending pair, where
-//! contacts stick, slip and lift off, give the same solutions in the schur (`auto`) and dense
-//! formulations; `fricbound run` of a narrow window completes with its result files and
+//! contacts stick, slip and lift off, give the same solutions in the schur (the scene's),
+//! schur-lowrank and dense formulations; `fricbound run` of a narrow window completes with its result files and
 //! VTU output; the FRF over 840-900 Hz is complete through both folds on the event-resolved
 //! `jenkins-2d`; and the m = +1 limit curve crosses its former stall at
 //! 852.78 Hz. The tests of the path at single contact transitions were measured on the sampled
@@ -46,65 +46,73 @@ fn problem(overrides: &[&str]) -> Problem {
 
 #[test]
 fn the_reduced_3d_scene_has_2d_friction_and_schur_and_dense_solve_it_alike() {
-    // One reduction serves both checks (it is most of the test's time).
-    let schur = problem(&[]);
-    let friction_2d = schur
+    // One reduction serves every check (it is most of the test's time).
+    let scene = problem(&[]);
+    let friction_2d = scene
         .contacts
         .iter()
         .filter(|c| c.friction_law() == FrictionLaw::Jenkins2d)
         .count();
     // 28 pairs per side on two sides, plus the two frictionless axial retention springs.
     assert_eq!(friction_2d, 56);
-    assert_eq!(schur.contacts.len(), 58);
+    assert_eq!(scene.contacts.len(), 58);
     // Craig-Bampton: 336 contact DOFs, 1 output DOF and 21 interior coordinates.
     assert!(
-        schur.model.n_dofs() < 400,
+        scene.model.n_dofs() < 400,
         "{} reduced DOFs",
-        schur.model.n_dofs()
+        scene.model.n_dofs()
     );
-    assert_eq!(schur.formulation(), Formulation::Schur);
-    let mut dense = schur.clone();
-    dense.analysis.formulation = Formulation::Dense;
-    assert_eq!(dense.formulation(), Formulation::Dense);
-    let mut a = PointSolver::new(&schur).unwrap();
-    let mut b = PointSolver::new(&dense).unwrap();
-    let mut slipping = 0;
-    for f in FREQUENCIES {
-        let guess = stuck_guess(
-            &schur,
-            &schur.unknown_harmonics(),
-            2.0 * std::f64::consts::PI * f,
-        )
-        .unwrap();
-        let x = a.solve(&guess, f).unwrap();
-        let y = b.solve(&guess, f).unwrap();
-        let scale = x.coefficients.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        let largest = x
-            .coefficients
-            .iter()
-            .zip(&y.coefficients)
-            .fold(0.0_f64, |m, (p, q)| m.max((p - q).abs()));
-        println!(
-            "{f} Hz: amplitude {:.6e} m, schur {} / dense {} Newton iterations, \
-             largest difference {:.2e} of the largest coefficient",
-            x.amplitudes[0],
-            x.newton_iterations,
-            y.newton_iterations,
-            largest / scale
-        );
-        assert!(
-            largest <= 1e-6 * scale,
-            "{f} Hz: {largest:.3e} vs {scale:.3e}"
-        );
-        assert_eq!(x.states, y.states, "{f} Hz");
-        // The first two contacts are the frictionless axial retention springs.
-        slipping += x.states[2..]
-            .iter()
-            .filter(|s| matches!(s, ContactState::StickSlip | ContactState::StickSlipLiftoff))
-            .count();
+    // The scene sets schur (the scene file says why).
+    assert_eq!(scene.formulation(), Formulation::Schur);
+    let with = |formulation: Formulation| {
+        let mut p = scene.clone();
+        p.analysis.formulation = formulation;
+        assert_eq!(p.formulation(), formulation);
+        p
+    };
+    let dense = with(Formulation::Dense);
+    let mut reference = PointSolver::new(&dense).unwrap();
+    for formulation in [Formulation::Schur, Formulation::SchurLowRank] {
+        let schur = with(formulation);
+        let mut a = PointSolver::new(&schur).unwrap();
+        let mut slipping = 0;
+        for f in FREQUENCIES {
+            let guess = stuck_guess(
+                &schur,
+                &schur.unknown_harmonics(),
+                2.0 * std::f64::consts::PI * f,
+            )
+            .unwrap();
+            let x = a.solve(&guess, f).unwrap();
+            let y = reference.solve(&guess, f).unwrap();
+            let scale = x.coefficients.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            let largest = x
+                .coefficients
+                .iter()
+                .zip(&y.coefficients)
+                .fold(0.0_f64, |m, (p, q)| m.max((p - q).abs()));
+            println!(
+                "{formulation:?}, {f} Hz: amplitude {:.6e} m, {} / dense {} Newton iterations, \
+                 largest difference {:.2e} of the largest coefficient",
+                x.amplitudes[0],
+                x.newton_iterations,
+                y.newton_iterations,
+                largest / scale
+            );
+            assert!(
+                largest <= 1e-6 * scale,
+                "{formulation:?}, {f} Hz: {largest:.3e} vs {scale:.3e}"
+            );
+            assert_eq!(x.states, y.states, "{formulation:?}, {f} Hz");
+            // The first two contacts are the frictionless axial retention springs.
+            slipping += x.states[2..]
+                .iter()
+                .filter(|s| matches!(s, ContactState::StickSlip | ContactState::StickSlipLiftoff))
+                .count();
+        }
+        // The 2D friction law is exercised: some patch points slip.
+        assert!(slipping > 0);
     }
-    // The 2D friction law is exercised: some patch points slip.
-    assert!(slipping > 0);
 }
 
 #[test]
