@@ -118,6 +118,18 @@ impl HarmonicSet {
         self.blocks.iter().position(|b| *b == Block::Sin(h))
     }
 
+    /// The block that d/dτ maps block `block` onto, with the sign of that map per unit of
+    /// harmonic: d/dτ (cos hτ) = −h sin hτ, so a cosine block's partner is its sine block with
+    /// −1, and a sine block's its cosine block with +1. None for the constant block and for a
+    /// block whose partner is not in the set.
+    pub fn quadrature_partner(&self, block: Block) -> Option<(usize, f64)> {
+        match block {
+            Block::Cos(h) => self.sin_block(h).map(|b| (b, -1.0)),
+            Block::Sin(h) => self.cos_block(h).map(|b| (b, 1.0)),
+            Block::Constant => None,
+        }
+    }
+
     /// Index of the constant block, if present.
     pub fn constant_block(&self) -> Option<usize> {
         self.blocks.iter().position(|b| *b == Block::Constant)

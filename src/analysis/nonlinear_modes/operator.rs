@@ -31,7 +31,7 @@
 //! continuation, which measures λ in "Hz" (λ / 2π), counts one unit per decade from 1 at
 //! a_min (see [`LogAmplitude`]).
 
-use crate::contact::harmonic::{Block, HarmonicSet};
+use crate::contact::harmonic::HarmonicSet;
 use crate::hbm::{HbmError, HbmSystem};
 use crate::model::Problem;
 use crate::numerics::jacobian::{AssembledJacobian, Storage};
@@ -200,12 +200,9 @@ impl<'p> EpmcOperator<'p> {
         let set = self.system.unknowns();
         let mx = self.system.problem().model.mass.mul_blocks(x, self.nb);
         for (j, b) in set.blocks().iter().enumerate() {
-            let (partner, sign) = match *b {
-                Block::Cos(h) => (set.sin_block(h), -1.0),
-                Block::Sin(h) => (set.cos_block(h), 1.0),
-                Block::Constant => (None, 0.0),
+            let Some((pj, sign)) = set.quadrature_partner(*b) else {
+                continue;
             };
-            let Some(pj) = partner else { continue };
             let h = b.harmonic() as f64;
             for p in 0..n {
                 let e = sign * h * mx[(p, pj)];
@@ -309,12 +306,9 @@ impl<'p> EpmcOperator<'p> {
         let set = self.system.unknowns();
         let mass = self.system.problem().model.mass.triplets();
         for (j, b) in set.blocks().iter().enumerate() {
-            let (partner, sign) = match *b {
-                Block::Cos(h) => (set.sin_block(h), -1.0),
-                Block::Sin(h) => (set.cos_block(h), 1.0),
-                Block::Constant => (None, 0.0),
+            let Some((pj, sign)) = set.quadrature_partner(*b) else {
+                continue;
             };
-            let Some(pj) = partner else { continue };
             let e = sign * b.harmonic() as f64 * omega * xi;
             for &(p, q, m) in &mass {
                 let slot = jac.slot(j * n + p, pj * n + q);

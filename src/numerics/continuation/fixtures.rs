@@ -81,6 +81,7 @@ pub(super) fn settings(start: f64, end: f64) -> ContinuationSettings {
 /// a path that cannot be followed on.
 pub(super) struct SmoothS {
     end: f64,
+    sparse: bool,
 }
 
 impl SmoothS {
@@ -91,7 +92,16 @@ impl SmoothS {
 
     /// The S with no solution for x > `end`.
     pub(super) fn ending_at(end: f64) -> Self {
-        Self { end }
+        Self { end, sparse: false }
+    }
+
+    /// The same S with its Jacobian in sparse storage, whose factorisations a corrector with
+    /// chord steps carries to the next point (a dense one is not carried).
+    pub(super) fn with_sparse_jacobian(self) -> Self {
+        Self {
+            sparse: true,
+            ..self
+        }
     }
 
     /// g(x) (Hz).
@@ -114,7 +124,11 @@ impl ParametricResidual for SmoothS {
         Ok(())
     }
     fn new_jacobian(&mut self) -> AssembledJacobian {
-        AssembledJacobian::dense(1)
+        if self.sparse {
+            AssembledJacobian::sparse(1, [(0, 0)])
+        } else {
+            AssembledJacobian::dense(1)
+        }
     }
     fn residual_and_jacobian(
         &mut self,

@@ -111,8 +111,7 @@ impl Continuation {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::numerics::continuation::fixtures::{settings, Never, SmoothS};
-    use crate::numerics::jacobian::AssembledJacobian;
+    use crate::numerics::continuation::fixtures::{settings, SmoothS};
 
     /// The unit tangent of the smooth S at x, oriented with x rising (scaled space: x, Hz).
     fn s_tangent(x: f64) -> Vec<f64> {
@@ -168,36 +167,6 @@ mod tests {
         }
     }
 
-    /// The smooth S with a sparse Jacobian, whose factorisations a corrector carries to the
-    /// next point.
-    struct SparseS(SmoothS);
-
-    impl ParametricResidual for SparseS {
-        type Error = Never;
-        fn dim(&self) -> usize {
-            1
-        }
-        fn residual_scale(&self) -> f64 {
-            1.0
-        }
-        fn residual(&mut self, x: &[f64], omega: f64, r: &mut [f64]) -> Result<(), Never> {
-            self.0.residual(x, omega, r)
-        }
-        fn new_jacobian(&mut self) -> AssembledJacobian {
-            AssembledJacobian::sparse(1, [(0, 0)])
-        }
-        fn residual_and_jacobian(
-            &mut self,
-            x: &[f64],
-            omega: f64,
-            r: &mut [f64],
-            jac: &mut AssembledJacobian,
-            dr: &mut [f64],
-        ) -> Result<(), Never> {
-            self.0.residual_and_jacobian(x, omega, r, jac, dr)
-        }
-    }
-
     /// A corrector that converges keeps its factorisation for the next point; one that fails
     /// leaves none to carry to the next try.
     #[test]
@@ -206,7 +175,7 @@ mod tests {
         s.chord_min_unknowns = 1;
         let c = Continuation::new(s, vec![1.0]);
         // Past x = 1.5 the residual has no zero.
-        let mut system = SparseS(SmoothS::ending_at(1.5));
+        let mut system = SmoothS::ending_at(1.5).with_sparse_jacobian();
         let predicted = [1.2, SmoothS::g(1.2) + 0.01];
         c.correct(&mut system, &predicted, &s_tangent(1.2)).unwrap();
         assert!(c.carried.borrow().is_some());
