@@ -442,7 +442,7 @@ fn schur_cost(
     let modal = low_rank && modal_elimination_expected(p);
     let (per_harmonic, elimination) = if modal {
         // Per harmonic G (n_q·n_z real) and S_h (n_q² complex), S₀ = A₀_qq − G Δ⁻¹ Gᵀ in
-        // 2·n_q²·n_z real flops; the modes once per scene are not counted per factorisation.
+        // 2·n_q²·n_z real flops; the modes, once per system, are not counted per factorisation.
         let per = C64 * n_q * n_q + F64 * n_q * n_z;
         let harmonics = dynamic + if has_static { 1.0 } else { 0.0 };
         (harmonics * per, harmonics * 2.0 * n_q * n_q * n_z)

@@ -41,7 +41,7 @@
 //! and [`lowrank`] (the reduced matrix factorised as a per-harmonic baseline plus a low-rank update
 //! for the contacts that slip: the `schur-lowrank` formulation, for many contact points) and
 //! [`modal`] (schur-lowrank's per-harmonic elimination from the modes of the glued structure,
-//! computed once per scene, instead of an LU of Ã_zz at every frequency).
+//! computed once per harmonic-balance system, instead of an LU of Ã_zz at every frequency).
 
 mod coordinates;
 mod elimination;

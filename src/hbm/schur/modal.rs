@@ -1,5 +1,6 @@
 //! The per-harmonic elimination of z = (w, x_o) from the modes of the glued structure, computed
-//! once per scene, in place of a dense LU of Ã_zz at every frequency (the `schur-lowrank`
+//! once per harmonic-balance system (each curve, limit case and point solver builds its own), in
+//! place of a dense LU of Ã_zz at every frequency (the `schur-lowrank`
 //! formulation).
 //!
 //! Ã_zz(s) = K_zz − s²M_zz + i s C_zz (s = hω) is the structure with every contact glued. Solve
@@ -55,7 +56,7 @@ pub const MAX_DAMPING_RANK_FRACTION: f64 = 0.25;
 const RANK_TOLERANCE: f64 = 1e-13;
 
 /// The modes of the glued structure and the products that the per-harmonic elimination needs,
-/// computed once per scene.
+/// computed once per harmonic-balance system (on its first factorisation).
 #[derive(Debug)]
 pub(super) struct ModalBasis {
     /// Φ (n_z × n_z), stiffness-normalised modes of (K_zz, M_zz): Φᵀ K_zz Φ = I.
