@@ -7,9 +7,7 @@
 use std::sync::Arc;
 
 use fricbound::hbm::schur::{ReducedSolver, RelativeCoordinates};
-use fricbound::model::Formulation;
 use fricbound::numerics::ImplicitFactor;
-use fricbound::study::contacts::{self, ContactCase};
 use fricbound::study::scaling::{self, ModelSize};
 
 /// Contact blocks where every contact is stuck (kt, kn on every coefficient block, no coupling
@@ -93,33 +91,68 @@ fn the_structured_factorisation_solves_as_the_dense_lu() {
     }
 }
 
+/// One case of `fricbound bench contacts` as its contacts.json writes it. The benchmark runs in
+/// its own process: the work counters ([`fricbound::numerics::work`]) are process-wide, and the
+/// other tests of this binary add into them while they run.
+fn bench_case(dir: &std::path::Path) -> Vec<serde_json::Value> {
+    let out = dir.join("bench");
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_fricbound"))
+        .args([
+            "bench",
+            "contacts",
+            "--contact-refine",
+            "8",
+            "--harmonics",
+            "3",
+            "--formulation",
+            "schur,schur-lowrank",
+            "--points",
+            "150",
+            "--peaks",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let json = std::fs::read_to_string(out.join("contacts.json")).unwrap();
+    serde_json::from_str(&json).unwrap()
+}
+
 #[test]
 fn a_limit_curve_with_49_pairs_per_side_has_the_schur_peaks() {
     let dir = tempfile::tempdir().unwrap();
-    let run = |formulation| {
-        let case = ContactCase {
-            contact_refine: 8,
-            harmonics: 3,
-            formulation,
-            max_points: 150,
-        };
-        contacts::measure_case(&case, dir.path(), true).unwrap()
-    };
-    let schur = run(Formulation::Schur);
-    let structured = run(Formulation::SchurLowRank);
-    assert_eq!(schur.pairs_per_side, 49);
-    assert_eq!(structured.formulation, "schur-lowrank");
+    let cases = bench_case(dir.path());
+    assert_eq!(cases.len(), 2);
+    let (schur, structured) = (&cases[0], &cases[1]);
+    let count = |case: &serde_json::Value, field: &str| case["work"][field].as_u64().unwrap();
+    assert_eq!(schur["pairs_per_side"], 49);
+    assert_eq!(schur["formulation"], "schur");
+    assert_eq!(structured["formulation"], "schur-lowrank");
     // The structured factorisation was used, with a rank below the reduced rows.
-    let w = &structured.work;
-    assert!(w.low_rank_factorisations > 0);
-    assert!(w.low_rank_rows / w.low_rank_factorisations < 49 * 2 * 2 * 7);
+    let low_rank = count(structured, "low_rank_factorisations");
+    assert!(low_rank > 0);
+    assert!(count(structured, "low_rank_rows") / low_rank < 49 * 2 * 2 * 7);
     // Its harmonics were eliminated from the glued structure's modes (the blade pair's damping
     // is of low rank), schur's by LU.
-    assert!(w.modal_eliminations >= 4 * w.factorisations / 2);
-    assert_eq!(schur.work.modal_eliminations, 0);
-    assert!(!schur.peaks.is_empty());
-    assert_eq!(schur.peaks.len(), structured.peaks.len());
-    for (a, b) in schur.peaks.iter().zip(&structured.peaks) {
+    assert!(count(structured, "modal_eliminations") >= 4 * count(structured, "factorisations") / 2);
+    assert_eq!(count(schur, "modal_eliminations"), 0);
+    let peaks = |case: &serde_json::Value| -> Vec<(f64, f64)> {
+        case["peaks"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| (p[0].as_f64().unwrap(), p[1].as_f64().unwrap()))
+            .collect()
+    };
+    let (schur_peaks, structured_peaks) = (peaks(schur), peaks(structured));
+    assert!(!schur_peaks.is_empty());
+    assert_eq!(schur_peaks.len(), structured_peaks.len());
+    for (a, b) in schur_peaks.iter().zip(&structured_peaks) {
         let rel = (a.1 - b.1).abs() / a.1.abs();
         assert!(
             rel <= 1e-8,
@@ -136,10 +169,8 @@ fn a_limit_curve_with_49_pairs_per_side_has_the_schur_peaks() {
         );
     }
     // Exact solves: Newton takes the same iterations (within round-off effects on a few points).
-    let (i0, i1) = (
-        schur.newton_iterations as f64,
-        structured.newton_iterations as f64,
-    );
+    let iterations = |case: &serde_json::Value| case["newton_iterations"].as_f64().unwrap();
+    let (i0, i1) = (iterations(schur), iterations(structured));
     assert!(
         (i1 - i0).abs() <= 0.05 * i0,
         "{i0} against {i1} Newton iterations"
