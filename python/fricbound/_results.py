@@ -282,16 +282,19 @@ class LimitsResult(_Result):
 
 class SweepResult(_Result):
     """A sweep of the limit analysis (:func:`fricbound.sweep`): per value (``value``,
-    ``series``) and case (``cases``: the two limit cases, then the intermediate ones)
-    ``peak_amplitude`` (m) and ``peak_freq_hz`` of the resonance peak (NaN where the case
-    failed or did not cover the range), ``peak_refined``; ``failures`` per value, ``status``.
+    ``series``) and case (``cases``: the ``limit_cases`` limit cases, then the intermediate
+    ones) ``peak_amplitude`` (m) and ``peak_freq_hz`` of the resonance peak (NaN where the case
+    failed or did not cover the range), ``peak_refined``; ``failures`` per value, ``status``,
+    ``peaks_from``. On a forced-response scene the limit cases are m = +1 and m = -1; on a
+    nonlinear-mode scene every combination of m = +1 / -1 per damper side, and the peaks are
+    those the mode of each case predicts.
     """
 
     def limit_peaks(self) -> "tuple[np.ndarray, np.ndarray]":
-        """Upper and lower limit-curve peak amplitude (m) per value (the larger and smaller
-        of the two limit cases), as the paper's optimal curves (Fig. 16a)."""
-        two = self.peak_amplitude[:, :2]
-        return np.max(two, axis=1), np.min(two, axis=1)
+        """Upper and lower limit peak amplitude (m) per value (the largest and smallest over
+        the limit cases), as the paper's optimal curves (Fig. 16a)."""
+        limits = self.peak_amplitude[:, : self.limit_cases]
+        return np.max(limits, axis=1), np.min(limits, axis=1)
 
     def to_pandas(self):
         """One row per value: ``<parameter>`` (and the series parameter), then

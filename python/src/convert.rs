@@ -480,7 +480,8 @@ pub fn limits_dict<'py>(
 /// A sweep: `parameter`, `unit`, `series_parameter`, per point (in scene order) `value`,
 /// `series` (NaN without a series), and per point × case (`cases`) the resonance peak's
 /// `peak_amplitude` (m) and `peak_freq_hz` (NaN where the case failed or did not cover the
-/// range), `peak_refined`, `retries`; `failures` (one list of lines per point) and `status`.
+/// range), `peak_refined`, `retries`; `limit_cases` (how many leading cases bound the
+/// response), `peaks_from`; `failures` (one list of lines per point) and `status`.
 pub fn sweep_dict<'py>(
     py: Python<'py>,
     spec: &SweepSpec,
@@ -535,6 +536,10 @@ pub fn sweep_dict<'py>(
         points.iter().map(|p| p.retries.clone()).collect::<Vec<_>>(),
     )?;
     d.set_item("cases", cases)?;
+    d.set_item(
+        "limit_cases",
+        points.first().map_or(2, |p| p.limit_cases),
+    )?;
     let failures: Vec<Vec<String>> = points.iter().map(|p| p.failures.clone()).collect();
     let failed: Vec<String> = points
         .iter()

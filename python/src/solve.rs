@@ -361,7 +361,9 @@ pub fn sweep<'py>(
         })
     })?;
     let points = result.map_err(|e| PyValueError::new_err(format!("{label}: {e}")))?;
-    convert::sweep_dict(py, &spec, &points)
+    let d = convert::sweep_dict(py, &spec, &points)?;
+    d.set_item("peaks_from", fricbound::study::sweep::peaks_from(&problem))?;
+    Ok(d)
 }
 
 /// The lowest natural frequencies of the scene's structure with its contacts open or stuck.

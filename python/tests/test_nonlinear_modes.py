@@ -58,3 +58,31 @@ def test_keywords_set_the_mode_and_bad_input_names_the_field():
     assert peak is not None and 1e-4 < peak["amplitude"] < 1e-3
     with pytest.raises(ValueError, match="analysis.amplitude"):
         fricbound.nonlinear_modes(scene, mode=2, dof="y2", amplitude=[1e-3, 1e-7])
+
+
+def test_a_sweep_of_a_mode_scene_predicts_each_case_peak():
+    """fricbound.sweep on a nonlinear-mode scene with [limits]: per pre-load the peak each
+    case's mode predicts (the four sign combinations per side bound the response), equal to
+    the prediction of fricbound.nonlinear_modes at that pre-load."""
+    scene = (
+        Scene.paper()
+        .set("analysis.kind", "nonlinear-modes")
+        .set("analysis.mode", 2)
+        .set("analysis.dof", "y2")
+        .set("analysis.amplitude", [1e-8, 3e-3])
+        .set("analysis.freq_start_hz", 140.0)
+        .set("analysis.freq_end_hz", 185.0)
+        .set("accuracy.estimate", False)
+        .set("limits.peak_window_hz", [140.0, 185.0])
+    )
+    result = fricbound.sweep(scene, "static_loads.0.value", [60.0, 240.0], scale=-1.0, parameter="F0", unit="N")
+    assert result.peaks_from == "predicted from the nonlinear mode of each case"
+    assert result.limit_cases == 4
+    assert result.cases[:2] == ["m+1", "m-1"]
+    upper, lower = result.limit_peaks()
+    assert np.all(upper >= lower) and np.all(lower > 0)
+    modes = fricbound.nonlinear_modes(scene.copy().set("static_loads.0.value", -240.0))
+    for k, name in enumerate(result.cases):
+        np.testing.assert_allclose(
+            result.peak_amplitude[1, k], modes.cases[name].predicted_peak["amplitude"], rtol=1e-9
+        )

@@ -128,6 +128,7 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
             "error estimate off ([accuracy] estimate = false)".to_string()
         }
     );
+    let _ = writeln!(s, "stability    {}", stability_line(&problem));
     let frf_estimate = problem.analysis.nonlinear_modes.is_none();
     if let Some(refined) =
         crate::analysis::error_estimate::EstimateProblems::new(&problem).filter(|_| frf_estimate)
@@ -256,6 +257,56 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
     }
     s.push_str(&modes::boundary_check_lines(&scene, &label)?);
     Ok(s)
+}
+
+/// What `check` says of the stability verdicts: off, or the method and how each of its solves
+/// runs at this problem's size, with the dense matrices it holds (Hill's dense eigen solve of
+/// the companion matrix up to [`MAX_HILL_UNKNOWNS`](crate::analysis::stability::MAX_HILL_UNKNOWNS)
+/// unknowns, the sparse shift-invert solve above it; the monodromy's dense time integration).
+fn stability_line(problem: &crate::model::Problem) -> String {
+    use crate::analysis::stability_sparse::uses_shift_invert;
+    use crate::hbm::cost::format_bytes;
+    let analysis = &problem.analysis;
+    if !analysis.stability {
+        return "off (analysis.stability = false)".to_string();
+    }
+    let method = analysis.stability_method;
+    let n = problem.model.n_dofs();
+    let unknowns = n * problem.unknown_harmonics().n_blocks();
+    let mut parts = Vec::new();
+    if method.uses_hill() {
+        parts.push(if uses_shift_invert(analysis.hill_solver, unknowns) {
+            format!(
+                "Hill by the sparse shift-invert solve of its {unknowns} unknowns (a complex \
+                 sparse LU per shift), exponents {}",
+                analysis
+                    .hill_max_freq_hz
+                    .map(|f| format!("up to {f} Hz"))
+                    .unwrap_or_else(|| "of every mode".to_string())
+            )
+        } else {
+            let rows = 2 * unknowns;
+            format!(
+                "Hill by the dense eigen solve of the {rows}-row companion matrix ({} per \
+                 dense copy)",
+                format_bytes((rows * rows * 8) as f64)
+            )
+        });
+    }
+    if method.uses_monodromy() {
+        parts.push(format!(
+            "the monodromy by a dense time integration of the {n} DOFs ({} per dense matrix, \
+             at most {} DOFs){}",
+            format_bytes((n * n * 8) as f64),
+            crate::analysis::verify::MAX_VERIFY_DOFS,
+            if method.uses_hill() {
+                " where Hill is not reliable"
+            } else {
+                ""
+            }
+        ));
+    }
+    format!("{}: {}", method.label(), parts.join("; "))
 }
 
 /// Most contacts and loads `check` lists one by one (FE scenes have hundreds).

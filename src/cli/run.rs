@@ -59,11 +59,11 @@ pub fn run(options: &RunOptions) -> Result<RunReport, CommandError> {
         stuck,
         options,
     };
-    if ctx.problem.analysis.nonlinear_modes.is_some() {
-        return modes_nl_run::run_modes(&ctx);
-    }
     if ctx.scene.sweep.is_some() {
         return sweep_run::run_sweep(&ctx);
+    }
+    if ctx.problem.analysis.nonlinear_modes.is_some() {
+        return modes_nl_run::run_modes(&ctx);
     }
     if ctx.limits.is_some() {
         return limits_run::run_limits(&ctx);

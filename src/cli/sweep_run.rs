@@ -229,6 +229,7 @@ pub fn run_sweep(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
         "targets": spec.targets,
         "series": spec.series,
         "output": spec.output,
+        "peaks_from": sweep::peaks_from(&ctx.problem),
         "points": points,
         "variability": variability,
     });
@@ -242,7 +243,7 @@ pub fn run_sweep(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
     }
     Ok(RunReport {
         dir: ctx.dir.clone(),
-        summary: summary(&spec, &points, elapsed),
+        summary: summary(&spec, &points, elapsed, sweep::peaks_from(&ctx.problem)),
         incomplete,
         outcome: RunOutcome::Sweep(points),
         open: ctx.open.clone(),
@@ -252,10 +253,10 @@ pub fn run_sweep(ctx: &RunContext<'_>) -> Result<RunReport, CommandError> {
 
 /// A few lines on a finished sweep: its size and time, the largest limit-peak ratio and how
 /// many points have failed cases.
-fn summary(spec: &SweepSpec, points: &[SweepPoint], elapsed: f64) -> String {
+fn summary(spec: &SweepSpec, points: &[SweepPoint], elapsed: f64, peaks_from: &str) -> String {
     use std::fmt::Write as _;
     let mut s = format!(
-        "sweep of {} over {} points in {elapsed:.2} s",
+        "sweep of {} over {} points in {elapsed:.2} s (peaks {peaks_from})",
         spec.parameter,
         points.len()
     );
@@ -347,6 +348,7 @@ fn plot_peaks(
             lower: Vec<f64>,
             upper: Vec<f64>,
         }
+        let limits = first.limit_cases.clamp(1, first.cases.len());
         let data: Vec<Group> = groups
             .iter()
             .map(|(s, pts)| {
@@ -358,8 +360,20 @@ fn plot_peaks(
                 let ys: Vec<Vec<f64>> = (0..first.cases.len())
                     .map(|c| pts.iter().map(|p| value(p, c)).collect())
                     .collect();
-                let lower = ys[0].iter().zip(&ys[1]).map(|(a, b)| a.min(*b)).collect();
-                let upper = ys[0].iter().zip(&ys[1]).map(|(a, b)| a.max(*b)).collect();
+                // The band spans the limit cases (two for a forced response, every sign
+                // combination per damper side for a nonlinear mode).
+                let bound = |pick: fn(f64, f64) -> f64| -> Vec<f64> {
+                    (0..pts.len())
+                        .map(|i| {
+                            ys[..limits]
+                                .iter()
+                                .map(|y| y[i])
+                                .reduce(pick)
+                                .unwrap_or(f64::NAN)
+                        })
+                        .collect()
+                };
+                let (lower, upper) = (bound(f64::min), bound(f64::max));
                 Group {
                     label,
                     x,
@@ -386,10 +400,10 @@ fn plot_peaks(
         let mut specs = Vec::new();
         for (gi, g) in data.iter().enumerate() {
             for (c, name) in first.cases.iter().enumerate() {
-                if series && c >= 2 {
+                if series && c >= limits {
                     continue;
                 }
-                let kind = if c < 2 { "limit" } else { "intermediate" };
+                let kind = if c < limits { "limit" } else { "intermediate" };
                 labels.push(if series {
                     format!("{}: {kind} {name}", g.label)
                 } else {
@@ -406,7 +420,7 @@ fn plot_peaks(
                 x: &data[gi].x,
                 y: &data[gi].ys[c],
                 color: if series { palette(gi) } else { palette(c) },
-                dashed: if series { c == 1 } else { c >= 2 },
+                dashed: if series { c % 2 == 1 } else { c >= limits },
                 markers: true,
             })
             .collect();

@@ -9,6 +9,7 @@ use crate::scene::check_analysis::{set_range, MODE_RANGE_END, MODE_RANGE_START};
 use crate::scene::checker::Checker;
 use crate::scene::error::SceneError;
 use crate::scene::schema::{AnalysisKind, Scene};
+use crate::scene::SweepOutput;
 
 /// For a nonlinear-mode scene without `analysis.freq_start_hz` / `freq_end_hz`: sets the range
 /// of the linear references to [`MODE_RANGE_START`] .. [`MODE_RANGE_END`] times the chosen
@@ -64,10 +65,14 @@ pub(super) fn mode_analysis(
         }
         return Ok(None);
     }
-    if scene.sweep.is_some() {
+    if scene
+        .sweep
+        .as_ref()
+        .is_some_and(|s| s.output == SweepOutput::Limits)
+    {
         return Err(ck.err(
-            "analysis.kind",
-            "a [sweep] of nonlinear modes is not supported: remove the [sweep] table",
+            "sweep.output",
+            "a sweep of nonlinear modes predicts the resonance peaks of every case (output = \"peaks\"); the whole analysis per value (\"limits\") is for forced responses",
         ));
     }
     if problem.analysis.stability {

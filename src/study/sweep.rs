@@ -1,5 +1,8 @@
 //! Parameter sweeps of the limit analysis: optimal curves (peak amplitude of each limit case
 //! vs the pre-load), resonance-frequency limits, geometry variability (paper Figs. 15-19).
+//! On a nonlinear-mode scene each value computes the mode of every case and the resonance peak
+//! it predicts (single-nonlinear-mode theory): the optimal curve from one mode per case and
+//! value instead of one forced response.
 //!
 //! A sweep parameter p drives one or more scene fields linearly (field = offset + scale·p),
 //! so any numeric field can be swept, and a geometric parameter such as the apical angle β can
@@ -18,6 +21,7 @@
 use rayon::prelude::*;
 
 use crate::analysis::limits::{self, LimitAnalysis, LimitSettings, Peak};
+use crate::analysis::nonlinear_modes::{self, NonlinearModeRun, NonlinearModeSettings};
 use crate::model::Problem;
 use crate::scene::{self, Scene, SceneError, SweepOutput, SweepSpec};
 
@@ -43,8 +47,12 @@ pub struct SweepPoint {
     pub value: f64,
     /// Series parameter value, when the sweep has a series.
     pub series: Option<f64>,
-    /// Case names: the two limit cases, then the intermediate ones.
+    /// Case names: the limit cases, then the intermediate ones.
     pub cases: Vec<String>,
+    /// How many of the leading cases bound the response: the two limit cases m = ±1 of a
+    /// forced response; every combination of m = ±1 per damper side of a nonlinear mode
+    /// ([`nonlinear_modes::mode_cases`]).
+    pub limit_cases: usize,
     /// Resonance peak of each case (first output DOF); `None` where the case failed or did not
     /// cover the range (an unfinished path's highest point need not be the peak).
     pub peaks: Vec<Option<Peak>>,
@@ -61,25 +69,44 @@ pub struct SweepPoint {
 }
 
 impl SweepPoint {
-    /// Larger and smaller resonance-peak amplitude of the two limit cases (m); `None` if one
+    /// Larger and smaller resonance-peak amplitude over the limit cases (m); `None` if one
     /// of them failed.
     pub fn limit_amplitudes(&self) -> Option<(f64, f64)> {
-        let (a, b) = (self.peaks[0].as_ref()?, self.peaks[1].as_ref()?);
-        Some((a.amplitude.max(b.amplitude), a.amplitude.min(b.amplitude)))
+        self.limit_range(|p| p.amplitude)
     }
 
-    /// Higher and lower resonance frequency of the two limit cases (Hz); `None` if one of them
+    /// Higher and lower resonance frequency over the limit cases (Hz); `None` if one of them
     /// failed.
     pub fn limit_frequencies(&self) -> Option<(f64, f64)> {
-        let (a, b) = (self.peaks[0].as_ref()?, self.peaks[1].as_ref()?);
-        Some((a.freq_hz.max(b.freq_hz), a.freq_hz.min(b.freq_hz)))
+        self.limit_range(|p| p.freq_hz)
     }
 
-    /// Whether both limit peaks are refined interior maxima (true resonance peaks).
+    /// Largest and smallest of `value` over the limit cases' peaks; `None` if one is missing.
+    fn limit_range(&self, value: impl Fn(&Peak) -> f64) -> Option<(f64, f64)> {
+        let peaks = &self.peaks[..self.limit_cases.min(self.peaks.len())];
+        peaks
+            .iter()
+            .try_fold((f64::NEG_INFINITY, f64::INFINITY), |(hi, lo), p| {
+                let v = value(p.as_ref()?);
+                Some((hi.max(v), lo.min(v)))
+            })
+    }
+
+    /// Whether the limit cases' peaks are all refined interior maxima (true resonance peaks).
     pub fn limits_refined(&self) -> bool {
-        self.peaks[..2]
+        self.peaks[..self.limit_cases.min(self.peaks.len())]
             .iter()
             .all(|p| p.as_ref().is_some_and(|p| p.refined))
+    }
+}
+
+/// Where a sweep's resonance peaks come from: the forced response of each case of the limit
+/// analysis, or on a nonlinear-mode scene the prediction of each case's mode.
+pub fn peaks_from(problem: &Problem) -> &'static str {
+    if problem.analysis.nonlinear_modes.is_some() {
+        "predicted from the nonlinear mode of each case"
+    } else {
+        "of the forced response of each case"
     }
 }
 
@@ -175,6 +202,9 @@ pub fn solve_value(
     series: Option<f64>,
     value: f64,
 ) -> SweepPoint {
+    if let Some(modes) = NonlinearModeSettings::of_problem(problem) {
+        return solve_modes_value(problem, &modes, settings, series, value);
+    }
     let mut cases = limits::two_point_cases(problem);
     cases.extend(settings.intermediate_cases(problem));
     let names: Vec<String> = cases.iter().map(|c| c.name.clone()).collect();
@@ -182,6 +212,7 @@ pub fn solve_value(
         value,
         series,
         cases: names,
+        limit_cases: 2,
         peaks: vec![None; cases.len()],
         retries: vec![0; cases.len()],
         failures: Vec::new(),
@@ -219,4 +250,74 @@ pub fn solve_value(
         },
     }
     point
+}
+
+/// One sweep point of a nonlinear-mode scene: the mode of every case of
+/// [`nonlinear_modes::mode_cases`] (m = ±1 per damper side, then the intermediate and listed
+/// cases) and the resonance peak each predicts for the scene's first-harmonic loads
+/// ([`nonlinear_modes::predict`]). A peak's amplitude at the first output DOF, and its
+/// coefficients, are interpolated between the two mode points around the crossing as the
+/// prediction's amplitude is (log-linearly; the coefficients linearly), its contact states are
+/// the nearer point's. A case whose mode failed, or ended below the amplitude of its peak, has
+/// none and is recorded in [`SweepPoint::failures`]; a mode that ended short after its peak
+/// still predicts it.
+fn solve_modes_value(
+    problem: &Problem,
+    modes: &NonlinearModeSettings,
+    settings: &LimitSettings,
+    series: Option<f64>,
+    value: f64,
+) -> SweepPoint {
+    let solved = nonlinear_modes::mode_limits(problem, modes, settings);
+    let mut point = SweepPoint {
+        value,
+        series,
+        cases: solved.cases.iter().map(|c| c.case.name.clone()).collect(),
+        limit_cases: solved.cases.len() - settings.intermediate_cases(problem).len(),
+        peaks: vec![None; solved.cases.len()],
+        retries: vec![0; solved.cases.len()],
+        failures: Vec::new(),
+        analysis: None,
+    };
+    for (k, case) in solved.cases.iter().enumerate() {
+        let name = &case.case.name;
+        match &case.run {
+            Err(e) => point.failures.push(format!("mode `{name}` failed: {e}")),
+            Ok(run) => match mode_peak(problem, run) {
+                Some(peak) => point.peaks[k] = Some(peak),
+                None => point.failures.push(format!(
+                    "mode `{name}` predicts no peak: {}",
+                    run.incomplete_reason().unwrap_or_else(|| {
+                        "the excitation drives it beyond the amplitudes computed".to_string()
+                    })
+                )),
+            },
+        }
+    }
+    point
+}
+
+/// The resonance peak a mode predicts at the first output DOF (see [`solve_modes_value`]).
+fn mode_peak(problem: &Problem, run: &NonlinearModeRun) -> Option<Peak> {
+    let (i, t) = nonlinear_modes::predict::peak_crossing(problem, run)?;
+    let predicted = nonlinear_modes::predicted_peak(problem, run)?;
+    let (p0, p1) = (&run.points[i - 1], &run.points[i]);
+    let set = problem.unknown_harmonics();
+    let n = problem.model.n_dofs();
+    let (c1, s1) = (set.cos_block(1)?, set.sin_block(1)?);
+    let dof = *problem.outputs.first()?;
+    let amplitude = |c: &[f64]| c[c1 * n + dof].hypot(c[s1 * n + dof]);
+    let (a0, a1) = (amplitude(&p0.coefficients), amplitude(&p1.coefficients));
+    Some(Peak {
+        freq_hz: predicted.freq_hz,
+        amplitude: (a0.ln() + t * (a1.ln() - a0.ln())).exp(),
+        refined: true,
+        coefficients: p0
+            .coefficients
+            .iter()
+            .zip(&p1.coefficients)
+            .map(|(u, v)| u + t * (v - u))
+            .collect(),
+        states: if t < 0.5 { &p0.states } else { &p1.states }.clone(),
+    })
 }

@@ -574,7 +574,7 @@ const COMMANDS_NOT_RUN: &[(&str, &str)] = &[
     ("bench scaling", "the scaling study takes minutes"),
     (
         "bench contacts",
-        "its curves take up to minutes each; tests/it/schur_lowrank.rs runs its library code",
+        "its curves take up to minutes each; tests/it/schur_lowrank.rs runs it on one contact refinement",
     ),
 ];
 

@@ -331,3 +331,51 @@ fn scenes_the_methods_do_not_suit_are_refused_naming_the_field() {
     ]);
     assert!(out.status.success(), "{}", text(&out.stderr));
 }
+
+/// `check` names how the stability verdicts are computed at the scene's size: Hill's dense
+/// eigen solve (with its matrix) below the 600-unknown limit, the sparse shift-invert solve
+/// above it, the monodromy's dense time integration, or off.
+#[test]
+fn check_names_the_stability_solve_and_its_dense_matrices() {
+    let line = |overrides: &[&str]| {
+        let mut args = vec!["check".to_string(), scene("full-range.toml")];
+        for o in overrides {
+            args.extend(["--set".to_string(), o.to_string()]);
+        }
+        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = fricbound(&refs);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let stdout = text(&out.stdout);
+        stdout
+            .lines()
+            .find(|l| l.starts_with("stability "))
+            .unwrap_or_else(|| panic!("no stability line in\n{stdout}"))
+            .to_string()
+    };
+    assert!(line(&["analysis.stability=false"]).contains("off"));
+    let dense = line(&["analysis.stability=true"]);
+    assert!(
+        dense.contains("hill: Hill by the dense eigen solve of the"),
+        "{dense}"
+    );
+    assert!(!dense.contains("monodromy"), "{dense}");
+    let sparse = line(&["analysis.stability=true", "harmonics.max=120"]);
+    assert!(sparse.contains("sparse shift-invert"), "{sparse}");
+    let both = line(&[
+        "analysis.stability=true",
+        "analysis.stability_method=hill+monodromy",
+    ]);
+    assert!(
+        both.contains("dense eigen solve") && both.contains("where Hill is not reliable"),
+        "{both}"
+    );
+    let monodromy = line(&[
+        "analysis.stability=true",
+        "analysis.stability_method=monodromy",
+    ]);
+    assert!(
+        monodromy.contains("monodromy: the monodromy by a dense time integration")
+            && !monodromy.contains("Hill"),
+        "{monodromy}"
+    );
+}

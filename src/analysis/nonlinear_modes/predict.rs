@@ -48,29 +48,32 @@ pub fn modal_force(problem: &Problem, point: &NonlinearModePoint) -> f64 {
     re.hypot(im)
 }
 
-/// The peak predicted from the mode for the first-harmonic loads of `problem`: the first
-/// crossing, rising in modal amplitude along the path, of ξ ω a = |ψ₁ᴴ F̂₁|, interpolated
-/// linearly in log a between the two points around it. None when the mode does not reach it
-/// (the excitation drives the mode beyond the amplitudes computed, or not at all).
-pub fn predicted_peak(problem: &Problem, run: &NonlinearModeRun) -> Option<PredictedPeak> {
+/// Where the peak predicted from the mode for the first-harmonic loads of `problem` lies: the
+/// first crossing, rising in modal amplitude along the path, of ξ ω a = |ψ₁ᴴ F̂₁|, as the
+/// index i of the point after it and the fraction t ∈ (0, 1] of the way from point i − 1 to
+/// point i (linear in the crossing function). None when the mode does not reach it (the
+/// excitation drives the mode beyond the amplitudes computed, or not at all).
+pub fn peak_crossing(problem: &Problem, run: &NonlinearModeRun) -> Option<(usize, f64)> {
     let g = |p: &NonlinearModePoint| p.xi * p.omega * p.modal_amplitude - modal_force(problem, p);
     let points = &run.points;
-    for i in 1..points.len() {
-        let (p0, p1) = (&points[i - 1], &points[i]);
-        let (g0, g1) = (g(p0), g(p1));
-        if g0 <= 0.0 && g1 > 0.0 {
-            let t = -g0 / (g1 - g0);
-            let lerp = |u: f64, v: f64| u + t * (v - u);
-            let log_a = lerp(p0.modal_amplitude.ln(), p1.modal_amplitude.ln());
-            let log_dof = lerp(p0.dof_amplitude.ln(), p1.dof_amplitude.ln());
-            return Some(PredictedPeak {
-                modal_amplitude: log_a.exp(),
-                dof_amplitude: log_dof.exp(),
-                freq_hz: lerp(p0.omega, p1.omega) / TAU,
-            });
-        }
-    }
-    None
+    (1..points.len()).find_map(|i| {
+        let (g0, g1) = (g(&points[i - 1]), g(&points[i]));
+        (g0 <= 0.0 && g1 > 0.0).then(|| (i, -g0 / (g1 - g0)))
+    })
+}
+
+/// The peak predicted from the mode for the first-harmonic loads of `problem`
+/// ([`peak_crossing`]), its amplitudes interpolated linearly in log a between the two points
+/// around it. None when the mode does not reach it.
+pub fn predicted_peak(problem: &Problem, run: &NonlinearModeRun) -> Option<PredictedPeak> {
+    let (i, t) = peak_crossing(problem, run)?;
+    let (p0, p1) = (&run.points[i - 1], &run.points[i]);
+    let lerp = |u: f64, v: f64| u + t * (v - u);
+    Some(PredictedPeak {
+        modal_amplitude: lerp(p0.modal_amplitude.ln(), p1.modal_amplitude.ln()).exp(),
+        dof_amplitude: lerp(p0.dof_amplitude.ln(), p1.dof_amplitude.ln()).exp(),
+        freq_hz: lerp(p0.omega, p1.omega) / TAU,
+    })
 }
 
 /// The predicted forced response near the resonance: for every point of the mode, the
