@@ -1,5 +1,7 @@
 //! Results on the FE mesh, as VTU for ParaView: at one converged point, the static displacement
-//! (0th harmonic), the first-harmonic amplitude per direction at every node, and the contact
+//! (0th harmonic), the first harmonic per direction at every node (its amplitude, and its
+//! cosine and sine parts, which hold the phase: the motion is c cos ωt + s sin ωt, so a
+//! travelling or complex shape shows by animating c cos φ + s sin φ over φ), and the contact
 //! state at the contact nodes.
 //!
 //! Reduced problems are mapped back to the mesh through the Craig-Bampton basis kept with the
@@ -53,11 +55,14 @@ pub fn write_point(
     let index = fe.mesh.node_index_map();
     let mut statics = vec![[0.0; 3]; fe.mesh.nodes.len()];
     let mut amplitude = vec![[0.0; 3]; fe.mesh.nodes.len()];
+    let (mut cosine, mut sine) = (amplitude.clone(), amplitude.clone());
     for (row, dof) in fe.dofs.dofs().iter().enumerate() {
         if let (Some(&i), true) = (index.get(&dof.node), dof.direction.is_translation()) {
             let a = dof.direction.axis();
             statics[i][a] = q0[row];
             amplitude[i][a] = c1[row].hypot(s1[row]);
+            cosine[i][a] = c1[row];
+            sine[i][a] = s1[row];
         }
     }
     // Contact nodes: the nodes named by each contact's DOFs (`<node>.<direction>`).
@@ -82,6 +87,8 @@ pub fn write_point(
         &[
             PointField::vectors("static_displacement", statics),
             PointField::vectors("first_harmonic_amplitude", amplitude),
+            PointField::vectors("first_harmonic_cos", cosine),
+            PointField::vectors("first_harmonic_sin", sine),
             PointField::scalars("contact_state", state),
         ],
     )?;

@@ -616,6 +616,8 @@ fn fe_scene_writes_the_mode_shapes_on_the_mesh() {
             std::fs::read_to_string(dir.path().join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
         for field in [
             "first_harmonic_amplitude",
+            "first_harmonic_cos",
+            "first_harmonic_sin",
             "contact_state",
             "static_displacement",
         ] {
