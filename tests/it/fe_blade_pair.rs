@@ -559,39 +559,17 @@ fn vtu_output_parses_back() {
         ],
     )
     .unwrap();
-    let vtk = vtkio::Vtk::import(&path).unwrap();
-    let vtkio::model::DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
-        panic!("not an unstructured grid");
-    };
-    let piece = pieces
-        .into_iter()
-        .next()
-        .unwrap()
-        .into_loaded_piece_data(None)
-        .unwrap();
+    let piece = crate::support::vtu_piece(&path);
     assert_eq!(piece.num_points(), mesh.nodes.len());
     assert_eq!(piece.cells.types.len(), count(&mesh, ElementKind::Quad4));
     let points: Vec<f64> = piece.points.cast_into().unwrap();
     assert_eq!(points[3..6], mesh.nodes[1].coords);
-    let mut found = 0;
-    for attribute in &piece.data.point {
-        if let vtkio::model::Attribute::DataArray(array) = attribute {
-            let data: Vec<f64> = array.data.cast_into().unwrap();
-            match array.name.as_str() {
-                "displacement" => {
-                    assert_eq!(data.len(), 3 * mesh.nodes.len());
-                    assert_eq!(data[3..6], vectors[1]);
-                    found += 1;
-                }
-                "contact_state" => {
-                    assert_eq!(data, state);
-                    found += 1;
-                }
-                other => panic!("unexpected array {other}"),
-            }
-        }
-    }
-    assert_eq!(found, 2);
+    let arrays = crate::support::vtu_point_arrays(&piece);
+    let names: Vec<&String> = arrays.keys().collect();
+    assert_eq!(names, ["contact_state", "displacement"]);
+    assert_eq!(arrays["displacement"].len(), 3 * mesh.nodes.len());
+    assert_eq!(arrays["displacement"][3..6], vectors[1]);
+    assert_eq!(arrays["contact_state"], state);
     // Wrong field length is an error naming the field.
     let err = write_vtu(&path, &mesh, &[PointField::scalars("short", vec![0.0; 3])]).unwrap_err();
     assert!(

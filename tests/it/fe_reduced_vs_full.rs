@@ -148,23 +148,7 @@ fn reduced_solution_recovers_the_full_displacement_field() {
     )
     .unwrap()
     .expect("the reduced problem keeps its basis");
-    let vtk = vtkio::Vtk::import(&written).unwrap();
-    let vtkio::model::DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
-        panic!("not an unstructured grid");
-    };
-    let piece = pieces
-        .into_iter()
-        .next()
-        .unwrap()
-        .into_loaded_piece_data(None)
-        .unwrap();
-    let mut fields = std::collections::BTreeMap::new();
-    for attribute in &piece.data.point {
-        if let vtkio::model::Attribute::DataArray(array) = attribute {
-            let data: Vec<f64> = array.data.cast_into().unwrap();
-            fields.insert(array.name.clone(), data);
-        }
-    }
+    let fields = crate::support::vtu_point_arrays(&crate::support::vtu_piece(&written));
     let names: Vec<&str> = fields.keys().map(String::as_str).collect();
     assert_eq!(
         names,

@@ -75,3 +75,34 @@ pub fn run_scene(scene: &str, out: &Path, overrides: &[&str]) -> Output {
     }
     fricbound(&args)
 }
+
+/// The first piece of a VTU file written by the binary or the library, with its data loaded.
+pub fn vtu_piece(path: &Path) -> vtkio::model::UnstructuredGridPiece {
+    let vtk = vtkio::Vtk::import(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let vtkio::model::DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
+        panic!("{}: not an unstructured grid", path.display());
+    };
+    pieces
+        .into_iter()
+        .next()
+        .expect("one piece")
+        .into_loaded_piece_data(None)
+        .unwrap()
+}
+
+/// The point data arrays of a VTU piece by name, as f64 (vectors flattened per node).
+pub fn vtu_point_arrays(
+    piece: &vtkio::model::UnstructuredGridPiece,
+) -> std::collections::BTreeMap<String, Vec<f64>> {
+    piece
+        .data
+        .point
+        .iter()
+        .filter_map(|attribute| match attribute {
+            vtkio::model::Attribute::DataArray(array) => {
+                Some((array.name.clone(), array.data.clone().cast_into().unwrap()))
+            }
+            _ => None,
+        })
+        .collect()
+}
