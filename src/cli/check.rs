@@ -128,7 +128,6 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
             "error estimate off ([accuracy] estimate = false)".to_string()
         }
     );
-    let _ = writeln!(s, "stability    {}", stability_line(&problem));
     let frf_estimate = problem.analysis.nonlinear_modes.is_none();
     if let Some(refined) =
         crate::analysis::error_estimate::EstimateProblems::new(&problem).filter(|_| frf_estimate)
@@ -139,7 +138,18 @@ pub fn check(scene_path: Option<&Path>, overrides: &[String]) -> Result<String, 
             "  beyond     the step's linear range: {}",
             budget.summary(estimate.beyond_linear_range)
         );
+        for (label, extended) in [("2H + 1", &refined.truncation), ("4H + 3", &refined.wider)] {
+            let cost = crate::hbm::cost::estimate(extended);
+            let _ = writeln!(
+                s,
+                "  {label:<10} {}: factorised matrix of {} rows, {}",
+                crate::hbm::cost::formulation_name(cost.formulation),
+                cost.factored,
+                crate::hbm::cost::linear_solver_description(extended, cost.formulation)
+            );
+        }
     }
+    let _ = writeln!(s, "stability    {}", stability_line(&problem));
     let _ = writeln!(
         s,
         "contacts     {} on {} damper side(s)",

@@ -484,6 +484,19 @@ fn check_names_the_sets_the_estimate_solves_on() {
             && auto.contains("[auto: "),
         "{auto}"
     );
+    // The extended systems' formulation and factorised size are named under it.
+    let o = fricbound(&["check", scene.as_str(), "--set", "harmonics.max=3"]);
+    let stdout = text(&o.stdout);
+    for (set, rows) in [("2H + 1", 420), ("4H + 3", 868)] {
+        let named = stdout
+            .lines()
+            .find(|l| l.starts_with(&format!("  {set}")))
+            .unwrap_or_default();
+        assert!(
+            named.contains(&format!("factorised matrix of {rows} rows")),
+            "{stdout}"
+        );
+    }
     let h3 = line(&["harmonics.max=3"]);
     assert!(
         h3.contains("solved on H = 7") && h3.contains("not stepped, its points flagged, on H = 15"),
