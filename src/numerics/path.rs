@@ -114,6 +114,13 @@ pub trait Observer<S: ParametricResidual> {
     fn rejected(&mut self, _freq_hz: f64, _step: f64, _new_step: f64, _reason: &NewtonFailure) {}
     /// dω/ds changed sign between the previous and this point.
     fn turning_point(&mut self, _freq_hz: f64) {}
+    /// Whether the path has reached the observer's own end, asked after each accepted point:
+    /// the run then stops there as at the end frequency ([`PathEnd::EndFrequency`]). A path
+    /// whose range ends in a quantity other than λ (e.g. a nonlinear mode's amplitude at a DOF,
+    /// whose continuation runs in the modal amplitude) ends where that quantity passes its end.
+    fn reached_end(&self) -> bool {
+        false
+    }
 }
 
 /// An observer that does nothing.

@@ -370,6 +370,85 @@ fn bad_mode_fields_are_refused_with_the_field_named() {
     }
 }
 
+/// The path runs from the amplitude asked at the DOF to the one asked, not to their
+/// conversions with the linear shape at rest: on the paper's 2nd mode (y2, 10⁻⁷ to 10⁻³ m) the
+/// first and last points' first-harmonic amplitudes at y2 equal the ends asked to 10⁻⁹
+/// relatively at H = 1 and 3, where the high end converted with the linear shape lands 0.9 %
+/// and 3.5 % short of 10⁻³ m (its modal amplitude is 0.9 % and 3.7 % below the last point's),
+/// and the end point lies on the path between the point before it and the modal amplitude
+/// the linear shape would have stopped at. A run whose point budget runs out first says so with
+/// the amplitude at the DOF it reached.
+#[test]
+fn the_path_runs_between_the_amplitudes_asked_at_the_dof() {
+    let [low, high] = [1e-7, 1e-3];
+    for h in [1, 3] {
+        let problem = scenes::paper(&[&format!("harmonics.max={h}"), "accuracy.estimate=false"]);
+        let dof = problem.outputs[0];
+        let s = settings(ModeChoice::Number(2), dof, [low, high]);
+        let run = solve(&problem, &s);
+        let free = nonlinear_modes::autonomous(&problem);
+        let start = nonlinear_modes::linear_start(&free, ModeChoice::Number(2), dof).unwrap();
+        let converted = high / start.shape[dof].abs();
+        let (first, last) = (&run.points[0], run.points.last().unwrap());
+        let before = &run.points[run.points.len() - 2];
+        let shortfall = 1.0 - last.modal_amplitude.recip() * converted;
+        eprintln!(
+            "H = {h}: {} points, first {:.12e} m, last {:.12e} m at a = {:.6e} (the linear \
+             shape's {converted:.6e}, {:.2} % below), point before {:.6e} m",
+            run.points.len(),
+            first.dof_amplitude,
+            last.dof_amplitude,
+            last.modal_amplitude,
+            100.0 * shortfall,
+            before.dof_amplitude
+        );
+        assert!((first.dof_amplitude - low).abs() <= 1e-9 * low, "H = {h}");
+        assert!((last.dof_amplitude - high).abs() <= 1e-9 * high, "H = {h}");
+        assert!(shortfall > 5e-3, "H = {h}: {shortfall:.2e}");
+        assert!(before.dof_amplitude < high && before.modal_amplitude < last.modal_amplitude);
+    }
+    let problem = scenes::paper(&["accuracy.estimate=false"]);
+    let dof = problem.outputs[0];
+    let mut s = settings(ModeChoice::Number(2), dof, [low, high]);
+    s.max_points = 10;
+    let run = nonlinear_modes::solve(&problem, &s).unwrap();
+    assert_eq!(run.end, nonlinear_modes::NonlinearModeEnd::MaxPoints);
+    let reached = run.points.last().unwrap().dof_amplitude;
+    assert!(reached < high);
+    let reason = run.incomplete_reason().unwrap();
+    assert!(
+        reason.contains(&format!(
+            "at amplitude {reached:.4e} m at the DOF of 1.0000e-3 m"
+        )),
+        "{reason}"
+    );
+}
+
+/// The error estimate is formed by two Newton steps of the extended system where they stay in
+/// their linear range and solved to convergence elsewhere: on the 1-DOF Jenkins oscillator at
+/// H = 1 both ways size points (the steps more than 50 of them: their estimates are among those
+/// `checks::error_estimate_sizes_the_change_at_higher_harmonics` holds to 1 % of the change to
+/// a run at 2H + 1), every point is counted once, and the stuck points need neither.
+#[test]
+fn error_estimate_steps_where_it_can_and_solves_elsewhere() {
+    let problem = scenes::problem(&jenkins_oscillator(), &[]);
+    let run = solve(&problem, &settings(ModeChoice::Number(1), 0, [1e-6, 1e-2]));
+    let counts = run.estimate_counts.expect("the estimate is on by default");
+    eprintln!("{} points: {counts:?}", run.points.len());
+    assert_eq!(
+        counts.converged + counts.stepped + counts.solved + counts.not_sized,
+        run.points.len()
+    );
+    let stuck = run
+        .points
+        .iter()
+        .filter(|p| p.states[0] == ContactState::Stuck)
+        .count();
+    assert!(counts.converged >= stuck, "{counts:?}: {stuck} stuck");
+    assert!(counts.stepped > 50 && counts.solved > 50, "{counts:?}");
+    assert_eq!(counts.not_sized, 0);
+}
+
 /// Single-nonlinear-mode theory on the paper's system around its 2nd resonance, where the
 /// response is unique (paper §4.2): the peak predicted from the 2nd nonlinear mode and the
 /// modal force of the paper's excitation is the HBM forced response's refined peak within 2 %

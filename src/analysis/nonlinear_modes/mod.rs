@@ -17,14 +17,16 @@
 //! is D = ξ / (2ω); for a linear structure with proportional damping these are its natural
 //! frequencies and modal damping ratios exactly.
 //!
-//! Continuation runs in log₁₀ a from the linear mode at rest (contacts stuck, [`start`]) to the
-//! highest amplitude asked ([`run::solve`]).
+//! Continuation runs in log₁₀ a from the linear mode at rest (contacts stuck, [`start`]), from
+//! the point whose first-harmonic amplitude at the DOF is the low end asked to the one where it
+//! is the high end ([`ends`], [`run::solve`]).
 //!
 //! | module | main items | job |
 //! |---|---|---|
 //! | [`operator`] | [`EpmcOperator`], [`LogAmplitude`] | the extended residual and its analytic Jacobian |
 //! | [`start`] | [`linear_start`], [`linearised_modes`] | the linear modes at rest and the mode asked |
 //! | [`run`] | [`solve`], [`NonlinearModeRun`], [`NonlinearModePoint`] | the continuation and its points |
+//! | [`ends`] | `solve_at_dof_amplitude` | the path's ends at the amplitudes asked at the DOF |
 //! | [`predict`] | [`predicted_peak`], [`predicted_frf`] | the forced response near the resonance from the mode (single-nonlinear-mode theory) |
 //! | [`accuracy`] | [`ModeAccuracy`] | each point's error estimate: the change when the harmonics are raised to 2H + 1 |
 //! | [`warnings`](mod@warnings) | [`warnings::largest`], [`warnings::warnings`] | the estimates of a run in words |
@@ -32,6 +34,7 @@
 //! | [`limits`] | [`mode_limits`], [`ModeBand`] | the mode per initial tangential state (m = ±1 per side) and the band they span |
 
 pub mod accuracy;
+mod ends;
 pub mod error;
 pub mod limits;
 pub mod operator;
@@ -41,7 +44,7 @@ pub mod start;
 pub mod verify;
 pub mod warnings;
 
-pub use accuracy::ModeAccuracy;
+pub use accuracy::{EstimateCounts, ModeAccuracy, StepRule, STEP_RULE};
 pub use limits::{band, mode_cases, mode_limits, scene_modes, ModeBand, ModeCase, ModeLimits};
 pub use operator::{EpmcOperator, LogAmplitude};
 pub use predict::{modal_force, predicted_frf, predicted_peak, PredictedPeak};

@@ -4,7 +4,8 @@
 use std::f64::consts::{PI, TAU};
 use std::time::Instant;
 
-use super::accuracy::{extended_problem, ModeAccuracy, ModeEstimator, PointValues};
+use super::accuracy::{extended_problem, EstimateCounts, ModeAccuracy, ModeEstimator, PointValues};
+use super::ends::solve_at_dof_amplitude;
 pub use super::error::NonlinearModeError;
 use super::operator::{EpmcOperator, LogAmplitude};
 use super::start::{linear_start, start_guess, LinearStart};
@@ -24,9 +25,9 @@ pub struct NonlinearModeSettings {
     /// DOF whose first-harmonic sine is fixed at zero (the phase condition) and whose
     /// first-harmonic amplitude the range is given at.
     pub dof: usize,
-    /// First-harmonic amplitude range at `dof` (m), low to high. Converted to the modal
-    /// amplitude a with the linear mode's shape (a = A / |φ_dof|): the continuation runs from
-    /// a_min to a_max; the amplitude at the DOF of each point is the computed one.
+    /// First-harmonic amplitude range at `dof` (m), low to high: the first point has the low
+    /// end and the last the high end at `dof` (to Newton's tolerance, [`super::ends`]); the
+    /// continuation runs in the modal amplitude a between them.
     pub amplitude: [f64; 2],
     /// Most continuation points.
     pub max_points: usize,
@@ -84,8 +85,12 @@ pub struct NonlinearModePoint {
 /// How a nonlinear-mode run ended.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub enum NonlinearModeEnd {
-    /// The continuation reached the highest amplitude asked.
+    /// The continuation reached the highest amplitude asked at the DOF.
     Reached,
+    /// The modal amplitude reached its limit ([`MODAL_HEADROOM_DECADES`] past the high end
+    /// converted with the linear shape at rest) with the amplitude at the DOF still below the
+    /// high end: that amplitude turned back, or grows far more slowly than the modal one.
+    ModalLimit,
     /// The point budget ran out first.
     MaxPoints,
     /// The path turned back below the lowest amplitude.
@@ -104,7 +109,11 @@ pub struct NonlinearModeRun {
     pub linear_freq_hz: f64,
     /// Its modal damping ratio φᵀCφ / (2ω₀) (–).
     pub linear_damping_ratio: f64,
-    /// The modal amplitude range asked (kg^½·m).
+    /// The first-harmonic amplitude range asked at the DOF (m).
+    pub amplitude_range: [f64; 2],
+    /// The modal amplitude range of the continuation (kg^½·m): from the first point's, at the
+    /// low end of `amplitude_range`, to the limit the path may run to
+    /// ([`MODAL_HEADROOM_DECADES`] past the high end converted with the linear shape at rest).
     pub modal_range: [f64; 2],
     /// The points.
     pub points: Vec<NonlinearModePoint>,
@@ -114,6 +123,8 @@ pub struct NonlinearModeRun {
     pub elapsed_s: f64,
     /// Of it, the error estimate's (s; 0 without it).
     pub estimate_elapsed_s: f64,
+    /// How the points' estimates were formed (None without the estimate).
+    pub estimate_counts: Option<EstimateCounts>,
 }
 
 impl NonlinearModeRun {
@@ -122,21 +133,32 @@ impl NonlinearModeRun {
         self.end == NonlinearModeEnd::Reached
     }
 
-    /// Why the run is incomplete, in words; None when complete.
+    /// Why the run is incomplete, in words, with the amplitude at the DOF it reached; None when
+    /// complete.
     pub fn incomplete_reason(&self) -> Option<String> {
-        let reached = self.points.last().map_or(0.0, |p| p.modal_amplitude);
+        let last = self.points.last().map_or(0.0, |p| p.dof_amplitude);
+        let highest = self
+            .points
+            .iter()
+            .map(|p| p.dof_amplitude)
+            .fold(0.0, f64::max);
+        let high = self.amplitude_range[1];
         match &self.end {
             NonlinearModeEnd::Reached => None,
             NonlinearModeEnd::MaxPoints => Some(format!(
-                "point budget used up at modal amplitude {reached:.4e} of {:.4e}",
-                self.modal_range[1]
+                "point budget used up at amplitude {last:.4e} m at the DOF of {high:.4e} m"
             )),
             NonlinearModeEnd::LeftRange => {
                 Some("the path turned back below the lowest amplitude".to_string())
             }
-            NonlinearModeEnd::Stalled(reason) => Some(format!(
-                "continuation stalled at modal amplitude {reached:.4e} of {:.4e}: {reason}",
+            NonlinearModeEnd::ModalLimit => Some(format!(
+                "the amplitude at the DOF reached at most {highest:.4e} m of {high:.4e} m up to \
+                 the modal amplitude {:.4e} (its limit)",
                 self.modal_range[1]
+            )),
+            NonlinearModeEnd::Stalled(reason) => Some(format!(
+                "continuation stalled at amplitude {last:.4e} m at the DOF of {high:.4e} m: \
+                 {reason}"
             )),
         }
     }
@@ -147,6 +169,12 @@ const INITIAL_STEP: f64 = 0.05;
 const MIN_STEP: f64 = 1e-6;
 const MAX_STEP: f64 = 0.25;
 
+/// Decades the modal amplitude may run past the high end of the range converted with the
+/// linear shape at rest (a = A / |φ_dof|) while the amplitude at the DOF has not reached it:
+/// the shape's share at the DOF falls as contacts slip and lift off (on the paper's 2nd mode
+/// the high end of 10⁻³ m at y2 lies 0.01-0.02 decades past the converted one).
+pub const MODAL_HEADROOM_DECADES: f64 = 2.0;
+
 /// The autonomous problem: the same structure, contacts and static loads, no harmonic loads.
 pub fn autonomous(problem: &Problem) -> Problem {
     let mut p = problem.clone();
@@ -154,7 +182,9 @@ pub fn autonomous(problem: &Problem) -> Problem {
     p
 }
 
-/// Computes a nonlinear mode of `problem` by EPMC (module docs).
+/// Computes a nonlinear mode of `problem` by EPMC (module docs): from the point whose
+/// amplitude at the DOF is the low end of the range to the one where it is the high end
+/// ([`super::ends`]), by continuation in the modal amplitude between them.
 pub fn solve(
     problem: &Problem,
     settings: &NonlinearModeSettings,
@@ -174,32 +204,36 @@ pub fn solve(
     let map = LogAmplitude {
         a_min: low / at_dof,
     };
-    let a_max = high / at_dof;
+    let a_limit = high / at_dof * 10f64.powf(MODAL_HEADROOM_DECADES);
     let m_phi = mass_times(&free, &start.shape);
     let row_scale = start.omega * start.omega * crate::numerics::linalg::norm(&m_phi);
     let mut op = EpmcOperator::new(&free, start.statics.clone(), settings.dof, map, row_scale)?;
-    let y0 = start_guess(&free, &set, &start);
     let base = problem.analysis.continuation;
+    let scale = arc_length_scale(&free, &set, &start);
+    let newton = Continuation::new(base, scale.clone());
+    let (y0, lambda0) = low_end(&mut op, &newton, settings, start_guess(&free, &set, &start));
     let continuation_settings = ContinuationSettings {
-        freq_start_hz: 1.0,
-        freq_end_hz: map.decade(a_max),
+        freq_start_hz: lambda0 / TAU,
+        freq_end_hz: map.decade(a_limit),
         initial_step: INITIAL_STEP,
         min_step: MIN_STEP,
         max_step: MAX_STEP,
         max_points: settings.max_points,
         ..base
     };
-    let scale = arc_length_scale(&free, &set, &start);
     let mut continuation = Continuation::new(continuation_settings, scale);
     let mut collect = Collect {
         points: Vec::new(),
         settings,
+        crossed: false,
     };
     let outcome = continuation.run(&mut op, &y0, &mut collect);
+    let crossed = collect.crossed;
     let mut points = collect.points;
     let end = match outcome {
+        Ok(_) if crossed => NonlinearModeEnd::Reached,
         Ok(summary) => match summary.end {
-            PathEnd::EndFrequency => NonlinearModeEnd::Reached,
+            PathEnd::EndFrequency => NonlinearModeEnd::ModalLimit,
             PathEnd::MaxPoints => NonlinearModeEnd::MaxPoints,
             PathEnd::LeftRangeBelow => NonlinearModeEnd::LeftRange,
         },
@@ -211,8 +245,12 @@ pub fn solve(
             NonlinearModeEnd::Stalled(stall_reason(&e))
         }
     };
+    if crossed {
+        high_end(&mut op, &newton, settings, &mut points);
+    }
     let estimate_started = Instant::now();
     let mut estimate_elapsed_s = 0.0;
+    let mut estimate_counts = None;
     if problem.analysis.error_estimate.enabled {
         let extended = extended_problem(&free);
         let mut estimator = ModeEstimator::new(
@@ -233,18 +271,86 @@ pub fn solve(
             };
             p.accuracy = Some(estimator.estimate(&values, &psi));
         }
+        estimate_counts = Some(estimator.counts);
         estimate_elapsed_s = estimate_started.elapsed().as_secs_f64();
     }
     Ok(NonlinearModeRun {
         mode: start.number,
         linear_freq_hz: start.omega / TAU,
         linear_damping_ratio: start.xi / (2.0 * start.omega),
-        modal_range: [map.a_min, a_max],
+        amplitude_range: settings.amplitude,
+        modal_range: [map.amplitude(lambda0), a_limit],
         points,
         end,
         elapsed_s: started.elapsed().as_secs_f64(),
         estimate_elapsed_s,
+        estimate_counts,
     })
+}
+
+/// The continuation's first point (ψ, ω, ξ) and its λ: the point whose amplitude at the DOF is
+/// the low end of the range, from the linear mode `y0` at the modal amplitude converted with
+/// the linear shape (λ = 2π); that point itself where the bordered solve fails.
+fn low_end(
+    op: &mut EpmcOperator<'_>,
+    newton: &Continuation,
+    settings: &NonlinearModeSettings,
+    y0: Vec<f64>,
+) -> (Vec<f64>, f64) {
+    let mut guess = y0.clone();
+    guess.push(TAU);
+    match solve_at_dof_amplitude(op, newton, (settings.dof, settings.amplitude[0]), &guess) {
+        Ok(p) => (p.x, p.omega),
+        Err(_) => (y0, TAU),
+    }
+}
+
+/// Replaces the last of `points`, the first whose amplitude at the DOF reached the high end of
+/// the range, by the point at exactly the high end: solved on the bordered system from the
+/// guess interpolated in ln A between it and the point before, else from it. Where both fail
+/// the last point stays (it covers the range, past its end).
+fn high_end(
+    op: &mut EpmcOperator<'_>,
+    newton: &Continuation,
+    settings: &NonlinearModeSettings,
+    points: &mut [NonlinearModePoint],
+) {
+    let high = settings.amplitude[1];
+    let map = op.map();
+    let dim_h = op.harmonic_dim();
+    let unknowns = |op: &EpmcOperator<'_>, p: &NonlinearModePoint| {
+        let mut z = op.normalised(&p.coefficients, p.modal_amplitude);
+        z.truncate(dim_h);
+        z.extend([p.omega, p.xi, TAU * map.decade(p.modal_amplitude)]);
+        z
+    };
+    let Some((last, before)) = points.split_last_mut() else {
+        return;
+    };
+    let z_last = unknowns(op, last);
+    let mut guesses = Vec::new();
+    if let Some(previous) = before.last() {
+        let z_prev = unknowns(op, previous);
+        let (l0, l1) = (previous.dof_amplitude.ln(), last.dof_amplitude.ln());
+        if l1 > l0 {
+            let t = ((high.ln() - l0) / (l1 - l0)).clamp(0.0, 1.0);
+            guesses.push(
+                z_prev
+                    .iter()
+                    .zip(&z_last)
+                    .map(|(a, b)| a + t * (b - a))
+                    .collect(),
+            );
+        }
+    }
+    guesses.push(z_last);
+    for guess in guesses {
+        if let Ok(point) = solve_at_dof_amplitude(op, newton, (settings.dof, high), &guess) {
+            let states = op.system().states.clone();
+            *last = mode_point(op, &point, settings.dof, states);
+            return;
+        }
+    }
 }
 
 /// The point of the mode of `problem` (as [`solve`] computes it with `settings`) at the modal
@@ -326,17 +432,25 @@ fn arc_length_scale(problem: &Problem, set: &HarmonicSet, start: &LinearStart) -
     scale
 }
 
-/// Collects the converged points as [`NonlinearModePoint`]s.
+/// Collects the converged points as [`NonlinearModePoint`]s, and ends the path at the first
+/// whose amplitude at the DOF reaches the high end of the range.
 struct Collect<'s> {
     points: Vec<NonlinearModePoint>,
     settings: &'s NonlinearModeSettings,
+    /// Whether the last point reached the high end.
+    crossed: bool,
 }
 
 impl<'p> Observer<EpmcOperator<'p>> for Collect<'_> {
     fn accepted(&mut self, op: &mut EpmcOperator<'p>, point: &PathPoint, _normal: Option<&[f64]>) {
         let states = op.system().states.clone();
-        self.points
-            .push(mode_point(op, point, self.settings.dof, states));
+        let p = mode_point(op, point, self.settings.dof, states);
+        self.crossed = p.dof_amplitude >= self.settings.amplitude[1];
+        self.points.push(p);
+    }
+
+    fn reached_end(&self) -> bool {
+        self.crossed
     }
 }
 

@@ -31,7 +31,8 @@ impl Continuation {
     /// (a jump to another branch, unless the step is already within twice the minimum); an
     /// accepted step sets the next one from Newton's iterations, the tangent's turn and the
     /// change of the watched amplitudes. Turning points (dω/ds changing sign) are reported and
-    /// followed. The last point is solved at exactly the end frequency. A step cut below the
+    /// followed. The last point is solved at exactly the end frequency, unless the observer's
+    /// own end comes first ([`Observer::reached_end`]). A step cut below the
     /// minimum is a corner of the path, taken on a sphere about the last point
     /// ([`Self::turn_corner`]); where that finds no way on, the run ends with
     /// [`ContinuationError::Stalled`], every point accepted before reported to the observer.
@@ -58,6 +59,10 @@ impl Continuation {
             rejected_steps: 0,
             end: PathEnd::MaxPoints,
         };
+        if observer.reached_end() {
+            summary.end = PathEnd::EndFrequency;
+            return Ok(summary);
+        }
         let mut ds = a.initial_step.clamp(a.min_step, a.max_step);
         // The frequency (Hz) of a corner the path is being taken past with the response
         // weighing more in the arc length (see `WINDOW_FRACTION`).
@@ -90,6 +95,10 @@ impl Continuation {
                         if self.accept(system, observer, &mut summary, point, t_new, &mut tangent) {
                             return Ok(summary);
                         }
+                        if observer.reached_end() {
+                            summary.end = PathEnd::EndFrequency;
+                            return Ok(summary);
+                        }
                         ds = self.next_step(ds, iterations, degrees, &summary);
                         if let Some(corner_hz) = window {
                             let reached = summary.points.last().map_or(corner_hz, |p| p.freq_hz());
@@ -113,6 +122,10 @@ impl Continuation {
                     self.turn_corner(system, &y, &tangent, &summary.points)
                 {
                     if self.accept(system, observer, &mut summary, point, t_new, &mut tangent) {
+                        return Ok(summary);
+                    }
+                    if observer.reached_end() {
+                        summary.end = PathEnd::EndFrequency;
                         return Ok(summary);
                     }
                     ds = a.initial_step.clamp(a.min_step, a.max_step);
@@ -207,7 +220,7 @@ impl Continuation {
 mod tests {
     use super::*;
     use crate::numerics::continuation::fixtures::{settings, Collect, SmoothS};
-    use crate::numerics::path::NoObserver;
+    use crate::numerics::path::{NoObserver, PathPoint};
 
     /// Both folds of the smooth S are followed: the path reaches the end, with a turning point
     /// at each fold (16 and 12 Hz), through the middle branch, every point on the path.
@@ -262,6 +275,32 @@ mod tests {
         assert_eq!(summary.end, PathEnd::LeftRangeBelow, "{summary:?}");
         assert_eq!(summary.turning_points.len(), 1);
         assert!(summary.points.last().unwrap().freq_hz() < start - 1.0);
+    }
+
+    /// An observer whose own end is x ≥ 0 (on the S's middle branch, after its upper fold)
+    /// stops the path at the first point past it, as at the end frequency: the points before
+    /// it are below, and none after it is taken.
+    #[test]
+    fn a_path_stops_at_the_observers_end() {
+        struct UpToZero(Vec<PathPoint>);
+        impl<S: ParametricResidual> Observer<S> for UpToZero {
+            fn accepted(&mut self, _: &mut S, point: &PathPoint, _: Option<&[f64]>) {
+                self.0.push(point.clone());
+            }
+            fn reached_end(&self) -> bool {
+                self.0.last().is_some_and(|p| p.x[0] >= 0.0)
+            }
+        }
+        let mut observer = UpToZero(Vec::new());
+        let mut c = Continuation::new(settings(12.0, 17.0), vec![1.0]);
+        let summary = c
+            .run(&mut SmoothS::whole(), &[-2.0], &mut observer)
+            .unwrap();
+        assert_eq!(summary.end, PathEnd::EndFrequency);
+        assert_eq!(summary.turning_points.len(), 1, "{summary:?}");
+        let (last, before) = observer.0.split_last().unwrap();
+        assert!(last.x[0] >= 0.0 && before.iter().all(|p| p.x[0] < 0.0));
+        assert_eq!(summary.points.len(), observer.0.len());
     }
 
     /// A residual with no solution past a point stalls the run there: the error names the
