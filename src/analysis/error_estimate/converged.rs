@@ -153,12 +153,15 @@ impl<'p> ErrorEstimator<'p> {
     /// The truncation estimate of the point `x` at `omega` on the wider set (4H + 3): at the
     /// fixed frequency, and across the path when the path's `normal` (run unknowns, then ω) is
     /// given and the bordered matrix factorises; None when the estimate cannot be formed.
+    /// `across` says which of the two the point reports: only that step's contraction is
+    /// evaluated (one residual at the stepped point), the other's is NaN.
     pub(super) fn wider_truncation(
         &mut self,
         x: &[f64],
         omega: f64,
         normal: Option<&[f64]>,
         base: &[f64],
+        across: bool,
     ) -> Option<Wider> {
         let n = self.problem.model.n_dofs();
         let row = normal.and_then(|normal| self.row_on(&self.wider, normal));
@@ -175,10 +178,12 @@ impl<'p> ErrorEstimator<'p> {
         let problem = self.problem;
         let r_norm = crate::numerics::linalg::norm(&r);
         let padded_converged = solves_padded(problem, &wider.operator, r_norm);
-        // The change of each output and the step's contraction ([`LinearRange`]).
-        let change = |w: &mut Refined, delta: &[f64], d_omega: f64| {
-            let contraction = w
-                .after_step(&xr, delta, omega - d_omega)
+        // The change of each output and, for the step the point reports, the step's
+        // contraction ([`LinearRange`]).
+        let change = |w: &mut Refined, delta: &[f64], d_omega: f64, reported: bool| {
+            let contraction = reported
+                .then(|| w.after_step(&xr, delta, omega - d_omega))
+                .flatten()
                 .map_or(f64::NAN, |(_, after)| after / r_norm);
             w.stepped(&xr, delta, omega - d_omega).map(|full| {
                 (
@@ -198,9 +203,9 @@ impl<'p> ErrorEstimator<'p> {
                     let (d_omega, z_omega) = (step[dim], z[dim]);
                     let s = d_omega / z_omega;
                     let fixed: Vec<f64> = step.iter().zip(&z).map(|(a, b)| a - s * b).collect();
-                    let across = change(wider, &step[..dim], d_omega);
-                    let fixed_change = change(wider, &fixed[..dim], fixed[dim]);
-                    if let (Some(f), Some(a)) = (fixed_change, across) {
+                    let across_change = change(wider, &step[..dim], d_omega, across);
+                    let fixed_change = change(wider, &fixed[..dim], fixed[dim], !across);
+                    if let (Some(f), Some(a)) = (fixed_change, across_change) {
                         return Some(Wider {
                             padded_converged,
                             fixed: f.0,
@@ -214,7 +219,8 @@ impl<'p> ErrorEstimator<'p> {
             }
         }
         let step = wider.jacobian.solve_many(&[&r]).ok()?.pop()?;
-        change(wider, &step, 0.0).map(|f| Wider {
+        // Only reported where the point reports the fixed-frequency step.
+        change(wider, &step, 0.0, !across).map(|f| Wider {
             padded_converged,
             fixed: f.0,
             fixed_contraction: f.1,

@@ -21,10 +21,12 @@ pub(super) struct Wider {
     pub(super) padded_converged: bool,
     /// At the fixed frequency, per output.
     pub(super) fixed: Vec<f64>,
-    /// The fixed-frequency step's contraction ([`LinearRange`]).
+    /// The fixed-frequency step's contraction ([`LinearRange`]); NaN where the point reports
+    /// the step across the path (not evaluated).
     pub(super) fixed_contraction: f64,
-    /// Across the path (per output) and that step's contraction, where the path's normal was
-    /// given and the bordered matrix factorised.
+    /// Across the path (per output) and that step's contraction (NaN where the point reports
+    /// the fixed-frequency step), where the path's normal was given and the bordered matrix
+    /// factorised.
     pub(super) across: Option<(Vec<f64>, f64)>,
     /// The fixed-frequency step (wider unknowns), for the start of a converged solve.
     pub(super) fixed_step: Vec<f64>,
@@ -34,7 +36,8 @@ pub(super) struct Wider {
 }
 
 /// What one set of Newton steps (across the path or at the fixed frequency) gives on the
-/// first extension.
+/// first extension. The contraction and the regime change are evaluated for the set the point
+/// reports only (one residual at the stepped point); the other set's are NaN and false.
 struct Assessed {
     /// Truncation estimate per output.
     pub(super) truncation: Vec<f64>,
@@ -325,8 +328,8 @@ impl<'p> ErrorEstimator<'p> {
         // Per reported step set (across the path or at the fixed frequency): the truncation
         // estimate, whether its tail needs the wider set, whether the step changes a contact's
         // regime, and the sampling estimate.
-        let mut assess = |steps: &[Vec<f64>]| {
-            let (full, moved) = amplitudes_after(&steps[0], true);
+        let mut assess = |steps: &[Vec<f64>], reported: bool| {
+            let (full, moved) = amplitudes_after(&steps[0], reported);
             let (low, _) = amplitudes_after(&steps[1], false);
             let needs_wider = base
                 .iter()
@@ -348,8 +351,11 @@ impl<'p> ErrorEstimator<'p> {
             }
         };
         let top = extended_harmonic(self.h_max);
-        let first = assess(&deltas);
         let step = path.map_or(f64::NAN, |p| p.step);
+        // Whether a path point reports the step across the path; a point at a fixed frequency
+        // (no path direction) reports its only step set.
+        let across = fixed_deltas.is_some() && PathSwitch::across(slide, step);
+        let first = assess(&deltas, fixed_deltas.is_none() || across);
         let Some(fixed_steps) = fixed_deltas else {
             let mut truncation = first.truncation.clone();
             let mut estimate_harmonic = top;
@@ -358,7 +364,7 @@ impl<'p> ErrorEstimator<'p> {
             let widens = first.needs_wider
                 && self.widens(&first.truncation, first.contraction, padded_converged);
             if widens && self.budget.wider.steps {
-                if let Some(w) = self.wider_truncation(x, omega, None, &base) {
+                if let Some(w) = self.wider_truncation(x, omega, None, &base, false) {
                     padded_converged = w.padded_converged;
                     truncation = w.fixed;
                     contraction = w.fixed_contraction;
@@ -392,8 +398,7 @@ impl<'p> ErrorEstimator<'p> {
                 method,
             };
         };
-        let fixed = assess(&fixed_steps);
-        let across = PathSwitch::across(slide, step);
+        let fixed = assess(&fixed_steps, !across);
         let reported = if across { &first } else { &fixed };
         let mut both = (fixed.truncation.clone(), first.truncation.clone());
         let mut contractions = (fixed.contraction, first.contraction);
@@ -405,7 +410,7 @@ impl<'p> ErrorEstimator<'p> {
         let widens = reported.needs_wider
             && self.widens(&reported.truncation, reported.contraction, padded_converged);
         if widens && self.budget.wider.steps {
-            if let Some(w) = self.wider_truncation(x, omega, normal, &base) {
+            if let Some(w) = self.wider_truncation(x, omega, normal, &base, across) {
                 let wider_converged = w.padded_converged;
                 if let (Some((a, a_contraction)), Some(a_step)) = (w.across, w.across_step) {
                     padded_converged = wider_converged;

@@ -93,7 +93,9 @@
 //! (in the formulation the cost model picks for that system, see `extended_formulation`),
 //! one residual at twice the samples, and two solves with the same factors (three with the
 //! path's direction on a path point; before the sampling step reused the factors, it took a
-//! Jacobian and a factorisation of its own). The bordered factorisation adds one row and
+//! Jacobian and a factorisation of its own), and one residual at the stepped point for the
+//! contraction of the step the point reports (a path point evaluated it for both of its step
+//! sets before, on 2H + 1 and on 4H + 3). The bordered factorisation adds one row and
 //! column (dense storage) or one solve for the border column (storages that eliminate the
 //! border by blocks). A point whose step leaves its linear range ([`LinearRange`]) adds a
 //! Newton solve of the extended system: a Jacobian, a factorisation and the line search's
