@@ -361,19 +361,17 @@ fn plot_peaks(
                     .map(|c| pts.iter().map(|p| value(p, c)).collect())
                     .collect();
                 // The band spans the limit cases (two for a forced response, every sign
-                // combination per damper side for a nonlinear mode).
-                let bound = |pick: fn(f64, f64) -> f64| -> Vec<f64> {
-                    (0..pts.len())
-                        .map(|i| {
-                            ys[..limits]
-                                .iter()
-                                .map(|y| y[i])
-                                .reduce(pick)
-                                .unwrap_or(f64::NAN)
-                        })
-                        .collect()
+                // combination per damper side for a nonlinear mode); none where one failed.
+                let range = |p: &SweepPoint| {
+                    if amplitude {
+                        p.limit_amplitudes()
+                    } else {
+                        p.limit_frequencies()
+                    }
+                    .unwrap_or((f64::NAN, f64::NAN))
                 };
-                let (lower, upper) = (bound(f64::min), bound(f64::max));
+                let lower = pts.iter().map(|p| range(p).1).collect();
+                let upper = pts.iter().map(|p| range(p).0).collect();
                 Group {
                     label,
                     x,

@@ -300,7 +300,7 @@ fn solve_modes_value(
 /// The resonance peak a mode predicts at the first output DOF (see [`solve_modes_value`]).
 fn mode_peak(problem: &Problem, run: &NonlinearModeRun) -> Option<Peak> {
     let (i, t) = nonlinear_modes::predict::peak_crossing(problem, run)?;
-    let predicted = nonlinear_modes::predicted_peak(problem, run)?;
+    let predicted = nonlinear_modes::predict::peak_at(run, (i, t));
     let (p0, p1) = (&run.points[i - 1], &run.points[i]);
     let set = problem.unknown_harmonics();
     let n = problem.model.n_dofs();

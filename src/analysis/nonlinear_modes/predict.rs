@@ -63,17 +63,21 @@ pub fn peak_crossing(problem: &Problem, run: &NonlinearModeRun) -> Option<(usize
 }
 
 /// The peak predicted from the mode for the first-harmonic loads of `problem`
-/// ([`peak_crossing`]), its amplitudes interpolated linearly in log a between the two points
-/// around it. None when the mode does not reach it.
+/// ([`peak_crossing`]). None when the mode does not reach it.
 pub fn predicted_peak(problem: &Problem, run: &NonlinearModeRun) -> Option<PredictedPeak> {
-    let (i, t) = peak_crossing(problem, run)?;
+    peak_crossing(problem, run).map(|crossing| peak_at(run, crossing))
+}
+
+/// The peak at a crossing `(i, t)` of [`peak_crossing`]: its amplitudes interpolated linearly
+/// in log a, its frequency linearly, between the points i − 1 and i.
+pub fn peak_at(run: &NonlinearModeRun, (i, t): (usize, f64)) -> PredictedPeak {
     let (p0, p1) = (&run.points[i - 1], &run.points[i]);
     let lerp = |u: f64, v: f64| u + t * (v - u);
-    Some(PredictedPeak {
+    PredictedPeak {
         modal_amplitude: lerp(p0.modal_amplitude.ln(), p1.modal_amplitude.ln()).exp(),
         dof_amplitude: lerp(p0.dof_amplitude.ln(), p1.dof_amplitude.ln()).exp(),
         freq_hz: lerp(p0.omega, p1.omega) / TAU,
-    })
+    }
 }
 
 /// The predicted forced response near the resonance: for every point of the mode, the
