@@ -5,13 +5,20 @@
 use super::{AftError, AftWorkspace, MarchReport, SampleKind, Signal};
 use crate::contact::events::bounds::BoundLaw;
 use crate::contact::events::march::{
-    closed_intervals, periodic_orbit, Anchor, Grid, LawParams, Phase, Signals,
+    closed_intervals, periodic_orbit, Anchor, Grid, LawParams, Phase, Piece, Signals,
 };
 use crate::contact::events::{ForceOutputs, MarchFailure};
 use crate::contact::{ContactEffects, ContactState, JenkinsLaw};
 use std::f64::consts::PI;
 
 impl AftWorkspace {
+    /// The phases (stick, slip, open) of the last [`Self::evaluate_events`] over one period,
+    /// in time order: where the law is differentiable and where it has a seam (a slip that
+    /// appears inside a stick, [`crate::contact::events`]) is read from them.
+    pub fn event_phases(&self) -> &[Piece] {
+        &self.events.pieces
+    }
+
     /// Evaluates the contact forces (and, if asked, their Jacobian) for coefficients û, v̂ with
     /// the transitions located in continuous time ([`crate::contact::events`]); the samples
     /// (N of them) only bracket the events and carry the time histories for outputs.

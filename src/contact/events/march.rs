@@ -494,7 +494,8 @@ impl Marcher<'_> {
         let size = match event {
             Event::SlipOnset(_) => kt * (k.u[0].abs() + w.abs()) + l[0].abs(),
             Event::StickOnset(_) => l[1].abs() + kt * k.u[1].abs(),
-            Event::Opening | Event::Closing => k.v[0].abs(),
+            // v is zero where the contact has just closed or opened: its rates set the size.
+            Event::Opening | Event::Closing => k.v[0].abs() + k.v[1].abs() + k.v[2].abs(),
         };
         1e-12 * size
     }
@@ -638,7 +639,7 @@ impl Marcher<'_> {
                 return Some(brent(f, a, b, fa, fb));
             }
             if first || fa <= zero {
-                return Some(self.rising_root(&f, a, b, fb));
+                return Some(self.rising_root(&f, (a, b), fb, zero));
             }
             // Above zero at a cell start past the first: a root missed before; stop here.
             return Some(a);
@@ -651,32 +652,33 @@ impl Marcher<'_> {
                 if fa < -zero {
                     return Some(brent(f, a, peak, fa, f_peak));
                 }
-                return Some(self.rising_root(&f, a, peak, f_peak));
+                return Some(self.rising_root(&f, (a, peak), f_peak, zero));
             }
         }
         None
     }
 
     /// The first rise of f through zero in (a, b] where f(a) ≈ 0 and f(b) > 0: a point where
-    /// f is negative is sought on a fine subdivision, then the root is refined from it; with
-    /// none, f rises from a itself.
-    fn rising_root(&self, f: &impl Fn(f64) -> f64, a: f64, b: f64, fb: f64) -> f64 {
-        const SUBDIVISIONS: usize = 16;
+    /// f is below −`zero` (its round-off) is sought on a subdivision that is geometric toward a
+    /// (the stretch where f dips below zero may be far shorter than the cell: a contact that
+    /// closes and opens again, a slider that stops for an instant and slips on) and uniform
+    /// beyond, then the root is refined from it; where f rises above `zero` first, it rises
+    /// from a itself.
+    fn rising_root(&self, f: &impl Fn(f64) -> f64, (a, b): (f64, f64), fb: f64, zero: f64) -> f64 {
+        const GEOMETRIC: i32 = 40;
+        const UNIFORM: usize = 16;
+        let geometric = (5..=GEOMETRIC).rev().map(|k| a + (b - a) * 0.5_f64.powi(k));
+        let uniform = (1..=UNIFORM).map(|i| a + (b - a) * i as f64 / UNIFORM as f64);
         let mut negative: Option<(f64, f64)> = None;
-        for i in 1..=SUBDIVISIONS {
-            let t = if i == SUBDIVISIONS {
-                b
-            } else {
-                a + (b - a) * i as f64 / SUBDIVISIONS as f64
-            };
-            let ft = if i == SUBDIVISIONS { fb } else { f(t) };
-            if ft > 0.0 {
+        for t in geometric.chain(uniform) {
+            let ft = if t >= b { fb } else { f(t) };
+            if ft > zero {
                 return match negative {
                     Some((tn, fneg)) => brent(f, tn, t, fneg, ft),
                     None => a,
                 };
             }
-            if ft < 0.0 {
+            if ft < -zero {
                 negative = Some((t, ft));
             }
         }

@@ -10,6 +10,16 @@
 //! grid and puts a kink in the residual each time a transition crosses a sample; Newton then
 //! stagnates just above its tolerance there. This law has no such kinks.
 //!
+//! One seam is the element's own, and stays: where a stick's slider changes the slip that
+//! anchors it. Where the trial force kₜ(u − w) of a stick touches ±μN without crossing it, a
+//! slip of vanishing length appears inside the stick (for a contact stuck all period, slip
+//! begins) and the slider after it moves by max(e, 0)/kₜ, e the excess of the trial force over
+//! μN at its peak; where a stuck orbit touches the cone at two peaks of nearly equal height,
+//! the slider is anchored at the higher one. Either way the forces stay continuous but their
+//! derivatives jump, as a play operator's do. The sampled law tends to the same one-sided
+//! slopes as N grows (`tests/it/aft_jenkins/seam.rs`), and the continuation turns such corners
+//! ([`crate::numerics::continuation`]).
+//!
 //! # The law (paper Eqs. 4-6)
 //!
 //! u(τ) and v(τ) are trigonometric polynomials of the unknowns; with a variable normal load

@@ -24,9 +24,10 @@
 //!
 //! The event-resolved contact laws make the residual continuously differentiable wherever a
 //! contact slips or lifts off, so Newton converges to the tolerance and plain step control
-//! follows the folds. One seam is left: where a contact goes from stuck all period to
-//! slipping, its periodic state changes from the one its initial state sets to the one its
-//! slip sets, and the path has a corner. Where the steps are cut to the minimum at such a
+//! follows the folds. One seam is left: where a contact's slider changes what anchors it
+//! ([`crate::contact::events`]), mostly where a contact goes from stuck all period to slipping
+//! and its periodic state changes from the one its initial state sets to the one its slip
+//! sets, the path has a corner. Where the steps are cut to the minimum at such a
 //! corner, the path is taken on past it on a sphere about the last point
 //! ([`Continuation::turn_corner`]); only where that fails too does the run stall. A sampled
 //! contact law (`jenkins-1d-sampled`, `jenkins-2d-sampled`) has a kink wherever a transition

@@ -7,6 +7,9 @@ use fricbound::contact::jenkins_describing_function;
 use fricbound::contact::{ContactEffects, ContactState, JenkinsLaw, NormalLoad};
 use proptest::prelude::*;
 
+mod event_jacobian;
+mod seam;
+
 fn law(kt: f64, kn: f64, mu: f64, m: f64) -> JenkinsLaw {
     JenkinsLaw {
         kt,
@@ -375,128 +378,6 @@ fn event_law_equals_the_describing_function_to_round_off() {
                     "c_eq at ratio {ratio}, {samples} samples: {c} vs {c_ref}"
                 );
             }
-        }
-    }
-}
-
-/// Largest |analytic − central difference| of the event law's Jacobian, relative to the
-/// largest entry (each column scaled by its coefficient scale), at H = 3 with a coarse
-/// bracketing grid. The law is C¹, so central differences apply whatever the regime.
-fn event_jacobian_error(
-    l: JenkinsLaw,
-    effects: ContactEffects,
-    u: &[f64],
-    v: &[f64],
-) -> (f64, ContactState) {
-    let set = HarmonicSet::up_to(3);
-    let nb = set.n_blocks();
-    let mut aft = AftWorkspace::new(&set, 32);
-    let state = aft.evaluate_events(&l, effects, u, v, true).unwrap().state;
-    let (tu, tv, nv) = (aft.dt_du.clone(), aft.dt_dv.clone(), aft.dn_dv.clone());
-    let scale_u = u.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
-    let scale_v = v.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
-    let max_entry = (0..nb * nb)
-        .map(|k| (tu[k].abs() * scale_u).max((tv[k].abs().max(nv[k].abs())) * scale_v))
-        .fold(f64::MIN_POSITIVE, f64::max);
-    let mut max_err = 0.0_f64;
-    for i in 0..nb {
-        for (which, scale) in [(0, scale_u), (1, scale_v)] {
-            let h = 1e-6 * scale;
-            let mut forces = |sign: f64| {
-                let (mut up, mut vp) = (u.to_vec(), v.to_vec());
-                if which == 0 {
-                    up[i] += sign * h;
-                } else {
-                    vp[i] += sign * h;
-                }
-                aft.evaluate_events(&l, effects, &up, &vp, false).unwrap();
-                (aft.t_hat.clone(), aft.n_hat.clone())
-            };
-            let (tp, np) = forces(1.0);
-            let (tm, nm) = forces(-1.0);
-            for j in 0..nb {
-                let (at, an) = if which == 0 {
-                    (tu[j * nb + i], 0.0)
-                } else {
-                    (tv[j * nb + i], nv[j * nb + i])
-                };
-                let ct = (tp[j] - tm[j]) / (2.0 * h);
-                let cn = (np[j] - nm[j]) / (2.0 * h);
-                max_err = max_err.max((ct - at).abs().max((cn - an).abs()) * scale);
-            }
-        }
-    }
-    (max_err / max_entry, state)
-}
-
-proptest! {
-    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
-
-    #[test]
-    fn event_jacobian_stuck((s, m, mu) in regime_strategy(), constant in any::<bool>()) {
-        let (u, v) = coefficients(&s, 1e-6, 1e-3, 1e-5);
-        let (err, state) = event_jacobian_error(law(1e5, 1e5, mu, m), effects(constant, true), &u, &v);
-        prop_assert_eq!(state, ContactState::Stuck);
-        prop_assert!(err < 1e-6, "relative error {}", err);
-    }
-
-    #[test]
-    fn event_jacobian_stick_slip((s, m, mu) in regime_strategy(), constant in any::<bool>()) {
-        let (u, v) = stick_slip_inputs(&s);
-        let (err, state) = event_jacobian_error(law(1e5, 1e5, mu, m), effects(constant, true), &u, &v);
-        prop_assert_eq!(state, ContactState::StickSlip);
-        prop_assert!(err < 1e-6, "relative error {}", err);
-    }
-
-    #[test]
-    fn event_jacobian_stick_slip_liftoff((s, m, mu) in regime_strategy()) {
-        let (u, v) = liftoff_inputs(&s, 1e-4);
-        let (err, state) = event_jacobian_error(law(1e5, 1e5, mu, m), effects(false, true), &u, &v);
-        prop_assert_eq!(state, ContactState::StickSlipLiftoff);
-        prop_assert!(err < 1e-6, "relative error {}", err);
-    }
-
-    #[test]
-    fn event_jacobian_open((s, m, mu) in regime_strategy()) {
-        let (u, v) = coefficients(&s, 1e-4, -1e-3, 1e-4);
-        let mut aft = AftWorkspace::new(&HarmonicSet::up_to(3), 32);
-        let report = aft.evaluate_events(&law(1e5, 1e5, mu, m), effects(false, true), &u, &v, true).unwrap();
-        prop_assert_eq!(report.state, ContactState::Open);
-        prop_assert!(aft.dt_du.iter().chain(&aft.dt_dv).chain(&aft.dn_dv).all(|x| *x == 0.0));
-        prop_assert!(aft.t_hat.iter().chain(&aft.n_hat).all(|x| *x == 0.0));
-    }
-
-    #[test]
-    fn event_jacobian_grazing((s, m, mu) in regime_strategy(), touch in 0.97..1.03f64) {
-        // The contact just touches or just separates once per period: no input is excluded,
-        // the closing instant being located, not sampled.
-        let (u, v) = grazing_inputs(&s, touch);
-        let (err, _) = event_jacobian_error(law(1e5, 1e5, mu, m), effects(false, true), &u, &v);
-        prop_assert!(err < 1e-5, "relative error {}", err);
-    }
-
-    #[test]
-    fn event_jacobian_without_liftoff((s, m, mu) in regime_strategy()) {
-        let (u, v) = liftoff_inputs(&s, 4e-5);
-        let (err, _) = event_jacobian_error(law(1e5, 1e5, mu, m), effects(false, false), &u, &v);
-        prop_assert!(err < 1e-6, "relative error {}", err);
-    }
-
-    #[test]
-    fn event_law_tends_to_the_sampled_law((s, m, mu) in regime_strategy()) {
-        // Both laws on the same stick-slip-liftoff input: the sampled law's error falls like
-        // 1/N (each transition snapped to the grid), so at 8 192 samples the two agree to a
-        // few 1e-4 of the force scale.
-        let (u, v) = liftoff_inputs(&s, 1e-4);
-        let l = law(1e5, 1e5, mu, m);
-        let set = HarmonicSet::up_to(3);
-        let mut events = AftWorkspace::new(&set, 64);
-        events.evaluate_events(&l, effects(false, true), &u, &v, false).unwrap();
-        let mut sampled = AftWorkspace::new(&set, 8192);
-        sampled.evaluate(&l, effects(false, true), &u, &v, false).unwrap();
-        let scale = events.n_hat.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
-        for (a, b) in events.t_hat.iter().chain(&events.n_hat).zip(sampled.t_hat.iter().chain(&sampled.n_hat)) {
-            prop_assert!((a - b).abs() < 2e-3 * scale, "{} vs {} (scale {})", a, b, scale);
         }
     }
 }
