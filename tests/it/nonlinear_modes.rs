@@ -425,19 +425,17 @@ fn the_path_runs_between_the_amplitudes_asked_at_the_dof() {
     );
 }
 
-/// The error estimate is formed by two Newton steps of the extended system where they stay in
-/// their linear range and solved to convergence elsewhere: on the 1-DOF Jenkins oscillator at
-/// H = 1 both ways size points (the steps more than 50 of them: their estimates are among those
-/// `checks::error_estimate_sizes_the_change_at_higher_harmonics` holds to 1 % of the change to
-/// a run at 2H + 1), every point is counted once, and the stuck points need neither.
+/// Every point's estimate is counted once, by how it was formed: on the 1-DOF Jenkins
+/// oscillator at H = 1 the stuck points already solve the extension (estimate 0, no solve), the
+/// others are solved to convergence, none is left unsized.
 #[test]
-fn error_estimate_steps_where_it_can_and_solves_elsewhere() {
+fn error_estimate_counts_every_point_once() {
     let problem = scenes::problem(&jenkins_oscillator(), &[]);
     let run = solve(&problem, &settings(ModeChoice::Number(1), 0, [1e-6, 1e-2]));
     let counts = run.estimate_counts.expect("the estimate is on by default");
     eprintln!("{} points: {counts:?}", run.points.len());
     assert_eq!(
-        counts.converged + counts.stepped + counts.solved + counts.not_sized,
+        counts.converged + counts.solved + counts.not_sized,
         run.points.len()
     );
     let stuck = run
@@ -446,7 +444,7 @@ fn error_estimate_steps_where_it_can_and_solves_elsewhere() {
         .filter(|p| p.states[0] == ContactState::Stuck)
         .count();
     assert!(counts.converged >= stuck, "{counts:?}: {stuck} stuck");
-    assert!(counts.stepped > 50 && counts.solved > 50, "{counts:?}");
+    assert!(counts.solved > 100, "{counts:?}");
     assert_eq!(counts.not_sized, 0);
 }
 

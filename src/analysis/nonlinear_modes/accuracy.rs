@@ -16,42 +16,37 @@
 //! Newton may not reach one: 2 of 63 points at H = 1 and 47 of 317 at H = 3 are not sized
 //! there.
 //!
-//! Like the forced response's estimate, a point is first stepped: the first two Newton steps of
-//! the extended system from the padded point are kept where they stay in their linear range
-//! ([`StepRule`]: the residual after the first step within the forced response's
-//! [`LinearRange`], and the second step changing ω, D and A by at most 1 % of their estimate);
-//! elsewhere the point is solved to convergence, going on from the last step that lowered the
-//! residual, and from the previous point's extended solution where that fails. The
-//! estimate is then that of the extended set to well within 1 %, also where a contact's regime
-//! changes with the harmonics. Where the padded point already solves the extended system
-//! within the run's residual tolerance (every contact stuck or open all period, the forces
-//! linear in the motion) the estimate is 0 without a step, so that the round-off of a vanishing
-//! damping ratio is not read as a relative change. Where the solve does not converge the
-//! estimate is NaN and reported as not sized. Sampling is not estimated: the extended set is
-//! solved at enough samples for its own harmonics, and with the event-resolved laws the samples
-//! only bracket the transitions. How many points took which way is counted
-//! ([`EstimateCounts`], `estimate_counts` in `modes_nl.json`).
+//! The extended system is solved by Newton from the padded point, and from the previous
+//! point's extended solution where that fails (ψ is normalised, so it changes little from
+//! point to point; where a contact's regime changes with the harmonics the padded point can
+//! lie outside Newton's reach). Unlike the forced response's estimate, no point is sized from
+//! its first Newton steps: ω and D change only through the contacts' response to the new
+//! harmonics while the residual is dominated by those harmonics' own rows, so a step within
+//! the forced response's linear range gave 0.07-5.4 times the converged change of the
+//! frequency on the 1-DOF Jenkins oscillator, and two steps kept where the second changed
+//! little sized a third of that oscillator's points and almost none of the paper's modes, with
+//! no run time saved. Where the padded point already solves the extended system within the
+//! run's residual tolerance (every contact stuck or open all period, the forces linear in the
+//! motion) the estimate is 0 without a solve, so that the round-off of a vanishing damping
+//! ratio is not read as a relative change. Where the solve does not converge the estimate is
+//! NaN and reported as not sized. Sampling is not estimated: the extended set is solved at
+//! enough samples for its own harmonics, and with the event-resolved laws the samples only
+//! bracket the transitions. How many points took which way is counted ([`EstimateCounts`],
+//! `estimate_counts` in `modes_nl.json`).
 //!
-//! Cost per point: two Newton iterations of the dense EPMC system on 2H + 1 harmonics (about
-//! (2H + 1)/H times the unknowns of the run) and a residual where the steps are kept; where
-//! they are not, the solve goes on from them (one residual more than the solve alone, one
-//! iteration more where the first step raised the residual), and a solve that does not
-//! converge takes up to three times the run's iteration limit (less where its residual
-//! stagnates), twice where the second start fails too. On the 1-DOF Jenkins oscillator the steps size 55 of the 207 points that need an
-//! estimate at H = 1 and 73 of 211 at H = 3; on the paper's 2nd mode, where the wedge slips
-//! and lifts off, 0 of 39 at H = 1 and 4 of 291 at H = 3: there the time goes to the solves,
-//! most of it to the first starts that do not converge (131 at H = 3, 84 of them solved from
-//! the previous point's extended solution). Measured run times (no time saved by the steps):
-//! docs/src/nonlinear-modes.md, "Accuracy of each point".
+//! Cost per point: a Newton solve of the dense EPMC system on 2H + 1 harmonics (about
+//! (2H + 1)/H times the unknowns of the run); one that does not converge takes up to three
+//! times the run's iteration limit (less where its residual stagnates), twice where the second
+//! start fails too. Measured run times: docs/src/nonlinear-modes.md, "Accuracy of each
+//! point".
 
 use std::f64::consts::TAU;
 
 use super::operator::{EpmcOperator, LogAmplitude};
-use crate::analysis::error_estimate::{extended_harmonic, LinearRange};
+use crate::analysis::error_estimate::extended_harmonic;
 use crate::contact::harmonic::HarmonicSet;
 use crate::model::Problem;
 use crate::numerics::continuation::StagnationExit;
-use crate::numerics::jacobian::AssembledJacobian;
 use crate::numerics::{Continuation, ParametricResidual};
 
 /// The error estimate of a mode point (relative changes when the harmonics are raised to
@@ -103,8 +98,6 @@ pub(super) struct ModeEstimator<'p> {
     harmonic: usize,
     /// The last extended solution (ψ', ω', ξ'), the second start of the next point's solve.
     last: Option<Vec<f64>>,
-    /// The extended Jacobian of the step.
-    jac: AssembledJacobian,
     /// How the estimates so far were formed.
     pub(super) counts: EstimateCounts,
 }
@@ -138,8 +131,7 @@ impl<'p> ModeEstimator<'p> {
         (map, row_scale): (LogAmplitude, f64),
         newton: &Continuation,
     ) -> Result<Self, crate::hbm::HbmError> {
-        let mut op = EpmcOperator::new(extended, statics, dof, map, row_scale)?;
-        let jac = op.new_jacobian();
+        let op = EpmcOperator::new(extended, statics, dof, map, row_scale)?;
         let run_set = free.unknown_harmonics();
         let ext_set = op.unknowns().clone();
         let n = free.model.n_dofs();
@@ -168,18 +160,13 @@ impl<'p> ModeEstimator<'p> {
             dof,
             harmonic: ext_set.max_harmonic(),
             last: None,
-            jac,
             counts: EstimateCounts::default(),
         })
     }
 
     /// The estimate of the point `point`, whose normalised harmonics are `psi` (the run's
-    /// layout): the first two Newton steps of the extended system from the padded point, kept
-    /// where they stay within their linear range ([`StepRule`]); else Newton to convergence
-    /// going on from the last step that lowered the residual (from the padded point where none
-    /// did), and from the previous point's extended solution where that fails (ψ is
-    /// normalised, so it changes little from point to point; where a contact's regime changes
-    /// with the harmonics the padded point can lie outside Newton's reach).
+    /// layout): the extended system solved from the padded point, else from the previous
+    /// point's extended solution.
     pub(super) fn estimate(&mut self, point: &PointValues, psi: &[f64]) -> ModeAccuracy {
         let n = self.n;
         let dim_h = self.op.harmonic_dim();
@@ -211,23 +198,11 @@ impl<'p> ModeEstimator<'p> {
                 harmonic: self.harmonic,
             };
         }
-        let reference = [point.omega, point.damping_ratio, point.dof_amplitude];
-        let solution = match self.steps(&y, lambda, (padded, point.modal_amplitude, reference)) {
-            Steps::Kept(y2) => {
-                self.counts.stepped += 1;
-                y2
-            }
-            Steps::Beyond(from) => match self.solve(from.as_deref().unwrap_or(&y), lambda) {
-                Some(x) => {
-                    self.counts.solved += 1;
-                    x
-                }
-                None => {
-                    self.counts.not_sized += 1;
-                    return not_sized;
-                }
-            },
+        let Some(solution) = self.solve(&y, lambda) else {
+            self.counts.not_sized += 1;
+            return not_sized;
         };
+        self.counts.solved += 1;
         let [omega, damping_ratio, amplitude] = self.values(&solution, point.modal_amplitude);
         self.last = Some(solution);
         ModeAccuracy {
@@ -248,59 +223,6 @@ impl<'p> ModeEstimator<'p> {
         [omega, xi / (2.0 * omega), a * at(cos1).hypot(at(sin1))]
     }
 
-    /// The first two Newton steps of the extended system at λ from the padded point `y`, whose
-    /// relative residual is `padded` (the point's modal amplitude and (ω, D, A) with it): the
-    /// twice-stepped point where the steps stay in their linear range ([`STEP_RULE`]), else
-    /// the iterate a solve goes on from, as Newton from the padded point would reach it (the
-    /// stepped point where a step lowered the residual; None: the padded point). The second
-    /// step is taken only where the first is within its linear range, so that a point solved
-    /// to convergence spends one residual more than the solve alone.
-    fn steps(&mut self, y: &[f64], lambda: f64, (padded, a, point): (f64, f64, [f64; 3])) -> Steps {
-        let Some((y1, _)) = self.newton_step(y, lambda) else {
-            return Steps::Beyond(None);
-        };
-        let mut r = vec![0.0; y.len()];
-        let contraction = match self.op.residual(&y1, lambda, &mut r) {
-            Ok(()) => crate::numerics::linalg::norm(&r) / self.op.residual_scale() / padded,
-            Err(_) => return Steps::Beyond(None),
-        };
-        if !LinearRange::holds(contraction, false) {
-            return Steps::Beyond((contraction < 1.0).then_some(y1));
-        }
-        let Some((y2, _)) = self.newton_step(&y1, lambda) else {
-            return Steps::Beyond(Some(y1));
-        };
-        let (v1, v2) = (self.values(&y1, a), self.values(&y2, a));
-        let settled = (0..3).all(|k| {
-            let estimate = (v2[k] - point[k])
-                .abs()
-                .max(STEP_RULE.floor * point[k].abs());
-            (v2[k] - v1[k]).abs() <= STEP_RULE.second_step * estimate
-        });
-        if settled {
-            Steps::Kept(y2)
-        } else {
-            Steps::Beyond(Some(y2))
-        }
-    }
-
-    /// One Newton step of the extended system at λ from `y`: y − J⁻¹R and the relative residual
-    /// at `y`. None where the residual or Jacobian could not be formed or solved.
-    fn newton_step(&mut self, y: &[f64], lambda: f64) -> Option<(Vec<f64>, f64)> {
-        let mut r = vec![0.0; y.len()];
-        let mut dr = vec![0.0; y.len()];
-        self.op
-            .residual_and_jacobian(y, lambda, &mut r, &mut self.jac, &mut dr)
-            .ok()?;
-        let relative = crate::numerics::linalg::norm(&r) / self.op.residual_scale();
-        let rhs: Vec<f64> = r.iter().map(|v| -v).collect();
-        let delta = self.jac.solve(&rhs).ok()?;
-        if delta.iter().any(|v| !v.is_finite()) {
-            return None;
-        }
-        Some((y.iter().zip(&delta).map(|(a, b)| a + b).collect(), relative))
-    }
-
     /// The extended system solved to convergence at λ from `from`, else from the previous
     /// point's extended solution.
     fn solve(&mut self, from: &[f64], lambda: f64) -> Option<Vec<f64>> {
@@ -315,51 +237,13 @@ impl<'p> ModeEstimator<'p> {
     }
 }
 
-/// What the first two Newton steps of an estimate gave: the twice-stepped point, kept, or the
-/// iterate a solve to convergence goes on from (None: the padded point).
-enum Steps {
-    Kept(Vec<f64>),
-    Beyond(Option<Vec<f64>>),
-}
-
-/// When the first two Newton steps of the extended system size a point without a solve to
-/// convergence ([`StepRule`]).
-pub const STEP_RULE: StepRule = StepRule {
-    second_step: 1e-2,
-    floor: 1e-6,
-};
-
-/// When an estimate is kept from the first two Newton steps of the extended system from the
-/// padded point: the residual after the first step is within the linear range of the forced
-/// response's estimate ([`LinearRange`], at most 5 % of the padded point's), and the second
-/// step changes each of ω, D and A by at most [`Self::second_step`] of the estimate itself
-/// (the change from the point, at least [`Self::floor`] of the value). Newton converging
-/// quadratically, the twice-stepped point is then off the converged one by far less than the
-/// second step.
-///
-/// The first step alone, kept on the residual's contraction as the forced response keeps its
-/// step, is not enough here: ω and D change only through the contacts' response to the new
-/// harmonics, while the residual is dominated by those harmonics' own rows; on the 1-DOF Jenkins
-/// oscillator at H = 1 the steps within that range gave 0.07-5.4 times the converged change of
-/// the frequency (`tests/it/nonlinear_modes/checks.rs` asks for 0.99-1.01).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StepRule {
-    /// Largest change of a property by the second step, relative to its estimate (–).
-    pub second_step: f64,
-    /// Smallest estimate the rule measures against, relative to the property's value (–).
-    pub floor: f64,
-}
-
 /// How the estimates of a run were formed: points whose padded point already solved the
-/// extension, points sized by the first two Newton steps, points solved to convergence, points
-/// not sized.
+/// extension, points solved to convergence, points not sized.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
 pub struct EstimateCounts {
     /// The padded point solves the extended system (estimate 0).
     pub converged: usize,
-    /// The first two Newton steps ([`StepRule`]).
-    pub stepped: usize,
-    /// Solved to convergence (the steps left their linear range).
+    /// Solved to convergence.
     pub solved: usize,
     /// The extended system could not be solved.
     pub not_sized: usize,

@@ -44,7 +44,7 @@ pub mod start;
 pub mod verify;
 pub mod warnings;
 
-pub use accuracy::{EstimateCounts, ModeAccuracy, StepRule, STEP_RULE};
+pub use accuracy::{EstimateCounts, ModeAccuracy};
 pub use limits::{band, mode_cases, mode_limits, scene_modes, ModeBand, ModeCase, ModeLimits};
 pub use operator::{EpmcOperator, LogAmplitude};
 pub use predict::{modal_force, predicted_frf, predicted_peak, PredictedPeak};
