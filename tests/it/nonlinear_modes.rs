@@ -425,6 +425,81 @@ fn the_path_runs_between_the_amplitudes_asked_at_the_dof() {
     );
 }
 
+/// Two masses on springs to ground (k₁ = 4·10⁴, k₂ = 10⁴ N/m), held together by a Jenkins
+/// contact (kₜ = 10⁵ N/m, μN = 3 N): stuck, the first mode moves both about alike; in full
+/// slip it is the second mass's own, and the friction force, at most μN, drives the first mass
+/// to (4/π) μN / (k₁ − ω²m₁), a few 10⁻⁴ m at most.
+const SATURATING_PAIR: &str = r#"
+[model]
+dofs = ["x1", "x2"]
+mass = [[1.0, 0.0], [0.0, 1.0]]
+stiffness = [[4.0e4, 0.0], [0.0, 1.0e4]]
+damping = [[2.0, 0.0], [0.0, 2.0]]
+
+[[contacts]]
+name = "joint"
+damper = ["x1"]
+body = ["x2"]
+tangent = [1.0]
+normal = [0.0]
+kt = 1.0e5
+kn = 1.0e5
+mu = 0.3
+gap = -1.0e-4
+
+[[harmonic_loads]]
+dof = "x2"
+harmonic = 1
+cos = 1.0
+
+[harmonics]
+max = 1
+samples = 64
+
+[effects]
+normal_load = "constant"
+
+[analysis]
+freq_start_hz = 5.0
+freq_end_hz = 40.0
+
+[output]
+dofs = ["x1"]
+"#;
+
+/// A mode whose amplitude at the DOF saturates ends at its modal amplitude limit (100 times
+/// the high end's conversion with the linear shape) as `incomplete`, naming the highest
+/// amplitude at the DOF it reached: asked up to 10⁻² m at the first mass, it reaches the
+/// friction-driven bound (measured 2.1·10⁻⁴ m, at the modal amplitude limit 1.53).
+#[test]
+fn a_mode_whose_dof_amplitude_saturates_ends_at_the_modal_limit() {
+    let problem = scenes::problem(SATURATING_PAIR, &["accuracy.estimate=false"]);
+    let (low, high) = (1e-6, 1e-2);
+    let run =
+        nonlinear_modes::solve(&problem, &settings(ModeChoice::Number(1), 0, [low, high])).unwrap();
+    assert_eq!(run.end, nonlinear_modes::NonlinearModeEnd::ModalLimit);
+    assert!(!run.is_complete());
+    let highest = run
+        .points
+        .iter()
+        .map(|p| p.dof_amplitude)
+        .fold(0.0, f64::max);
+    let last = run.points.last().unwrap();
+    eprintln!(
+        "{} points, highest {highest:.4e} m at the DOF, last a = {:.4e} (limit {:.4e})",
+        run.points.len(),
+        last.modal_amplitude,
+        run.modal_range[1]
+    );
+    assert!(highest > 5e-5 && highest < 1e-3, "{highest:.4e}");
+    assert!((last.modal_amplitude - run.modal_range[1]).abs() <= 1e-9 * run.modal_range[1]);
+    let reason = run.incomplete_reason().unwrap();
+    assert!(
+        reason.contains(&format!("reached at most {highest:.4e} m of 1.0000e-2 m")),
+        "{reason}"
+    );
+}
+
 /// Every point's estimate is counted once, by how it was formed: on the 1-DOF Jenkins
 /// oscillator at H = 1 the stuck points already solve the extension (estimate 0, no solve), the
 /// others are solved to convergence, none is left unsized.
