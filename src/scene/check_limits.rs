@@ -3,6 +3,7 @@
 //! bound scan, the frequency grid, the peak window and the hysteresis loops to write.
 
 use crate::analysis::limits::{signed, CaseSpec, HysteresisRequest, LimitSettings};
+use crate::contact::{ContactPoint, DamperSide};
 use crate::scene::checker::Checker;
 use crate::scene::error::SceneError;
 use crate::scene::schema::Scene;
@@ -12,9 +13,14 @@ pub const MAX_ENVELOPE_GROUPS: usize = 64;
 
 /// The limit-analysis settings of the scene's `[limits]` table; `None` without one. The
 /// frequency range of `[analysis]` bounds the peak window and the loop frequencies.
+///
+/// Sides and points are those of the built contact set (`contacts`, `sides`), so that a case
+/// may name a contact patch's side and its points (`<side>-<k>`, numbered from 1 as the
+/// matching made them) as well as the `[[contacts]]`.
 pub(super) fn limit_settings(
     scene: &Scene,
     ck: &Checker,
+    (contacts, sides): (&[ContactPoint], &[DamperSide]),
 ) -> Result<Option<LimitSettings>, SceneError> {
     let Some(l) = &scene.limits else {
         return Ok(None);
@@ -43,23 +49,14 @@ pub(super) fn limit_settings(
             format!("must be in 2..=100000, got {}", l.grid_points),
         ));
     }
-    let side_names = {
-        let mut names: Vec<String> = Vec::new();
-        for c in &scene.contacts {
-            let s = c.side_name();
-            if !names.contains(&s) {
-                names.push(s);
-            }
-        }
-        names
-    };
-    let sides = side_names.len();
-    let combinations = (l.bound_scan.len() as f64).powi(sides as i32);
+    let side_names: Vec<String> = sides.iter().map(|s| s.name.clone()).collect();
+    let side_count = side_names.len();
+    let combinations = (l.bound_scan.len() as f64).powi(side_count as i32);
     if combinations > 4096.0 {
         return Err(ck.err(
             "limits.bound_scan",
             format!(
-                "{} values on {sides} sides make {combinations} curves; at most 4096",
+                "{} values on {side_count} sides make {combinations} curves; at most 4096",
                 l.bound_scan.len()
             ),
         ));
@@ -70,23 +67,21 @@ pub(super) fn limit_settings(
     if let Some(mode) = l.envelope {
         // A group with 2D-friction points searches its m = (m₁, m₂) in the unit disc: two
         // variables.
-        let two_d_sides = side_names
+        let two_d_sides = sides
             .iter()
             .filter(|side| {
-                scene
-                    .contacts
+                side.contacts
                     .iter()
-                    .any(|c| c.law.is_2d() && &c.side_name() == *side)
-                    || scene
-                        .contact_patches
-                        .iter()
-                        .any(|p| p.law.is_2d() && &p.side == *side)
+                    .any(|&c| contacts[c].second_tangent.is_some())
             })
             .count();
-        let two_d_points = scene.contacts.iter().filter(|c| c.law.is_2d()).count();
+        let two_d_points = contacts
+            .iter()
+            .filter(|c| c.second_tangent.is_some())
+            .count();
         let k = match mode {
-            crate::analysis::limits::EnvelopeMode::Sides => sides + two_d_sides,
-            crate::analysis::limits::EnvelopeMode::Points => scene.contacts.len() + two_d_points,
+            crate::analysis::limits::EnvelopeMode::Sides => side_count + two_d_sides,
+            crate::analysis::limits::EnvelopeMode::Points => contacts.len() + two_d_points,
         };
         if k > MAX_ENVELOPE_GROUPS {
             return Err(ck.err(
@@ -94,7 +89,11 @@ pub(super) fn limit_settings(
                 format!(
                     "{k} initial states to optimise (one per {}); at most \
                      {MAX_ENVELOPE_GROUPS}: use `sides`",
-                    if sides == k { "side" } else { "contact point" }
+                    if side_count == k {
+                        "side"
+                    } else {
+                        "contact point"
+                    }
                 ),
             ));
         }
@@ -106,6 +105,7 @@ pub(super) fn limit_settings(
         .chain(&l.intermediate)
         .map(|&m| format!("m{}", signed(m)))
         .collect();
+    let contact_index = |name: &str| contacts.iter().position(|k| k.name == name);
     let mut cases = Vec::new();
     for (i, c) in l.cases.iter().enumerate() {
         let f = |name: &str| format!("limits.cases[{i}].{name}");
@@ -139,24 +139,8 @@ pub(super) fn limit_settings(
         let mut contact_states = Vec::new();
         for (name, &m) in &c.contacts {
             let field = format!("{}.{name}", f("contacts"));
-            let contact = scene
-                .contacts
-                .iter()
-                .position(|k| &k.name == name)
-                .ok_or_else(|| {
-                    ck.err(
-                        field.clone(),
-                        format!(
-                            "unknown contact `{name}` (the scene has {})",
-                            scene
-                                .contacts
-                                .iter()
-                                .map(|k| k.name.as_str())
-                                .collect::<Vec<_>>()
-                                .join(", ")
-                        ),
-                    )
-                })?;
+            let contact = contact_index(name)
+                .ok_or_else(|| ck.err(field.clone(), unknown_contact(name, contacts, sides)))?;
             contact_states.push((contact, check_m(field, m)?));
         }
         // m₂ of 2D points: per side (for its `jenkins-2d` points) and per `jenkins-2d` contact,
@@ -203,11 +187,11 @@ pub(super) fn limit_settings(
         let mut contact_states2 = Vec::new();
         for (name, &m2) in &c.contacts2 {
             let field = format!("{}.{name}", f("contacts2"));
-            let Some(contact) = scene.contacts.iter().position(|k| &k.name == name) else {
-                return Err(ck.err(field, format!("unknown contact `{name}`")));
+            let Some(contact) = contact_index(name) else {
+                return Err(ck.err(field, unknown_contact(name, contacts, sides)));
             };
-            let k = &scene.contacts[contact];
-            if !k.law.is_2d() {
+            let k = &contacts[contact];
+            if k.second_tangent.is_none() {
                 return Err(ck.err(
                     field,
                     format!("contact `{name}` is not `jenkins-2d`: m₂ needs 2D friction"),
@@ -217,9 +201,9 @@ pub(super) fn limit_settings(
             let m1 = c
                 .contacts
                 .get(name)
-                .or(c.sides.get(&k.side_name()))
+                .or(c.sides.get(&sides[k.side].name))
                 .copied()
-                .unwrap_or(k.initial_state);
+                .unwrap_or(k.law.initial_state);
             if m1.hypot(m2) > 1.0 {
                 return Err(ck.err(
                     field,
@@ -318,4 +302,28 @@ pub(super) fn limit_settings(
         hysteresis,
         envelope: l.envelope,
     }))
+}
+
+/// Why `name` names no contact point: the `[[contacts]]` names, and each contact patch's
+/// points as a range (`left-1 … left-7`).
+fn unknown_contact(name: &str, contacts: &[ContactPoint], sides: &[DamperSide]) -> String {
+    let mut known: Vec<String> = Vec::new();
+    for side in sides {
+        let patch_points = |k: usize| format!("{}-{k}", side.name);
+        let points: Vec<&str> = side
+            .contacts
+            .iter()
+            .map(|&c| contacts[c].name.as_str())
+            .collect();
+        let n = points.len();
+        if n > 2 && (1..=n).all(|k| points.contains(&patch_points(k).as_str())) {
+            known.push(format!("{} … {}", patch_points(1), patch_points(n)));
+        } else {
+            known.extend(points.iter().map(|p| p.to_string()));
+        }
+    }
+    format!(
+        "unknown contact `{name}` (the scene has {})",
+        known.join(", ")
+    )
 }

@@ -121,7 +121,7 @@ impl Scene {
         let reduction =
             reduction_settings(self.reduction.as_ref(), &self.model, ck, dofs, fe.as_ref())?;
 
-        let limits = limit_settings(self, ck)?;
+        let limits = limit_settings(self, ck, (&contacts, &sides))?;
         let problem = Problem {
             model,
             contacts,

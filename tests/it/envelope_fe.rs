@@ -98,3 +98,47 @@ fn per_point_envelope_contains_the_per_side_envelope_and_the_limit_states() {
         "per-point min {point_lo:.6e} above the per-side min {side_lo:.6e}"
     );
 }
+
+/// A `[[limits.cases]]` entry may name a contact patch's side and its points (`<side>-<k>`,
+/// numbered as the matching made them): the case sets m on exactly those points. A point
+/// beyond the patch is refused, the error naming the patch's points.
+#[test]
+fn limit_cases_name_contact_patch_sides_and_points() {
+    let mesh = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/meshes/blade-pair/blade-pair-2d.msh"
+    );
+    let text = std::fs::read_to_string("meshes/blade-pair/blade-pair-2d-envelope.toml")
+        .unwrap()
+        .replace("mesh = \"blade-pair-2d.msh\"", &format!("mesh = {mesh:?}"));
+    let dir = tempfile::tempdir().unwrap();
+    let validate = |point: &str| {
+        let case = format!(
+            "\n[[limits.cases]]\nname = \"probe\"\nsides = {{ right = -0.5 }}\n\
+             contacts = {{ \"{point}\" = 0.5 }}\n"
+        );
+        let file = dir.path().join("scene.toml");
+        std::fs::write(&file, format!("{text}{case}")).unwrap();
+        fricbound::scene::load(&file, &["harmonics.max=1".to_string()])
+            .and_then(|scene| scene.validate_with_limits("scene.toml"))
+    };
+    let (problem, settings) = validate("left-3").unwrap_or_else(|e| panic!("{e}"));
+    let settings = settings.expect("the scene has [limits]");
+    let case = LimitCase::from_spec(&problem, &settings.cases[0]);
+    for (contact, m) in problem.contacts.iter().zip(&case.contact_states) {
+        let expected = match (contact.name.as_str(), contact.name.starts_with("right-")) {
+            ("left-3", _) => 0.5,
+            (_, true) => -0.5,
+            _ => contact.law.initial_state,
+        };
+        assert_eq!(*m, expected, "{}", contact.name);
+    }
+    let error = validate("left-8").unwrap_err().to_string();
+    assert!(
+        error.contains("limits.cases[0].contacts.left-8")
+            && error.contains(
+                "unknown contact `left-8` (the scene has left-1 … left-7, right-1 … right-7)"
+            ),
+        "{error}"
+    );
+}
