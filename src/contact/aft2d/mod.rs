@@ -112,10 +112,12 @@
 //! march), [`settle`] (the march to the periodic steady state, with Newton restarts) and
 //! [`jacobian`] (the analytic Jacobian through it) for the sampled law (`jenkins-2d-sampled`);
 //! [`resolved`] for the event-resolved law (`jenkins-2d`, [`crate::contact::events2d`]),
-//! whose periodic state is found by Newton on the continuous period map.
+//! whose periodic state is found by Newton on the continuous period map, and [`grazing`] for
+//! the corner of the stuck set its march creeps into at the onset of slip, found directly.
 
 #[cfg(test)]
 mod fixtures;
+mod grazing;
 mod jacobian;
 mod march;
 mod resolved;

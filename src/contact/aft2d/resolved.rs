@@ -20,6 +20,24 @@
 //! the plain periods that led there. A Newton step that lands in the stuck set is therefore
 //! not kept: the march then repeats with plain periods from the initial condition.
 //!
+//! # Degenerate states at the onset of slip
+//!
+//! Where the stuck set (the slider positions stuck all period) is a thin lens, as where a
+//! nearly straight path is about to slip, a slider outside it slips a little at each of the
+//! lens's two ends every period and creeps into its corner, geometrically with a ratio close to
+//! 1 and like n^(−1/2) where the lens closes: the limit is a stuck period that just grazes the
+//! friction limit twice, never reached in a finite number of periods. Newton on Φ then lands
+//! in the lens (its fixed point is the corner, on the edge of the stuck set) and the plain
+//! periods creep. Each plain period, and the Newton fixed point, are therefore tested for such
+//! a corner ([`grazing`](super::grazing)): the two grazings' conditions are solved for it
+//! directly, it is accepted when the rest of the period stays inside the friction circle and
+//! the slider lies in its normal cone (from where the march converges to it), and its
+//! derivative follows from the implicit function theorem on the grazing conditions (the
+//! history's limit). The plain periods otherwise end when the Newton step (I − A)⁻¹(Φ(w) − w),
+//! the estimated distance to the fixed point, is within the tolerance, not the last period's
+//! drift, which a slowly converging sequence meets far from its limit; the polish likewise
+//! continues while it shortens that step.
+//!
 //! # The Jacobian
 //!
 //! The final period is marched with the sensitivities of every parameter (w_start, û₁, û₂,
@@ -28,6 +46,7 @@
 //! [`FIXED_POINT_CONDITION`] the singular direction is left out, as in the sampled march), or
 //! the history's, and dT̂/dx = G_x + G_w dw_start.
 
+use super::grazing::{corner_derivative, creeping_corner};
 use super::settle::{newton_step, pseudo_inverse, FIXED_POINT_CONDITION};
 use super::workspace::{Aft2dWorkspace, SampleKind};
 use crate::contact::aft::{AftError, MarchReport};
@@ -174,7 +193,16 @@ impl Aft2dWorkspace {
         let settled = self.newton(&small, s, first.w)?;
         s.buffers.resize(&march.columns);
         match settled {
-            Settled::FixedPoint { w, periods } => Ok((Start::FixedPoint, w, periods)),
+            Settled::FixedPoint { w, periods } => {
+                // A fixed point within the tolerance of a corner of the stuck set, slipping by
+                // no more than the tolerance allows, is the corner (the plain march's limit).
+                if !first.opened {
+                    if let Some(found) = self.corner(march, w) {
+                        return Ok((found.0, found.1, periods));
+                    }
+                }
+                Ok((Start::FixedPoint, w, periods))
+            }
             Settled::Stuck {
                 w,
                 periods,
@@ -248,35 +276,49 @@ impl Aft2dWorkspace {
         }
     }
 
-    /// Newton steps on a fixed point within the tolerance, while they cut its mismatch and
-    /// keep the period slipping (or lifting off), down to round-off.
+    /// Newton steps on a fixed point within the tolerance, while they keep the period slipping
+    /// (or lifting off) and shorten the Newton step (the estimated distance to the fixed
+    /// point: where I − A is nearly singular, rounding along the slip direction hides the
+    /// mismatch across it) without raising the mismatch beyond twice its rounding, down to
+    /// round-off.
     fn polish(
         &self,
         march: &PeriodMarch<'_>,
         s: &mut EventScratch,
         mut current: Trial,
     ) -> Result<[f64; 2], MarchFailure> {
+        let Some(mut step) = newton_step(current.mismatch(), current.a, self.march_scale) else {
+            return Ok(current.start);
+        };
         for _ in 0..POLISH_STEPS {
-            let round_off =
-                64.0 * f64::EPSILON * (current.start[0].hypot(current.start[1]) + self.march_scale);
-            if current.drift <= round_off {
+            let scale = current.start[0].hypot(current.start[1]) + self.march_scale;
+            let length = step[0].hypot(step[1]);
+            if length <= 4.0 * f64::EPSILON * scale {
                 break;
             }
-            let Some(step) = newton_step(current.mismatch(), current.a, self.march_scale) else {
-                break;
-            };
             let start = [current.start[0] + step[0], current.start[1] + step[1]];
             let t = trial(march, s, start)?;
-            if !(t.moves() && t.drift < current.drift) {
+            let rounding = 64.0 * f64::EPSILON * scale;
+            if !(t.moves() && t.drift <= 2.0 * current.drift.max(rounding)) {
+                break;
+            }
+            let Some(next) = newton_step(t.mismatch(), t.a, self.march_scale) else {
+                break;
+            };
+            let shorter = next[0].hypot(next[1]) < length;
+            if !(shorter || t.drift < current.drift) {
                 break;
             }
             current = t;
+            step = next;
         }
         Ok(current.start)
     }
 
     /// Plain periods from the initial condition with the start's derivative carried along,
-    /// until a period is stuck throughout (the history's state) or repeats with slip.
+    /// until a period is stuck throughout (the history's state), the Newton step of the period
+    /// map (the estimated distance to its fixed point) is within the tolerance, or the slider
+    /// is found creeping into a corner of the stuck set ([`grazing`](super::grazing)).
     fn plain(
         &self,
         march: &PeriodMarch<'_>,
@@ -284,17 +326,33 @@ impl Aft2dWorkspace {
     ) -> Result<(Start, [f64; 2], usize), MarchFailure> {
         let tol = self.settings.periodicity_tolerance * self.tolerance_scale;
         let budget = self.settings.max_periods.max(2);
+        let c = march.columns.count;
         let mut derivative = s.start_derivative.clone();
         let mut w = self.initial_slider;
         let mut drift = f64::INFINITY;
         for period in 1..=budget {
+            // The w_start columns restart from the identity each period (A of this period);
+            // the coefficient columns carry the history.
+            derivative[..2].copy_from_slice(&[1.0, 0.0]);
+            derivative[c..c + 2].copy_from_slice(&[0.0, 1.0]);
             s.buffers.dw.copy_from_slice(&derivative);
             let end = march.run(&mut s.buffers, w, None)?;
             if !(end.slipped || end.opened) {
                 return Ok((Start::History(x_part(&derivative, march)), w, period));
             }
-            drift = (end.w[0] - w[0]).hypot(end.w[1] - w[1]);
-            if drift <= tol {
+            let mismatch = [end.w[0] - w[0], end.w[1] - w[1]];
+            drift = mismatch[0].hypot(mismatch[1]);
+            let d = &s.buffers.dw;
+            let a = [d[0], d[1], d[c], d[c + 1]];
+            let distance = newton_step(mismatch, a, self.march_scale)
+                .map_or(f64::INFINITY, |step| step[0].hypot(step[1]));
+            if !end.opened {
+                if let Some((start, corner)) = self.corner(march, w) {
+                    return Ok((start, corner, period));
+                }
+            }
+            let round_off = 64.0 * f64::EPSILON * (w[0].hypot(w[1]) + self.march_scale);
+            if distance <= tol || drift <= round_off {
                 return Ok((Start::FixedPoint, w, period));
             }
             derivative.copy_from_slice(&s.buffers.dw);
@@ -304,6 +362,18 @@ impl Aft2dWorkspace {
             periods: budget,
             drift,
         })
+    }
+
+    /// The corner of the stuck set that the slider `w`, at the start of a period that slips
+    /// without lift-off, creeps into, with its derivative ([`grazing`](super::grazing)).
+    fn corner(&self, march: &PeriodMarch<'_>, w: [f64; 2]) -> Option<(Start, [f64; 2])> {
+        let corner = creeping_corner(march, w, self.march_scale)?;
+        let derivative = if march.columns.full() {
+            corner_derivative(march, &corner)?
+        } else {
+            Vec::new()
+        };
+        Some((Start::History(derivative), corner.w))
     }
 
     /// Marches the periodic period from `w` with every sensitivity and fills the outputs.
