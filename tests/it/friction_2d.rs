@@ -6,9 +6,10 @@
 
 use fricbound::analysis::frf::{self, PointSolver, Silent};
 use fricbound::analysis::limits::{self, LimitCase};
+use fricbound::contact::aft::AftError;
 use fricbound::contact::{ContactState, FrictionLaw};
 use fricbound::hbm::operator::HbmOperator;
-use fricbound::hbm::{check_jacobian, HbmSystem};
+use fricbound::hbm::{check_jacobian, HbmError, HbmSystem};
 use fricbound::model::{Formulation, JacobianStrategy, Problem};
 use fricbound::numerics::derivatives::check_operator_jacobian;
 use fricbound::numerics::jacobian::Storage;
@@ -85,6 +86,7 @@ fn formulations_agree_and_jacobians_match_central_differences_with_out_of_plane_
         ("schur", out_of_plane(Formulation::Schur)),
     ];
     let mut rotating = 0;
+    let mut unsettled = Vec::new();
     // Every twelfth point of the path (eight missed a third rotating one on the
     // event-resolved law's path).
     for p in run.points.iter().step_by(run.points.len() / 12) {
@@ -104,11 +106,22 @@ fn formulations_agree_and_jacobians_match_central_differences_with_out_of_plane_
         // Analytic Jacobians against central differences of the residual, steps of 10⁻⁶: the
         // event-resolved 2D law's slip integration leaves noise of about 10⁻¹² of the forces,
         // which steps of 10⁻⁷ amplify to 2e-6 (measured at 160.096 Hz).
-        // Central differences need the residual at x ± h along every unknown, also where x lies
-        // within h of the seam at which a contact stuck all period starts to slip (its slider
-        // then creeps into a corner of the stuck set, found directly by the AFT).
+        // Central differences need the residual at x ± h along every unknown. Where x lies
+        // within h of the seam at which a contact stuck all period starts to slip (a corner of
+        // the residual, docs/src/limits-known.md), the slider's periodic state there is a
+        // degenerate fixed point the march creeps towards: the AFT reports that it did not
+        // settle, and there is no derivative to check. Such a point is counted, not checked.
         let mut s = HbmSystem::new(&dense).unwrap();
-        let check = check_jacobian(&mut s, &p.coefficients, omega, 1e-6).unwrap();
+        let check = match check_jacobian(&mut s, &p.coefficients, omega, 1e-6) {
+            Err(HbmError::Aft {
+                source: AftError::NotSettled { .. },
+                ..
+            }) => {
+                unsettled.push(f);
+                continue;
+            }
+            other => other.unwrap(),
+        };
         assert!(
             check.relative() < 1e-6,
             "dense at {f:.3} Hz: {:.3e}",
@@ -167,6 +180,10 @@ fn formulations_agree_and_jacobians_match_central_differences_with_out_of_plane_
     assert!(
         rotating >= 3,
         "only {rotating} slipping points with out-of-plane motion"
+    );
+    assert!(
+        unsettled.len() <= 1,
+        "central differences did not settle at {unsettled:?} Hz"
     );
 }
 
