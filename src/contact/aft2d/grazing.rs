@@ -86,7 +86,7 @@ fn maximum(march: &PeriodMarch<'_>, w: [f64; 2], a: f64, b: f64) -> f64 {
 fn intersection(p: [[f64; 2]; 2], r: [f64; 2], near: [f64; 2]) -> Option<[f64; 2]> {
     let d = [p[1][0] - p[0][0], p[1][1] - p[0][1]];
     let dist = d[0].hypot(d[1]);
-    if !(dist > 0.0) {
+    if !(dist.is_finite() && dist > 0.0) {
         return None;
     }
     let a = (r[0] * r[0] - r[1] * r[1] + dist * dist) / (2.0 * dist);
@@ -166,7 +166,7 @@ pub(super) fn creeping_corner(march: &PeriodMarch<'_>, w: [f64; 2], scale: f64) 
             break;
         }
     }
-    if !(moved <= round_off / sine.max(1e-8)) {
+    if moved.is_nan() || moved > round_off / sine.max(1e-8) {
         return None;
     }
     // Inside the friction circle the rest of the period (to rounding of the motion scale).
