@@ -2,6 +2,11 @@
 //! H = 5, analytic Jacobian; and H = 1 with forward differences as the baseline; without the
 //! error estimate of every point, then at H = 1 and 5 with it (its cost).
 //!
+//! `oscillator_frf`: one FRF (5-40 Hz, H = 1) of a one-DOF Jenkins oscillator, the smallest
+//! problem there is (m = 1 kg, k = 10⁴ N/m, c = 2 N·s/m, a contact to ground with
+//! kₜ = kₙ = 10⁵ N/m, μ = 0.3 and a constant 10 N normal load, 256 samples), without and
+//! with the error estimate: the floor of the per-point cost.
+//!
 //! `contact_law_residual`: one harmonic-balance residual, and one residual with its Jacobian
 //! (`_jacobian`), with every contact on the
 //! event-resolved law (`jenkins-1d`) against the sampled one (`jenkins-1d-sampled`) at 128,
@@ -50,6 +55,59 @@ fn paper_frf(c: &mut Criterion) {
         let p = problem(&overrides);
         group.bench_function(name, |b| {
             b.iter(|| frf::solve(&p, &mut Silent).expect("paper FRF solves"))
+        });
+    }
+    group.finish();
+}
+
+/// The one-DOF Jenkins oscillator of `oscillator_frf`.
+const JENKINS_OSCILLATOR: &str = r#"
+[model]
+dofs = ["x"]
+mass = [[1.0]]
+stiffness = [[1.0e4]]
+damping = [[2.0]]
+
+[[contacts]]
+name = "ground"
+damper = ["x"]
+tangent = [1.0]
+normal = [0.0]
+kt = 1.0e5
+kn = 1.0e5
+mu = 0.3
+gap = -1.0e-4
+
+[[harmonic_loads]]
+dof = "x"
+harmonic = 1
+cos = 5.0
+
+[harmonics]
+max = 1
+samples = 256
+
+[effects]
+normal_load = "constant"
+
+[analysis]
+freq_start_hz = 5.0
+freq_end_hz = 40.0
+
+[output]
+dofs = ["x"]
+"#;
+
+fn oscillator_frf(c: &mut Criterion) {
+    let mut group = c.benchmark_group("oscillator_frf");
+    for (name, estimate) in [("H1", "false"), ("H1_estimate", "true")] {
+        let o = vec![format!("accuracy.estimate={estimate}")];
+        let p = scene::parse(JENKINS_OSCILLATOR, "oscillator", &o)
+            .expect("oscillator scene parses")
+            .validate("oscillator")
+            .expect("oscillator scene is valid");
+        group.bench_function(name, |b| {
+            b.iter(|| frf::solve(&p, &mut Silent).expect("oscillator FRF solves"))
         });
     }
     group.finish();
@@ -129,5 +187,5 @@ fn contact_law_residual(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, paper_frf, contact_law_residual);
+criterion_group!(benches, paper_frf, oscillator_frf, contact_law_residual);
 criterion_main!(benches);

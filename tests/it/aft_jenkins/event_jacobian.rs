@@ -3,7 +3,8 @@
 //! law's seam, and its forces against the sampled law's.
 
 use super::{
-    coefficients, effects, grazing_inputs, law, liftoff_inputs, regime_strategy, stick_slip_inputs,
+    coefficients, effects, grazing_inputs, jacobian_scales, law, liftoff_inputs, regime_strategy,
+    stick_slip_inputs,
 };
 use fricbound::contact::aft::AftWorkspace;
 use fricbound::contact::events::march::{Anchor, Phase, Piece};
@@ -60,11 +61,7 @@ fn event_jacobian_error(
     let state = aft.evaluate_events(&l, effects, u, v, true).unwrap().state;
     let base_phases = aft.event_phases().to_vec();
     let (tu, tv, nv) = (aft.dt_du.clone(), aft.dt_dv.clone(), aft.dn_dv.clone());
-    let scale_u = u.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
-    let scale_v = v.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
-    let max_entry = (0..nb * nb)
-        .map(|k| (tu[k].abs() * scale_u).max((tv[k].abs().max(nv[k].abs())) * scale_v))
-        .fold(f64::MIN_POSITIVE, f64::max);
+    let [scale_u, scale_v, max_entry] = jacobian_scales((u, v), (&tu, &tv, &nv));
     let mut max_err = 0.0_f64;
     for i in 0..nb {
         for (which, scale) in [(0, scale_u), (1, scale_v)] {

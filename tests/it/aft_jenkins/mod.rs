@@ -124,6 +124,18 @@ fn stuck_limit_states_touch_the_coulomb_limits() {
     }
 }
 
+/// The coefficient scales of û and v̂ (their largest magnitudes) and the largest Jacobian entry
+/// with each column scaled by its coefficient's scale: what the Jacobian checks measure
+/// their errors against.
+fn jacobian_scales((u, v): (&[f64], &[f64]), (tu, tv, nv): (&[f64], &[f64], &[f64])) -> [f64; 3] {
+    let scale_u = u.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+    let scale_v = v.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+    let max_entry = (0..tu.len())
+        .map(|k| (tu[k].abs() * scale_u).max((tv[k].abs().max(nv[k].abs())) * scale_v))
+        .fold(f64::MIN_POSITIVE, f64::max);
+    [scale_u, scale_v, max_entry]
+}
+
 /// Time samples per period in [`jacobian_error`].
 const GRAZING_SAMPLES: usize = 128;
 
@@ -146,11 +158,7 @@ fn jacobian_error(
     let state = aft.evaluate(&l, effects, u, v, true).unwrap().state;
     let (tu, tv, nv) = (aft.dt_du.clone(), aft.dt_dv.clone(), aft.dn_dv.clone());
     let (t0, n0) = (aft.t_hat.clone(), aft.n_hat.clone());
-    let scale_u = u.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
-    let scale_v = v.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
-    let max_entry = (0..nb * nb)
-        .map(|k| (tu[k].abs() * scale_u).max((tv[k].abs().max(nv[k].abs())) * scale_v))
-        .fold(f64::MIN_POSITIVE, f64::max);
+    let [scale_u, scale_v, max_entry] = jacobian_scales((u, v), (&tu, &tv, &nv));
     let mut max_err = 0.0_f64;
     for i in 0..nb {
         for (which, scale) in [(0, scale_u), (1, scale_v)] {
