@@ -60,43 +60,8 @@ fn paper_frf(c: &mut Criterion) {
     group.finish();
 }
 
-/// The one-DOF Jenkins oscillator of `oscillator_frf`.
-const JENKINS_OSCILLATOR: &str = r#"
-[model]
-dofs = ["x"]
-mass = [[1.0]]
-stiffness = [[1.0e4]]
-damping = [[2.0]]
-
-[[contacts]]
-name = "ground"
-damper = ["x"]
-tangent = [1.0]
-normal = [0.0]
-kt = 1.0e5
-kn = 1.0e5
-mu = 0.3
-gap = -1.0e-4
-
-[[harmonic_loads]]
-dof = "x"
-harmonic = 1
-cos = 5.0
-
-[harmonics]
-max = 1
-samples = 256
-
-[effects]
-normal_load = "constant"
-
-[analysis]
-freq_start_hz = 5.0
-freq_end_hz = 40.0
-
-[output]
-dofs = ["x"]
-"#;
+/// The one-DOF Jenkins oscillator of `oscillator_frf`, the tests' scene.
+const JENKINS_OSCILLATOR: &str = include_str!("../tests/it/common/jenkins-oscillator.toml");
 
 fn oscillator_frf(c: &mut Criterion) {
     let mut group = c.benchmark_group("oscillator_frf");

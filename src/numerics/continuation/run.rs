@@ -95,10 +95,6 @@ impl Continuation {
                         if self.accept(system, observer, &mut summary, point, t_new, &mut tangent) {
                             return Ok(summary);
                         }
-                        if observer.reached_end() {
-                            summary.end = PathEnd::EndFrequency;
-                            return Ok(summary);
-                        }
                         ds = self.next_step(ds, iterations, degrees, &summary);
                         if let Some(corner_hz) = window {
                             let reached = summary.points.last().map_or(corner_hz, |p| p.freq_hz());
@@ -122,10 +118,6 @@ impl Continuation {
                     self.turn_corner(system, &y, &tangent, &summary.points)
                 {
                     if self.accept(system, observer, &mut summary, point, t_new, &mut tangent) {
-                        return Ok(summary);
-                    }
-                    if observer.reached_end() {
-                        summary.end = PathEnd::EndFrequency;
                         return Ok(summary);
                     }
                     ds = a.initial_step.clamp(a.min_step, a.max_step);

@@ -1,5 +1,6 @@
 //! Accepting a corrected point: its tangent and how far the step turned the path, the turning
-//! points, the observer's report, and the range's end behind the start.
+//! points, the observer's report, and the ends at a point: the range's end behind the start, the
+//! observer's own.
 
 use super::predictor::MAX_TURN_DEGREES;
 use super::settings::{Continuation, OMEGA_SCALE};
@@ -54,8 +55,9 @@ impl Continuation {
 
     /// Takes a converged point with its tangent onto the path: reports it (and a turning point
     /// when dω/ds changed sign from `tangent`), makes its tangent the current one and lets the
-    /// scale follow the response. Returns true when the point left the range for good behind
-    /// the start (the summary's end is then [`PathEnd::LeftRangeBelow`]).
+    /// scale follow the response. Returns true when the path ends at the point: it left the
+    /// range for good behind the start ([`PathEnd::LeftRangeBelow`]), or the observer's own end
+    /// is reached ([`Observer::reached_end`]: [`PathEnd::EndFrequency`]).
     pub(super) fn accept<S: ParametricResidual, O: Observer<S>>(
         &mut self,
         system: &mut S,
@@ -75,10 +77,13 @@ impl Continuation {
         *tangent = t_new;
         self.adapt_scale(&point.x, tangent);
         summary.points.push(point);
+        let observer_end = observer.reached_end();
         if left {
             summary.end = PathEnd::LeftRangeBelow;
+        } else if observer_end {
+            summary.end = PathEnd::EndFrequency;
         }
-        left
+        left || observer_end
     }
 
     /// The hyperplane normal to the path of the unit tangent `t` (scaled space), as a covector

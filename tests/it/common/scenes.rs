@@ -39,40 +39,5 @@ pub fn load(path: &str, overrides: &[&str]) -> Problem {
 
 /// The single-DOF oscillator of `docs/scene.md` (m = 1 kg, k = 1e4 N/m, c = 2 N·s/m, a Jenkins
 /// contact to the ground with kₜ = 1e5 N/m, μN₀ = 3 N, F = 5 N) at H = 1 with a constant
-/// normal load.
-pub const JENKINS_OSCILLATOR: &str = r#"
-[model]
-dofs = ["x"]
-mass = [[1.0]]
-stiffness = [[1.0e4]]
-damping = [[2.0]]
-
-[[contacts]]
-name = "ground"
-damper = ["x"]
-tangent = [1.0]
-normal = [0.0]
-kt = 1.0e5
-kn = 1.0e5
-mu = 0.3
-gap = -1.0e-4
-
-[[harmonic_loads]]
-dof = "x"
-harmonic = 1
-cos = 5.0
-
-[harmonics]
-max = 1
-samples = 256
-
-[effects]
-normal_load = "constant"
-
-[analysis]
-freq_start_hz = 5.0
-freq_end_hz = 40.0
-
-[output]
-dofs = ["x"]
-"#;
+/// normal load; also the scene of the `oscillator_frf` benchmark (`benches/paper_frf.rs`).
+pub const JENKINS_OSCILLATOR: &str = include_str!("jenkins-oscillator.toml");
