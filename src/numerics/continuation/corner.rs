@@ -20,9 +20,9 @@
 //! ‖R‖ (2.6·10⁻⁸, above the tolerance), while Newton at a fixed frequency, with its
 //! backtracking, converges just past the corner in 4-7 iterations. So past a corner the path
 //! is taken on from a point solved at a fixed frequency a little beyond the last point, ahead
-//! in the direction of travel and else behind it (a corner fold), refusing a landing back on
-//! the incoming piece or further from the corner than the largest step; the tangent there is
-//! oriented along the chord from the corner.
+//! in the direction of travel, refusing a landing back on the incoming piece or further from
+//! the corner than the largest step; the tangent there is oriented along the chord from the
+//! corner.
 
 use super::settings::{Continuation, OMEGA_SCALE};
 use crate::numerics::linalg::{dot, norm};
@@ -49,7 +49,7 @@ impl Continuation {
     /// outgoing piece, whose direction is the null direction t_out of the Jacobian just past
     /// the corner (at y + h·t_in, on the outgoing side of the seam), by the corrector on the
     /// hyperplane normal to t_out through y ± h·t_out; then Newton at a fixed frequency h
-    /// ahead of the corner in the direction of travel, and h behind it. The first landing that
+    /// ahead of the corner in the direction of travel. The first landing that
     /// lies neither back on the path already `followed` ([`ON_PATH_FRACTION`]) nor further
     /// than the largest step from the corner is taken. None when there is none.
     pub(super) fn turn_corner<S: ParametricResidual>(
@@ -86,11 +86,9 @@ impl Continuation {
                     });
                 }
             }
-            for side in [ahead, -ahead] {
-                let x: Vec<f64> = (0..n).map(|j| y[j] * self.x_scale[j]).collect();
-                if let Ok(point) = self.solve_fixed(system, &x, (y[n] + side * h) * OMEGA_SCALE) {
-                    landings.push(point);
-                }
+            let x: Vec<f64> = (0..n).map(|j| y[j] * self.x_scale[j]).collect();
+            if let Ok(point) = self.solve_fixed(system, &x, (y[n] + ahead * h) * OMEGA_SCALE) {
+                landings.push(point);
             }
             for mut point in landings {
                 let landing = self.scaled(&point);
