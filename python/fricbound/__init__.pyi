@@ -94,7 +94,6 @@ class FrfResult(ContinuationPath):
 class Curve(ContinuationPath):
     name: str
     contact_states: List[float]
-    retries: int
     peak: Optional[Dict[str, Any]]
     turning_points_hz: List[float]
 
@@ -128,7 +127,6 @@ class SweepResult:
     peak_amplitude: _F
     peak_freq_hz: _F
     peak_refined: _F
-    retries: List[List[int]]
     failures: List[List[str]]
     status: str
     @property

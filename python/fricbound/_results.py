@@ -211,7 +211,7 @@ class FrfResult(ContinuationPath):
 class Curve(ContinuationPath):
     """A limit or intermediate curve of a limit analysis: the points of :class:`ContinuationPath`, plus
     ``name`` (``m+1``, ``m-1``, ...), ``contact_states`` (m per contact), ``status``,
-    ``retries``, ``turning_points_hz`` and ``peak`` (dict ``freq_hz``, ``amplitude`` (m),
+    ``turning_points_hz`` and ``peak`` (dict ``freq_hz``, ``amplitude`` (m),
     ``refined``, ``states``; None when no point lies in the peak window)."""
 
     def __init__(self, d: Dict[str, Any], names: Dict[str, Any]):

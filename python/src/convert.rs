@@ -355,14 +355,13 @@ fn peak_obj<'py>(py: Python<'py>, peak: Option<&Peak>) -> PyResult<Bound<'py, Py
 }
 
 /// One limit or intermediate curve: `name`, `contact_states` (m per contact), `status`,
-/// `complete`, `retries`, `peak`, `turning_points_hz` and its `points` ([`points_dict`]).
+/// `complete`, `peak`, `turning_points_hz` and its `points` ([`points_dict`]).
 fn curve_dict<'py>(py: Python<'py>, c: &CaseCurve) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("name", &c.case.name)?;
     d.set_item("contact_states", c.case.contact_states.clone())?;
     d.set_item("status", c.status.text())?;
     d.set_item("complete", c.status.is_complete())?;
-    d.set_item("retries", c.retries)?;
     d.set_item("peak", peak_obj(py, c.peak.as_ref())?)?;
     d.set_item("turning_points_hz", c.turning_points.clone())?;
     d.set_item("points", points_dict(py, &c.points)?)?;
@@ -480,7 +479,7 @@ pub fn limits_dict<'py>(
 /// A sweep: `parameter`, `unit`, `series_parameter`, per point (in scene order) `value`,
 /// `series` (NaN without a series), and per point × case (`cases`) the resonance peak's
 /// `peak_amplitude` (m) and `peak_freq_hz` (NaN where the case failed or did not cover the
-/// range), `peak_refined`, `retries`; `limit_cases` (how many leading cases bound the
+/// range), `peak_refined`; `limit_cases` (how many leading cases bound the
 /// response), `peaks_from`; `failures` (one list of lines per point) and `status`.
 pub fn sweep_dict<'py>(
     py: Python<'py>,
@@ -530,10 +529,6 @@ pub fn sweep_dict<'py>(
     d.set_item(
         "peak_refined",
         array2(py, n, k, peak_field(&|p| if p.refined { 1.0 } else { 0.0 }))?,
-    )?;
-    d.set_item(
-        "retries",
-        points.iter().map(|p| p.retries.clone()).collect::<Vec<_>>(),
     )?;
     d.set_item("cases", cases)?;
     d.set_item(

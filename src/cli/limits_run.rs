@@ -204,7 +204,6 @@ struct CurveJson<'a> {
     /// `complete`, `incomplete: <why the path did not cover the range>` or `failed: <cause>`.
     status: &'a limits::CurveStatus,
     peak: Option<&'a limits::Peak>,
-    continuation_retries: usize,
     /// Largest error estimates over the curve's points (when the scene asks for them).
     #[serde(skip_serializing_if = "Option::is_none")]
     accuracy: Option<files::AccuracySummary>,
@@ -223,7 +222,6 @@ fn curve_json(ctx: &RunContext<'_>, c: &CaseCurve, stability: bool) -> serde_jso
         case: &c.case,
         status: &c.status,
         peak: c.peak.as_ref(),
-        continuation_retries: c.retries,
         accuracy: files::accuracy_summary(
             &info.outputs,
             ctx.problem.analysis.error_estimate.warn_threshold,
@@ -481,7 +479,7 @@ fn plot(ctx: &RunContext<'_>, a: &LimitAnalysis) -> Result<(), CommandError> {
     Ok(())
 }
 
-/// A few lines on a finished analysis: peaks, regime, bound scan, retries, missing loops.
+/// A few lines on a finished analysis: peaks, regime, bound scan, missing loops.
 pub(super) fn summary(a: &LimitAnalysis, elapsed: f64) -> String {
     use std::fmt::Write as _;
     let mut s = format!("limit analysis in {elapsed:.2} s\n");
@@ -501,13 +499,8 @@ pub(super) fn summary(a: &LimitAnalysis, elapsed: f64) -> String {
         };
         let _ = writeln!(
             s,
-            "  {:<24} {peak}{}{}",
+            "  {:<24} {peak}{}",
             c.case.name,
-            if c.retries > 0 {
-                format!(" ({} continuation retries)", c.retries)
-            } else {
-                String::new()
-            },
             if c.status.is_complete() {
                 String::new()
             } else {

@@ -56,8 +56,6 @@ pub struct SweepPoint {
     /// Resonance peak of each case (first output DOF); `None` where the case failed or did not
     /// cover the range (an unfinished path's highest point need not be the peak).
     pub peaks: Vec<Option<Peak>>,
-    /// Continuation retries of each case (see [`limits::attempt_case`]).
-    pub retries: Vec<usize>,
     /// Every case (limit, intermediate and, with `output = "limits"`, scanned) that failed or
     /// did not cover the range, one line each ("curve `<name>` failed: …", "curve `<name>`
     /// incomplete: …"); empty when everything was solved.
@@ -214,7 +212,6 @@ pub fn solve_value(
         cases: names,
         limit_cases: 2,
         peaks: vec![None; cases.len()],
-        retries: vec![0; cases.len()],
         failures: Vec::new(),
         analysis: None,
     };
@@ -222,7 +219,6 @@ pub fn solve_value(
         SweepOutput::Peaks => {
             for (k, case) in cases.iter().enumerate() {
                 let curve = limits::attempt_case(problem, case, settings.peak_window_hz);
-                point.retries[k] = curve.retries;
                 point.failures.extend(curve.unfinished_reason());
                 // The peak of an unfinished curve is not the case's: its path may stop short.
                 if curve.status.is_complete() {
@@ -241,7 +237,6 @@ pub fn solve_value(
                     if c.status.is_complete() {
                         point.peaks[k] = c.peak.clone();
                     }
-                    point.retries[k] = c.retries;
                 }
                 point.failures.extend(analysis.unfinished());
                 point.analysis = Some(Box::new(analysis));
@@ -275,7 +270,6 @@ fn solve_modes_value(
         cases: solved.cases.iter().map(|c| c.case.name.clone()).collect(),
         limit_cases: solved.cases.len() - settings.intermediate_cases(problem).len(),
         peaks: vec![None; solved.cases.len()],
-        retries: vec![0; solved.cases.len()],
         failures: Vec::new(),
         analysis: None,
     };

@@ -12,7 +12,7 @@ use fricbound::scene;
 use support::{csv, fricbound, json, scene as scene_path, text};
 
 /// Continuation step (scaled arc length) used as initial, smallest and largest step, so that
-/// every retry of a case takes the same path and its point count is fixed.
+/// a case's path takes fixed steps and its point count is fixed.
 const STEP: &str = "0.25";
 
 /// The Figs. 13-14 scene (3rd resonance, 200-235 Hz) with fixed steps, a small grid, one
@@ -46,8 +46,8 @@ fn analyse(extra: &[String]) -> LimitAnalysis {
     limits::analyse(&p, &l, |_| {}).unwrap()
 }
 
-/// The smallest `analysis.max_points` with which `case` covers the range, retries with other
-/// steps included (bisection; completion is checked again where it is used).
+/// The smallest `analysis.max_points` with which `case` covers the range (bisection;
+/// completion is checked again where it is used).
 fn min_budget(problem: &Problem, case: &limits::LimitCase) -> usize {
     let complete = |b: usize| {
         let mut p = problem.clone();

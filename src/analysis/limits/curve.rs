@@ -71,8 +71,6 @@ pub struct CaseCurve {
     /// Resonance peak of the first output DOF in the peak window; `None` when no finished point
     /// lies in it.
     pub peak: Option<Peak>,
-    /// Continuation retries with other step settings after the first attempt (0: none).
-    pub retries: usize,
     /// How the case ended.
     pub status: CurveStatus,
 }
@@ -85,11 +83,6 @@ impl CaseCurve {
             .then(|| format!("curve `{}` {}", self.case.name, self.status.text()))
     }
 }
-
-/// Factors on the scene's continuation steps (initial and largest) tried in turn when a curve
-/// fails: a continuation that stalls at a corner of the piecewise-smooth path (a contact
-/// changing state) usually passes it when the corner is approached with other steps.
-const STEP_RETRIES: [f64; 4] = [1.0, 0.5, 0.25, 2.0];
 
 /// Collects the path as it comes, so that the points of a continuation that fails are kept.
 #[derive(Default)]
@@ -111,79 +104,37 @@ impl FrfObserver for Collect {
     }
 }
 
-/// One attempt: its points, turning points and status (before the peak is sought).
-struct Attempt {
-    points: Vec<FrfPoint>,
-    turning_points: Vec<f64>,
-    jumps: Vec<Jump>,
-    status: CurveStatus,
-}
-
-impl Attempt {
-    /// Highest frequency the attempt reached (Hz; −∞ without points).
-    fn reach_hz(&self) -> f64 {
-        self.points
-            .iter()
-            .map(|p| p.freq_hz)
-            .fold(f64::NEG_INFINITY, f64::max)
-    }
-}
-
 /// Solves the FRF of one case and locates its peak (first output DOF) in `window` (Hz).
 /// Never fails: how the case ended is in [`CaseCurve::status`].
 ///
-/// If the continuation fails, or ends before the end of the range (an incomplete run: the
-/// curve would not cover the range the limits are asked for), it is repeated with the scene's
-/// initial and largest steps scaled by the factors 0.5, 0.25 and 2 in turn; the number of
-/// retries is recorded. When no attempt covers the range, the attempt that reached the highest
-/// frequency is kept (the first of equals) with its finished points and its status
-/// (`Incomplete` or `Failed`). A path that covers the range but has no point in the peak
-/// window is `Failed` with [`LimitError::NoPeak`] (its points are kept).
+/// A continuation that fails, or ends before the end of the range (an incomplete run: the
+/// curve would not cover the range the limits are asked for), keeps its finished points with
+/// its status (`Incomplete` or `Failed`). A path that covers the range but has no point in the
+/// peak window is `Failed` with [`LimitError::NoPeak`] (its points are kept).
 pub fn attempt_case(problem: &Problem, case: &LimitCase, window: Option<(f64, f64)>) -> CaseCurve {
     let p = case.apply(problem);
-    let mut best: Option<(usize, Attempt)> = None;
-    for (retries, factor) in STEP_RETRIES.iter().enumerate() {
-        let mut attempt_problem = p.clone();
-        let a = &mut attempt_problem.analysis.continuation;
-        a.max_step = (a.max_step * factor).max(a.min_step);
-        a.initial_step = (a.initial_step * factor).clamp(a.min_step, a.max_step);
-        let mut collect = Collect::default();
-        let attempt = match frf::solve(&attempt_problem, &mut collect) {
-            Ok(run) => Attempt {
-                status: match run.incomplete_reason() {
-                    None => CurveStatus::Complete,
-                    Some(reason) => CurveStatus::Incomplete { reason },
-                },
-                points: run.points,
-                turning_points: run.turning_points,
-                jumps: run.jumps,
-            },
-            Err(source) => Attempt {
-                points: collect.points,
-                turning_points: collect.turning_points,
-                jumps: collect.jumps,
-                status: CurveStatus::Failed {
-                    error: LimitError::Curve {
-                        case: case.name.clone(),
-                        source,
-                    },
+    let mut collect = Collect::default();
+    let (points, turning_points, jumps, mut status) = match frf::solve(&p, &mut collect) {
+        Ok(run) => {
+            let status = match run.incomplete_reason() {
+                None => CurveStatus::Complete,
+                Some(reason) => CurveStatus::Incomplete { reason },
+            };
+            (run.points, run.turning_points, run.jumps, status)
+        }
+        Err(source) => (
+            collect.points,
+            collect.turning_points,
+            collect.jumps,
+            CurveStatus::Failed {
+                error: LimitError::Curve {
+                    case: case.name.clone(),
+                    source,
                 },
             },
-        };
-        let complete = attempt.status.is_complete();
-        if best
-            .as_ref()
-            .is_none_or(|(_, b)| complete || attempt.reach_hz() > b.reach_hz())
-        {
-            best = Some((retries, attempt));
-        }
-        if complete {
-            break;
-        }
-    }
-    let (retries, attempt) = best.expect("STEP_RETRIES is not empty");
-    let mut status = attempt.status;
-    let peak = match refine_peak(&p, &attempt.points, 0, window) {
+        ),
+    };
+    let peak = match refine_peak(&p, &points, 0, window) {
         Ok(peak) => peak,
         Err(source) => {
             if status.is_complete() {
@@ -209,11 +160,10 @@ pub fn attempt_case(problem: &Problem, case: &LimitCase, window: Option<(f64, f6
     }
     CaseCurve {
         case: case.clone(),
-        points: attempt.points,
-        turning_points: attempt.turning_points,
-        jumps: attempt.jumps,
+        points,
+        turning_points,
+        jumps,
         peak,
-        retries,
         status,
     }
 }

@@ -71,8 +71,6 @@ pub struct ScannedCase {
     pub case: LimitCase,
     /// Resonance peak of the first output DOF in the peak window, if the path has a point there.
     pub peak: Option<Peak>,
-    /// Continuation retries with other step settings.
-    pub retries: usize,
     /// How the case ended (`complete`, `incomplete: …`, `failed: …` in JSON).
     pub status: CurveStatus,
 }
@@ -288,7 +286,6 @@ where
                 let scanned = ScannedCase {
                     case: curve.case,
                     peak: curve.peak,
-                    retries: curve.retries,
                     status: curve.status,
                 };
                 (scanned, sols)

@@ -270,30 +270,12 @@ pub fn key_numbers(figures: &[FigureResult]) -> KeyNumbers {
         let Some(report) = f.report() else { continue };
         match &report.outcome {
             RunOutcome::Limits(a) => {
-                for c in a.limits.iter().chain(&a.intermediate) {
-                    if c.retries > 0 {
-                        k.retries.push(format!(
-                            "{}: curve {}, {} retries",
-                            f.job.id, c.case.name, c.retries
-                        ));
-                    }
-                }
                 k.analyses
                     .extend(analysis_row(f.job.id, String::new(), None, a));
             }
             RunOutcome::Sweep(points) => {
                 let spec = sweep_spec(f.job);
                 for p in points {
-                    for (case, r) in p.cases.iter().zip(&p.retries) {
-                        if *r > 0 {
-                            k.retries.push(format!(
-                                "{} at {} = {}: curve {case}, {r} retries",
-                                f.job.id,
-                                sweep_name(&spec),
-                                p.value
-                            ));
-                        }
-                    }
                     for e in &p.failures {
                         k.failures.push(format!(
                             "{} at {} = {}: {e}",

@@ -1,6 +1,6 @@
 //! `summary.md`: the document around the comparison with the paper ([`markdown`]): the header,
 //! the key-number table and the differences (from the comparison), the bound checks, the
-//! envelope over all initial states against the limits, one section per figure with its images and numbers, the continuation retries and the failures.
+//! envelope over all initial states against the limits, one section per figure with its images and numbers, and the failures.
 
 use std::fmt::Write as _;
 
@@ -37,17 +37,6 @@ pub fn markdown(figures: &[FigureResult], k: &KeyNumbers, quick: bool, elapsed_s
     envelope_table(&mut s, k);
     figure_sections(&mut s, figures, k);
     differences(&mut s, k);
-    if !k.retries.is_empty() {
-        let _ = writeln!(
-            s,
-            "## Continuation retries\n\nThese curves stalled with the scene's continuation steps \
-             and were solved with other steps (`limits::solve_case`):\n"
-        );
-        for r in &k.retries {
-            let _ = writeln!(s, "- {r}");
-        }
-        s.push('\n');
-    }
     if !k.failures.is_empty() {
         let _ = writeln!(s, "## Failures\n");
         for f in &k.failures {

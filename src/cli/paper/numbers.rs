@@ -212,8 +212,6 @@ pub struct KeyNumbers {
     pub f0_sweep_max_freq_change_pct: Option<(f64, f64)>,
     /// Loops at resonance (Fig. 16c).
     pub loops: Vec<LoopRow>,
-    /// Curves that needed continuation retries, one line each.
-    pub retries: Vec<String>,
     /// Sweep points or figures that failed, one line each.
     pub failures: Vec<String>,
     /// Figures that compute the envelope in the full study but skipped it in this (`--quick`)
