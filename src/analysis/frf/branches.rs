@@ -1,7 +1,6 @@
 //! The branch past a fold the path did not come back from: a point solved just past the highest
 //! frequency reached, and the branch through it followed back down toward that frequency.
 
-use std::collections::VecDeque;
 use std::f64::consts::PI;
 
 use super::observer::{Adapter, Silent};
@@ -18,16 +17,30 @@ use crate::numerics::{Continuation, ContinuationSettings, PathSummary};
 /// tried in turn until a point converges there.
 const JUMP_FRACTIONS: &[f64] = &[0.0005, 0.002, 0.005, 0.01, 0.02, 0.03, 0.05, 0.1, 0.2];
 
-/// What the branches of one run share: the settings, the arc-length scale, how it grows and
-/// which amplitudes the steps follow.
-pub(super) struct Branching<'a> {
+/// What the branches of one run share: the settings, the arc-length scale (each branch starts
+/// with the one the branch before grew to), how it grows and which amplitudes the steps follow.
+pub(super) struct Branching {
     pub(super) settings: ContinuationSettings,
-    pub(super) x_scale: &'a [f64],
-    pub(super) adaptive: &'a AdaptiveScale,
-    pub(super) amplitude_groups: &'a [Vec<usize>],
+    pub(super) x_scale: Vec<f64>,
+    pub(super) adaptive: AdaptiveScale,
+    pub(super) amplitude_groups: Vec<Vec<usize>>,
 }
 
-impl Branching<'_> {
+impl Branching {
+    /// The continuation of a branch from `from_hz` toward `to_hz` (Hz, below or above) with at
+    /// most `max_points` points.
+    pub(super) fn continuation(&self, from_hz: f64, to_hz: f64, max_points: usize) -> Continuation {
+        let settings = ContinuationSettings {
+            freq_start_hz: from_hz,
+            freq_end_hz: to_hz,
+            max_points,
+            ..self.settings
+        };
+        Continuation::new(settings, self.x_scale.clone())
+            .with_adaptive_scale(self.adaptive.clone())
+            .with_amplitude_steps(self.amplitude_groups.clone())
+    }
+
     /// Follows the path silently from `x` (the operator's unknowns, converged at `from_hz`)
     /// toward `to_hz` (below or above) with at most `max_points` points. Returns the points in
     /// path order (the first is the start point) and the summary, None when the continuation
@@ -43,23 +56,9 @@ impl Branching<'_> {
         max_points: usize,
         estimates: Option<&EstimatePool<'_>>,
     ) -> (Vec<FrfPoint>, Option<PathSummary>) {
-        let settings = ContinuationSettings {
-            freq_start_hz: from_hz,
-            freq_end_hz: to_hz,
-            max_points,
-            ..self.settings
-        };
-        let mut collect = Adapter {
-            observer: &mut Silent,
-            points: Vec::new(),
-            failure: None,
-            estimates,
-            in_order: false,
-            held: VecDeque::new(),
-        };
-        let mut continuation = Continuation::new(settings, self.x_scale.to_vec())
-            .with_adaptive_scale(self.adaptive.clone())
-            .with_amplitude_steps(self.amplitude_groups.to_vec());
+        let mut silent = Silent;
+        let mut collect = Adapter::new(&mut silent, estimates, false);
+        let mut continuation = self.continuation(from_hz, to_hz, max_points);
         let summary = continuation.run(system, x, &mut collect).ok();
         (std::mem::take(&mut collect.points), summary)
     }

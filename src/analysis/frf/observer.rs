@@ -54,7 +54,24 @@ pub(super) enum Held {
     Jump(Jump),
 }
 
-impl<O: FrfObserver> Adapter<'_, '_, '_, O> {
+impl<'o, 'p, 'e, O: FrfObserver> Adapter<'o, 'p, 'e, O> {
+    /// An adapter with no points yet, passing events to `observer` (in order behind pending
+    /// estimates when `in_order`), estimating on `estimates` when the run estimates.
+    pub(super) fn new(
+        observer: &'o mut O,
+        estimates: Option<&'p EstimatePool<'e>>,
+        in_order: bool,
+    ) -> Self {
+        Adapter {
+            observer,
+            points: Vec::new(),
+            failure: None,
+            estimates,
+            in_order,
+            held: VecDeque::new(),
+        }
+    }
+
     /// Gives `point` its error estimate at ω = `omega` (rad/s), at once or pending on a
     /// worker, when the run estimates.
     pub(super) fn estimate(&self, point: &mut FrfPoint, omega: f64, place: Option<PathPlace>) {

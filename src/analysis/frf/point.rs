@@ -180,27 +180,18 @@ fn correct_on_hyperplane(
     normal: &[f64],
 ) -> Result<FrfPoint, NewtonFailure> {
     let (y, iterations, residual) = newton.correct(system, predicted, normal)?;
-    let n = y.len() - 1;
-    let x: Vec<f64> = y[..n]
-        .iter()
-        .zip(&newton.x_scale)
-        .map(|(v, s)| v * s)
-        .collect();
-    let omega = 2.0 * PI * y[n];
-    let mut r = vec![0.0; n];
-    system
-        .residual(&x, omega, &mut r)
-        .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
     let path_point = PathPoint {
-        omega,
-        x,
         iterations,
         residual,
-        step: 0.0,
+        ..newton.unscaled(&y)
     };
+    let mut r = vec![0.0; path_point.x.len()];
+    system
+        .residual(&path_point.x, path_point.omega, &mut r)
+        .map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
     let mut point =
         full_point(system, &path_point).map_err(|e| NewtonFailure::Evaluation(e.to_string()))?;
-    point.freq_hz = y[n];
+    point.freq_hz = y[y.len() - 1];
     Ok(point)
 }
 

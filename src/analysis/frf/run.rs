@@ -1,7 +1,6 @@
 //! The FRF driver: the starting guess, the continuation over the range, and the jump past a
 //! fold the path does not come back from, reported to the observer as they come.
 
-use std::collections::VecDeque;
 use std::f64::consts::PI;
 use std::thread::Scope;
 use std::time::Instant;
@@ -55,22 +54,17 @@ fn solve_in<'scope, 'p, O: FrfObserver>(
     let set = system.unknowns().clone();
     let settings = problem.analysis.continuation;
     let omega0 = 2.0 * PI * settings.freq_start_hz;
-    let mut x_scale = arc_length_x_scale(problem, &set, &system)?;
-    let mut guess = start_guess(problem, &set, &mut system, &x_scale, omega0)?;
-    // How the scale grows and which amplitudes the steps follow: the same on every branch.
-    let adaptive = adaptive_scale(problem, &set, &system);
-    let amplitude_groups = output_amplitude_groups(problem, &set, &system);
+    let mut branching = Branching {
+        settings,
+        x_scale: arc_length_x_scale(problem, &set, &system)?,
+        adaptive: adaptive_scale(problem, &set, &system),
+        amplitude_groups: output_amplitude_groups(problem, &set, &system),
+    };
+    let mut guess = start_guess(problem, &set, &mut system, &branching.x_scale, omega0)?;
     let pool = refined
         .map(|r| EstimatePool::start(scope, problem, r, EstimatePool::default_workers()))
         .transpose()?;
-    let mut adapter = Adapter {
-        observer,
-        points: Vec::new(),
-        failure: None,
-        estimates: pool.as_ref(),
-        in_order: true,
-        held: VecDeque::new(),
-    };
+    let mut adapter = Adapter::new(observer, pool.as_ref(), true);
     let mut run = FrfRun {
         points: Vec::new(),
         turning_points: Vec::new(),
@@ -81,17 +75,11 @@ fn solve_in<'scope, 'p, O: FrfObserver>(
     };
     let mut start_hz = settings.freq_start_hz;
     loop {
-        let segment = ContinuationSettings {
-            freq_start_hz: start_hz,
-            max_points: settings.max_points.saturating_sub(adapter.points.len()),
-            ..settings
-        };
-        let mut continuation = Continuation::new(segment, x_scale.clone())
-            .with_adaptive_scale(adaptive.clone())
-            .with_amplitude_steps(amplitude_groups.clone());
+        let remaining = settings.max_points.saturating_sub(adapter.points.len());
+        let mut continuation = branching.continuation(start_hz, settings.freq_end_hz, remaining);
         let outcome = continuation.run(&mut system, &guess, &mut adapter);
         // The next branch starts with the scale this one grew to.
-        x_scale.clone_from(&continuation.x_scale);
+        branching.x_scale.clone_from(&continuation.x_scale);
         if let Some(e) = adapter.failure.take() {
             return Err(FrfError::Setup(e));
         }
@@ -123,12 +111,6 @@ fn solve_in<'scope, 'p, O: FrfObserver>(
         // report those points first (in rising frequency) so that the path reads on from the
         // jump. The fill's first point (at the jump target) is solved again by the branch's
         // own run.
-        let branching = Branching {
-            settings,
-            x_scale: &x_scale,
-            adaptive: &adaptive,
-            amplitude_groups: &amplitude_groups,
-        };
         let (mut fill, fill_summary) = branching.follow(
             &mut system,
             &x,

@@ -29,15 +29,10 @@ impl Continuation {
         let n = yc.len() - 1;
         let apart: Vec<f64> = yc.iter().zip(predicted).map(|(a, b)| a - b).collect();
         let point = PathPoint {
-            omega: yc[n] * OMEGA_SCALE,
-            x: yc[..n]
-                .iter()
-                .zip(&self.x_scale)
-                .map(|(v, s)| v * s)
-                .collect(),
             iterations,
             residual,
             step: ds,
+            ..self.unscaled(yc)
         };
         let from_chord = self.last_factor.borrow().is_some();
         let mut t_new = self.tangent(system, &point, Some(tangent))?;
@@ -100,6 +95,19 @@ impl Continuation {
                 }
             })
             .collect()
+    }
+
+    /// The path point (unknowns in m, ω in rad/s) of a y in the scaled space (x / x_scale,
+    /// ω / 2π), with no iterations, residual or step.
+    pub fn unscaled(&self, y: &[f64]) -> PathPoint {
+        let n = y.len() - 1;
+        PathPoint {
+            omega: y[n] * OMEGA_SCALE,
+            x: (0..n).map(|j| y[j] * self.x_scale[j]).collect(),
+            iterations: 0,
+            residual: 0.0,
+            step: 0.0,
+        }
     }
 
     /// The point `last` in the scaled space (x / x_scale, ω / 2π).
