@@ -78,6 +78,7 @@ impl Continuation {
             .map(|p| self.scaled(p))
             .collect();
         let ahead = if tangent[n] >= 0.0 { 1.0 } else { -1.0 };
+        let corner = self.unscaled(y);
         for factor in CORNER_OFFSETS {
             let h = factor * self.settings.min_step;
             if h > self.settings.max_step {
@@ -99,8 +100,8 @@ impl Continuation {
                     });
                 }
             }
-            let x: Vec<f64> = (0..n).map(|j| y[j] * self.x_scale[j]).collect();
-            if let Ok(point) = self.solve_fixed(system, &x, (y[n] + ahead * h) * OMEGA_SCALE) {
+            if let Ok(point) = self.solve_fixed(system, &corner.x, (y[n] + ahead * h) * OMEGA_SCALE)
+            {
                 landings.push(point);
             }
             for mut point in landings {
