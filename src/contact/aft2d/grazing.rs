@@ -122,28 +122,33 @@ pub(super) fn creeping_corner(march: &PeriodMarch<'_>, w: [f64; 2], scale: f64) 
     let g: Vec<f64> = (0..n)
         .map(|k| exceedance(march, k as f64 * cell, w)[0])
         .collect();
-    // The active times: the grid's local maxima of g above −`inside` (one may have just been
-    // met, to rounding), exactly two, one of them above 0.
+    // The active times: the local maxima of g, bracketed on the grid and refined (a grazing
+    // peak lies between samples: at 128 samples a period of the first harmonic puts the
+    // samples next to it up to g″ cell²/8 below it, far more than the excess of a creeping
+    // slip), above −`inside` (one may have just been met, to rounding): exactly two, one of
+    // them above 0.
     let inside = 1e-9 * scale;
-    if !g.iter().any(|&x| x > 0.0) {
-        return None;
-    }
-    let mut peaks = [0usize; 2];
+    let mut times = [0.0; 2];
     let mut count = 0;
+    let mut exceeds = false;
     for k in 0..n {
         let (before, after) = (g[(k + n - 1) % n], g[(k + 1) % n]);
-        if g[k] > -inside && g[k] >= before && g[k] > after {
-            if count == 2 {
-                return None;
+        if g[k] >= before && g[k] > after {
+            let t = maximum(march, w, (k as f64 - 1.0) * cell, (k as f64 + 1.0) * cell);
+            let peak = exceedance(march, t, w)[0];
+            if peak > -inside {
+                if count == 2 {
+                    return None;
+                }
+                times[count] = t;
+                count += 1;
+                exceeds |= peak > 0.0;
             }
-            peaks[count] = k;
-            count += 1;
         }
     }
-    if count != 2 {
+    if count != 2 || !exceeds {
         return None;
     }
-    let mut times = peaks.map(|k| k as f64 * cell);
     let mut c = w;
     let round_off = 16.0 * f64::EPSILON * (scale + w[0].hypot(w[1]));
     let mut moved = f64::INFINITY;

@@ -21,7 +21,7 @@ pub(super) fn crossing(
             return Some(brent(value, a, b, fa, fb));
         }
         if first || fa <= zero {
-            return Some(rising_root(&value, a, b, fb, dfa));
+            return Some(rising_root(&value, (a, b), fb, zero));
         }
         return Some(a);
     }
@@ -32,57 +32,35 @@ pub(super) fn crossing(
             if fa < -zero {
                 return Some(brent(value, a, peak, fa, f_peak));
             }
-            return Some(rising_root(&value, a, peak, f_peak, dfa));
+            return Some(rising_root(&value, (a, peak), f_peak, zero));
         }
     }
     None
 }
 
-/// The first rise of f through zero in (a, b] where f(a) ≈ 0 (rate `dfa`) and f(b) > 0.
-///
-/// Where f falls at a (dfa < 0) but is already positive at the first subdivision, the dip
-/// below zero is shorter than a subdivision (a trial force that barely lags the friction
-/// limit at a closing, say): it is found by halving towards a, rather than taking a itself
-/// as the root (which would end the phase where it starts, and the next phase there too).
-fn rising_root(f: &impl Fn(f64) -> f64, a: f64, b: f64, fb: f64, dfa: f64) -> f64 {
-    const SUBDIVISIONS: usize = 16;
+/// The first rise of f through zero in (a, b] where f(a) ≈ 0 and f(b) > 0: a point where
+/// f is below −`zero` (its round-off) is sought on a subdivision that is geometric toward a
+/// (the stretch where f dips below zero may be far shorter than the cell: a contact that
+/// closes and opens again, a slider that stops for an instant and slips on) and uniform
+/// beyond, then the root is refined from it; where f rises above `zero` first, it rises from
+/// a itself. The same rule as the 1D march's ([`crate::contact::events::march`]).
+fn rising_root(f: &impl Fn(f64) -> f64, (a, b): (f64, f64), fb: f64, zero: f64) -> f64 {
+    const GEOMETRIC: i32 = 40;
+    const UNIFORM: usize = 16;
+    let geometric = (5..=GEOMETRIC).rev().map(|k| a + (b - a) * 0.5_f64.powi(k));
+    let uniform = (1..=UNIFORM).map(|i| a + (b - a) * i as f64 / UNIFORM as f64);
     let mut negative: Option<(f64, f64)> = None;
-    for i in 1..=SUBDIVISIONS {
-        let t = if i == SUBDIVISIONS {
-            b
-        } else {
-            a + (b - a) * i as f64 / SUBDIVISIONS as f64
-        };
-        let ft = if i == SUBDIVISIONS { fb } else { f(t) };
-        if ft > 0.0 {
-            return match negative.or_else(|| dip(f, a, t, dfa)) {
+    for t in geometric.chain(uniform) {
+        let ft = if t >= b { fb } else { f(t) };
+        if ft > zero {
+            return match negative {
                 Some((tn, fneg)) => brent(f, tn, t, fneg, ft),
                 None => a,
             };
         }
-        if ft < 0.0 {
+        if ft < -zero {
             negative = Some((t, ft));
         }
     }
     b
-}
-
-/// A point of (a, t) where f < 0, found by halving t − a, when f falls at a (dfa < 0).
-fn dip(f: &impl Fn(f64) -> f64, a: f64, t: f64, dfa: f64) -> Option<(f64, f64)> {
-    if dfa >= 0.0 {
-        return None;
-    }
-    let mut step = t - a;
-    for _ in 0..60 {
-        step *= 0.5;
-        let tk = a + step;
-        if tk <= a {
-            break;
-        }
-        let fk = f(tk);
-        if fk < 0.0 {
-            return Some((tk, fk));
-        }
-    }
-    None
 }

@@ -433,7 +433,8 @@ impl PeriodMarch<'_> {
                 let speed = k.u[0][1].hypot(k.u[1][1]);
                 10.0 * ODE_TOLERANCE * (l[1].abs() + kt * speed)
             }
-            Exit::Opening | Exit::Closing => 1e-12 * k.v[0].abs(),
+            // v is zero where the contact has just closed or opened: its rates set the size.
+            Exit::Opening | Exit::Closing => 1e-12 * (k.v[0].abs() + k.v[1].abs() + k.v[2].abs()),
         }
     }
 

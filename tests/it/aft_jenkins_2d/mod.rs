@@ -355,3 +355,4 @@ fn grazing_inside_the_stick_circle_keeps_the_history_derivative() {
 }
 
 mod events;
+mod recorded;
