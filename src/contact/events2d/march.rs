@@ -189,6 +189,7 @@ impl PeriodMarch<'_> {
         let mut t = 0.0;
         let mut events = 0;
         let mut steps = 0;
+        let mut strict = false;
         let (mut slipped, mut opened, mut all_open) = (false, false, true);
         loop {
             let (tau, exit) = match phase {
@@ -198,7 +199,7 @@ impl PeriodMarch<'_> {
                     } else {
                         &[Exit::SlipOnset]
                     };
-                    let next = self.next_explicit(exits, w, t, end);
+                    let next = self.next_explicit(exits, w, (t, end), strict);
                     let tau = next.map_or(end, |n| n.0);
                     if let Some(r) = record.as_deref_mut() {
                         r.sticks.push((t, tau, w));
@@ -218,7 +219,7 @@ impl PeriodMarch<'_> {
                     } else {
                         &[]
                     };
-                    let next = self.next_explicit(exits, [0.0; 2], t, end);
+                    let next = self.next_explicit(exits, [0.0; 2], (t, end), strict);
                     let tau = next.map_or(end, |n| n.0);
                     if let Some(r) = record.as_deref_mut() {
                         self.fill_samples(r, t, tau, |_, _| [0.0; 2]);
@@ -226,7 +227,9 @@ impl PeriodMarch<'_> {
                     }
                     (tau, next.map(|n| n.1))
                 }
-                Phase2::Slip => self.slip(buf, record.as_deref_mut(), t, end, &mut steps)?,
+                Phase2::Slip => {
+                    self.slip(buf, record.as_deref_mut(), (t, end), &mut steps, strict)?
+                }
             };
             if tau > t {
                 match phase {
@@ -237,6 +240,13 @@ impl PeriodMarch<'_> {
                 all_open &= phase == Phase2::Open;
             }
             let Some(exit) = exit else { break };
+            // A phase that ended where it began (its exit function within its round-off band
+            // at once) hands over at an instant where the next phase's exit function is within
+            // its own band too: where both rise from it, the two phases alternated there for
+            // ever (a contact closing as its trial force grows exactly as fast as the friction
+            // limit, kₜ|u′| ≈ L′). The next phase's first cell then reads signs against the
+            // round-off alone, which find the stretch it holds for, however short.
+            strict = tau <= t;
             phase = self.after(buf, phase, exit, tau);
             t = tau;
             events += 1;
@@ -419,33 +429,44 @@ impl PeriodMarch<'_> {
         }
     }
 
-    /// The size of f below which it counts as zero (round-off of its terms, or the slip
-    /// angle's tolerance for the end of a slip).
-    fn zero_level(&self, exit: Exit, w: [f64; 2], k: &Kinematics2) -> f64 {
+    /// The size of f below which it counts as zero: a margin over the round-off of its terms
+    /// (10⁻¹² of them), or the slip angle's tolerance for the end of a slip. `strict`: the
+    /// round-off itself (16 ε of the terms), for the first cell of a phase that follows one
+    /// that ended at once ([`Self::run`]), where the margin hides which way f goes.
+    fn zero_level(&self, exit: Exit, w: [f64; 2], k: &Kinematics2, strict: bool) -> f64 {
         let kt = self.law.kt;
         let l = self.law.limit(k);
+        let relative = if strict { 16.0 * f64::EPSILON } else { 1e-12 };
         match exit {
             Exit::SlipOnset => {
                 let u = k.u[0][0].hypot(k.u[1][0]);
-                1e-12 * (kt * (u + w[0].hypot(w[1])) + l[0].abs())
+                relative * (kt * (u + w[0].hypot(w[1])) + l[0].abs())
             }
             Exit::StickOnset => {
                 let speed = k.u[0][1].hypot(k.u[1][1]);
-                10.0 * ODE_TOLERANCE * (l[1].abs() + kt * speed)
+                let relative = if strict {
+                    relative
+                } else {
+                    10.0 * ODE_TOLERANCE
+                };
+                relative * (l[1].abs() + kt * speed)
             }
             // v is zero where the contact has just closed or opened: its rates set the size.
-            Exit::Opening | Exit::Closing => 1e-12 * (k.v[0].abs() + k.v[1].abs() + k.v[2].abs()),
+            Exit::Opening | Exit::Closing => {
+                relative * (k.v[0].abs() + k.v[1].abs() + k.v[2].abs())
+            }
         }
     }
 
     /// The first exit of an explicit phase (stick with slider w, or open) in (t0, t_end],
-    /// bracketed on the grid cells and refined by Brent's method.
+    /// bracketed on the grid cells and refined by Brent's method; `strict`: the first cell
+    /// reads signs against round-off alone (after a phase that ended at once, [`Self::run`]).
     fn next_explicit(
         &self,
         exits: &[Exit],
         w: [f64; 2],
-        t0: f64,
-        t_end: f64,
+        (t0, t_end): (f64, f64),
+        strict: bool,
     ) -> Option<(f64, Exit)> {
         if exits.is_empty() {
             return None;
@@ -462,7 +483,7 @@ impl PeriodMarch<'_> {
                 let mut best: Option<(f64, Exit)> = None;
                 for &exit in exits {
                     let f = |t: f64| self.exit(exit, w, 0.0, &self.path.at(t));
-                    let zero = self.zero_level(exit, w, &ka);
+                    let zero = self.zero_level(exit, w, &ka, strict && first);
                     let fa = self.exit(exit, w, 0.0, &ka);
                     let fb = self.exit(exit, w, 0.0, &kb);
                     if let Some(tau) = crossing(&f, (a, fa), (b, fb), zero, first) {
@@ -487,17 +508,18 @@ impl PeriodMarch<'_> {
 
     /// Integrates a slip from t0 (θ, S in `buf.y`) until it ends (the slip rate reaches
     /// zero, or the contact opens) or until t_end; returns the end and its exit. Records the
-    /// force integrals and samples on the way.
+    /// force integrals and samples on the way; `strict`: its first step reads signs against
+    /// round-off alone (after a phase that ended at once, [`Self::run`]).
     fn slip(
         &self,
         buf: &mut Buffers,
         mut record: Option<&mut Record>,
-        t0: f64,
-        t_end: f64,
+        (t0, t_end): (f64, f64),
         steps: &mut usize,
+        strict: bool,
     ) -> Result<(f64, Option<Exit>), MarchFailure> {
         let (t_stop, stop_exit) = if self.variable() {
-            match self.next_explicit(&[Exit::Opening], [0.0; 2], t0, t_end) {
+            match self.next_explicit(&[Exit::Opening], [0.0; 2], (t0, t_end), false) {
                 Some((tau, e)) => (tau, Some(e)),
                 None => (t_end, None),
             }
@@ -570,7 +592,7 @@ impl PeriodMarch<'_> {
                 continue;
             }
             let fa = self.exit(Exit::StickOnset, [0.0; 2], y[0], &k);
-            let zero = self.zero_level(Exit::StickOnset, [0.0; 2], &k);
+            let zero = self.zero_level(Exit::StickOnset, [0.0; 2], &k, strict && first);
             let t1 = t + h;
             let kb = self.path.at(t1);
             let fb = self.exit(Exit::StickOnset, [0.0; 2], dopri.y_new[0], &kb);

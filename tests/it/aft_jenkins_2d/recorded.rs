@@ -145,3 +145,45 @@ fn a_creeping_corner_whose_grazings_lie_between_samples_is_found() {
         .count();
     assert_eq!(touching, 2, "the slider sits on two friction circles");
 }
+
+/// A point that closes while its trial force grows almost exactly as fast as the friction
+/// limit (kₜ|u′| = 0.0846383 N/rad against L′ = 0.0846386 N/rad at the closing): just after it,
+/// the stick's exit function and the slip's both lie within the 10⁻¹² band that stands for
+/// their round-off, and each phase was taken to end where it began, for ever (`too many
+/// events` on the 3D blade pair at 857.2 Hz). After a phase that ends at once, the next one's
+/// first cell now reads signs against round-off alone, which finds the short stick that
+/// follows. The forces do not depend on the bracketing grid and the Jacobian equals
+/// central differences.
+#[test]
+fn a_contact_closing_with_its_trial_force_as_fast_as_the_limit_is_marched() {
+    let l = patch_law(5.555_555_555_555_539e5);
+    let u1 = [
+        2.369_517_727_749_461_5e-6,
+        -2.510_344_050_772_008e-7,
+        2.201_736_511_283_204_6e-8,
+    ];
+    let u2 = [
+        2.018_778_369_945_838_7e-6,
+        -1.043_264_385_907_125_9e-7,
+        7.998_518_790_269_09e-9,
+    ];
+    let v = [
+        6.457_622_351_239_471e-7,
+        8.110_466_593_783_59e-7,
+        -1.307_874_855_333_614_3e-7,
+    ];
+    let x = [&u1[..], &u2[..], &v[..]];
+    let (state, coarse) = forces(&l, x, 128);
+    assert_eq!(state, ContactState::StickSlipLiftoff);
+    let (_, fine) = forces(&l, x, 512);
+    let difference = relative_difference(&coarse, &fine);
+    assert!(
+        difference < 1e-12,
+        "128 against 512 samples: {difference:.2e}"
+    );
+    let (error, _) = jacobian_error_of(March::Events, l, effects(false), x, 1e-7);
+    assert!(
+        error < 1e-6,
+        "Jacobian against central differences: {error:.2e}"
+    );
+}
