@@ -62,6 +62,12 @@ pub trait ImplicitFactor: Send + Sync {
     /// J⁻¹ b; with `single`, an approximate solve with factors rounded to single precision
     /// where the factorisation keeps them (for chord steps, judged on the true residual).
     fn solve(&self, b: &[f64], single: bool) -> Vec<f64>;
+    /// The sign (±1) of det J where the factorisation gives it, up to a factor that is the
+    /// same for every factorisation of the same Jacobian structure (a fixed change of
+    /// coordinates); None where it does not.
+    fn det_sign(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// A factorised bordered matrix `[[s·J, col], [row]]`, kept for several solves (the chord
@@ -100,6 +106,15 @@ enum InnerKind {
 }
 
 impl InnerFactor {
+    /// The sign of det(J S), where the factorisation gives it (not faer's sparse LU).
+    fn det_sign(&self) -> Option<f64> {
+        let scale = crate::numerics::linalg::diagonal_sign(self.col_scale.iter().copied());
+        match &self.kind {
+            InnerKind::Sparse(_) => None,
+            InnerKind::Implicit(f) => f.det_sign().map(|s| s * scale),
+        }
+    }
+
     /// (J S)⁻¹ b.
     fn solve(&self, b: &[f64]) -> Vec<f64> {
         self.solve_with(b, false)
@@ -142,6 +157,23 @@ impl BorderedFactor {
                     },
                 })
             }
+        }
+    }
+
+    /// The sign (±1) of the bordered matrix's determinant, where the factorisation gives it
+    /// (up to a factor fixed by the Jacobian's structure, see [`ImplicitFactor::det_sign`]):
+    /// from the dense LU, or det(s·J)·d for the border eliminated by blocks.
+    pub fn det_sign(&self) -> Option<f64> {
+        use crate::numerics::linalg::{diagonal_sign, permutation_sign};
+        match &self.kind {
+            FactorKind::Dense(lu) => {
+                let u = lu.U();
+                let (fwd, _) = lu.P().arrays();
+                Some(diagonal_sign((0..u.nrows()).map(|i| u[(i, i)])) * permutation_sign(fwd))
+            }
+            FactorKind::Eliminated {
+                lu, denominator, ..
+            } => lu.det_sign().map(|s| s * denominator.signum()),
         }
     }
 
@@ -468,8 +500,23 @@ impl AssembledJacobian {
         row: &[f64],
         rhs: &[f64],
     ) -> Result<Vec<f64>, LinearSolveError> {
+        Ok(self.solve_bordered_signed(col_scale, col, row, rhs)?.0)
+    }
+
+    /// [`Self::solve_bordered`], with the sign of the bordered matrix's determinant where the
+    /// factorisation gives it ([`BorderedFactor::det_sign`]).
+    pub fn solve_bordered_signed(
+        &mut self,
+        col_scale: &[f64],
+        col: &[f64],
+        row: &[f64],
+        rhs: &[f64],
+    ) -> Result<(Vec<f64>, Option<f64>), LinearSolveError> {
         match self.storage {
-            Storage::Dense => self.factor_bordered(col_scale, col, row)?.solve(rhs),
+            Storage::Dense => {
+                let factor = self.factor_bordered(col_scale, col, row)?;
+                Ok((factor.solve(rhs)?, factor.det_sign()))
+            }
             Storage::Sparse | Storage::Schur => {
                 self.solve_eliminated_bordered(col_scale, col, row, rhs)
             }
@@ -625,7 +672,7 @@ impl AssembledJacobian {
         col: &[f64],
         row: &[f64],
         rhs: &[f64],
-    ) -> Result<Vec<f64>, LinearSolveError> {
+    ) -> Result<(Vec<f64>, Option<f64>), LinearSolveError> {
         let n = self.n;
         // One LU of s·J (non-finite input is refused by the factorisation and its solves); each solve eliminates the border by blocks.
         let factor = self.factor_bordered(col_scale, col, row)?;
@@ -655,7 +702,7 @@ impl AssembledJacobian {
         if !rn.is_finite() || rn > 1e-6 * scale {
             return Err(LinearSolveError::Singular { ratio: rn / scale });
         }
-        Ok(y)
+        Ok((y, factor.det_sign()))
     }
 }
 

@@ -204,6 +204,7 @@ fn sparse_and_condensed_jacobians_match_central_differences() {
     let condensed = with_formulation(base.clone(), Formulation::Condensed);
     let schur = with_formulation(base.clone(), Formulation::Schur);
     let mut checked_slipping = 0;
+    let mut sign_ratios = Vec::new();
     for p in run.points.iter().step_by(7) {
         let omega = 2.0 * std::f64::consts::PI * p.freq_hz;
         let mut s = HbmSystem::new(&sparse).unwrap();
@@ -233,7 +234,12 @@ fn sparse_and_condensed_jacobians_match_central_differences() {
             p.freq_hz,
             check.relative()
         );
-        schur_solves_match_dense(&base, &schur, &p.coefficients, omega);
+        sign_ratios.push(schur_solves_match_dense(
+            &base,
+            &schur,
+            &p.coefficients,
+            omega,
+        ));
         if p.states.iter().any(|s| s.is_unique()) {
             checked_slipping += 1;
         }
@@ -241,6 +247,13 @@ fn sparse_and_condensed_jacobians_match_central_differences() {
     assert!(
         checked_slipping >= 3,
         "only {checked_slipping} slipping states checked"
+    );
+    // The schur factorisation's determinant sign is the dense one's up to a factor fixed by
+    // the change to relative coordinates, at every point (the continuation orients its
+    // tangents by it).
+    assert!(
+        sign_ratios.iter().all(|r| *r == sign_ratios[0]),
+        "{sign_ratios:?}"
     );
 }
 
@@ -275,8 +288,9 @@ fn full_continuation_runs_agree_between_formulations() {
 }
 
 /// The schur Jacobian at (x, ω) has the dense Jacobian's entries, and its solves (plain and
-/// bordered) give the dense solutions.
-fn schur_solves_match_dense(dense: &Problem, schur: &Problem, x: &[f64], omega: f64) {
+/// bordered) give the dense solutions. Returns the ratio of the bordered matrices'
+/// determinant signs (dense over schur).
+fn schur_solves_match_dense(dense: &Problem, schur: &Problem, x: &[f64], omega: f64) -> f64 {
     let mut d = HbmSystem::new(dense).unwrap();
     let mut s = HbmSystem::new(schur).unwrap();
     let n = d.dim();
@@ -317,8 +331,12 @@ fn schur_solves_match_dense(dense: &Problem, schur: &Problem, x: &[f64], omega: 
     let mut brhs = rhs.clone();
     brhs.push(0.7);
     let col_scale = vec![3.0; n];
-    let yd = jd.solve_bordered(&col_scale, &dw, &row, &brhs).unwrap();
-    let ys = js.solve_bordered(&col_scale, &dw, &row, &brhs).unwrap();
+    let (yd, sign_d) = jd
+        .solve_bordered_signed(&col_scale, &dw, &row, &brhs)
+        .unwrap();
+    let (ys, sign_s) = js
+        .solve_bordered_signed(&col_scale, &dw, &row, &brhs)
+        .unwrap();
     let yn = yd.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     for i in 0..=n {
         assert!(
@@ -328,6 +346,7 @@ fn schur_solves_match_dense(dense: &Problem, schur: &Problem, x: &[f64], omega: 
             ys[i]
         );
     }
+    sign_d.expect("the dense LU's sign") * sign_s.expect("the schur LU's sign")
 }
 
 #[test]

@@ -419,6 +419,18 @@ impl ImplicitFactor for SchurFactor {
             self.reduced.solve(r_q, single)
         })
     }
+
+    /// The sign of det J up to a fixed factor: that of the reduced matrix's dense LU. The
+    /// eliminated part adds only det of each harmonic's linear dynamic stiffness on the
+    /// eliminated coordinates, in cosine-sine form |det(K − k²ω²M + ikωC)|² ≥ 0 (the static
+    /// stiffness for k = 0), and the change to relative coordinates is fixed. None for the
+    /// low-rank factorisation.
+    fn det_sign(&self) -> Option<f64> {
+        match &self.reduced {
+            ReducedFactor::Dense { lu, .. } => Some(lu.det_sign()),
+            ReducedFactor::LowRank(_) => None,
+        }
+    }
 }
 
 /// Solves (Ã + [R 0; 0 0]) y = Tᵀ b by the per-harmonic elimination `harmonics` and returns

@@ -89,7 +89,9 @@ impl Continuation {
     }
 
     /// Unit tangent in scaled space at a converged point, oriented along `previous` (or
-    /// towards the end frequency when there is none).
+    /// towards the end frequency when there is none). Where the factorisation gives the sign
+    /// of the bordered matrix's determinant, the sign of det [J; tᵀ] of the tangent returned
+    /// is kept in `formed_orientation` (see [`Self::orient`]).
     pub(super) fn tangent<S: ParametricResidual>(
         &self,
         system: &mut S,
@@ -108,9 +110,12 @@ impl Continuation {
                 let mut t = factor.solve(&rhs)?;
                 let nt = norm(&t);
                 t.iter_mut().for_each(|v| *v /= nt);
+                let mut sign = factor.det_sign();
                 if dot(&t, p) < 0.0 {
                     t.iter_mut().for_each(|v| *v = -*v);
+                    sign = sign.map(|s| -s);
                 }
+                self.formed_orientation.set(sign);
                 return Ok(t);
             }
         }
@@ -129,7 +134,7 @@ impl Continuation {
                 e
             }
         };
-        let mut t = jac.solve_bordered(&self.x_scale, &col, &row, &rhs)?;
+        let (mut t, mut sign) = jac.solve_bordered_signed(&self.x_scale, &col, &row, &rhs)?;
         let nt = norm(&t);
         t.iter_mut().for_each(|v| *v /= nt);
         let orientation = match previous {
@@ -138,16 +143,63 @@ impl Continuation {
         };
         if orientation < 0.0 {
             t.iter_mut().for_each(|v| *v = -*v);
+            sign = sign.map(|s| -s);
         }
+        self.formed_orientation.set(sign);
         Ok(t)
+    }
+
+    /// Orients the tangent `t` at a corrected point as the path is oriented: det [J; tᵀ]
+    /// keeps its sign along a path through regular points (Allgower & Georg, Introduction to
+    /// Numerical Continuation Methods, 2.1), where both signs are known (the tangent formed
+    /// last, [`Self::tangent`], and the path's at its last point). Along a smooth path this
+    /// is the orientation along the previous tangent; they differ where the path turns back
+    /// at a corner by more than 90° (a fold at a corner, where a contact's slider changes what
+    /// anchors it): there the tangent oriented along the incoming one points back to the
+    /// corner, and a step along it lands on the incoming piece. Without this the 3D blade
+    /// pair's path over 840-900 Hz turns back at its corner fold at 886.82 Hz onto the very
+    /// points it came along, down to the range's start
+    /// (`blade_pair_3d::the_3d_frf_over_the_bending_pair_is_complete_through_both_folds`).
+    pub(super) fn orient(&self, t: &mut [f64]) {
+        if let (Some(path), Some(formed)) = (self.orientation.get(), self.formed_orientation.get())
+        {
+            if formed != path {
+                t.iter_mut().for_each(|v| *v = -*v);
+                self.formed_orientation.set(Some(path));
+            }
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::numerics::continuation::fixtures::settings;
+    use crate::numerics::continuation::fixtures::{g, settings, ZPath};
     use crate::numerics::continuation::settings::AdaptiveScale;
+
+    /// Past the Z's first fold, a corner where the path turns back by about 163°, the tangent
+    /// on the middle piece is oriented down in frequency, away from the corner, as the path
+    /// goes on: det [J; tᵀ] keeps its sign. Oriented along the incoming tangent alone it
+    /// would point back up to the corner.
+    #[test]
+    fn past_a_corner_fold_the_tangent_points_away_from_the_corner() {
+        let c = Continuation::new(settings(10.0, 18.0), vec![1.0]);
+        let at = |x: f64| PathPoint {
+            omega: g(x).0 * OMEGA_SCALE,
+            x: vec![x],
+            iterations: 1,
+            residual: 0.0,
+            step: 0.01,
+        };
+        let incoming = c.tangent(&mut ZPath, &at(0.95), None).unwrap();
+        assert!(incoming[0] > 0.0 && incoming[1] > 0.0, "{incoming:?}");
+        c.orientation.set(c.formed_orientation.get());
+        assert!(c.orientation.get().is_some());
+        let mut middle = c.tangent(&mut ZPath, &at(1.05), Some(&incoming)).unwrap();
+        assert!(middle[1] > 0.0, "along the incoming tangent: back up");
+        c.orient(&mut middle);
+        assert!(middle[0] > 0.0 && middle[1] < 0.0, "{middle:?}");
+    }
 
     /// The scale of a group grows with its norm along the path and the tangent is carried over
     /// to the new scaled space as the same direction.

@@ -58,6 +58,7 @@ impl Continuation {
             .solve_fixed(system, x_guess, a.freq_start_hz * OMEGA_SCALE)
             .map_err(start_failed)?;
         let mut tangent = self.tangent(system, &first, None).map_err(start_failed)?;
+        self.orientation.set(self.formed_orientation.get());
         // The tangent evaluated the operator at the first point, as the observer expects.
         observer.accepted(system, &first, Some(&self.path_normal(&tangent)));
         let mut summary = PathSummary {

@@ -53,6 +53,11 @@ pub struct Continuation {
     /// Newton gives up once its residual stagnates, if set (see
     /// [`Continuation::with_stagnation_exit`]).
     pub(super) stagnation: Option<StagnationExit>,
+    /// The path's orientation: the sign of det [J; tᵀ] (scaled unknowns, ω last) at its last
+    /// accepted point, where the factorisation gives it (see [`Continuation::tangent`]).
+    pub(super) orientation: std::cell::Cell<Option<f64>>,
+    /// The same sign for the tangent [`Continuation::tangent`] formed last.
+    pub(super) formed_orientation: std::cell::Cell<Option<f64>>,
 }
 
 /// Newton's exit on a stagnating residual: once past its first [`Self::after`] iterations, a
@@ -135,6 +140,8 @@ impl Continuation {
             adaptive: None,
             amplitudes: Vec::new(),
             stagnation: None,
+            orientation: std::cell::Cell::new(None),
+            formed_orientation: std::cell::Cell::new(None),
         }
     }
 

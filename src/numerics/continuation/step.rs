@@ -44,6 +44,7 @@ impl Continuation {
             // there. A fold or a sharp turn is judged on the Jacobian at the point itself.
             t_new = self.tangent(system, &point, Some(tangent))?;
         }
+        self.orient(&mut t_new);
         let degrees = turn(&t_new);
         Ok((point, t_new, norm(&apart) / ds, degrees))
     }
@@ -68,6 +69,7 @@ impl Continuation {
             observer.turning_point(point.freq_hz());
         }
         observer.accepted(system, &point, Some(&self.path_normal(&t_new)));
+        self.orientation.set(self.formed_orientation.get());
         let left = self.left_range(&point);
         *tangent = t_new;
         self.adapt_scale(&point.x, tangent);
