@@ -492,20 +492,9 @@ impl AssembledJacobian {
     }
 
     /// Solves the bordered system `[[s·J, col], [row]] y = rhs`, with `col` of length n and
-    /// `row`, `rhs` of length n + 1.
+    /// `row`, `rhs` of length n + 1; with the sign of the bordered matrix's determinant where
+    /// the factorisation gives it ([`BorderedFactor::det_sign`]).
     pub fn solve_bordered(
-        &mut self,
-        col_scale: &[f64],
-        col: &[f64],
-        row: &[f64],
-        rhs: &[f64],
-    ) -> Result<Vec<f64>, LinearSolveError> {
-        Ok(self.solve_bordered_signed(col_scale, col, row, rhs)?.0)
-    }
-
-    /// [`Self::solve_bordered`], with the sign of the bordered matrix's determinant where the
-    /// factorisation gives it ([`BorderedFactor::det_sign`]).
-    pub fn solve_bordered_signed(
         &mut self,
         col_scale: &[f64],
         col: &[f64],
@@ -745,8 +734,8 @@ mod tests {
         let row = [1.0, 0.0, 1.0, 3.0];
         let rhs = [0.0, 1.0, 0.0, 1.0];
         let scale = [2.0, 0.5, 3.0];
-        let yd = d.solve_bordered(&scale, &col, &row, &rhs).unwrap();
-        let ys = s.solve_bordered(&scale, &col, &row, &rhs).unwrap();
+        let (yd, _) = d.solve_bordered(&scale, &col, &row, &rhs).unwrap();
+        let (ys, _) = s.solve_bordered(&scale, &col, &row, &rhs).unwrap();
         for i in 0..4 {
             assert!((yd[i] - ys[i]).abs() < 1e-13, "{yd:?} vs {ys:?}");
         }

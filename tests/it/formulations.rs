@@ -331,12 +331,8 @@ fn schur_solves_match_dense(dense: &Problem, schur: &Problem, x: &[f64], omega: 
     let mut brhs = rhs.clone();
     brhs.push(0.7);
     let col_scale = vec![3.0; n];
-    let (yd, sign_d) = jd
-        .solve_bordered_signed(&col_scale, &dw, &row, &brhs)
-        .unwrap();
-    let (ys, sign_s) = js
-        .solve_bordered_signed(&col_scale, &dw, &row, &brhs)
-        .unwrap();
+    let (yd, sign_d) = jd.solve_bordered(&col_scale, &dw, &row, &brhs).unwrap();
+    let (ys, sign_s) = js.solve_bordered(&col_scale, &dw, &row, &brhs).unwrap();
     let yn = yd.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     for i in 0..=n {
         assert!(

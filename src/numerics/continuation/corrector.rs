@@ -297,7 +297,7 @@ impl Continuation {
         let col: Vec<f64> = dr.iter().map(|v| v * OMEGA_SCALE).collect();
         effort.factorisations += 1;
         if !effort.chord {
-            return Ok(jac.solve_bordered(&self.x_scale, &col, tangent, rhs)?);
+            return Ok(jac.solve_bordered(&self.x_scale, &col, tangent, rhs)?.0);
         }
         let f = jac.factor_bordered(&self.x_scale, &col, tangent)?;
         let d = f.solve(rhs)?;

@@ -134,7 +134,7 @@ impl Continuation {
                 e
             }
         };
-        let (mut t, mut sign) = jac.solve_bordered_signed(&self.x_scale, &col, &row, &rhs)?;
+        let (mut t, mut sign) = jac.solve_bordered(&self.x_scale, &col, &row, &rhs)?;
         let nt = norm(&t);
         t.iter_mut().for_each(|v| *v /= nt);
         let orientation = match previous {
