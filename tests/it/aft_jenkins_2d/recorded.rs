@@ -34,13 +34,22 @@ fn forces(l: &Jenkins2dLaw, x: [&[f64]; 3], samples: usize) -> (ContactState, Ve
     (report.state, t)
 }
 
-/// The largest difference of two force vectors relative to the largest force.
-fn relative_difference(a: &[f64], b: &[f64]) -> f64 {
-    let scale = a.iter().fold(f64::MIN_POSITIVE, |m, x| m.max(x.abs()));
-    a.iter()
-        .zip(b)
+/// Asserts the point's state at 128 bracketing samples and that its forces at 128 and 512
+/// samples differ by less than `bound` relative to the largest force.
+fn assert_grid_independent(l: &Jenkins2dLaw, x: [&[f64]; 3], state: ContactState, bound: f64) {
+    let (found, coarse) = forces(l, x, 128);
+    assert_eq!(found, state);
+    let (_, fine) = forces(l, x, 512);
+    let scale = coarse.iter().fold(f64::MIN_POSITIVE, |m, v| m.max(v.abs()));
+    let difference = coarse
+        .iter()
+        .zip(&fine)
         .fold(0.0_f64, |m, (p, q)| m.max((p - q).abs()))
-        / scale
+        / scale;
+    assert!(
+        difference < bound,
+        "128 against 512 samples: {difference:.2e}"
+    );
 }
 
 /// A point whose normal gap closes to within 3 × 10⁻¹⁵ m of opening once a period while it
@@ -70,14 +79,7 @@ fn a_contact_opening_for_an_instant_while_it_slips_is_located() {
         1.276_744_084_634_616e-10,
     ];
     let x = [&u1[..], &u2[..], &v[..]];
-    let (state, coarse) = forces(&l, x, 128);
-    assert_eq!(state, ContactState::StickSlipLiftoff);
-    let (_, fine) = forces(&l, x, 512);
-    let difference = relative_difference(&coarse, &fine);
-    assert!(
-        difference < 1e-11,
-        "128 against 512 samples: {difference:.2e}"
-    );
+    assert_grid_independent(&l, x, ContactState::StickSlipLiftoff, 1e-11);
 }
 
 /// A point whose nearly straight tangential path (amplitude 1.2 × 10⁻⁸ m) slips a little at
@@ -108,14 +110,7 @@ fn a_creeping_corner_whose_grazings_lie_between_samples_is_found() {
         -4.149_167_156_564_255_5e-11,
     ];
     let x = [&u1[..], &u2[..], &v[..]];
-    let (state, coarse) = forces(&l, x, 128);
-    assert_eq!(state, ContactState::Stuck);
-    let (_, fine) = forces(&l, x, 512);
-    let difference = relative_difference(&coarse, &fine);
-    assert!(
-        difference < 1e-11,
-        "128 against 512 samples: {difference:.2e}"
-    );
+    assert_grid_independent(&l, x, ContactState::Stuck, 1e-11);
 
     // The slider against the friction circles: g(τ) = |u(τ) − w| − μ kₙ v(τ)/kₜ on a fine
     // grid (H = 1: blocks constant, cos τ, sin τ).
@@ -173,14 +168,7 @@ fn a_contact_closing_with_its_trial_force_as_fast_as_the_limit_is_marched() {
         -1.307_874_855_333_614_3e-7,
     ];
     let x = [&u1[..], &u2[..], &v[..]];
-    let (state, coarse) = forces(&l, x, 128);
-    assert_eq!(state, ContactState::StickSlipLiftoff);
-    let (_, fine) = forces(&l, x, 512);
-    let difference = relative_difference(&coarse, &fine);
-    assert!(
-        difference < 1e-12,
-        "128 against 512 samples: {difference:.2e}"
-    );
+    assert_grid_independent(&l, x, ContactState::StickSlipLiftoff, 1e-12);
     let (error, _) = jacobian_error_of(March::Events, l, effects(false), x, 1e-7);
     assert!(
         error < 1e-6,
