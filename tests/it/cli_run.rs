@@ -163,16 +163,17 @@ fn set_overrides_change_the_solve() {
 
 #[test]
 fn failed_continuation_keeps_finished_points_and_exits_nonzero() {
-    // One Newton iteration per step and a large minimum step: stuck points (a linear
-    // problem) converge in one iteration, so the path over the full range, stuck at its
-    // start, must stall at the first stick-slip transition, after some converged stuck points.
+    // Two Newton iterations per step and a large minimum step: stuck points (a linear
+    // problem) converge in two (one step, and the residual after it checked), so the path
+    // over the full range, stuck at its start, must stall at the first stick-slip transition
+    // (159.8 Hz), after some converged stuck points.
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("stall");
     let o = run_scene(
         &scene("full-range.toml"),
         &out,
         &[
-            "analysis.max_iterations=1",
+            "analysis.max_iterations=2",
             "analysis.min_step=0.05",
             "analysis.initial_step=0.1",
         ],

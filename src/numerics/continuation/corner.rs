@@ -17,27 +17,22 @@
 //! the outgoing piece runs nearly along the hyperplane (the pieces meet at close to 90° or
 //! more): on the paper's system with μ = 5 the Jacobian jumps by half its size across the seam
 //! at 160.4396 Hz, and Newton's iterates on every hyperplane down to the minimum step end at
-//! the kink's minimum of ‖R‖ (2.6·10⁻⁸, above the tolerance), while Newton at a fixed
-//! frequency, with its backtracking, converges just past the corner in 4-7 iterations. So
-//! past a corner the path is taken on by the corrector on a hyperplane normal to the outgoing
-//! piece, else from a point solved at a fixed frequency a little ahead of the corner in the
-//! direction of travel, refusing a landing back on the incoming piece or further from the
-//! corner than the largest step; the tangent there is oriented along the chord from the
-//! corner.
+//! the kink's minimum of ‖R‖ (2.6·10⁻⁸, above the tolerance). So past a corner the path is
+//! taken on by the corrector on a hyperplane normal to the outgoing piece, refusing a landing
+//! back on the incoming piece or further from the corner than the largest step; the tangent
+//! there is oriented along the chord from the corner.
 //!
-//! Both ways are still needed with the event-resolved laws. Without the corrector along the
-//! outgoing piece the paper's system over 50-600 Hz
+//! Still needed with the event-resolved laws: without it the paper's system over 50-600 Hz
 //! (`hard_cases::starts_on_resonances_and_ranges_across_the_damper_mode_cover_the_range`)
 //! stalls at 396.5722 Hz, the reduced blade pair of
 //! `error_estimate_fe::truncation_estimate_tracks_the_true_error_on_the_blade_pair` at
 //! 924.6755 Hz and the out-of-plane 2D run of
 //! `friction_2d::formulations_agree_and_jacobians_match_central_differences_with_out_of_plane_motion`
-//! at 160.0984 Hz. Without the landing ahead the 3D blade pair's path over 840-900 Hz
-//! (`blade_pair_3d::the_3d_frf_over_the_bending_pair_is_complete_through_both_folds`) jumps
-//! to another branch instead of following its folds. A landing behind the corner (at a
-//! corner fold), tried last, was taken by no path of the tests, and is gone.
+//! at 160.0984 Hz. Landings by Newton at a fixed frequency ahead of the corner and behind it
+//! are gone: with the tangent oriented by the determinant's sign ([`Continuation::orient`])
+//! no path of the tests needs them.
 
-use super::settings::{Continuation, OMEGA_SCALE};
+use super::settings::Continuation;
 use crate::numerics::linalg::{dot, norm};
 use crate::numerics::path::PathPoint;
 use crate::numerics::residual::ParametricResidual;
@@ -58,11 +53,10 @@ const FOLLOWED_POINTS: usize = 64;
 impl Continuation {
     /// A point past a corner at `y` (scaled, ω last) where the path arrived along `tangent`,
     /// with its unit tangent oriented along the chord from `y`. For each offset of
-    /// [`CORNER_OFFSETS`] (h, in the arc length's units), two ways are tried: along the
+    /// [`CORNER_OFFSETS`] (h, in the arc length's units), the path is sought along the
     /// outgoing piece, whose direction is the null direction t_out of the Jacobian just past
     /// the corner (at y + h·t_in, on the outgoing side of the seam), by the corrector on the
-    /// hyperplane normal to t_out through y ± h·t_out; then Newton at a fixed frequency h
-    /// ahead of the corner in the direction of travel. The first landing that lies neither
+    /// hyperplane normal to t_out through y ± h·t_out. The first landing that lies neither
     /// back on the path already `followed` ([`ON_PATH_FRACTION`]) nor further than the largest
     /// step from the corner is taken. None when there is none.
     pub(super) fn turn_corner<S: ParametricResidual>(
@@ -72,13 +66,10 @@ impl Continuation {
         tangent: &[f64],
         followed: &[PathPoint],
     ) -> Option<(PathPoint, Vec<f64>)> {
-        let n = y.len() - 1;
         let recent: Vec<Vec<f64>> = followed[followed.len().saturating_sub(FOLLOWED_POINTS)..]
             .iter()
             .map(|p| self.scaled(p))
             .collect();
-        let ahead = if tangent[n] >= 0.0 { 1.0 } else { -1.0 };
-        let corner = self.unscaled(y);
         for factor in CORNER_OFFSETS {
             let h = factor * self.settings.min_step;
             if h > self.settings.max_step {
@@ -99,10 +90,6 @@ impl Continuation {
                         ..self.unscaled(&yc)
                     });
                 }
-            }
-            if let Ok(point) = self.solve_fixed(system, &corner.x, (y[n] + ahead * h) * OMEGA_SCALE)
-            {
-                landings.push(point);
             }
             for mut point in landings {
                 let landing = self.scaled(&point);
@@ -155,6 +142,7 @@ fn distance_to_polyline(q: &[f64], points: &[Vec<f64>]) -> f64 {
 mod tests {
     use super::*;
     use crate::numerics::continuation::fixtures::{g, settings, ZPath};
+    use crate::numerics::continuation::settings::OMEGA_SCALE;
 
     /// At the Z's first fold, a corner where the path turns back by about 163°, the path goes
     /// on along the steep middle piece, behind the corner in frequency, not back along the
