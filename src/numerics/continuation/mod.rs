@@ -19,8 +19,8 @@
 //! watched output amplitudes. Turning points (sign changes of dω/ds) are reported and
 //! followed. The tangent keeps the sign of det [J; tᵀ] along the path where the
 //! factorisation gives it (dense LU, the schur formulation's reduced LU; see
-//! `Continuation::orient`), else it is
-//! oriented along the previous tangent. The last point is solved at exactly the end frequency. A path runs down in
+//! `Continuation::orient`), else it is oriented along the previous tangent. The last point
+//! is solved at exactly the end frequency. A path runs down in
 //! frequency when the end frequency is below the start (e.g. to fill in, back toward a fold,
 //! a branch found past it), and a path that turns back at a fold and runs half the range
 //! behind its start ends there ([`PathEnd::LeftRangeBelow`](crate::numerics::path::PathEnd::LeftRangeBelow)).
