@@ -11,8 +11,9 @@ use fricbound::numerics::ImplicitFactor;
 use fricbound::study::scaling::{self, ModelSize};
 
 /// Contact blocks where every contact is stuck (kt, kn on every coefficient block, no coupling
-/// of harmonics) except `slipping` ones, whose blocks are full (deterministic pseudo-random).
-fn contact_values(coords: &RelativeCoordinates, slipping: &[usize]) -> Vec<f64> {
+/// of harmonics) except `slipping` ones, whose blocks are full (deterministic pseudo-random, of
+/// entries up to `strength` / 2).
+fn contact_values(coords: &RelativeCoordinates, slipping: &[usize], strength: f64) -> Vec<f64> {
     let offsets = coords.value_offsets();
     let nb = coords.n_blocks();
     let mut values = vec![0.0; *offsets.last().unwrap()];
@@ -31,7 +32,7 @@ fn contact_values(coords: &RelativeCoordinates, slipping: &[usize]) -> Vec<f64> 
                     for b in 0..k {
                         let at = offset + ((j * nb + i) * k + a) * k + b;
                         values[at] = if slipping.contains(&p) {
-                            2.0e7 * random()
+                            strength * random()
                         } else if i == j && a == b {
                             2.0e7
                         } else {
@@ -59,8 +60,17 @@ fn the_structured_factorisation_solves_as_the_dense_lu() {
     let n = coords.n_dofs() * coords.n_blocks();
     let b: Vec<f64> = (0..n).map(|i| ((i * 37) % 101) as f64 - 50.0).collect();
     let omega = 2.0 * std::f64::consts::PI * 850.0;
-    for slipping in [vec![], vec![0, 3, 7]] {
-        let values = contact_values(&coords, &slipping);
+    let mut signs = Vec::new();
+    // Slip stiffnesses up to the stuck one, and far above it (where they decide the sign).
+    for (slipping, strength) in [
+        (vec![], 0.0),
+        (vec![0, 3, 7], 2.0e7),
+        (vec![1], 2.0e10),
+        (vec![2, 5], 2.0e10),
+        (vec![4, 6, 8], 2.0e10),
+        (vec![1, 2], -2.0e10),
+    ] {
+        let values = contact_values(&coords, &slipping, strength);
         let dense = coords.factor(omega, &values, ReducedSolver::Dense).unwrap();
         let structured = coords
             .factor(omega, &values, ReducedSolver::Structured)
@@ -88,7 +98,19 @@ fn the_structured_factorisation_solves_as_the_dense_lu() {
         let rn = r.iter().map(|v| v * v).sum::<f64>().sqrt();
         let bn = b.iter().map(|v| v * v).sum::<f64>().sqrt();
         assert!(rn <= 1e-9 * bn, "residual {rn:e} of {bn:e}");
+        // The sign of the determinant, which orients the continuation's tangent, is the dense
+        // LU's: the matrix determinant lemma on the per-harmonic baseline and the update.
+        signs.push(dense.det_sign());
+        assert_eq!(
+            structured.det_sign(),
+            dense.det_sign(),
+            "slipping {slipping:?}"
+        );
     }
+    assert!(
+        signs.contains(&Some(-1.0)) && signs.contains(&Some(1.0)),
+        "{signs:?}"
+    );
 }
 
 /// One case of `fricbound bench contacts` as its contacts.json writes it. The benchmark runs in

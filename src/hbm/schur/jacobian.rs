@@ -423,12 +423,13 @@ impl ImplicitFactor for SchurFactor {
     /// The sign of det J up to a fixed factor: that of the reduced matrix's dense LU. The
     /// eliminated part adds only det of each harmonic's linear dynamic stiffness on the
     /// eliminated coordinates, in cosine-sine form |det(K − k²ω²M + ikωC)|² ≥ 0 (the static
-    /// stiffness for k = 0), and the change to relative coordinates is fixed. None for the
-    /// low-rank factorisation.
+    /// stiffness for k = 0), and the change to relative coordinates is fixed. The low-rank
+    /// factorisation gives the same sign by the matrix determinant lemma
+    /// ([`LowRankFactor::det_sign`]).
     fn det_sign(&self) -> Option<f64> {
         match &self.reduced {
             ReducedFactor::Dense { lu, .. } => Some(lu.det_sign()),
-            ReducedFactor::LowRank(_) => None,
+            ReducedFactor::LowRank(f) => Some(f.det_sign()),
         }
     }
 }

@@ -321,6 +321,22 @@ impl LowRankFactor {
         self.rows.len()
     }
 
+    /// The sign of det Q (±1), as the dense LU of Q gives it: det Q = det P · det C (the matrix
+    /// determinant lemma for P + U M). A harmonic with cosine and sine blocks contributes
+    /// det [[A, B], [−B, A]] = |det(A − iB)|² ≥ 0 to det P (its blocks are the cosine-sine form
+    /// of the complex matrix its LU factorises), so only the real blocks' LUs and C's count.
+    pub(super) fn det_sign(&self) -> f64 {
+        let baseline: f64 = self
+            .lus
+            .iter()
+            .map(|h| match h {
+                HarmonicLu::Real { lu, .. } => lu.det_sign(),
+                HarmonicLu::Complex { .. } => 1.0,
+            })
+            .product();
+        baseline * self.capacitance.det_sign()
+    }
+
     /// Q⁻¹ r for the columns of `r` (reduced coordinates).
     pub(super) fn solve(&self, mut r: Mat<f64>) -> Mat<f64> {
         let n_q = self.n_q;

@@ -18,7 +18,8 @@
 //! sets the next from Newton's iterations, the turn of the tangent and the change of the
 //! watched output amplitudes. Turning points (sign changes of dω/ds) are reported and
 //! followed. The tangent keeps the sign of det [J; tᵀ] along the path where the
-//! factorisation gives it (dense LU, the schur formulation's reduced LU; see
+//! factorisation gives it (dense LU, the schur formulation's reduced LU and its low-rank
+//! factorisation; see
 //! `Continuation::orient`), else it is oriented along the previous tangent. The last point
 //! is solved at exactly the end frequency. A path runs down in
 //! frequency when the end frequency is below the start (e.g. to fill in, back toward a fold,
