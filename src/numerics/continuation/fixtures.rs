@@ -59,6 +59,54 @@ impl ParametricResidual for ZPath {
     }
 }
 
+/// R(x, ω) = ω/2π − b(x) with b rising by 0.2 Hz per unit of x up to x = 1 and by 3 beyond:
+/// a corner where the path bends by 60° without folding (a contact's slider changing what
+/// anchors it, in the event-resolved contact law).
+pub(super) struct Bend;
+
+impl Bend {
+    /// b(x) (Hz) and its slope.
+    pub(super) fn b(x: f64) -> (f64, f64) {
+        if x < 1.0 {
+            (10.0 + 0.2 * x, 0.2)
+        } else {
+            (10.2 + 3.0 * (x - 1.0), 3.0)
+        }
+    }
+}
+
+impl ParametricResidual for Bend {
+    type Error = Never;
+    fn dim(&self) -> usize {
+        1
+    }
+    fn residual_scale(&self) -> f64 {
+        1.0
+    }
+    fn residual(&mut self, x: &[f64], omega: f64, r: &mut [f64]) -> Result<(), Never> {
+        r[0] = omega / OMEGA_SCALE - Self::b(x[0]).0;
+        Ok(())
+    }
+    fn new_jacobian(&mut self) -> AssembledJacobian {
+        AssembledJacobian::dense(1)
+    }
+    fn residual_and_jacobian(
+        &mut self,
+        x: &[f64],
+        omega: f64,
+        r: &mut [f64],
+        jac: &mut AssembledJacobian,
+        dr: &mut [f64],
+    ) -> Result<(), Never> {
+        self.residual(x, omega, r)?;
+        jac.clear();
+        let slot = jac.slot(0, 0);
+        jac.add_at(slot, -Self::b(x[0]).1);
+        dr[0] = 1.0 / OMEGA_SCALE;
+        Ok(())
+    }
+}
+
 pub(super) fn settings(start: f64, end: f64) -> ContinuationSettings {
     ContinuationSettings {
         freq_start_hz: start,

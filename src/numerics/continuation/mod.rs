@@ -13,7 +13,8 @@
 //! amplified by an ill-conditioned Jacobian near a lightly damped resonance). A failed
 //! corrector (iteration limit, divergence, singular Jacobian, failed AFT), a correction
 //! further from the prediction than the step, or a tangent turned by more than 45° in one
-//! step (a jump to another branch) cuts the step in half and is reported to the observer;
+//! step (a jump to another branch; not where the half step lands on the same straight
+//! piece, a corner of the path) cuts the step in half and is reported to the observer;
 //! below the minimum step the run ends with [`ContinuationError::Stalled`](crate::numerics::path::ContinuationError::Stalled). An accepted step
 //! sets the next from Newton's iterations, the turn of the tangent and the change of the
 //! watched output amplitudes. Turning points (sign changes of dω/ds) are reported and

@@ -4,6 +4,7 @@
 
 use super::predictor::{MAX_TURN_DEGREES, TARGET_LOG_AMPLITUDE_CHANGE, TARGET_TURN_DEGREES};
 use super::settings::{Continuation, OMEGA_SCALE};
+use crate::numerics::linalg::{dot, norm};
 use crate::numerics::path::{ContinuationError, NewtonFailure, Observer, PathEnd, PathSummary};
 use crate::numerics::residual::ParametricResidual;
 
@@ -24,6 +25,31 @@ use crate::numerics::residual::ParametricResidual;
 /// needed it before the 2D law's fixes, no longer does.)
 const WINDOW_FRACTION: f64 = 0.01;
 
+/// A step refused as far from its prediction or sharply turned is the path's own corner when
+/// the step of half its length from the same point lands on the straight line through the two
+/// landings that meets the incoming tangent's line within the shorter step: near a corner the
+/// pieces are straight, so both landings lie on the outgoing piece, which starts at the corner
+/// on the incoming piece, while landings on another branch lie on a line that passes the
+/// incoming one at about their distance from the point. Within this fraction: of the shorter
+/// landing's distance from the point for the gap between the two lines, of the shorter step
+/// for where they meet. The corner is then taken at once, not after the step has been cut to
+/// the minimum.
+const CORNER_HALVING: f64 = 0.1;
+
+/// Largest turn (degrees) between the incoming tangent and the outgoing piece of a corner
+/// taken by [`CORNER_HALVING`]'s test. Towards 90° the hyperplane meets the outgoing piece ever
+/// further from the corner, and where several pieces leave it the landing need not be on the
+/// one the path goes on along: on the 3rd nonlinear mode of the paper's system at H = 5 that
+/// the guide verifies (`fricbound verify meshes/paper-wedge/modes-3rd.toml --amplitudes
+/// 1e-6,1e-4,3e-4 --set harmonics.max=5`, run by
+/// `cli_run::every_documented_command_exits_as_documented`), corners of 85-88° taken this way
+/// led the m = +1, m = 0 and mixed cases onto another branch (156 Hz instead of 203 Hz at
+/// 3·10⁻⁴ m, which time integration does not verify).
+const CORNER_MAX_TURN_DEGREES: f64 = 75.0;
+
+/// Why a step fails, with the landing (scaled) of a step refused as far or sharply turned.
+type Refusal = (NewtonFailure, Option<Vec<f64>>);
+
 impl Continuation {
     /// Half width (Hz) of the window around a corner (see [`WINDOW_FRACTION`]).
     fn window_half_width(&self) -> f64 {
@@ -35,7 +61,8 @@ impl Continuation {
     /// Each step predicts y + Δs·t and corrects on the hyperplane normal to t (paper Eqs. 8-9).
     /// A step is cut (halved) when the corrector fails, or when it went further from the
     /// prediction than the step or turned the tangent by more than [`MAX_TURN_DEGREES`]
-    /// (a jump to another branch, unless the step is already within twice the minimum); an
+    /// (a jump to another branch, unless the half step's landing shows a corner of the path,
+    /// [`CORNER_HALVING`], or the step is already within twice the minimum); an
     /// accepted step sets the next one from Newton's iterations, the tangent's turn and the
     /// change of the watched amplitudes. Turning points (dω/ds changing sign) are reported and
     /// followed. The last point is solved at exactly the end frequency, unless the observer's
@@ -75,6 +102,9 @@ impl Continuation {
         // The frequency (Hz) of a corner the path is being taken past with the response
         // weighing more in the arc length (see `WINDOW_FRACTION`).
         let mut window: Option<f64> = None;
+        // The landing (scaled) of the last step from the current point refused as far or
+        // sharply turned, of twice the present step (see `CORNER_HALVING`).
+        let mut refused: Option<Vec<f64>> = None;
         while summary.points.len() < a.max_points {
             let last = summary.points.last().expect("at least the first point");
             if crate::numerics::interrupt::requested() {
@@ -86,6 +116,7 @@ impl Continuation {
             let y = self.scaled(last);
             let predicted: Vec<f64> = y.iter().zip(&tangent).map(|(v, t)| v + ds * t).collect();
             let failure = if self.past_end(&predicted) {
+                refused = None;
                 match self.land_on_end(system, &y, &predicted) {
                     Ok((mut point, fraction)) => {
                         point.step = ds * fraction;
@@ -97,7 +128,7 @@ impl Continuation {
                     Err(reason) => reason,
                 }
             } else {
-                match self.step(system, &predicted, &tangent, ds) {
+                match self.step(system, (&y, &predicted), &tangent, ds, refused.take()) {
                     Ok((point, t_new, degrees)) => {
                         let iterations = point.iterations;
                         if self.accept(system, observer, &mut summary, point, t_new, &mut tangent) {
@@ -114,7 +145,10 @@ impl Continuation {
                         }
                         continue;
                     }
-                    Err(reason) => reason,
+                    Err((reason, landing)) => {
+                        refused = landing;
+                        reason
+                    }
                 }
             };
             let new_ds = ds * 0.5;
@@ -125,12 +159,14 @@ impl Continuation {
                 if let Some((point, t_new)) =
                     self.turn_corner(system, &y, &tangent, &summary.points)
                 {
+                    refused = None;
                     if self.accept(system, observer, &mut summary, point, t_new, &mut tangent) {
                         return Ok(summary);
                     }
                     ds = a.initial_step.clamp(a.min_step, a.max_step);
                     continue;
                 }
+                refused = None;
                 if window.is_none() {
                     self.rescale(WINDOW_FRACTION, &mut tangent);
                     window = Some(from_hz);
@@ -148,20 +184,27 @@ impl Continuation {
         Ok(summary)
     }
 
-    /// One predictor-corrector step from the prediction `predicted` (scaled, ω last) along
-    /// `tangent`: the corrected point, its tangent and the tangent's turn (degrees), or why the
-    /// step fails (the corrector's failure, or a correction far from the prediction or a sharp
-    /// turn while the step can still be cut).
+    /// One predictor-corrector step from the last point `y` to the prediction `predicted`
+    /// (scaled, ω last) along `tangent`: the corrected point, its tangent and the tangent's
+    /// turn (degrees), or why the step fails (the corrector's failure, or a correction far
+    /// from the prediction or a sharp turn while the step can still be cut) with the landing
+    /// of a far or sharply turned step. Such a landing is taken as the path's own corner when
+    /// it lies with `refused`, the landing of the step twice as long from `y` refused before,
+    /// on a straight piece that starts at the incoming one (see [`CORNER_HALVING`]).
     fn step<S: ParametricResidual>(
         &self,
         system: &mut S,
-        predicted: &[f64],
+        (y, predicted): (&[f64], &[f64]),
         tangent: &[f64],
         ds: f64,
-    ) -> Result<(crate::numerics::PathPoint, Vec<f64>, f64), NewtonFailure> {
-        let (yc, iterations, residual) = self.correct(system, predicted, tangent)?;
-        let (point, t_new, far, degrees) =
-            self.corrected_point(system, &yc, iterations, residual, ds, predicted, tangent)?;
+        refused: Option<Vec<f64>>,
+    ) -> Result<(crate::numerics::PathPoint, Vec<f64>, f64), Refusal> {
+        let (yc, iterations, residual) = self
+            .correct(system, predicted, tangent)
+            .map_err(|e| (e, None))?;
+        let (point, t_new, far, degrees) = self
+            .corrected_point(system, &yc, iterations, residual, ds, predicted, tangent)
+            .map_err(|e| (e, None))?;
         // Within twice the minimum step a far correction or a sharp turn is taken as the path's
         // own (a corner that the steps have closed in on). Still needed with the event-resolved
         // laws: with these checks at every step, the 3rd nonlinear mode of the paper's system at
@@ -169,15 +212,17 @@ impl Continuation {
         // --amplitudes 1e-6,1e-4,3e-4 --set harmonics.max=5`, run by
         // `cli_run::every_documented_command_exits_as_documented`) no longer verifies at
         // 3·10⁻⁴ m: its first harmonic is 1.9·10⁻² to 0.29 from the mode's (tolerance 10⁻²).
-        if ds > 2.0 * self.settings.min_step {
+        let corner = refused.is_some_and(|full| corner_between(y, tangent, (&full, &yc), ds));
+        if ds > 2.0 * self.settings.min_step && !corner {
             if far > 1.0 {
-                return Err(NewtonFailure::FarCorrection {
+                let failure = NewtonFailure::FarCorrection {
                     distance: far * ds,
                     step: ds,
-                });
+                };
+                return Err((failure, Some(yc)));
             }
             if degrees > MAX_TURN_DEGREES {
-                return Err(NewtonFailure::SharpTurn { degrees });
+                return Err((NewtonFailure::SharpTurn { degrees }, Some(yc)));
             }
         }
         Ok((point, t_new, degrees))
@@ -223,10 +268,44 @@ impl Continuation {
     }
 }
 
+/// Whether the landings `full` of a step from `y` along the unit tangent `tangent` and `half`
+/// of the step of half its length `ds` (all scaled) lie on a straight piece that meets the
+/// incoming tangent's line between `y` and the shorter step's prediction (within
+/// [`CORNER_HALVING`]), the corner behind `half` on it.
+fn corner_between(y: &[f64], tangent: &[f64], (full, half): (&[f64], &[f64]), ds: f64) -> bool {
+    let along: Vec<f64> = full.iter().zip(half).map(|(f, h)| f - h).collect();
+    let length = norm(&along);
+    let from: Vec<f64> = y.iter().zip(half).map(|(a, h)| a - h).collect();
+    let b: Vec<f64> = along.iter().map(|v| v / length).collect();
+    let (c, d, e) = (dot(tangent, &b), dot(tangent, &from), dot(&b, &from));
+    let parallel = 1.0 - c * c;
+    if !(length > 0.0 && parallel > 1e-9 && c >= CORNER_MAX_TURN_DEGREES.to_radians().cos()) {
+        return false;
+    }
+    // The closest points y + τ·tangent and half + s·b of the two lines.
+    let tau = (c * e - d) / parallel;
+    let s = (e - c * d) / parallel;
+    let gap: Vec<f64> = (0..y.len())
+        .map(|i| from[i] + tau * tangent[i] - s * b[i])
+        .collect();
+    // The shorter landing's offset from the incoming tangent's line: it lies on the outgoing
+    // piece, past the corner, not on the incoming piece (a turn flagged at a landing where the
+    // path is still straight says nothing of the piece beyond it).
+    let along_in = dot(&from, tangent);
+    let offset: Vec<f64> = (0..y.len())
+        .map(|i| from[i] - along_in * tangent[i])
+        .collect();
+    norm(&gap) <= CORNER_HALVING * norm(&from)
+        && norm(&offset) >= CORNER_HALVING * norm(&from)
+        && tau >= -CORNER_HALVING * ds
+        && tau <= (1.0 + CORNER_HALVING) * ds
+        && s <= CORNER_HALVING * length
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::numerics::continuation::fixtures::{settings, Collect, SmoothS};
+    use crate::numerics::continuation::fixtures::{settings, Bend, Collect, SmoothS};
     use crate::numerics::path::{NoObserver, PathPoint};
 
     /// Both folds of the smooth S are followed: the path reaches the end, with a turning point
@@ -250,6 +329,24 @@ mod tests {
         assert!((last.freq_hz() - 17.0).abs() < 1e-12);
         assert!((SmoothS::g(last.x[0]) - 17.0).abs() < 1e-9 && last.x[0] > 2.0);
         assert_eq!(points.len(), summary.points.len());
+    }
+
+    /// At a corner where the path bends by 60° (more than a step may turn) the step that
+    /// crosses it is refused, and the step of half its length lands on the outgoing piece
+    /// too, on the line through the longer one's landing and the corner: the corner is taken
+    /// there, after two refused steps, not after the step has been cut to within twice the
+    /// minimum (15 refused steps).
+    #[test]
+    fn a_corner_is_taken_once_halving_the_step_halves_the_landing() {
+        let mut points = Vec::new();
+        let mut c = Continuation::new(settings(10.0, 12.0), vec![1.0]);
+        let summary = c.run(&mut Bend, &[0.0], &mut Collect(&mut points)).unwrap();
+        assert_eq!(summary.end, PathEnd::EndFrequency);
+        for p in &points {
+            assert!((p.freq_hz() - Bend::b(p.x[0]).0).abs() < 1e-9, "{p:?}");
+        }
+        assert!(points.iter().any(|p| p.x[0] > 1.0 && p.x[0] < 1.1));
+        assert!(summary.rejected_steps <= 3, "{}", summary.rejected_steps);
     }
 
     /// With the end below the start the path runs down in frequency, through the same folds,
