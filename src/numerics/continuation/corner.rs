@@ -141,7 +141,7 @@ fn distance_to_polyline(q: &[f64], points: &[Vec<f64>]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::numerics::continuation::fixtures::{g, settings, ZPath};
+    use crate::numerics::continuation::fixtures::{g, settings, z_path};
     use crate::numerics::continuation::settings::OMEGA_SCALE;
 
     /// At the Z's first fold, a corner where the path turns back by about 163°, the path goes
@@ -166,7 +166,7 @@ mod tests {
             })
             .collect();
         let (point, tangent) = c
-            .turn_corner(&mut ZPath, &y, &t, &followed)
+            .turn_corner(&mut z_path(), &y, &t, &followed)
             .expect("a way on");
         assert!(point.x[0] > 1.0 && point.x[0] < 1.2, "{point:?}");
         assert!((point.freq_hz() - g(point.x[0]).0).abs() < 1e-9);

@@ -483,7 +483,7 @@ fn scaled_norm(v: &[f64], scale: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::numerics::continuation::fixtures::{settings, ZPath};
+    use crate::numerics::continuation::fixtures::{settings, z_path};
     use crate::numerics::continuation::settings::StagnationExit;
 
     /// A solve that does not converge because the residual has no root nearby (on the Z at
@@ -496,7 +496,7 @@ mod tests {
     fn a_stagnating_solve_is_given_up_after_its_guaranteed_iterations() {
         let omega = 16.0 * OMEGA_SCALE;
         let plain = Continuation::new(settings(10.0, 20.0), vec![1.0]);
-        match plain.solve_fixed(&mut ZPath, &[1.1], omega) {
+        match plain.solve_fixed(&mut z_path(), &[1.1], omega) {
             Err(NewtonFailure::MaxIterations {
                 iterations,
                 residual,
@@ -509,7 +509,7 @@ mod tests {
         let exit = StagnationExit { after: 12 };
         let stopping =
             Continuation::new(settings(10.0, 20.0), vec![1.0]).with_stagnation_exit(exit);
-        match stopping.solve_fixed(&mut ZPath, &[1.1], omega) {
+        match stopping.solve_fixed(&mut z_path(), &[1.1], omega) {
             Err(NewtonFailure::MaxIterations { iterations, .. }) => {
                 assert_eq!(
                     iterations, 13,
@@ -526,8 +526,8 @@ mod tests {
         let chord_stopping =
             Continuation::new(chord_settings, vec![1.0]).with_stagnation_exit(exit);
         match (
-            chord.solve_fixed(&mut ZPath, &[1.1], omega),
-            chord_stopping.solve_fixed(&mut ZPath, &[1.1], omega),
+            chord.solve_fixed(&mut z_path(), &[1.1], omega),
+            chord_stopping.solve_fixed(&mut z_path(), &[1.1], omega),
         ) {
             (
                 Err(NewtonFailure::MaxIterations {
@@ -545,10 +545,10 @@ mod tests {
         }
         // A converging solve on the third piece (g = 16 at x = 1.8) is the same either way.
         let a = plain
-            .solve_fixed(&mut ZPath, &[1.5], omega)
+            .solve_fixed(&mut z_path(), &[1.5], omega)
             .expect("converges");
         let b = stopping
-            .solve_fixed(&mut ZPath, &[1.5], omega)
+            .solve_fixed(&mut z_path(), &[1.5], omega)
             .expect("converges");
         assert_eq!(a, b);
         assert!((a.x[0] - 1.8).abs() < 1e-12);

@@ -7,12 +7,14 @@ use crate::numerics::residual::ParametricResidual;
 
 use super::settings::{ContinuationSettings, OMEGA_SCALE};
 
-/// R(x, ω) = ω/2π − g(x): a path whose frequency is the piecewise-linear g of the single
-/// unknown x. g rises to 15 Hz at x = 1, falls steeply to 13 Hz at x = 1.2 and rises on:
-/// a Z with two folds that are sharp corners (the tangent turns by about 163°), as a
-/// contact sample opening or closing makes them in the sampled contact law.
-pub(super) struct ZPath;
+/// R(x, ω) = ω/2π − f(x) for a piecewise-linear f of the single unknown x, given as
+/// (f(x), f′(x)) in Hz: a path with corners, as contact transitions make them.
+pub(super) struct Graph(fn(f64) -> (f64, f64));
 
+/// g(x) (Hz) and its slope: g rises to 15 Hz at x = 1, falls steeply to 13 Hz at x = 1.2 and
+/// rises on: a Z with two folds that are sharp corners (the tangent turns by about 163°), as a
+/// contact sample opening or closing makes them in the sampled contact law. The path of
+/// [`z_path`].
 pub(super) fn g(x: f64) -> (f64, f64) {
     if x < 1.0 {
         (10.0 + 5.0 * x, 5.0)
@@ -27,7 +29,7 @@ pub(super) fn g(x: f64) -> (f64, f64) {
 #[error("never")]
 pub(super) struct Never;
 
-impl ParametricResidual for ZPath {
+impl ParametricResidual for Graph {
     type Error = Never;
     fn dim(&self) -> usize {
         1
@@ -36,7 +38,7 @@ impl ParametricResidual for ZPath {
         1.0
     }
     fn residual(&mut self, x: &[f64], omega: f64, r: &mut [f64]) -> Result<(), Never> {
-        r[0] = omega / OMEGA_SCALE - g(x[0]).0;
+        r[0] = omega / OMEGA_SCALE - (self.0)(x[0]).0;
         Ok(())
     }
     fn new_jacobian(&mut self) -> AssembledJacobian {
@@ -53,58 +55,31 @@ impl ParametricResidual for ZPath {
         self.residual(x, omega, r)?;
         jac.clear();
         let slot = jac.slot(0, 0);
-        jac.add_at(slot, -g(x[0]).1);
+        jac.add_at(slot, -(self.0)(x[0]).1);
         dr[0] = 1.0 / OMEGA_SCALE;
         Ok(())
     }
 }
 
-/// R(x, ω) = ω/2π − b(x) with b rising by 0.2 Hz per unit of x up to x = 1 and by 3 beyond:
-/// a corner where the path bends by 60° without folding (a contact's slider changing what
-/// anchors it, in the event-resolved contact law).
-pub(super) struct Bend;
-
-impl Bend {
-    /// b(x) (Hz) and its slope.
-    pub(super) fn b(x: f64) -> (f64, f64) {
-        if x < 1.0 {
-            (10.0 + 0.2 * x, 0.2)
-        } else {
-            (10.2 + 3.0 * (x - 1.0), 3.0)
-        }
+/// b(x) (Hz) and its slope: rising by 0.2 Hz per unit of x up to x = 1 and by 3 beyond, a
+/// corner where the path bends by 60° without folding (a contact's slider changing what
+/// anchors it, in the event-resolved contact law). The path of [`bend`].
+pub(super) fn b(x: f64) -> (f64, f64) {
+    if x < 1.0 {
+        (10.0 + 0.2 * x, 0.2)
+    } else {
+        (10.2 + 3.0 * (x - 1.0), 3.0)
     }
 }
 
-impl ParametricResidual for Bend {
-    type Error = Never;
-    fn dim(&self) -> usize {
-        1
-    }
-    fn residual_scale(&self) -> f64 {
-        1.0
-    }
-    fn residual(&mut self, x: &[f64], omega: f64, r: &mut [f64]) -> Result<(), Never> {
-        r[0] = omega / OMEGA_SCALE - Self::b(x[0]).0;
-        Ok(())
-    }
-    fn new_jacobian(&mut self) -> AssembledJacobian {
-        AssembledJacobian::dense(1)
-    }
-    fn residual_and_jacobian(
-        &mut self,
-        x: &[f64],
-        omega: f64,
-        r: &mut [f64],
-        jac: &mut AssembledJacobian,
-        dr: &mut [f64],
-    ) -> Result<(), Never> {
-        self.residual(x, omega, r)?;
-        jac.clear();
-        let slot = jac.slot(0, 0);
-        jac.add_at(slot, -Self::b(x[0]).1);
-        dr[0] = 1.0 / OMEGA_SCALE;
-        Ok(())
-    }
+/// The Z of [`g`].
+pub(super) fn z_path() -> Graph {
+    Graph(g)
+}
+
+/// The bend of [`b`].
+pub(super) fn bend() -> Graph {
+    Graph(b)
 }
 
 pub(super) fn settings(start: f64, end: f64) -> ContinuationSettings {

@@ -174,7 +174,7 @@ impl Continuation {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::numerics::continuation::fixtures::{g, settings, ZPath};
+    use crate::numerics::continuation::fixtures::{g, settings, z_path};
     use crate::numerics::continuation::settings::AdaptiveScale;
 
     /// Past the Z's first fold, a corner where the path turns back by about 163°, the tangent
@@ -191,11 +191,13 @@ mod tests {
             residual: 0.0,
             step: 0.01,
         };
-        let incoming = c.tangent(&mut ZPath, &at(0.95), None).unwrap();
+        let incoming = c.tangent(&mut z_path(), &at(0.95), None).unwrap();
         assert!(incoming[0] > 0.0 && incoming[1] > 0.0, "{incoming:?}");
         c.orientation.set(c.formed_orientation.get());
         assert!(c.orientation.get().is_some());
-        let mut middle = c.tangent(&mut ZPath, &at(1.05), Some(&incoming)).unwrap();
+        let mut middle = c
+            .tangent(&mut z_path(), &at(1.05), Some(&incoming))
+            .unwrap();
         assert!(middle[1] > 0.0, "along the incoming tangent: back up");
         c.orient(&mut middle);
         assert!(middle[0] > 0.0 && middle[1] < 0.0, "{middle:?}");

@@ -305,7 +305,7 @@ fn corner_between(y: &[f64], tangent: &[f64], (full, half): (&[f64], &[f64]), ds
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::numerics::continuation::fixtures::{settings, Bend, Collect, SmoothS};
+    use crate::numerics::continuation::fixtures::{b, bend, settings, Collect, SmoothS};
     use crate::numerics::path::{NoObserver, PathPoint};
 
     /// Both folds of the smooth S are followed: the path reaches the end, with a turning point
@@ -340,10 +340,12 @@ mod tests {
     fn a_corner_is_taken_once_halving_the_step_halves_the_landing() {
         let mut points = Vec::new();
         let mut c = Continuation::new(settings(10.0, 12.0), vec![1.0]);
-        let summary = c.run(&mut Bend, &[0.0], &mut Collect(&mut points)).unwrap();
+        let summary = c
+            .run(&mut bend(), &[0.0], &mut Collect(&mut points))
+            .unwrap();
         assert_eq!(summary.end, PathEnd::EndFrequency);
         for p in &points {
-            assert!((p.freq_hz() - Bend::b(p.x[0]).0).abs() < 1e-9, "{p:?}");
+            assert!((p.freq_hz() - b(p.x[0]).0).abs() < 1e-9, "{p:?}");
         }
         assert!(points.iter().any(|p| p.x[0] > 1.0 && p.x[0] < 1.1));
         assert!(summary.rejected_steps <= 3, "{}", summary.rejected_steps);
