@@ -32,6 +32,7 @@
 //! are gone: with the tangent oriented by the determinant's sign ([`Continuation::orient`])
 //! no path of the tests needs them.
 
+use super::predictor::Oriented;
 use super::settings::Continuation;
 use crate::numerics::linalg::{dot, norm};
 use crate::numerics::path::PathPoint;
@@ -65,7 +66,7 @@ impl Continuation {
         y: &[f64],
         tangent: &[f64],
         followed: &[PathPoint],
-    ) -> Option<(PathPoint, Vec<f64>)> {
+    ) -> Option<(PathPoint, Oriented)> {
         let recent: Vec<Vec<f64>> = followed[followed.len().saturating_sub(FOLLOWED_POINTS)..]
             .iter()
             .map(|p| self.scaled(p))
@@ -76,7 +77,10 @@ impl Continuation {
                 break;
             }
             let past: Vec<f64> = y.iter().zip(tangent).map(|(a, t)| a + h * t).collect();
-            let outgoing = self.tangent(system, &self.unscaled(&past), None).ok();
+            let outgoing = self
+                .tangent(system, &self.unscaled(&past), None)
+                .ok()
+                .map(|o| o.t);
             let mut landings: Vec<PathPoint> = Vec::new();
             for sign in [1.0, -1.0] {
                 let Some(t_out) = &outgoing else { break };
@@ -170,6 +174,6 @@ mod tests {
             .expect("a way on");
         assert!(point.x[0] > 1.0 && point.x[0] < 1.2, "{point:?}");
         assert!((point.freq_hz() - g(point.x[0]).0).abs() < 1e-9);
-        assert!(tangent[1] < 0.0, "the middle piece runs down in frequency");
+        assert!(tangent.t[1] < 0.0, "the middle piece runs down in frequency");
     }
 }

@@ -19,6 +19,14 @@ pub(super) const MAX_TURN_DEGREES: f64 = 45.0;
 /// most doubled), as Newton's iteration count allows.
 pub(super) const TARGET_TURN_DEGREES: f64 = 10.0;
 
+/// A unit tangent (scaled space, ω last) with the sign of det [J; tᵀ] where the factorisation
+/// gives it (see [`Continuation::orient`]).
+#[derive(Debug, Clone)]
+pub(super) struct Oriented {
+    pub(super) t: Vec<f64>,
+    pub(super) sign: Option<f64>,
+}
+
 impl Continuation {
     /// The largest |ln(a_after / a_before)| over the watched amplitudes (0 without any).
     pub(super) fn log_amplitude_change(&self, before: &[f64], after: &[f64]) -> f64 {
@@ -89,15 +97,15 @@ impl Continuation {
     }
 
     /// Unit tangent in scaled space at a converged point, oriented along `previous` (or
-    /// towards the end frequency when there is none). Where the factorisation gives the sign
-    /// of the bordered matrix's determinant, the sign of det [J; tᵀ] of the tangent returned
-    /// is kept in `formed_orientation` (see [`Self::orient`]).
+    /// towards the end frequency when there is none), with the sign of det [J; tᵀ] where the
+    /// factorisation gives the sign of the bordered matrix's determinant (see
+    /// [`Self::orient`]).
     pub(super) fn tangent<S: ParametricResidual>(
         &self,
         system: &mut S,
         point: &PathPoint,
         previous: Option<&[f64]>,
-    ) -> Result<Vec<f64>, NewtonFailure> {
+    ) -> Result<Oriented, NewtonFailure> {
         let n = system.dim();
         let mut rhs = vec![0.0; n + 1];
         rhs[n] = 1.0;
@@ -115,8 +123,7 @@ impl Continuation {
                     t.iter_mut().for_each(|v| *v = -*v);
                     sign = sign.map(|s| -s);
                 }
-                self.formed_orientation.set(sign);
-                return Ok(t);
+                return Ok(Oriented { t, sign });
             }
         }
         let mut r = vec![0.0; n];
@@ -145,8 +152,7 @@ impl Continuation {
             t.iter_mut().for_each(|v| *v = -*v);
             sign = sign.map(|s| -s);
         }
-        self.formed_orientation.set(sign);
-        Ok(t)
+        Ok(Oriented { t, sign })
     }
 
     /// Orients the tangent `t` at a corrected point as the path is oriented: det [J; tᵀ]
@@ -160,12 +166,11 @@ impl Continuation {
     /// pair's path over 840-900 Hz turns back at its corner fold at 886.82 Hz onto the very
     /// points it came along, down to the range's start
     /// (`blade_pair_3d::the_3d_frf_over_the_bending_pair_is_complete_through_both_folds`).
-    pub(super) fn orient(&self, t: &mut [f64]) {
-        if let (Some(path), Some(formed)) = (self.orientation.get(), self.formed_orientation.get())
-        {
+    pub(super) fn orient(&self, tangent: &mut Oriented) {
+        if let (Some(path), Some(formed)) = (self.orientation, tangent.sign) {
             if formed != path {
-                t.iter_mut().for_each(|v| *v = -*v);
-                self.formed_orientation.set(Some(path));
+                tangent.t.iter_mut().for_each(|v| *v = -*v);
+                tangent.sign = Some(path);
             }
         }
     }
@@ -183,7 +188,7 @@ mod tests {
     /// would point back up to the corner.
     #[test]
     fn past_a_corner_fold_the_tangent_points_away_from_the_corner() {
-        let c = Continuation::new(settings(10.0, 18.0), vec![1.0]);
+        let mut c = Continuation::new(settings(10.0, 18.0), vec![1.0]);
         let at = |x: f64| PathPoint {
             omega: g(x).0 * OMEGA_SCALE,
             x: vec![x],
@@ -192,15 +197,15 @@ mod tests {
             step: 0.01,
         };
         let incoming = c.tangent(&mut z_path(), &at(0.95), None).unwrap();
-        assert!(incoming[0] > 0.0 && incoming[1] > 0.0, "{incoming:?}");
-        c.orientation.set(c.formed_orientation.get());
-        assert!(c.orientation.get().is_some());
+        assert!(incoming.t[0] > 0.0 && incoming.t[1] > 0.0, "{incoming:?}");
+        c.orientation = incoming.sign;
+        assert!(c.orientation.is_some());
         let mut middle = c
-            .tangent(&mut z_path(), &at(1.05), Some(&incoming))
+            .tangent(&mut z_path(), &at(1.05), Some(&incoming.t))
             .unwrap();
-        assert!(middle[1] > 0.0, "along the incoming tangent: back up");
+        assert!(middle.t[1] > 0.0, "along the incoming tangent: back up");
         c.orient(&mut middle);
-        assert!(middle[0] > 0.0 && middle[1] < 0.0, "{middle:?}");
+        assert!(middle.t[0] > 0.0 && middle.t[1] < 0.0, "{middle:?}");
     }
 
     /// The scale of a group grows with its norm along the path and the tangent is carried over

@@ -2,7 +2,9 @@
 //! accept the point or halve the step, until the end frequency, the range's end behind the
 //! start or the point budget.
 
-use super::predictor::{MAX_TURN_DEGREES, TARGET_LOG_AMPLITUDE_CHANGE, TARGET_TURN_DEGREES};
+use super::predictor::{
+    Oriented, MAX_TURN_DEGREES, TARGET_LOG_AMPLITUDE_CHANGE, TARGET_TURN_DEGREES,
+};
 use super::settings::{Continuation, OMEGA_SCALE};
 use crate::numerics::linalg::{dot, norm};
 use crate::numerics::path::{ContinuationError, NewtonFailure, Observer, PathEnd, PathSummary};
@@ -84,8 +86,9 @@ impl Continuation {
         let first = self
             .solve_fixed(system, x_guess, a.freq_start_hz * OMEGA_SCALE)
             .map_err(start_failed)?;
-        let mut tangent = self.tangent(system, &first, None).map_err(start_failed)?;
-        self.orientation.set(self.formed_orientation.get());
+        let first_tangent = self.tangent(system, &first, None).map_err(start_failed)?;
+        self.orientation = first_tangent.sign;
+        let mut tangent = first_tangent.t;
         // The tangent evaluated the operator at the first point, as the observer expects.
         observer.accepted(system, &first, Some(&self.path_normal(&tangent)));
         let mut summary = PathSummary {
@@ -198,7 +201,7 @@ impl Continuation {
         tangent: &[f64],
         ds: f64,
         refused: Option<Vec<f64>>,
-    ) -> Result<(crate::numerics::PathPoint, Vec<f64>, f64), Refusal> {
+    ) -> Result<(crate::numerics::PathPoint, Oriented, f64), Refusal> {
         let (yc, iterations, residual) = self
             .correct(system, predicted, tangent)
             .map_err(|e| (e, None))?;

@@ -55,9 +55,7 @@ pub struct Continuation {
     pub(super) stagnation: Option<StagnationExit>,
     /// The path's orientation: the sign of det [J; tᵀ] (scaled unknowns, ω last) at its last
     /// accepted point, where the factorisation gives it (see [`Continuation::tangent`]).
-    pub(super) orientation: std::cell::Cell<Option<f64>>,
-    /// The same sign for the tangent [`Continuation::tangent`] formed last.
-    pub(super) formed_orientation: std::cell::Cell<Option<f64>>,
+    pub(super) orientation: Option<f64>,
 }
 
 /// Newton's exit on a stagnating residual: once past its first [`Self::after`] iterations, a
@@ -140,8 +138,7 @@ impl Continuation {
             adaptive: None,
             amplitudes: Vec::new(),
             stagnation: None,
-            orientation: std::cell::Cell::new(None),
-            formed_orientation: std::cell::Cell::new(None),
+            orientation: None,
         }
     }
 

@@ -2,7 +2,7 @@
 //! points, the observer's report, and the ends at a point: the range's end behind the start, the
 //! observer's own.
 
-use super::predictor::MAX_TURN_DEGREES;
+use super::predictor::{Oriented, MAX_TURN_DEGREES};
 use super::settings::{Continuation, OMEGA_SCALE};
 use crate::numerics::linalg::{dot, norm};
 use crate::numerics::path::{NewtonFailure, Observer, PathEnd, PathPoint, PathSummary};
@@ -25,7 +25,7 @@ impl Continuation {
         ds: f64,
         predicted: &[f64],
         tangent: &[f64],
-    ) -> Result<(PathPoint, Vec<f64>, f64, f64), NewtonFailure> {
+    ) -> Result<(PathPoint, Oriented, f64, f64), NewtonFailure> {
         let n = yc.len() - 1;
         let apart: Vec<f64> = yc.iter().zip(predicted).map(|(a, b)| a - b).collect();
         let point = PathPoint {
@@ -37,7 +37,7 @@ impl Continuation {
         let from_chord = self.last_factor.borrow().is_some();
         let mut t_new = self.tangent(system, &point, Some(tangent))?;
         let turn = |t: &[f64]| dot(t, tangent).clamp(-1.0, 1.0).acos().to_degrees();
-        if from_chord && (t_new[n] * tangent[n] < 0.0 || turn(&t_new) > MAX_TURN_DEGREES) {
+        if from_chord && (t_new.t[n] * tangent[n] < 0.0 || turn(&t_new.t) > MAX_TURN_DEGREES) {
             // The chord's factorisation is of an earlier iterate, or carried from an earlier
             // point: near a fold its null direction lags the path's (or, made at an iterate
             // of a step that overshot the fold, leads it), and a fold it flags may not be
@@ -45,7 +45,7 @@ impl Continuation {
             t_new = self.tangent(system, &point, Some(tangent))?;
         }
         self.orient(&mut t_new);
-        let degrees = turn(&t_new);
+        let degrees = turn(&t_new.t);
         Ok((point, t_new, norm(&apart) / ds, degrees))
     }
 
@@ -60,18 +60,18 @@ impl Continuation {
         observer: &mut O,
         summary: &mut PathSummary,
         point: PathPoint,
-        t_new: Vec<f64>,
+        t_new: Oriented,
         tangent: &mut Vec<f64>,
     ) -> bool {
-        let n = t_new.len() - 1;
-        if t_new[n] * tangent[n] < 0.0 {
+        let n = t_new.t.len() - 1;
+        if t_new.t[n] * tangent[n] < 0.0 {
             summary.turning_points.push(point.freq_hz());
             observer.turning_point(point.freq_hz());
         }
-        observer.accepted(system, &point, Some(&self.path_normal(&t_new)));
-        self.orientation.set(self.formed_orientation.get());
+        observer.accepted(system, &point, Some(&self.path_normal(&t_new.t)));
+        self.orientation = t_new.sign;
         let left = self.left_range(&point);
-        *tangent = t_new;
+        *tangent = t_new.t;
         self.adapt_scale(&point.x, tangent);
         summary.points.push(point);
         let observer_end = observer.reached_end();
@@ -176,8 +176,8 @@ mod tests {
                 .corrected_point(&mut system, &yc, 3, 0.0, 0.01, &yc, &previous)
                 .unwrap();
             let exact = s_tangent(x);
-            assert!((t_new[0] - exact[0]).abs() < 1e-12, "{t_new:?} {exact:?}");
-            assert!((t_new[1] - exact[1]).abs() < 1e-12, "{t_new:?} {exact:?}");
+            assert!((t_new.t[0] - exact[0]).abs() < 1e-12, "{t_new:?} {exact:?}");
+            assert!((t_new.t[1] - exact[1]).abs() < 1e-12, "{t_new:?} {exact:?}");
             assert!(degrees < MAX_TURN_DEGREES, "{degrees}");
         }
     }
