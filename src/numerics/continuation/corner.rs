@@ -174,6 +174,9 @@ mod tests {
             .expect("a way on");
         assert!(point.x[0] > 1.0 && point.x[0] < 1.2, "{point:?}");
         assert!((point.freq_hz() - g(point.x[0]).0).abs() < 1e-9);
-        assert!(tangent.t[1] < 0.0, "the middle piece runs down in frequency");
+        assert!(
+            tangent.t[1] < 0.0,
+            "the middle piece runs down in frequency"
+        );
     }
 }

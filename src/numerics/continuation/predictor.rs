@@ -155,10 +155,10 @@ impl Continuation {
         Ok(Oriented { t, sign })
     }
 
-    /// Orients the tangent `t` at a corrected point as the path is oriented: det [J; tᵀ]
+    /// Orients the tangent at a corrected point as the path is oriented: det [J; tᵀ]
     /// keeps its sign along a path through regular points (Allgower & Georg, Introduction to
-    /// Numerical Continuation Methods, 2.1), where both signs are known (the tangent formed
-    /// last, [`Self::tangent`], and the path's at its last point). Along a smooth path this
+    /// Numerical Continuation Methods, 2.1), where both signs are known (the tangent's own,
+    /// from [`Self::tangent`], and the path's at its last point). Along a smooth path this
     /// is the orientation along the previous tangent; they differ where the path turns back
     /// at a corner by more than 90° (a fold at a corner, where a contact's slider changes what
     /// anchors it): there the tangent oriented along the incoming one points back to the
